@@ -1,1 +1,18 @@
-//! x
+//! # crr — coupled rocking rotations
+//!
+//! A Rust engine for the dynamics of rigid-block structures (free-standing blocks, columns of
+//! drums, trilithons and colonnades, four-hinged arches, walls) under earthquakes, after the
+//! theory of coupled rocking rotations (CRR).
+//!
+//! This facade re-exports the engine's crates and reads model files:
+//! - [`kinematics`] (crate `crr-kinematics`): the model, rotation operators Γ, γ, Jacobians,
+//!   M(q), U(q), loop closures Φ(q).
+//! - [`model_file`]: TOML/JSON model files with errors naming the file, item and problem.
+//! - [`inspect`]: the report of `crr inspect`.
+
+pub use crr_kinematics as kinematics;
+
+pub mod inspect;
+pub mod model_file;
+
+pub use model_file::{InputError, load_model};

@@ -1,0 +1,133 @@
+//! Loop closures: residuals Φ(q), their Jacobian Φ_q, and the closure angles.
+//!
+//! A hinge closure between frames A (parent) and B (child) with axis u and active pivot P imposes
+//! x_A(P) − x_B(P) = 0 (3 rows) and (Γ_A v₁)·(Γ_B u) = (Γ_A v₂)·(Γ_B u) = 0 (2 rows), v₁, v₂ ⊥ u:
+//! 5 rows (only 2 independent in a planar structure). A rocking-base closure imposes the corner
+//! coincidence and (Γ_A e₁)·(Γ_B e₂) = 0, the condition of two tilts in series (a Hooke joint):
+//! 4 rows.
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+
+use crate::data::Data;
+use crate::kinematics::{for_each_point_column, frame_point};
+use crate::model::{InterfaceKind, Model};
+use crate::pivots::ActivePivots;
+
+/// A unit vector perpendicular to `u` (deterministic).
+pub fn perpendicular(u: &Vector3<f64>) -> Vector3<f64> {
+    let e = if u.x.abs() <= u.y.abs() && u.x.abs() <= u.z.abs() {
+        Vector3::x()
+    } else if u.y.abs() <= u.z.abs() {
+        Vector3::y()
+    } else {
+        Vector3::z()
+    };
+    u.cross(&e).normalize()
+}
+
+fn frame_rot(data: &Data, k: Option<usize>) -> Matrix3<f64> {
+    k.map_or_else(Matrix3::identity, |k| data.rot_ops[k])
+}
+
+/// Frames (parent, child) of a closure interface.
+fn closure_frames(model: &Model, interface: usize) -> (Option<usize>, Option<usize>) {
+    let i = &model.interfaces[interface];
+    (model.frame_of(i.parent), Some(model.body_coord[i.child]))
+}
+
+/// The two unit vectors whose dot products are the orientation rows of a closure:
+/// pairs (a on A, b on B) with rows (Γ_A a)·(Γ_B b).
+fn orientation_pairs(kind: &InterfaceKind) -> ([(Vector3<f64>, Vector3<f64>); 2], usize) {
+    match kind {
+        InterfaceKind::Hinge { axis, .. } => {
+            let v1 = perpendicular(axis);
+            let v2 = axis.cross(&v1);
+            ([(v1, *axis), (v2, *axis)], 2)
+        }
+        InterfaceKind::RockingBase { e1, e2, .. } => ([(*e1, *e2), (*e1, *e2)], 1),
+    }
+}
+
+/// Fills `data.phi` with Φ(q). Requires [`crate::forward_kinematics`].
+pub fn constraint_residual(model: &Model, data: &mut Data, pivots: &ActivePivots) {
+    for cl in &model.closures {
+        let iface = &model.interfaces[cl.interface];
+        let (a, b) = closure_frames(model, cl.interface);
+        let p = iface.kind.pivot(pivots.of_interface(model, cl.interface));
+        let d = frame_point(data, a, &p) - frame_point(data, b, &p);
+        let r0 = cl.first_row;
+        data.phi.fixed_rows_mut::<3>(r0).copy_from(&d);
+        let (ra, rb) = (frame_rot(data, a), frame_rot(data, b));
+        let (pairs, count) = orientation_pairs(&iface.kind);
+        for (r, (va, vb)) in pairs.iter().take(count).enumerate() {
+            data.phi[r0 + 3 + r] = (ra * va).dot(&(rb * vb));
+        }
+    }
+}
+
+/// Fills `data.phi_q` with Φ_q = ∂Φ/∂q. Requires [`crate::forward_kinematics`].
+pub fn constraint_jacobian(model: &Model, data: &mut Data, pivots: &ActivePivots) {
+    data.phi_q.fill(0.0);
+    for cl in &model.closures {
+        let iface = &model.interfaces[cl.interface];
+        let (a, b) = closure_frames(model, cl.interface);
+        let p = iface.kind.pivot(pivots.of_interface(model, cl.interface));
+        let r0 = cl.first_row;
+        let (xa, xb) = (frame_point(data, a, &p), frame_point(data, b, &p));
+        let mut cols: Vec<(usize, Vector3<f64>, f64)> = Vec::new();
+        for_each_point_column(model, data, a, &xa, |j, c| cols.push((j, c, 1.0)));
+        for_each_point_column(model, data, b, &xb, |j, c| cols.push((j, c, -1.0)));
+        for (j, c, s) in &cols {
+            for r in 0..3 {
+                data.phi_q[(r0 + r, *j)] += s * c[r];
+            }
+        }
+        // d/dt (Γ_A a)·(Γ_B b) = (ω_A − ω_B)·((Γ_A a) × (Γ_B b)).
+        let (ra, rb) = (frame_rot(data, a), frame_rot(data, b));
+        let (pairs, count) = orientation_pairs(&iface.kind);
+        for (r, (va, vb)) in pairs.iter().take(count).enumerate() {
+            let nrm = (ra * va).cross(&(rb * vb));
+            for (frame, s) in [(a, 1.0), (b, -1.0)] {
+                let mut j = frame;
+                while let Some(jj) = j {
+                    data.phi_q[(r0 + 3 + r, jj)] += s * data.axis[jj].dot(&nrm);
+                    j = model.coords[jj].parent;
+                }
+            }
+        }
+    }
+}
+
+/// The relative angles of every closure slot (in slot order, `slot_count − DOF(1)` values) from
+/// the relative rotation Γ_Aᵀ Γ_B: for a hinge the twist angle about u (swing–twist decomposition); for a rocking base the tilts θ₁
+/// about e₁ and θ₂ about e₂ with Γ_AᵀΓ_B = R(e₁, θ₁)R(e₂, θ₂). Requires
+/// [`crate::forward_kinematics`].
+pub fn closure_angles(model: &Model, data: &Data, out: &mut [f64]) {
+    let base = model.dof();
+    for cl in &model.closures {
+        let iface = &model.interfaces[cl.interface];
+        let (a, b) = closure_frames(model, cl.interface);
+        let rel = frame_rot(data, a).transpose() * frame_rot(data, b);
+        let s0 = iface.slots.start - base;
+        match &iface.kind {
+            InterfaceKind::Hinge { axis, .. } => {
+                // Twist of the swing–twist decomposition: 2 atan2(v·u, w) of the quaternion
+                // (w, v) of Γ_AᵀΓ_B, independent of any reference direction.
+                let quat = UnitQuaternion::from_matrix(&rel);
+                let mut t = 2.0 * quat.imag().dot(axis).atan2(quat.w);
+                if t > std::f64::consts::PI {
+                    t -= 2.0 * std::f64::consts::PI;
+                } else if t <= -std::f64::consts::PI {
+                    t += 2.0 * std::f64::consts::PI;
+                }
+                out[s0] = t;
+            }
+            InterfaceKind::RockingBase { normal, e1, e2, .. } => {
+                let r2 = rel * e2;
+                out[s0] = normal.dot(&r2).atan2(e2.dot(&r2));
+                let r1 = rel.transpose() * e1;
+                out[s0 + 1] = normal.dot(&r1).atan2(e1.dot(&r1));
+            }
+        }
+    }
+}

@@ -1,0 +1,700 @@
+//! The validated, immutable model: bodies with exact mass properties, interfaces, and the chain
+//! (a spanning tree from the ground giving the coordinates, DOF(1), plus the loop closures).
+
+use std::collections::{HashMap, VecDeque};
+use std::ops::Range;
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::error::ModelError;
+use crate::shapes::{MassProperties, Shape};
+use crate::spec::{BodySpec, ImpactLaw, InterfaceSpec, PivotSpec, StructureSpec};
+
+/// Relative tolerance for geometric checks (parallel edges, planarity), times the model's size.
+pub const GEOMETRY_TOLERANCE: f64 = 1e-6;
+
+/// One rigid body with its exact mass properties (world coordinates at rest).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Name from the model file.
+    pub name: String,
+    /// The shape it was built from.
+    pub shape: Shape,
+    /// Mass Mⁿ (kg).
+    pub mass: f64,
+    /// Density used (kg/m³): the given one, or mass / volume when a mass is given.
+    pub density: f64,
+    /// Volume Vₙ (m³).
+    pub volume: f64,
+    /// Centre of mass at rest (m, world).
+    pub com: Vector3<f64>,
+    /// Inertia tensor about the centre of mass, world axes at rest (kg m²).
+    pub inertia: Matrix3<f64>,
+    /// Second moment ∫ρ (x − c)(x − c)ᵀ dV about the centre of mass (kg m²).
+    pub second_moment: Matrix3<f64>,
+}
+
+/// The parent side of an interface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Parent {
+    /// The ground (moves with the ground motion; fixed in the ground frame).
+    Ground,
+    /// A body, by index into [`Model::bodies`].
+    Body(usize),
+}
+
+/// Which of an angle's two pivots is active: P⁺ (for φ > 0) or P⁻ (for φ < 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Side {
+    /// P⁺, the pivot active for a positive angle.
+    Positive,
+    /// P⁻, the pivot active for a negative angle.
+    Negative,
+}
+
+impl Side {
+    /// The side selected by the sign of an angle; `tie` when it is exactly zero.
+    pub fn of(angle: f64, tie: Side) -> Side {
+        if angle > 0.0 {
+            Side::Positive
+        } else if angle < 0.0 {
+            Side::Negative
+        } else {
+            tie
+        }
+    }
+    /// +1 or −1.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Positive => 1.0,
+            Side::Negative => -1.0,
+        }
+    }
+    /// The other side.
+    pub fn flipped(self) -> Side {
+        match self {
+            Side::Positive => Side::Negative,
+            Side::Negative => Side::Positive,
+        }
+    }
+}
+
+/// The geometry of an interface.
+#[derive(Clone, Debug, PartialEq)]
+pub enum InterfaceKind {
+    /// One rotation coordinate φ about `axis`, pivoting on P⁺ (φ > 0) or P⁻ (φ < 0).
+    Hinge {
+        /// Unit axis u (world, at rest).
+        axis: Vector3<f64>,
+        /// A point of the pivot line P⁺ (m, world at rest).
+        pivot_positive: Vector3<f64>,
+        /// A point of the pivot line P⁻ (m, world at rest).
+        pivot_negative: Vector3<f64>,
+    },
+    /// Two tilts of the child on a rectangular contact: `.1` about e₁ (the direction of the first
+    /// edge, corner 0 → corner 1), then `.2` about e₂ = n × e₁, n the unit normal pointing to the
+    /// child. The pivot is the corner selected by the two signs.
+    RockingBase {
+        /// The four corners (m, world at rest), in the order given.
+        corners: [Vector3<f64>; 4],
+        /// Unit normal n of the contact plane, pointing to the child's side.
+        normal: Vector3<f64>,
+        /// Unit e₁, along the edge corner 0 → corner 1: axis of the first tilt.
+        e1: Vector3<f64>,
+        /// Unit e₂ = n × e₁: axis of the second tilt.
+        e2: Vector3<f64>,
+    },
+}
+
+impl InterfaceKind {
+    /// Number of angles the interface carries: 1 (hinge) or 2 (rocking base).
+    pub fn angle_count(&self) -> usize {
+        match self {
+            InterfaceKind::Hinge { .. } => 1,
+            InterfaceKind::RockingBase { .. } => 2,
+        }
+    }
+
+    /// Rest-frame axis of angle `component` (u for a hinge; e₁ or e₂ for a rocking base).
+    pub fn axis(&self, component: usize) -> Vector3<f64> {
+        match self {
+            InterfaceKind::Hinge { axis, .. } => *axis,
+            InterfaceKind::RockingBase { e1, e2, .. } => {
+                if component == 0 {
+                    *e1
+                } else {
+                    *e2
+                }
+            }
+        }
+    }
+
+    /// The active pivot point (world at rest) for the given sides of this interface's angles.
+    ///
+    /// Rocking base: a positive tilt about e₁ pivots on the corner edge of least e₂·x, a negative
+    /// one on the greatest; a positive tilt about e₂ pivots on the edge of greatest e₁·x, a negative
+    /// one on the least (so that the rest of the base lifts towards n).
+    pub fn pivot(&self, sides: &[Side]) -> Vector3<f64> {
+        match self {
+            InterfaceKind::Hinge { pivot_positive, pivot_negative, .. } => match sides[0] {
+                Side::Positive => *pivot_positive,
+                Side::Negative => *pivot_negative,
+            },
+            InterfaceKind::RockingBase { corners, e1, e2, .. } => {
+                let score = |c: &Vector3<f64>| -sides[0].sign() * e2.dot(c) + sides[1].sign() * e1.dot(c);
+                let mut best = corners[0];
+                for c in &corners[1..] {
+                    if score(c) > score(&best) {
+                        best = *c;
+                    }
+                }
+                best
+            }
+        }
+    }
+}
+
+/// Whether an interface is a coordinate of the spanning tree or a loop closure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// In the spanning tree: its angles are the coordinates `first_coord ..`.
+    Tree {
+        /// Index of its first coordinate in q.
+        first_coord: usize,
+    },
+    /// A loop closure: index into [`Model::closures`].
+    Closure {
+        /// Index into [`Model::closures`].
+        index: usize,
+    },
+}
+
+/// One interface, validated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Interface {
+    /// Name from the model file.
+    pub name: String,
+    /// Parent body or ground.
+    pub parent: Parent,
+    /// Child body index.
+    pub child: usize,
+    /// Hinge or rocking base geometry.
+    pub kind: InterfaceKind,
+    /// Impact law for the impact stage.
+    pub impact: ImpactLaw,
+    /// Tree coordinate(s) or loop closure.
+    pub role: Role,
+    /// The interface's pivot-side slots in an [`crate::ActivePivots`] (one per angle).
+    pub slots: Range<usize>,
+}
+
+/// One generalized coordinate qₖ (a tree angle), in the order of q.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coordinate {
+    /// `<interface>` for a hinge, `<interface>.1` / `<interface>.2` for a rocking base.
+    pub name: String,
+    /// Interface index.
+    pub interface: usize,
+    /// 0, or 1 for the second tilt of a rocking base.
+    pub component: usize,
+    /// Unit axis uₖ in the rest frame.
+    pub axis: Vector3<f64>,
+    /// The coordinate whose frame this one rotates relative to (None: the ground).
+    /// Always smaller than this coordinate's index (topological order).
+    pub parent: Option<usize>,
+}
+
+/// One loop closure: an interface not in the tree, imposing Φ(q) = 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Closure {
+    /// Interface index.
+    pub interface: usize,
+    /// Its first row in Φ.
+    pub first_row: usize,
+    /// Number of rows: 5 for a hinge (point coincidence 3 + axis alignment 2), 4 for a rocking base
+    /// (point coincidence 3 + the two tilt axes staying perpendicular 1).
+    pub rows: usize,
+}
+
+/// A validated structure: immutable once built.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Model {
+    /// Name of the structure.
+    pub name: String,
+    /// g (m/s²).
+    pub gravity: f64,
+    /// Bodies in file order.
+    pub bodies: Vec<Body>,
+    /// Interfaces in file order.
+    pub interfaces: Vec<Interface>,
+    /// Generalized coordinates q in order (DOF(1) = `coords.len()`).
+    pub coords: Vec<Coordinate>,
+    /// Loop closures.
+    pub closures: Vec<Closure>,
+    /// For each body, the coordinate whose frame it moves with (the last angle of the tree interface
+    /// whose child it is).
+    pub body_coord: Vec<usize>,
+    /// Total rows of Φ.
+    pub constraint_rows: usize,
+    /// Total pivot-side slots: one per tree coordinate (slot k = coordinate k), then one per closure
+    /// angle.
+    pub slot_count: usize,
+    /// A length scale of the model (largest extent of the bodies' centres and pivots, m, ≥ 1e-3),
+    /// used to scale tolerances.
+    pub size: f64,
+}
+
+fn finite3(v: &[f64; 3], item: &str, field: &str) -> Result<Vector3<f64>, ModelError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(Vector3::from(*v))
+    } else {
+        Err(ModelError::new(item, format!("{field} has a NaN or infinite value: {v:?}")))
+    }
+}
+
+fn quoted(kind: &str, name: &str) -> String {
+    format!("{kind} \"{name}\"")
+}
+
+fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
+    let item = quoted("body", &spec.name);
+    let mut shapes = Vec::new();
+    if let Some(s) = &spec.box_shape {
+        shapes.push(Shape::Box(s.clone()));
+    }
+    if let Some(s) = &spec.polyhedron {
+        shapes.push(Shape::Polyhedron(s.clone()));
+    }
+    if let Some(s) = &spec.prism {
+        shapes.push(Shape::Prism(s.clone()));
+    }
+    if let Some(s) = &spec.annular_sector {
+        shapes.push(Shape::AnnularSector(s.clone()));
+    }
+    let shape = match shapes.len() {
+        1 => shapes.pop().expect("one shape"),
+        0 => {
+            return Err(ModelError::new(
+                item,
+                "has no shape: give one of box, polyhedron, prism, annular_sector",
+            ));
+        }
+        _ => {
+            let kinds: Vec<_> = shapes.iter().map(|s| s.kind()).collect();
+            return Err(ModelError::new(
+                item,
+                format!("has {} shapes ({}): give exactly one", kinds.len(), kinds.join(", ")),
+            ));
+        }
+    };
+    let props: MassProperties = shape
+        .mass_properties()
+        .map_err(|e| ModelError::new(format!("{item} ({})", shape.kind()), e.to_string()))?;
+    let density = match (spec.density, spec.mass) {
+        (_, Some(m)) if !(m.is_finite() && m > 0.0) => {
+            return Err(ModelError::new(item, format!("mass must be a positive number of kg, got {m}")));
+        }
+        (Some(d), _) if !(d.is_finite() && d > 0.0) => {
+            return Err(ModelError::new(
+                item,
+                format!("density must be a positive number of kg/m³, got {d}"),
+            ));
+        }
+        (_, Some(m)) => m / props.volume,
+        (Some(d), None) => d,
+        (None, None) => {
+            return Err(ModelError::new(item, "needs a density (kg/m³) or a mass (kg)"));
+        }
+    };
+    Ok(Body {
+        name: spec.name.clone(),
+        mass: density * props.volume,
+        density,
+        volume: props.volume,
+        com: props.centroid,
+        inertia: props.inertia(density),
+        second_moment: props.second_moment * density,
+        shape,
+    })
+}
+
+/// A pivot given as a point or an edge: returns a point on the line, checking an edge is parallel
+/// to the axis.
+fn pivot_point(
+    p: &PivotSpec,
+    axis: &Vector3<f64>,
+    item: &str,
+    field: &str,
+    size: f64,
+) -> Result<Vector3<f64>, ModelError> {
+    match p {
+        PivotSpec::Point(x) => finite3(x, item, field),
+        PivotSpec::Segment([a, b]) => {
+            let a = finite3(a, item, field)?;
+            let b = finite3(b, item, field)?;
+            let d = b - a;
+            if d.norm() <= GEOMETRY_TOLERANCE * size {
+                return Err(ModelError::new(
+                    format!("{item} ({field})"),
+                    "the two end points of the pivot edge coincide",
+                ));
+            }
+            let sin = d.normalize().cross(axis).norm();
+            if sin > GEOMETRY_TOLERANCE {
+                return Err(ModelError::new(
+                    format!("{item} ({field})"),
+                    format!(
+                        "the pivot edge is not parallel to the axis: they differ by {:.4}°",
+                        sin.asin().to_degrees()
+                    ),
+                ));
+            }
+            Ok(a)
+        }
+    }
+}
+
+fn hinge_kind(
+    spec: &InterfaceSpec,
+    child_com: &Vector3<f64>,
+    item: &str,
+    size: f64,
+) -> Result<InterfaceKind, ModelError> {
+    let axis = spec
+        .axis
+        .ok_or_else(|| ModelError::new(item, "a hinge needs an axis (or give a rocking_base)"))?;
+    let axis = finite3(&axis, item, "axis")?;
+    let n = axis.norm();
+    if n == 0.0 {
+        return Err(ModelError::new(format!("{item} (axis)"), "the axis is the zero vector"));
+    }
+    let axis = axis / n;
+    let pp = spec
+        .pivot_positive
+        .as_ref()
+        .ok_or_else(|| ModelError::new(item, "a hinge needs pivot_positive"))?;
+    let pn = spec
+        .pivot_negative
+        .as_ref()
+        .ok_or_else(|| ModelError::new(item, "a hinge needs pivot_negative (equal to pivot_positive for a plain hinge)"))?;
+    let pp = pivot_point(pp, &axis, item, "pivot_positive", size)?;
+    let pn = pivot_point(pn, &axis, item, "pivot_negative", size)?;
+    // Offset between the two pivot lines, perpendicular to the axis.
+    let offset = (pn - pp) - axis * axis.dot(&(pn - pp));
+    if offset.norm() > GEOMETRY_TOLERANCE * size {
+        // A small positive rotation about P⁺ moves P⁻ with velocity u × (P⁻ − P⁺): it must go
+        // towards the child's side of the joint face, i.e. the side of the child's centre.
+        let lift = axis.cross(&offset);
+        let side = lift.dot(&(child_com - pp)) / (lift.norm() * size);
+        if side.abs() <= GEOMETRY_TOLERANCE {
+            return Err(ModelError::new(
+                item,
+                "the child's centre of mass lies in the joint face through the two pivots: cannot tell which side is the child's",
+            ));
+        }
+        if side < 0.0 {
+            return Err(ModelError::new(
+                item,
+                "pivots swapped: a small positive rotation about pivot_positive moves pivot_negative into the parent \
+                 (away from the child's centre of mass). With a right-handed angle about the axis, pivot_positive must be \
+                 the edge the child rocks on when the angle is positive; exchange pivot_positive and pivot_negative, or reverse the axis",
+            ));
+        }
+    }
+    Ok(InterfaceKind::Hinge { axis, pivot_positive: pp, pivot_negative: pn })
+}
+
+fn rocking_base_kind(
+    corners: &[[f64; 3]],
+    child_com: &Vector3<f64>,
+    item: &str,
+    size: f64,
+) -> Result<InterfaceKind, ModelError> {
+    let item_c = format!("{item} (rocking_base.corners)");
+    if corners.len() != 4 {
+        return Err(ModelError::new(item_c, format!("needs exactly 4 corners, got {}", corners.len())));
+    }
+    let mut c = [Vector3::zeros(); 4];
+    for (k, x) in corners.iter().enumerate() {
+        c[k] = finite3(x, &item_c, &format!("corner {k}"))?;
+    }
+    let tol = GEOMETRY_TOLERANCE * size;
+    let edges: Vec<Vector3<f64>> = (0..4).map(|k| c[(k + 1) % 4] - c[k]).collect();
+    if let Some(k) = edges.iter().position(|e| e.norm() <= tol) {
+        return Err(ModelError::new(item_c, format!("corners {k} and {} coincide", (k + 1) % 4)));
+    }
+    let mut normal = edges[0].cross(&edges[1]).normalize();
+    let off_plane = normal.dot(&(c[3] - c[0]));
+    if off_plane.abs() > tol {
+        return Err(ModelError::new(
+            item_c,
+            format!("the corners are not coplanar: corner 3 is {off_plane:.3e} m off the plane of the first three"),
+        ));
+    }
+    for k in 0..4 {
+        let cos = edges[k].normalize().dot(&edges[(k + 1) % 4].normalize());
+        if cos.abs() > GEOMETRY_TOLERANCE {
+            return Err(ModelError::new(
+                item_c,
+                format!(
+                    "not a rectangle: the angle at corner {} is {:.4}°, not 90° (are the corners in order around it?)",
+                    (k + 1) % 4,
+                    cos.clamp(-1.0, 1.0).acos().to_degrees()
+                ),
+            ));
+        }
+    }
+    let side = normal.dot(&(child_com - c[0]));
+    if side.abs() <= tol {
+        return Err(ModelError::new(
+            item_c,
+            "the child's centre of mass lies in the contact plane: cannot tell which side is the child's",
+        ));
+    }
+    if side < 0.0 {
+        normal = -normal;
+    }
+    let e1 = edges[0].normalize();
+    let e2 = normal.cross(&e1);
+    Ok(InterfaceKind::RockingBase { corners: c, normal, e1, e2 })
+}
+
+impl Model {
+    /// Validates a description and builds the model: mass properties, interface geometry, the
+    /// spanning tree from the ground (coordinates in breadth-first order, interfaces in file order)
+    /// and the loop closures.
+    pub fn from_spec(spec: &StructureSpec) -> Result<Model, ModelError> {
+        if !(spec.gravity.is_finite() && spec.gravity > 0.0) {
+            return Err(ModelError::new("gravity", format!("must be a positive number of m/s², got {}", spec.gravity)));
+        }
+        if spec.body.is_empty() {
+            return Err(ModelError::new(quoted("model", &spec.name), "has no bodies"));
+        }
+        let mut body_index = HashMap::new();
+        let mut bodies = Vec::with_capacity(spec.body.len());
+        for (k, b) in spec.body.iter().enumerate() {
+            if b.name.trim().is_empty() {
+                return Err(ModelError::new(format!("body #{}", k + 1), "has an empty name"));
+            }
+            if b.name == "ground" {
+                return Err(ModelError::new(quoted("body", &b.name), "\"ground\" is reserved for the ground"));
+            }
+            if body_index.insert(b.name.clone(), k).is_some() {
+                return Err(ModelError::new(quoted("body", &b.name), "the name is used by two bodies"));
+            }
+            bodies.push(build_body(b)?);
+        }
+        // A length scale for tolerances: extent of the centres and of every given point.
+        let mut pts: Vec<Vector3<f64>> = bodies.iter().map(|b| b.com).collect();
+        for i in &spec.interface {
+            for p in [&i.pivot_positive, &i.pivot_negative].into_iter().flatten() {
+                match p {
+                    PivotSpec::Point(x) => pts.push(Vector3::from(*x)),
+                    PivotSpec::Segment(s) => pts.extend(s.iter().map(|x| Vector3::from(*x))),
+                }
+            }
+            if let Some(rb) = &i.rocking_base {
+                pts.extend(rb.corners.iter().map(|x| Vector3::from(*x)));
+            }
+        }
+        let pts: Vec<_> = pts.into_iter().filter(|p| p.iter().all(|x| x.is_finite())).collect();
+        let mut size: f64 = bodies.iter().map(|b| b.volume.cbrt()).fold(1e-3, f64::max);
+        for a in &pts {
+            for b in &pts {
+                size = size.max((a - b).norm());
+            }
+        }
+
+        let mut names = HashMap::new();
+        let mut ends = Vec::with_capacity(spec.interface.len());
+        for (k, i) in spec.interface.iter().enumerate() {
+            let item = quoted("interface", &i.name);
+            if i.name.trim().is_empty() {
+                return Err(ModelError::new(format!("interface #{}", k + 1), "has an empty name"));
+            }
+            if names.insert(i.name.clone(), k).is_some() {
+                return Err(ModelError::new(item, "the name is used by two interfaces"));
+            }
+            let parent = if i.parent == "ground" {
+                Parent::Ground
+            } else {
+                Parent::Body(*body_index.get(&i.parent).ok_or_else(|| {
+                    ModelError::new(format!("{item} (parent)"), format!("no body is named \"{}\"", i.parent))
+                })?)
+            };
+            if i.child == "ground" {
+                return Err(ModelError::new(
+                    format!("{item} (child)"),
+                    "the child must be a body: to join a body to the ground make \"ground\" the parent",
+                ));
+            }
+            let child = *body_index.get(&i.child).ok_or_else(|| {
+                ModelError::new(format!("{item} (child)"), format!("no body is named \"{}\"", i.child))
+            })?;
+            if parent == Parent::Body(child) {
+                return Err(ModelError::new(item, format!("joins body \"{}\" to itself", i.child)));
+            }
+            let child_com = bodies[child].com;
+            let kind = match &i.rocking_base {
+                Some(rb) => {
+                    if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some() {
+                        return Err(ModelError::new(
+                            item,
+                            "a rocking_base defines its own axes and pivots: remove axis, pivot_positive and pivot_negative",
+                        ));
+                    }
+                    rocking_base_kind(&rb.corners, &child_com, &item, size)?
+                }
+                None => hinge_kind(i, &child_com, &item, size)?,
+            };
+            check_impact_law(&i.impact, &item)?;
+            ends.push((parent, child, kind));
+        }
+
+        // Spanning tree: breadth first from the ground along parent → child.
+        let n_i = spec.interface.len();
+        let mut in_tree = vec![false; n_i];
+        let mut reached = vec![false; bodies.len()];
+        let mut order = Vec::new(); // tree interfaces in coordinate order
+        let mut queue = VecDeque::from([Parent::Ground]);
+        while let Some(node) = queue.pop_front() {
+            for (k, (p, c, _)) in ends.iter().enumerate() {
+                if *p == node && !reached[*c] {
+                    reached[*c] = true;
+                    in_tree[k] = true;
+                    order.push(k);
+                    queue.push_back(Parent::Body(*c));
+                }
+            }
+        }
+        if let Some(b) = reached.iter().position(|r| !r) {
+            return Err(ModelError::new(
+                quoted("body", &bodies[b].name),
+                "has no path from the ground: every body must be reached from \"ground\" through interfaces, \
+                 following each interface from parent to child",
+            ));
+        }
+
+        let mut coords = Vec::new();
+        let mut body_coord = vec![usize::MAX; bodies.len()];
+        let mut roles = vec![Role::Closure { index: 0 }; n_i];
+        let mut slots = vec![0..0; n_i];
+        for &k in &order {
+            let (p, c, kind) = &ends[k];
+            let first = coords.len();
+            let mut parent = match p {
+                Parent::Ground => None,
+                Parent::Body(b) => Some(body_coord[*b]),
+            };
+            let n = kind.angle_count();
+            for comp in 0..n {
+                let name = if n == 1 {
+                    spec.interface[k].name.clone()
+                } else {
+                    format!("{}.{}", spec.interface[k].name, comp + 1)
+                };
+                coords.push(Coordinate { name, interface: k, component: comp, axis: kind.axis(comp), parent });
+                parent = Some(coords.len() - 1);
+            }
+            body_coord[*c] = coords.len() - 1;
+            roles[k] = Role::Tree { first_coord: first };
+            slots[k] = first..first + n;
+        }
+        let mut closures = Vec::new();
+        let mut slot = coords.len();
+        let mut row = 0;
+        for k in (0..n_i).filter(|&k| !in_tree[k]) {
+            let kind = &ends[k].2;
+            let rows = match kind {
+                InterfaceKind::Hinge { .. } => 5,
+                InterfaceKind::RockingBase { .. } => 4,
+            };
+            roles[k] = Role::Closure { index: closures.len() };
+            slots[k] = slot..slot + kind.angle_count();
+            slot += kind.angle_count();
+            closures.push(Closure { interface: k, first_row: row, rows });
+            row += rows;
+        }
+        let interfaces = ends
+            .into_iter()
+            .enumerate()
+            .map(|(k, (parent, child, kind))| Interface {
+                name: spec.interface[k].name.clone(),
+                parent,
+                child,
+                kind,
+                impact: spec.interface[k].impact,
+                role: roles[k],
+                slots: slots[k].clone(),
+            })
+            .collect();
+        Ok(Model {
+            name: spec.name.clone(),
+            gravity: spec.gravity,
+            bodies,
+            interfaces,
+            coords,
+            closures,
+            body_coord,
+            constraint_rows: row,
+            slot_count: slot,
+            size,
+        })
+    }
+
+    /// DOF(1): the number of tree coordinates.
+    pub fn dof(&self) -> usize {
+        self.coords.len()
+    }
+
+    /// Index of a coordinate by name.
+    pub fn coord_index(&self, name: &str) -> Option<usize> {
+        self.coords.iter().position(|c| c.name == name)
+    }
+
+    /// Index of a body by name.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Index of an interface by name.
+    pub fn interface_index(&self, name: &str) -> Option<usize> {
+        self.interfaces.iter().position(|i| i.name == name)
+    }
+
+    /// Total mass (kg).
+    pub fn total_mass(&self) -> f64 {
+        self.bodies.iter().map(|b| b.mass).sum()
+    }
+
+    /// The frame coordinate of a parent (None for the ground).
+    pub fn frame_of(&self, p: Parent) -> Option<usize> {
+        match p {
+            Parent::Ground => None,
+            Parent::Body(b) => Some(self.body_coord[b]),
+        }
+    }
+}
+
+fn check_impact_law(law: &ImpactLaw, item: &str) -> Result<(), ModelError> {
+    let bad_r = |r: f64| !(r.is_finite() && r > 0.0 && r <= 1.0);
+    let bad_pos = |x: f64| !(x.is_finite() && x > 0.0);
+    let problem = match *law {
+        ImpactLaw::Momentum => None,
+        ImpactLaw::Restitution(r) if bad_r(r) => Some(format!("restitution r must be in (0, 1], got {r}")),
+        ImpactLaw::Dirac { r, .. } | ImpactLaw::DiracRegularised { r, .. } if bad_r(r) => {
+            Some(format!("r must be in (0, 1], got {r}"))
+        }
+        ImpactLaw::Dirac { c, .. } | ImpactLaw::DiracRegularised { c, .. } if bad_pos(c) => {
+            Some(format!("c must be positive, got {c}"))
+        }
+        ImpactLaw::DiracRegularised { width, .. } if bad_pos(width) => {
+            Some(format!("width must be positive, got {width}"))
+        }
+        _ => None,
+    };
+    match problem {
+        Some(p) => Err(ModelError::new(format!("{item} (impact)"), p)),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,33 @@
+//! The dynamic chain: which pivot of every interface angle is active.
+
+use nalgebra::DVector;
+
+use crate::model::{Model, Side};
+
+/// The active pivot of every angle slot (the paper's "dynamic chain"): slot k < DOF(1) is
+/// coordinate k; the slots after them are the angles of the loop closures
+/// ([`crate::Interface::slots`]). Part of the state: an angle at exactly 0 keeps its side.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct ActivePivots {
+    /// One side per slot.
+    pub sides: Vec<Side>,
+}
+
+impl ActivePivots {
+    /// Every slot on `side`.
+    pub fn uniform(model: &Model, side: Side) -> Self {
+        Self { sides: vec![side; model.slot_count] }
+    }
+
+    /// Sides from the signs of the coordinates q (ties and closure slots keep `self`'s sides).
+    pub fn follow_coordinates(&mut self, q: &DVector<f64>) {
+        for (k, s) in self.sides.iter_mut().take(q.len()).enumerate() {
+            *s = Side::of(q[k], *s);
+        }
+    }
+
+    /// Sides of one interface's slots.
+    pub fn of_interface(&self, model: &Model, interface: usize) -> &[Side] {
+        &self.sides[model.interfaces[interface].slots.clone()]
+    }
+}
