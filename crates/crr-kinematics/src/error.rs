@@ -13,6 +13,9 @@ pub struct ModelError {
 impl ModelError {
     /// An error about `item`.
     pub fn new(item: impl Into<String>, problem: impl Into<String>) -> Self {
-        Self { item: item.into(), problem: problem.into() }
+        Self {
+            item: item.into(),
+            problem: problem.into(),
+        }
     }
 }

@@ -26,7 +26,11 @@ impl SplitMix {
     /// A random unit vector.
     pub fn unit(&mut self) -> Vector3<f64> {
         loop {
-            let v = Vector3::new(self.uniform(-1.0, 1.0), self.uniform(-1.0, 1.0), self.uniform(-1.0, 1.0));
+            let v = Vector3::new(
+                self.uniform(-1.0, 1.0),
+                self.uniform(-1.0, 1.0),
+                self.uniform(-1.0, 1.0),
+            );
             let n = v.norm();
             if n > 0.2 && n <= 1.0 {
                 return v / n;
@@ -45,7 +49,11 @@ pub fn box_body(name: &str, density: f64, center: [f64; 3], size: [f64; 3]) -> B
         name: name.into(),
         density: Some(density),
         mass: None,
-        box_shape: Some(BoxShape { center, size, rotation: None }),
+        box_shape: Some(BoxShape {
+            center,
+            size,
+            rotation: None,
+        }),
         polyhedron: None,
         prism: None,
         annular_sector: None,
@@ -53,7 +61,14 @@ pub fn box_body(name: &str, density: f64, center: [f64; 3], size: [f64; 3]) -> B
 }
 
 /// A hinge interface.
-pub fn hinge(name: &str, parent: &str, child: &str, axis: [f64; 3], pos: [f64; 3], neg: [f64; 3]) -> InterfaceSpec {
+pub fn hinge(
+    name: &str,
+    parent: &str,
+    child: &str,
+    axis: [f64; 3],
+    pos: [f64; 3],
+    neg: [f64; 3],
+) -> InterfaceSpec {
     InterfaceSpec {
         name: name.into(),
         parent: parent.into(),
@@ -67,7 +82,12 @@ pub fn hinge(name: &str, parent: &str, child: &str, axis: [f64; 3], pos: [f64; 3
 }
 
 /// A rocking-base interface.
-pub fn rocking_base(name: &str, parent: &str, child: &str, corners: [[f64; 3]; 4]) -> InterfaceSpec {
+pub fn rocking_base(
+    name: &str,
+    parent: &str,
+    child: &str,
+    corners: [[f64; 3]; 4],
+) -> InterfaceSpec {
     InterfaceSpec {
         name: name.into(),
         parent: parent.into(),
@@ -75,7 +95,9 @@ pub fn rocking_base(name: &str, parent: &str, child: &str, corners: [[f64; 3]; 4
         axis: None,
         pivot_positive: None,
         pivot_negative: None,
-        rocking_base: Some(RockingBaseSpec { corners: corners.to_vec() }),
+        rocking_base: Some(RockingBaseSpec {
+            corners: corners.to_vec(),
+        }),
         impact: ImpactLaw::Momentum,
     }
 }
@@ -88,8 +110,20 @@ pub fn single_block(b: f64, h: f64, density: f64) -> StructureSpec {
     StructureSpec {
         name: "single_block".into(),
         gravity: crate::spec::DEFAULT_GRAVITY,
-        body: vec![box_body("block", density, [0.0, 0.0, h], [2.0 * b, 2.0 * b, 2.0 * h])],
-        interface: vec![hinge("base", "ground", "block", [0.0, 1.0, 0.0], [b, 0.0, 0.0], [-b, 0.0, 0.0])],
+        body: vec![box_body(
+            "block",
+            density,
+            [0.0, 0.0, h],
+            [2.0 * b, 2.0 * b, 2.0 * h],
+        )],
+        interface: vec![hinge(
+            "base",
+            "ground",
+            "block",
+            [0.0, 1.0, 0.0],
+            [b, 0.0, 0.0],
+            [-b, 0.0, 0.0],
+        )],
     }
 }
 
@@ -102,14 +136,27 @@ pub fn random_chain(seed: u64, n: usize, closures: usize) -> StructureSpec {
     let mut interface = Vec::new();
     let mut centers: Vec<Vector3<f64>> = Vec::new();
     for k in 0..n {
-        let parent = if k == 0 { None } else { Some(rng.below(k + 1)).filter(|&p| p < k) };
+        let parent = if k == 0 {
+            None
+        } else {
+            Some(rng.below(k + 1)).filter(|&p| p < k)
+        };
         let base = parent.map_or(Vector3::zeros(), |p| centers[p]);
-        let c = base + Vector3::new(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), rng.uniform(0.8, 1.5));
+        let c = base
+            + Vector3::new(
+                rng.uniform(-0.5, 0.5),
+                rng.uniform(-0.5, 0.5),
+                rng.uniform(0.8, 1.5),
+            );
         let mut b = box_body(
             &format!("b{k}"),
             rng.uniform(1000.0, 3000.0),
             c.into(),
-            [rng.uniform(0.2, 0.8), rng.uniform(0.2, 0.8), rng.uniform(0.3, 1.2)],
+            [
+                rng.uniform(0.2, 0.8),
+                rng.uniform(0.2, 0.8),
+                rng.uniform(0.3, 1.2),
+            ],
         );
         if let Some(bx) = b.box_shape.as_mut() {
             bx.rotation = Some((rng.unit() * rng.uniform(0.0, 1.0)).into());
@@ -118,18 +165,41 @@ pub fn random_chain(seed: u64, n: usize, closures: usize) -> StructureSpec {
         centers.push(c);
         let pname = parent.map_or("ground".to_string(), |p| format!("b{p}"));
         let joint = (base + c) * 0.5 - Vector3::new(0.0, 0.0, 0.3);
-        interface.push(random_interface(&mut rng, &format!("j{k}"), &pname, &format!("b{k}"), joint, c));
+        interface.push(random_interface(
+            &mut rng,
+            &format!("j{k}"),
+            &pname,
+            &format!("b{k}"),
+            joint,
+            c,
+        ));
     }
     for m in 0..closures.min(n) {
         // A second interface of body `child` to the ground or an earlier body.
         let child = n - 1 - m;
         let parent = rng.below(child + 1);
-        let pname = if parent == child { "ground".to_string() } else { format!("b{parent}") };
+        let pname = if parent == child {
+            "ground".to_string()
+        } else {
+            format!("b{parent}")
+        };
         let c = centers[child];
         let joint = c - Vector3::new(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.6);
-        interface.push(random_interface(&mut rng, &format!("c{m}"), &pname, &format!("b{child}"), joint, c));
+        interface.push(random_interface(
+            &mut rng,
+            &format!("c{m}"),
+            &pname,
+            &format!("b{child}"),
+            joint,
+            c,
+        ));
     }
-    StructureSpec { name: format!("random_{seed}"), gravity: 9.81, body, interface }
+    StructureSpec {
+        name: format!("random_{seed}"),
+        gravity: 9.81,
+        body,
+        interface,
+    }
 }
 
 fn random_interface(
@@ -150,7 +220,17 @@ fn random_interface(
         let e2 = n.cross(&e1);
         let (a, b) = (rng.uniform(0.1, 0.4), rng.uniform(0.1, 0.4));
         let corner = |s: f64, t: f64| -> [f64; 3] { (joint + e1 * (s * a) + e2 * (t * b)).into() };
-        rocking_base(name, parent, child, [corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)])
+        rocking_base(
+            name,
+            parent,
+            child,
+            [
+                corner(-1.0, -1.0),
+                corner(1.0, -1.0),
+                corner(1.0, 1.0),
+                corner(-1.0, 1.0),
+            ],
+        )
     } else {
         let u = rng.unit();
         let d = crate::closure::perpendicular(&u) * rng.uniform(0.1, 0.5);
@@ -169,7 +249,8 @@ pub fn transformed(spec: &StructureSpec, rot: &Matrix3<f64>, t: &Vector3<f64>) -
     let mut out = spec.clone();
     for b in &mut out.body {
         if let Some(bx) = &mut b.box_shape {
-            let r0 = crate::rotation::rotation_vector(&Vector3::from(bx.rotation.unwrap_or([0.0; 3])));
+            let r0 =
+                crate::rotation::rotation_vector(&Vector3::from(bx.rotation.unwrap_or([0.0; 3])));
             let r = Rotation3::from_matrix_unchecked(rot * r0);
             bx.rotation = Some(r.scaled_axis().into());
             bx.center = p(&bx.center);
@@ -181,7 +262,13 @@ pub fn transformed(spec: &StructureSpec, rot: &Matrix3<f64>, t: &Vector3<f64>) -
             polygon.iter_mut().for_each(|v| *v = p(v));
             *extrude = d(extrude);
         }
-        if let Some(AnnularSectorShape { center, axis, start, .. }) = &mut b.annular_sector {
+        if let Some(AnnularSectorShape {
+            center,
+            axis,
+            start,
+            ..
+        }) = &mut b.annular_sector
+        {
             *center = p(center);
             *axis = d(axis);
             *start = d(start);
@@ -189,7 +276,10 @@ pub fn transformed(spec: &StructureSpec, rot: &Matrix3<f64>, t: &Vector3<f64>) -
     }
     for i in &mut out.interface {
         i.axis = i.axis.as_ref().map(d);
-        for piv in [&mut i.pivot_positive, &mut i.pivot_negative].into_iter().flatten() {
+        for piv in [&mut i.pivot_positive, &mut i.pivot_negative]
+            .into_iter()
+            .flatten()
+        {
             match piv {
                 PivotSpec::Point(x) => *x = p(x),
                 PivotSpec::Segment(s) => s.iter_mut().for_each(|x| *x = p(x)),

@@ -43,8 +43,14 @@ pub fn rot_ops_along_path(model: &Model, q: &DVector<f64>, b: usize) -> Vec<Matr
 /// ∂Γⁱ/∂q_{path[a]} for all a, i on the path of body `b` (zero for a > i), indexed `[a][i]`.
 pub fn rot_op_partials(model: &Model, q: &DVector<f64>, path: &[usize]) -> Vec<Vec<Matrix3<f64>>> {
     let m = path.len();
-    let rots: Vec<_> = path.iter().map(|&j| axis_angle(&model.coords[j].axis, q[j])).collect();
-    let drots: Vec<_> = path.iter().map(|&j| axis_angle_derivative(&model.coords[j].axis, q[j])).collect();
+    let rots: Vec<_> = path
+        .iter()
+        .map(|&j| axis_angle(&model.coords[j].axis, q[j]))
+        .collect();
+    let drots: Vec<_> = path
+        .iter()
+        .map(|&j| axis_angle_derivative(&model.coords[j].axis, q[j]))
+        .collect();
     (0..m)
         .map(|a| {
             let mut prod = Matrix3::identity();
@@ -78,7 +84,9 @@ pub fn mass_matrix_gamma(model: &Model, q: &DVector<f64>, pivots: &ActivePivots)
         let m = path.len();
         let d = rot_op_partials(model, q, &path);
         // Hinge vectors aⁱ (i < m − 1), centre x̄ and second moment S about the last pivot.
-        let hinge: Vec<Vector3<f64>> = (0..m - 1).map(|i| pivot_rest(path[i + 1]) - pivot_rest(path[i])).collect();
+        let hinge: Vec<Vector3<f64>> = (0..m - 1)
+            .map(|i| pivot_rest(path[i + 1]) - pivot_rest(path[i]))
+            .collect();
         let last = pivot_rest(path[m - 1]);
         let xbar = body.com - last;
         let s = body.second_moment + xbar * xbar.transpose() * body.mass;

@@ -14,10 +14,12 @@ use crate::rotation::skew;
 pub fn spatial_inertia(mass: f64, c: &nalgebra::Vector3<f64>, i_c: &Matrix3<f64>) -> Matrix6<f64> {
     let cx = skew(c);
     let mut s = Matrix6::zeros();
-    s.fixed_view_mut::<3, 3>(0, 0).copy_from(&(i_c - cx * cx * mass));
+    s.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&(i_c - cx * cx * mass));
     s.fixed_view_mut::<3, 3>(0, 3).copy_from(&(cx * mass));
     s.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-cx * mass));
-    s.fixed_view_mut::<3, 3>(3, 3).copy_from(&(Matrix3::identity() * mass));
+    s.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&(Matrix3::identity() * mass));
     s
 }
 

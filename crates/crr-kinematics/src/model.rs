@@ -136,12 +136,19 @@ impl InterfaceKind {
     /// one on the least (so that the rest of the base lifts towards n).
     pub fn pivot(&self, sides: &[Side]) -> Vector3<f64> {
         match self {
-            InterfaceKind::Hinge { pivot_positive, pivot_negative, .. } => match sides[0] {
+            InterfaceKind::Hinge {
+                pivot_positive,
+                pivot_negative,
+                ..
+            } => match sides[0] {
                 Side::Positive => *pivot_positive,
                 Side::Negative => *pivot_negative,
             },
-            InterfaceKind::RockingBase { corners, e1, e2, .. } => {
-                let score = |c: &Vector3<f64>| -sides[0].sign() * e2.dot(c) + sides[1].sign() * e1.dot(c);
+            InterfaceKind::RockingBase {
+                corners, e1, e2, ..
+            } => {
+                let score =
+                    |c: &Vector3<f64>| -sides[0].sign() * e2.dot(c) + sides[1].sign() * e1.dot(c);
                 let mut best = corners[0];
                 for c in &corners[1..] {
                     if score(c) > score(&best) {
@@ -248,7 +255,10 @@ fn finite3(v: &[f64; 3], item: &str, field: &str) -> Result<Vector3<f64>, ModelE
     if v.iter().all(|x| x.is_finite()) {
         Ok(Vector3::from(*v))
     } else {
-        Err(ModelError::new(item, format!("{field} has a NaN or infinite value: {v:?}")))
+        Err(ModelError::new(
+            item,
+            format!("{field} has a NaN or infinite value: {v:?}"),
+        ))
     }
 }
 
@@ -283,7 +293,11 @@ fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
             let kinds: Vec<_> = shapes.iter().map(|s| s.kind()).collect();
             return Err(ModelError::new(
                 item,
-                format!("has {} shapes ({}): give exactly one", kinds.len(), kinds.join(", ")),
+                format!(
+                    "has {} shapes ({}): give exactly one",
+                    kinds.len(),
+                    kinds.join(", ")
+                ),
             ));
         }
     };
@@ -292,7 +306,10 @@ fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
         .map_err(|e| ModelError::new(format!("{item} ({})", shape.kind()), e.to_string()))?;
     let density = match (spec.density, spec.mass) {
         (_, Some(m)) if !(m.is_finite() && m > 0.0) => {
-            return Err(ModelError::new(item, format!("mass must be a positive number of kg, got {m}")));
+            return Err(ModelError::new(
+                item,
+                format!("mass must be a positive number of kg, got {m}"),
+            ));
         }
         (Some(d), _) if !(d.is_finite() && d > 0.0) => {
             return Err(ModelError::new(
@@ -303,7 +320,10 @@ fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
         (_, Some(m)) => m / props.volume,
         (Some(d), None) => d,
         (None, None) => {
-            return Err(ModelError::new(item, "needs a density (kg/m³) or a mass (kg)"));
+            return Err(ModelError::new(
+                item,
+                "needs a density (kg/m³) or a mass (kg)",
+            ));
         }
     };
     Ok(Body {
@@ -366,17 +386,22 @@ fn hinge_kind(
     let axis = finite3(&axis, item, "axis")?;
     let n = axis.norm();
     if n == 0.0 {
-        return Err(ModelError::new(format!("{item} (axis)"), "the axis is the zero vector"));
+        return Err(ModelError::new(
+            format!("{item} (axis)"),
+            "the axis is the zero vector",
+        ));
     }
     let axis = axis / n;
     let pp = spec
         .pivot_positive
         .as_ref()
         .ok_or_else(|| ModelError::new(item, "a hinge needs pivot_positive"))?;
-    let pn = spec
-        .pivot_negative
-        .as_ref()
-        .ok_or_else(|| ModelError::new(item, "a hinge needs pivot_negative (equal to pivot_positive for a plain hinge)"))?;
+    let pn = spec.pivot_negative.as_ref().ok_or_else(|| {
+        ModelError::new(
+            item,
+            "a hinge needs pivot_negative (equal to pivot_positive for a plain hinge)",
+        )
+    })?;
     let pp = pivot_point(pp, &axis, item, "pivot_positive", size)?;
     let pn = pivot_point(pn, &axis, item, "pivot_negative", size)?;
     // Offset between the two pivot lines, perpendicular to the axis.
@@ -401,7 +426,11 @@ fn hinge_kind(
             ));
         }
     }
-    Ok(InterfaceKind::Hinge { axis, pivot_positive: pp, pivot_negative: pn })
+    Ok(InterfaceKind::Hinge {
+        axis,
+        pivot_positive: pp,
+        pivot_negative: pn,
+    })
 }
 
 fn rocking_base_kind(
@@ -412,7 +441,10 @@ fn rocking_base_kind(
 ) -> Result<InterfaceKind, ModelError> {
     let item_c = format!("{item} (rocking_base.corners)");
     if corners.len() != 4 {
-        return Err(ModelError::new(item_c, format!("needs exactly 4 corners, got {}", corners.len())));
+        return Err(ModelError::new(
+            item_c,
+            format!("needs exactly 4 corners, got {}", corners.len()),
+        ));
     }
     let mut c = [Vector3::zeros(); 4];
     for (k, x) in corners.iter().enumerate() {
@@ -421,14 +453,19 @@ fn rocking_base_kind(
     let tol = GEOMETRY_TOLERANCE * size;
     let edges: Vec<Vector3<f64>> = (0..4).map(|k| c[(k + 1) % 4] - c[k]).collect();
     if let Some(k) = edges.iter().position(|e| e.norm() <= tol) {
-        return Err(ModelError::new(item_c, format!("corners {k} and {} coincide", (k + 1) % 4)));
+        return Err(ModelError::new(
+            item_c,
+            format!("corners {k} and {} coincide", (k + 1) % 4),
+        ));
     }
     let mut normal = edges[0].cross(&edges[1]).normalize();
     let off_plane = normal.dot(&(c[3] - c[0]));
     if off_plane.abs() > tol {
         return Err(ModelError::new(
             item_c,
-            format!("the corners are not coplanar: corner 3 is {off_plane:.3e} m off the plane of the first three"),
+            format!(
+                "the corners are not coplanar: corner 3 is {off_plane:.3e} m off the plane of the first three"
+            ),
         ));
     }
     for k in 0..4 {
@@ -456,7 +493,12 @@ fn rocking_base_kind(
     }
     let e1 = edges[0].normalize();
     let e2 = normal.cross(&e1);
-    Ok(InterfaceKind::RockingBase { corners: c, normal, e1, e2 })
+    Ok(InterfaceKind::RockingBase {
+        corners: c,
+        normal,
+        e1,
+        e2,
+    })
 }
 
 impl Model {
@@ -465,22 +507,37 @@ impl Model {
     /// and the loop closures.
     pub fn from_spec(spec: &StructureSpec) -> Result<Model, ModelError> {
         if !(spec.gravity.is_finite() && spec.gravity > 0.0) {
-            return Err(ModelError::new("gravity", format!("must be a positive number of m/s², got {}", spec.gravity)));
+            return Err(ModelError::new(
+                "gravity",
+                format!("must be a positive number of m/s², got {}", spec.gravity),
+            ));
         }
         if spec.body.is_empty() {
-            return Err(ModelError::new(quoted("model", &spec.name), "has no bodies"));
+            return Err(ModelError::new(
+                quoted("model", &spec.name),
+                "has no bodies",
+            ));
         }
         let mut body_index = HashMap::new();
         let mut bodies = Vec::with_capacity(spec.body.len());
         for (k, b) in spec.body.iter().enumerate() {
             if b.name.trim().is_empty() {
-                return Err(ModelError::new(format!("body #{}", k + 1), "has an empty name"));
+                return Err(ModelError::new(
+                    format!("body #{}", k + 1),
+                    "has an empty name",
+                ));
             }
             if b.name == "ground" {
-                return Err(ModelError::new(quoted("body", &b.name), "\"ground\" is reserved for the ground"));
+                return Err(ModelError::new(
+                    quoted("body", &b.name),
+                    "\"ground\" is reserved for the ground",
+                ));
             }
             if body_index.insert(b.name.clone(), k).is_some() {
-                return Err(ModelError::new(quoted("body", &b.name), "the name is used by two bodies"));
+                return Err(ModelError::new(
+                    quoted("body", &b.name),
+                    "the name is used by two bodies",
+                ));
             }
             bodies.push(build_body(b)?);
         }
@@ -497,7 +554,10 @@ impl Model {
                 pts.extend(rb.corners.iter().map(|x| Vector3::from(*x)));
             }
         }
-        let pts: Vec<_> = pts.into_iter().filter(|p| p.iter().all(|x| x.is_finite())).collect();
+        let pts: Vec<_> = pts
+            .into_iter()
+            .filter(|p| p.iter().all(|x| x.is_finite()))
+            .collect();
         let mut size: f64 = bodies.iter().map(|b| b.volume.cbrt()).fold(1e-3, f64::max);
         for a in &pts {
             for b in &pts {
@@ -510,7 +570,10 @@ impl Model {
         for (k, i) in spec.interface.iter().enumerate() {
             let item = quoted("interface", &i.name);
             if i.name.trim().is_empty() {
-                return Err(ModelError::new(format!("interface #{}", k + 1), "has an empty name"));
+                return Err(ModelError::new(
+                    format!("interface #{}", k + 1),
+                    "has an empty name",
+                ));
             }
             if names.insert(i.name.clone(), k).is_some() {
                 return Err(ModelError::new(item, "the name is used by two interfaces"));
@@ -519,7 +582,10 @@ impl Model {
                 Parent::Ground
             } else {
                 Parent::Body(*body_index.get(&i.parent).ok_or_else(|| {
-                    ModelError::new(format!("{item} (parent)"), format!("no body is named \"{}\"", i.parent))
+                    ModelError::new(
+                        format!("{item} (parent)"),
+                        format!("no body is named \"{}\"", i.parent),
+                    )
                 })?)
             };
             if i.child == "ground" {
@@ -529,15 +595,22 @@ impl Model {
                 ));
             }
             let child = *body_index.get(&i.child).ok_or_else(|| {
-                ModelError::new(format!("{item} (child)"), format!("no body is named \"{}\"", i.child))
+                ModelError::new(
+                    format!("{item} (child)"),
+                    format!("no body is named \"{}\"", i.child),
+                )
             })?;
             if parent == Parent::Body(child) {
-                return Err(ModelError::new(item, format!("joins body \"{}\" to itself", i.child)));
+                return Err(ModelError::new(
+                    item,
+                    format!("joins body \"{}\" to itself", i.child),
+                ));
             }
             let child_com = bodies[child].com;
             let kind = match &i.rocking_base {
                 Some(rb) => {
-                    if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some() {
+                    if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some()
+                    {
                         return Err(ModelError::new(
                             item,
                             "a rocking_base defines its own axes and pivots: remove axis, pivot_positive and pivot_negative",
@@ -593,7 +666,13 @@ impl Model {
                 } else {
                     format!("{}.{}", spec.interface[k].name, comp + 1)
                 };
-                coords.push(Coordinate { name, interface: k, component: comp, axis: kind.axis(comp), parent });
+                coords.push(Coordinate {
+                    name,
+                    interface: k,
+                    component: comp,
+                    axis: kind.axis(comp),
+                    parent,
+                });
                 parent = Some(coords.len() - 1);
             }
             body_coord[*c] = coords.len() - 1;
@@ -609,10 +688,16 @@ impl Model {
                 InterfaceKind::Hinge { .. } => 5,
                 InterfaceKind::RockingBase { .. } => 4,
             };
-            roles[k] = Role::Closure { index: closures.len() };
+            roles[k] = Role::Closure {
+                index: closures.len(),
+            };
             slots[k] = slot..slot + kind.angle_count();
             slot += kind.angle_count();
-            closures.push(Closure { interface: k, first_row: row, rows });
+            closures.push(Closure {
+                interface: k,
+                first_row: row,
+                rows,
+            });
             row += rows;
         }
         let interfaces = ends
@@ -681,7 +766,9 @@ fn check_impact_law(law: &ImpactLaw, item: &str) -> Result<(), ModelError> {
     let bad_pos = |x: f64| !(x.is_finite() && x > 0.0);
     let problem = match *law {
         ImpactLaw::Momentum => None,
-        ImpactLaw::Restitution(r) if bad_r(r) => Some(format!("restitution r must be in (0, 1], got {r}")),
+        ImpactLaw::Restitution(r) if bad_r(r) => {
+            Some(format!("restitution r must be in (0, 1], got {r}"))
+        }
         ImpactLaw::Dirac { r, .. } | ImpactLaw::DiracRegularised { r, .. } if bad_r(r) => {
             Some(format!("r must be in (0, 1], got {r}"))
         }

@@ -16,7 +16,9 @@ pub struct ActivePivots {
 impl ActivePivots {
     /// Every slot on `side`.
     pub fn uniform(model: &Model, side: Side) -> Self {
-        Self { sides: vec![side; model.slot_count] }
+        Self {
+            sides: vec![side; model.slot_count],
+        }
     }
 
     /// Sides from the signs of the coordinates q (ties and closure slots keep `self`'s sides).

@@ -8,7 +8,13 @@ use crate::model::Model;
 /// U = g Σₙ Mⁿ zₙ (eq 3): absolute, the heights of the centres above z = 0 (J).
 /// Requires [`crate::forward_kinematics`].
 pub fn potential_energy(model: &Model, data: &Data) -> f64 {
-    model.gravity * model.bodies.iter().zip(&data.com).map(|(b, c)| b.mass * c.z).sum::<f64>()
+    model.gravity
+        * model
+            .bodies
+            .iter()
+            .zip(&data.com)
+            .map(|(b, c)| b.mass * c.z)
+            .sum::<f64>()
 }
 
 /// Generalized force of a uniform acceleration field `field` (m/s²) on every body:
@@ -16,7 +22,12 @@ pub fn potential_energy(model: &Model, data: &Data) -> f64 {
 /// effective gravity (−a_x, −a_y, −g − a_z) it is the full load of a ground motion.
 /// Computed in O(DOF(1)) from subtree masses and first moments:
 /// Qₖ = field · (wₖ × (Sₖ − mₖ pₖ)). Requires [`crate::forward_kinematics`].
-pub fn generalized_gravity(model: &Model, data: &mut Data, field: &Vector3<f64>, out: &mut DVector<f64>) {
+pub fn generalized_gravity(
+    model: &Model,
+    data: &mut Data,
+    field: &Vector3<f64>,
+    out: &mut DVector<f64>,
+) {
     let n = model.dof();
     data.subtree_mass.fill(0.0);
     data.subtree_moment.fill(Vector3::zeros());

@@ -55,6 +55,8 @@ mod tests {
     fn quarter_turn_about_z_maps_x_to_y() {
         let r = axis_angle(&Vector3::z(), std::f64::consts::FRAC_PI_2);
         assert!((r * Vector3::x() - Vector3::y()).norm() < 1e-15);
-        assert!((rotation_vector(&(Vector3::z() * std::f64::consts::FRAC_PI_2)) - r).norm() < 1e-15);
+        assert!(
+            (rotation_vector(&(Vector3::z() * std::f64::consts::FRAC_PI_2)) - r).norm() < 1e-15
+        );
     }
 }
