@@ -514,8 +514,8 @@ pub fn parse_at2(text: &str, source: &str) -> Result<Record, GroundMotionError> 
 /// Parses a time/acceleration table. `source` names the file in messages.
 ///
 /// Lines: the first `skip_rows` lines are skipped; `#` starts a comment; blank lines are
-/// ignored; the first remaining line is a header (skipped) if any of its fields is not
-/// a number. Times in s must be strictly increasing; at least 2 samples.
+/// ignored; the first remaining line is a header (skipped) if its time or acceleration
+/// field is missing or not a number while some field is text. Times in s must be strictly increasing; at least 2 samples.
 pub fn parse_table(
     text: &str,
     source: &str,
@@ -556,9 +556,16 @@ pub fn parse_table(
             RecordFormat::Csv => line.split(',').map(str::trim).collect(),
             _ => line.split_whitespace().collect(),
         };
-        if std::mem::take(&mut first_row) && fields.iter().any(|f| parse_fortran_float(f).is_none())
-        {
-            continue; // header row
+        if std::mem::take(&mut first_row) {
+            let numeric = |c: usize| {
+                fields
+                    .get(c)
+                    .is_some_and(|f| parse_fortran_float(f).is_some())
+            };
+            let any_text = fields.iter().any(|f| parse_fortran_float(f).is_none());
+            if any_text && !(numeric(options.time_column) && numeric(options.accel_column)) {
+                continue; // header row
+            }
         }
         if fields.len() < needed {
             return Err(err(

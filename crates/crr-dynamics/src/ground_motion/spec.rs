@@ -421,3 +421,44 @@ impl From<ComponentSpec> for RawComponentSpec {
         raw
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn component_spec_requires_exactly_one_signal() {
+        let none = ComponentSpec::try_from(RawComponentSpec::default()).unwrap_err();
+        assert!(none.contains("found none"), "{none}");
+        let two = ComponentSpec::try_from(RawComponentSpec {
+            sine: Some(SineSpec {
+                amplitude: 1.0,
+                period: Some(1.0),
+                frequency: None,
+                phase: 0.0,
+                cycles: None,
+                start: 0.0,
+            }),
+            constant: Some(ConstantSpec { value: 1.0 }),
+            ..RawComponentSpec::default()
+        })
+        .unwrap_err();
+        assert!(two.contains("found 2: sine, constant"), "{two}");
+    }
+
+    #[test]
+    fn component_spec_round_trips_through_the_wire_form() {
+        let spec = ComponentSpec {
+            signal: SignalSpec::Constant(ConstantSpec { value: 2.0 }),
+            scale: 1.5,
+        };
+        let raw = RawComponentSpec::from(spec.clone());
+        assert_eq!(raw.scale, Some(1.5));
+        assert_eq!(ComponentSpec::try_from(raw), Ok(spec));
+        // Scale 1 is omitted on output and restored as the default on input.
+        let unit = ComponentSpec::new(SignalSpec::Constant(ConstantSpec { value: 2.0 }));
+        let raw = RawComponentSpec::from(unit.clone());
+        assert_eq!(raw.scale, None);
+        assert_eq!(ComponentSpec::try_from(raw), Ok(unit));
+    }
+}
