@@ -20,7 +20,7 @@ pub const HULL_REL_TOL: f64 = 1e-9;
 /// surface (counter-clockwise seen from outside).
 ///
 /// Brute force over point triples with early rejection: O(n³) to O(n⁴),
-/// intended for up to a few hundred points (about 0.1 s for 200 points on a
+/// intended for up to a few hundred points (about 0.15 s for 200 points on a
 /// sphere, 2 s for 500, in an optimised build).
 ///
 /// Errors: fewer than 4 points, non-finite coordinates, or all points

@@ -453,9 +453,9 @@ fn oblique_prism_cavalieri_and_shear() {
 
 #[test]
 fn l_shaped_prism_is_sum_of_rectangles() {
-    // L = [0,2]×[0,1] ∪ [0,1]×[1,3], extruded 0.5 along -y in a vertical
-    // plane would also do; here a tilted plane: the L lies in the plane
-    // spanned by (1,0,0) and (0,1,1)/√2, extruded along an oblique vector.
+    // L = [0,2]×[0,1] ∪ [0,1]×[1,3] (non-convex, reflex vertex at (1,1)) in
+    // the tilted plane spanned by (1,0,0) and (0,1,1)/√2, extruded along an
+    // oblique vector; it is the disjoint union of the two rectangle prisms.
     let e1 = Vector3::new(1.0, 0.0, 0.0);
     let e2 = Vector3::new(0.0, 1.0, 1.0) / 2f64.sqrt();
     let o = Vector3::new(3.0, -1.0, 2.0);
