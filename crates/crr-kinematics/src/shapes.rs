@@ -18,7 +18,8 @@ mod hull;
 mod tests;
 
 pub use hull::{
-    convex_hull_triangles, polyhedron_properties_divergence, polyhedron_properties_tetrahedra,
+    HULL_REL_TOL, convex_hull_triangles, polyhedron_properties_divergence,
+    polyhedron_properties_tetrahedra,
 };
 
 /// Relative tolerance (w.r.t. the polygon's bounding-box diagonal) on the

@@ -19,8 +19,9 @@ pub const HULL_REL_TOL: f64 = 1e-9;
 /// fan-triangulated, so the triangles form a closed, consistently oriented
 /// surface (counter-clockwise seen from outside).
 ///
-/// Brute force over point triples with early rejection: worst case O(n⁴),
-/// intended for up to a few hundred points.
+/// Brute force over point triples with early rejection: O(n³) to O(n⁴),
+/// intended for up to a few hundred points (about 0.15 s for 200 points on a
+/// sphere, 2 s for 500, in an optimised build).
 ///
 /// Errors: fewer than 4 points, non-finite coordinates, or all points
 /// coplanar (within the tolerance).
@@ -54,6 +55,7 @@ pub fn convex_hull_triangles(points: &[Vector3<f64>]) -> Result<Vec<[usize; 3]>,
 
     let mut seen: HashSet<Vec<usize>> = HashSet::new();
     let mut faces: Vec<(Vec<usize>, Vector3<f64>)> = Vec::new();
+    let mut witnesses = [0usize, m - 1];
     for i in 0..m {
         for j in (i + 1)..m {
             let eij = q[j] - q[i];
@@ -68,12 +70,16 @@ pub fn convex_hull_triangles(points: &[Vector3<f64>]) -> Result<Vec<[usize; 3]>,
                 let u = nrm / nn;
                 let d0 = u.dot(&q[i]);
                 let (mut pos, mut neg) = (false, false);
-                for p in &q {
-                    let s = u.dot(p) - d0;
+                // Points that refuted earlier triples are tried first: they
+                // usually refute this one too (large speed-up on round shapes).
+                for l in witnesses.into_iter().chain(0..m) {
+                    let s = u.dot(&q[l]) - d0;
                     if s > tol {
                         pos = true;
+                        witnesses[0] = l;
                     } else if s < -tol {
                         neg = true;
+                        witnesses[1] = l;
                     }
                     if pos && neg {
                         break;
