@@ -37,7 +37,10 @@ fn closure_frames(model: &Model, interface: usize) -> (Option<usize>, Option<usi
 
 /// The two unit vectors whose dot products are the orientation rows of a closure:
 /// pairs (a on A, b on B) with rows (Γ_A a)·(Γ_B b).
-fn orientation_pairs(kind: &InterfaceKind) -> ([(Vector3<f64>, Vector3<f64>); 2], usize) {
+/// A pair (a on frame A, b on frame B) whose dot product (Γ_A a)·(Γ_B b) is one orientation row.
+type OrientationPair = (Vector3<f64>, Vector3<f64>);
+
+fn orientation_pairs(kind: &InterfaceKind) -> ([OrientationPair; 2], usize) {
     match kind {
         InterfaceKind::Hinge { axis, .. } => {
             let v1 = perpendicular(axis);
