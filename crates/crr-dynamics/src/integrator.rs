@@ -164,7 +164,7 @@ impl Options {
         if self.rtol == 0.0 && self.atol == 0.0 {
             return bad("rtol and atol must not both be 0");
         }
-        if !(self.h_max > 0.0) {
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
             return bad("h_max must be > 0");
         }
         if let Some(h) = self.h_init
@@ -633,6 +633,9 @@ impl Solver {
             }
             let h_planned = h;
             let last = self.t + 1.01 * h >= t_end;
+            if adaptive && !last && !(h > 10.0 * f64::EPSILON * self.t.abs() && h > 0.0) {
+                return Err(SolveError::StepSizeUnderflow { t: self.t, h });
+            }
             let t1 = if last {
                 h = t_end - self.t;
                 t_end
@@ -659,9 +662,6 @@ impl Solver {
                     self.stats.rejected += 1;
                     self.last_rejected = true;
                     h /= (1.0 / fac_min).min(fac11 / safe);
-                    if !(h > 0.0) || h <= 10.0 * f64::EPSILON * self.t.abs() {
-                        return Err(SolveError::StepSizeUnderflow { t: self.t, h });
-                    }
                     continue;
                 }
                 let fac = fac11 / self.facold.powf(beta);

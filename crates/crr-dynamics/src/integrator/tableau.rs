@@ -6,6 +6,10 @@
 //! Hairer's `dopri5.f`. The lower-triangular matrices are stored row by row:
 //! row `i` holds `a[i][0..i]`.
 
+// The coefficients are kept with the digits published by Hairer so they can
+// be checked against the source; rounding to f64 happens at compile time.
+#![allow(clippy::excessive_precision)]
+
 // ---------------------------------------------------------------- DOP853
 
 /// Number of stages of DOP853 including the FSAL stage (13) and the three
