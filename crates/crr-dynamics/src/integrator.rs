@@ -571,7 +571,11 @@ impl Solver {
     /// or until the first event, whichever comes first. `on_step` is called
     /// for every accepted step with its dense output (for an event, the
     /// partial step ending at the event). See the module documentation for
-    /// the event semantics.
+    /// the event semantics. The step repeated to land on an event time is
+    /// shorter than the accepted trial step it replaces, so its error
+    /// estimate is not re-checked. Interior double crossings of an event
+    /// function within one step (no sign change at the step ends) are not
+    /// detected; limit `h_max` if that matters.
     ///
     /// # Panics
     /// If `sys.dim()` differs from the solver dimension.
