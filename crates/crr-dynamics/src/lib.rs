@@ -1,2 +1,3 @@
 //! x
 pub mod ground_motion;
+pub mod integrator;

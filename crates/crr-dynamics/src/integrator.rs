@@ -1,0 +1,1045 @@
+//! Explicit Runge–Kutta ODE integrators with dense output and exact event
+//! location, tailored to piecewise-smooth rocking dynamics.
+//!
+//! Three methods are provided (see [`Method`]):
+//!
+//! * [`Method::Dop853`] — Dormand & Prince 8(5,3) as in Hairer's `dop853.f`,
+//!   adaptive, with its 7th-order continuous extension;
+//! * [`Method::Dopri5`] — Dormand & Prince 5(4), adaptive, FSAL, with the
+//!   4th-order continuous extension of Hairer's `dopri5.f`;
+//! * [`Method::Rk4`] — classical fixed-step Runge–Kutta of order 4 with a
+//!   cubic Hermite interpolant as dense output.
+//!
+//! The [`Solver`] keeps its state `(t, y)` between calls of
+//! [`Solver::advance`], which integrates until a caller-given end time
+//! (landed on *exactly*, so it can serve as a breakpoint of a piecewise
+//! forcing) or until the first event of an [`EventFunctions`] set.
+//!
+//! # Events
+//!
+//! After each accepted step the event functions `g_i(t, y)` are evaluated at
+//! the step end. An event `i` is detected when `g_i` changes sign across the
+//! step in the direction allowed by [`EventFunctions::direction`]. Its time
+//! is located by Brent's method on `g_i(t, y_dense(t))` to a bracket width
+//! `≤ 1e-13·max(1, |t|)`; the earliest located root among all functions
+//! wins. The returned time is the end of the final bracket on the
+//! *post-crossing* side, so `g_i` has (to interpolation accuracy) already
+//! changed sign there.
+//!
+//! **The state at the event is not taken from the interpolant**: the solver
+//! repeats the step from its start `t0` with the step size `t* − t0`, i.e.
+//! a genuine step of the method lands exactly on `t*`. The solver state then
+//! is `(t*, y(t*))` and the dense output of that *partial* step (not of the
+//! full trial step) is the one passed to `on_step`.
+//!
+//! **No re-firing on restart**: at the start of every [`Solver::advance`]
+//! the event functions are evaluated at the current state. A function that
+//! is zero there (`|g_i| ≤` [`EVENT_ZERO_TOL`]), or the function that fired
+//! the previous event at exactly this time (also across
+//! [`Solver::reset`] to the same time), is considered to be *at* its root:
+//! it cannot fire at the start and its sign is taken from the first point
+//! after the start (the dense solution at `t0 + 10⁻³·h` of the first step,
+//! or later points if `g_i` is still zero there).
+
+mod tableau;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use tableau::*;
+
+/// Error returned by a right-hand side evaluation; the message is shown by
+/// `Display`.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[error("{0}")]
+pub struct RhsError(pub String);
+
+/// A first-order ODE system `y' = f(t, y)`.
+pub trait OdeSystem {
+    /// Dimension of the state vector.
+    fn dim(&self) -> usize;
+    /// Evaluates `dydt = f(t, y)`. Both slices have length [`Self::dim`].
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError>;
+}
+
+/// Allowed crossing direction of an event function.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Direction {
+    /// Both directions trigger the event.
+    #[default]
+    Any,
+    /// Only crossings from negative to non-negative values.
+    Rising,
+    /// Only crossings from positive to non-positive values.
+    Falling,
+}
+
+/// A set of event (switching) functions `g_i(t, y)`, `i < count()`.
+///
+/// Functions should be scaled to `O(1)`: values with magnitude
+/// `≤` [`EVENT_ZERO_TOL`] at the start of an advance are treated as zero.
+pub trait EventFunctions {
+    /// Number of event functions.
+    fn count(&self) -> usize;
+    /// Evaluates all event functions at `(t, y)` into `g` (length `count()`).
+    fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]);
+    /// Allowed crossing direction of function `i`.
+    fn direction(&self, i: usize) -> Direction;
+}
+
+/// The empty event set.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NoEvents;
+
+impl EventFunctions for NoEvents {
+    fn count(&self) -> usize {
+        0
+    }
+    fn eval(&mut self, _t: f64, _y: &[f64], _g: &mut [f64]) {}
+    fn direction(&self, _i: usize) -> Direction {
+        Direction::Any
+    }
+}
+
+/// Absolute threshold below which an event function value at the start of
+/// an advance counts as exactly zero (no firing at the start).
+pub const EVENT_ZERO_TOL: f64 = 1e-14;
+
+/// Integration method.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum Method {
+    /// Dormand–Prince 8(5,3), adaptive, 7th-order dense output.
+    #[default]
+    Dop853,
+    /// Dormand–Prince 5(4), adaptive, FSAL, 4th-order dense output.
+    Dopri5,
+    /// Classical fixed-step RK4 with cubic Hermite dense output.
+    Rk4 {
+        /// The (fixed) step size; the last step before an end time is
+        /// shortened (or stretched by at most 1 %) to land on it.
+        step: f64,
+    },
+}
+
+/// Integration options. Tolerances are ignored by [`Method::Rk4`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Options {
+    /// Relative tolerance (default `1e-10`).
+    pub rtol: f64,
+    /// Absolute tolerance (default `1e-12`).
+    pub atol: f64,
+    /// Initial step size; `None` (default) selects it by Hairer's
+    /// heuristic. Used only while the solver has no step-size history.
+    pub h_init: Option<f64>,
+    /// Maximum step size (default `+∞`, i.e. unlimited; `inf` in TOML).
+    pub h_max: f64,
+    /// Maximum number of attempted steps per call of [`Solver::advance`]
+    /// (default `1_000_000`).
+    pub max_steps: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            rtol: 1e-10,
+            atol: 1e-12,
+            h_init: None,
+            h_max: f64::INFINITY,
+            max_steps: 1_000_000,
+        }
+    }
+}
+
+impl Options {
+    /// Checks that the options are meaningful.
+    pub fn validate(&self) -> Result<(), SolveError> {
+        let bad = |m: &str| Err(SolveError::InvalidOptions(m.to_string()));
+        if !(self.rtol >= 0.0 && self.rtol.is_finite()) {
+            return bad("rtol must be finite and >= 0");
+        }
+        if !(self.atol >= 0.0 && self.atol.is_finite()) {
+            return bad("atol must be finite and >= 0");
+        }
+        if self.rtol == 0.0 && self.atol == 0.0 {
+            return bad("rtol and atol must not both be 0");
+        }
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return bad("h_max must be > 0");
+        }
+        if let Some(h) = self.h_init
+            && !(h > 0.0 && h.is_finite())
+        {
+            return bad("h_init must be finite and > 0");
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps must be > 0");
+        }
+        Ok(())
+    }
+}
+
+/// Step statistics accumulated since the solver was created.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Stats {
+    /// Steps computed (accepted, rejected and event re-steps).
+    pub steps: usize,
+    /// Steps accepted by the error control (for RK4: all regular steps).
+    pub accepted: usize,
+    /// Steps rejected by the error control.
+    pub rejected: usize,
+    /// Right-hand side evaluations.
+    pub rhs_evals: usize,
+}
+
+/// Why [`Solver::advance`] returned.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stop {
+    /// The end time was reached; `Solver::t() == t_end` exactly.
+    Reached,
+    /// Event `index` occurred at `t`; the solver state is `(t, y(t))`.
+    Event {
+        /// Index of the event function.
+        index: usize,
+        /// Located event time.
+        t: f64,
+    },
+}
+
+/// Integration failure.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SolveError {
+    /// The right-hand side returned an error.
+    #[error("right-hand side failed at t = {t}: {source}")]
+    Rhs {
+        /// Time of the failing evaluation.
+        t: f64,
+        /// The error of the system.
+        source: RhsError,
+    },
+    /// The step size fell below the resolution of `t`.
+    #[error("step size underflow at t = {t} (h = {h:e})")]
+    StepSizeUnderflow {
+        /// Current time.
+        t: f64,
+        /// The too-small step size.
+        h: f64,
+    },
+    /// `max_steps` steps were attempted in one advance.
+    #[error("too many steps ({max_steps}) at t = {t}")]
+    TooManySteps {
+        /// Time reached.
+        t: f64,
+        /// The limit.
+        max_steps: usize,
+    },
+    /// The new state or the error estimate of a step starting at `t` is NaN
+    /// or infinite.
+    #[error("non-finite state or error estimate in the step from t = {t} (h = {h:e})")]
+    NonFinite {
+        /// Start of the failing step.
+        t: f64,
+        /// Its step size.
+        h: f64,
+    },
+    /// `t_end` is before the current time (backward integration is not
+    /// supported).
+    #[error("end time {t_end} is before the current time {t}")]
+    BackwardEnd {
+        /// Current time.
+        t: f64,
+        /// Requested end.
+        t_end: f64,
+    },
+    /// Invalid [`Options`] or method parameters.
+    #[error("invalid integrator options: {0}")]
+    InvalidOptions(String),
+}
+
+/// Dense output of one step `[t0, t1]`, valid for `t0 ≤ t ≤ t1`.
+#[derive(Debug, Clone, Copy)]
+pub struct DenseStep<'a> {
+    t0: f64,
+    t1: f64,
+    h: f64,
+    dim: usize,
+    coef: &'a [f64],
+}
+
+impl DenseStep<'_> {
+    /// Start of the step.
+    pub fn t0(&self) -> f64 {
+        self.t0
+    }
+    /// End of the step.
+    pub fn t1(&self) -> f64 {
+        self.t1
+    }
+    /// State dimension.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+    /// Interpolates the state at `t` into `out` (length `dim`). `t` should
+    /// lie in `[t0, t1]`; outside that interval the polynomial extrapolates.
+    pub fn eval(&self, t: f64, out: &mut [f64]) {
+        dense_eval(self.coef, self.dim, self.t0, self.h, t, out);
+    }
+    /// Interpolates component `i` of the state at `t`.
+    pub fn eval_component(&self, t: f64, i: usize) -> f64 {
+        let ncoef = self.coef.len() / self.dim;
+        let s = (t - self.t0) / self.h;
+        let col = |j: usize| self.coef[j * self.dim + i];
+        nested(ncoef, s, col)
+    }
+}
+
+/// Evaluates `r1 + s(r2 + (1-s)(r3 + s(r4 + (1-s)(...))))`.
+#[inline]
+fn nested(ncoef: usize, s: f64, r: impl Fn(usize) -> f64) -> f64 {
+    let s1 = 1.0 - s;
+    let mut acc = r(ncoef - 1);
+    for j in (0..ncoef - 1).rev() {
+        let m = if (j + 1) % 2 == 1 { s } else { s1 };
+        acc = r(j) + m * acc;
+    }
+    acc
+}
+
+fn dense_eval(coef: &[f64], dim: usize, t0: f64, h: f64, t: f64, out: &mut [f64]) {
+    if dim == 0 {
+        return;
+    }
+    let ncoef = coef.len() / dim;
+    let s = (t - t0) / h;
+    for (i, o) in out.iter_mut().enumerate().take(dim) {
+        *o = nested(ncoef, s, |j| coef[j * dim + i]);
+    }
+}
+
+/// `out = y + h Σ_j a_j k_j`.
+#[inline]
+fn stage_input(y: &[f64], k: &[f64], dim: usize, h: f64, a: &[f64], out: &mut [f64]) {
+    for i in 0..dim {
+        let mut s = 0.0;
+        for (j, &aj) in a.iter().enumerate() {
+            if aj != 0.0 {
+                s += aj * k[j * dim + i];
+            }
+        }
+        out[i] = y[i] + h * s;
+    }
+}
+
+/// Calls the right-hand side, counting and mapping errors.
+fn call_rhs(
+    sys: &mut impl OdeSystem,
+    stats: &mut Stats,
+    t: f64,
+    y: &[f64],
+    out: &mut [f64],
+) -> Result<(), SolveError> {
+    stats.rhs_evals += 1;
+    sys.rhs(t, y, out)
+        .map_err(|source| SolveError::Rhs { t, source })
+}
+
+/// Brent's root finder on `[a, b]` with `f(a)·f(b) < 0`. Returns the final
+/// bracket `(x, fx, x', fx')` where `x` is the best estimate and `x'` the
+/// other end (`fx·fx' ≤ 0`), `|x - x'| ≤ 2·(2ε|x| + tol/2)`.
+fn brent(
+    mut f: impl FnMut(f64) -> f64,
+    a0: f64,
+    fa0: f64,
+    b0: f64,
+    fb0: f64,
+    tol: f64,
+) -> (f64, f64, f64, f64) {
+    let (mut a, mut fa, mut b, mut fb) = (a0, fa0, b0, fb0);
+    let (mut c, mut fc) = (b, fb);
+    let (mut d, mut e) = (b - a, b - a);
+    for _ in 0..200 {
+        if (fb > 0.0 && fc > 0.0) || (fb < 0.0 && fc < 0.0) {
+            c = a;
+            fc = fa;
+            d = b - a;
+            e = d;
+        }
+        if fc.abs() < fb.abs() {
+            a = b;
+            b = c;
+            c = a;
+            fa = fb;
+            fb = fc;
+            fc = fa;
+        }
+        let tol1 = 2.0 * f64::EPSILON * b.abs() + 0.5 * tol;
+        let xm = 0.5 * (c - b);
+        if xm.abs() <= tol1 || fb == 0.0 {
+            return (b, fb, c, fc);
+        }
+        if e.abs() >= tol1 && fa.abs() > fb.abs() {
+            let s = fb / fa;
+            let (mut p, mut q);
+            if a == c {
+                p = 2.0 * xm * s;
+                q = 1.0 - s;
+            } else {
+                let qq = fa / fc;
+                let r = fb / fc;
+                p = s * (2.0 * xm * qq * (qq - r) - (b - a) * (r - 1.0));
+                q = (qq - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if p > 0.0 {
+                q = -q;
+            }
+            p = p.abs();
+            let min1 = 3.0 * xm * q - (tol1 * q).abs();
+            let min2 = (e * q).abs();
+            if 2.0 * p < min1.min(min2) {
+                e = d;
+                d = p / q;
+            } else {
+                d = xm;
+                e = d;
+            }
+        } else {
+            d = xm;
+            e = d;
+        }
+        a = b;
+        fa = fb;
+        b += if d.abs() > tol1 { d } else { tol1.copysign(xm) };
+        fb = f(b);
+    }
+    (b, fb, c, fc)
+}
+
+/// Whether a sign change from `ga` (non-zero) to `gb` is an allowed crossing.
+fn crosses(ga: f64, gb: f64, dir: Direction) -> bool {
+    let rising = ga < 0.0 && gb >= 0.0;
+    let falling = ga > 0.0 && gb <= 0.0;
+    match dir {
+        Direction::Any => rising || falling,
+        Direction::Rising => rising,
+        Direction::Falling => falling,
+    }
+}
+
+/// Fraction of the first step at which the sign of an event function that
+/// starts at zero is sampled.
+const ZERO_START_PROBE: f64 = 1e-3;
+
+/// An ODE solver holding the current state `(t, y)`.
+///
+/// All work buffers are allocated in [`Solver::new`]; stepping does not
+/// allocate (event buffers are sized on the first advance with a given
+/// number of event functions).
+#[derive(Debug, Clone)]
+pub struct Solver {
+    method: Method,
+    opts: Options,
+    dim: usize,
+    t: f64,
+    y: Vec<f64>,
+    /// `f(t, y)` when `f_valid`.
+    f: Vec<f64>,
+    f_valid: bool,
+    y_new: Vec<f64>,
+    y_tmp: Vec<f64>,
+    /// Stage derivatives, `stages × dim`.
+    k: Vec<f64>,
+    /// Dense-output coefficients of the last computed step, `ncoef × dim`.
+    dense: Vec<f64>,
+    /// Proposed next step size; 0 if unknown.
+    h_next: f64,
+    facold: f64,
+    last_rejected: bool,
+    stats: Stats,
+    g_prev: Vec<f64>,
+    g_new: Vec<f64>,
+    g_ref: Vec<f64>,
+    g_tmp: Vec<f64>,
+    zero_start: Vec<bool>,
+    /// Event fired last (index, time).
+    fired: Option<(usize, f64)>,
+}
+
+impl Solver {
+    /// Creates a solver for systems of dimension `dim`, with state
+    /// `(0, 0…0)`; call [`Solver::reset`] to set the initial condition.
+    pub fn new(method: Method, options: Options, dim: usize) -> Result<Self, SolveError> {
+        options.validate()?;
+        if let Method::Rk4 { step } = method
+            && !(step > 0.0 && step.is_finite())
+        {
+            return Err(SolveError::InvalidOptions(
+                "RK4 step must be finite and > 0".into(),
+            ));
+        }
+        let (stages, ncoef) = match method {
+            Method::Dop853 => (DOP853_STAGES, 8),
+            Method::Dopri5 => (DOPRI5_STAGES, 5),
+            Method::Rk4 { .. } => (5, 4),
+        };
+        Ok(Self {
+            method,
+            opts: options,
+            dim,
+            t: 0.0,
+            y: vec![0.0; dim],
+            f: vec![0.0; dim],
+            f_valid: false,
+            y_new: vec![0.0; dim],
+            y_tmp: vec![0.0; dim],
+            k: vec![0.0; stages * dim],
+            dense: vec![0.0; ncoef * dim],
+            h_next: 0.0,
+            facold: 1e-4,
+            last_rejected: false,
+            stats: Stats::default(),
+            g_prev: Vec::new(),
+            g_new: Vec::new(),
+            g_ref: Vec::new(),
+            g_tmp: Vec::new(),
+            zero_start: Vec::new(),
+            fired: None,
+        })
+    }
+
+    /// Sets the state to `(t0, y0)`, e.g. after an impact. Forgets the FSAL
+    /// derivative and the step-size controller history but keeps the last
+    /// proposed step size as the initial guess. If `t0` equals the time of
+    /// the last event, that event function is still treated as being at its
+    /// root (it cannot fire at `t0`).
+    ///
+    /// # Panics
+    /// If `y0.len() != dim`.
+    pub fn reset(&mut self, t0: f64, y0: &[f64]) {
+        assert_eq!(y0.len(), self.dim, "reset: state has wrong dimension");
+        self.t = t0;
+        self.y.copy_from_slice(y0);
+        self.f_valid = false;
+        self.facold = 1e-4;
+        self.last_rejected = false;
+        if let Some((_, tf)) = self.fired
+            && tf != t0
+        {
+            self.fired = None;
+        }
+    }
+
+    /// Current time.
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Current state.
+    pub fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    /// State dimension.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// The method.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// The options.
+    pub fn options(&self) -> &Options {
+        &self.opts
+    }
+
+    /// Step size the controller proposes for the next step (0 if none yet).
+    pub fn step_size_guess(&self) -> f64 {
+        self.h_next
+    }
+
+    /// Accumulated statistics.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    fn ncoef(&self) -> usize {
+        self.dense.len() / self.dim.max(1)
+    }
+
+    /// Integrates from the current state until `t_end` (landed on exactly)
+    /// or until the first event, whichever comes first. `on_step` is called
+    /// for every accepted step with its dense output (for an event, the
+    /// partial step ending at the event). See the module documentation for
+    /// the event semantics. The step repeated to land on an event time is
+    /// shorter than the accepted trial step it replaces, so its error
+    /// estimate is not re-checked. Interior double crossings of an event
+    /// function within one step (no sign change at the step ends) are not
+    /// detected; limit `h_max` if that matters.
+    ///
+    /// # Panics
+    /// If `sys.dim()` differs from the solver dimension.
+    pub fn advance(
+        &mut self,
+        sys: &mut impl OdeSystem,
+        t_end: f64,
+        events: &mut impl EventFunctions,
+        on_step: &mut impl FnMut(&DenseStep),
+    ) -> Result<Stop, SolveError> {
+        assert_eq!(sys.dim(), self.dim, "advance: system dimension mismatch");
+        if t_end < self.t || t_end.is_nan() {
+            return Err(SolveError::BackwardEnd { t: self.t, t_end });
+        }
+        if t_end == self.t {
+            return Ok(Stop::Reached);
+        }
+        if !self.f_valid {
+            call_rhs(sys, &mut self.stats, self.t, &self.y, &mut self.f)?;
+            self.f_valid = true;
+        }
+
+        // Event set-up.
+        let ne = events.count();
+        self.g_prev.resize(ne, 0.0);
+        self.g_new.resize(ne, 0.0);
+        self.g_ref.resize(ne, 0.0);
+        self.g_tmp.resize(ne, 0.0);
+        self.zero_start.resize(ne, false);
+        if ne > 0 {
+            events.eval(self.t, &self.y, &mut self.g_prev);
+            for i in 0..ne {
+                let just_fired = matches!(self.fired, Some((j, tf)) if j == i && tf == self.t);
+                self.zero_start[i] = just_fired || self.g_prev[i].abs() <= EVENT_ZERO_TOL;
+            }
+        }
+
+        let adaptive = !matches!(self.method, Method::Rk4 { .. });
+        let mut h = match self.method {
+            Method::Rk4 { step } => step,
+            _ if self.h_next > 0.0 => self.h_next,
+            _ => match self.opts.h_init {
+                Some(h0) => h0,
+                None => self.initial_step(sys)?,
+            },
+        };
+        let mut steps_here = 0usize;
+
+        loop {
+            if steps_here >= self.opts.max_steps {
+                return Err(SolveError::TooManySteps {
+                    t: self.t,
+                    max_steps: self.opts.max_steps,
+                });
+            }
+            steps_here += 1;
+            if adaptive {
+                h = h.min(self.opts.h_max);
+            }
+            let h_planned = h;
+            let last = self.t + 1.01 * h >= t_end;
+            if adaptive && !last && !(h > 10.0 * f64::EPSILON * self.t.abs() && h > 0.0) {
+                return Err(SolveError::StepSizeUnderflow { t: self.t, h });
+            }
+            let t1 = if last {
+                h = t_end - self.t;
+                t_end
+            } else {
+                self.t + h
+            };
+
+            let err = self.rk_step(sys, h, t1)?;
+            self.stats.steps += 1;
+            if !err.is_finite() || self.y_new.iter().any(|v| !v.is_finite()) {
+                return Err(SolveError::NonFinite { t: self.t, h });
+            }
+
+            // Step-size control.
+            let mut h_new = h;
+            if adaptive {
+                let (expo, beta, fac_min, fac_max): (f64, f64, f64, f64) = match self.method {
+                    Method::Dop853 => (1.0 / 8.0, 0.0, 0.333, 6.0),
+                    _ => (0.2 - 0.04 * 0.75, 0.04, 0.2, 10.0),
+                };
+                let safe = 0.9;
+                let fac11 = err.powf(expo);
+                if err > 1.0 {
+                    self.stats.rejected += 1;
+                    self.last_rejected = true;
+                    h /= (1.0 / fac_min).min(fac11 / safe);
+                    continue;
+                }
+                let fac = fac11 / self.facold.powf(beta);
+                let fac = (1.0 / fac_max).max((1.0 / fac_min).min(fac / safe));
+                h_new = (h / fac).min(self.opts.h_max);
+                if self.last_rejected {
+                    h_new = h_new.min(h);
+                }
+                self.facold = err.max(1e-4);
+                self.last_rejected = false;
+            }
+            self.stats.accepted += 1;
+            self.finish_step(sys, h, t1)?;
+
+            // Event detection.
+            let mut found: Option<(usize, f64)> = None;
+            if ne > 0 {
+                events.eval(t1, &self.y_new, &mut self.g_new);
+                let any_zero = self.zero_start.iter().any(|&z| z);
+                let t_probe = self.t + ZERO_START_PROBE * h;
+                if any_zero {
+                    dense_eval(&self.dense, self.dim, self.t, h, t_probe, &mut self.y_tmp);
+                    events.eval(t_probe, &self.y_tmp, &mut self.g_ref);
+                }
+                for i in 0..ne {
+                    let gb = self.g_new[i];
+                    let (ta, ga) = if self.zero_start[i] {
+                        if self.g_ref[i].abs() > EVENT_ZERO_TOL {
+                            (t_probe, self.g_ref[i])
+                        } else {
+                            continue;
+                        }
+                    } else {
+                        (self.t, self.g_prev[i])
+                    };
+                    if !crosses(ga, gb, events.direction(i)) {
+                        continue;
+                    }
+                    let tb = match found {
+                        Some((_, tf)) => tf.min(t1),
+                        None => t1,
+                    };
+                    let root = self.locate(events, i, ta, ga, t1, gb, tb, h);
+                    if let Some(tr) = root
+                        && found.is_none_or(|(_, tf)| tr < tf)
+                    {
+                        found = Some((i, tr));
+                    }
+                }
+            }
+
+            if let Some((index, t_star)) = found {
+                if t_star != t1 {
+                    // Integrate exactly to the event time from the step start.
+                    let h_star = t_star - self.t;
+                    self.rk_step(sys, h_star, t_star)?;
+                    self.stats.steps += 1;
+                    if self.y_new.iter().any(|v| !v.is_finite()) {
+                        return Err(SolveError::NonFinite {
+                            t: self.t,
+                            h: h_star,
+                        });
+                    }
+                    self.finish_step(sys, h_star, t_star)?;
+                    self.emit(on_step, h_star, t_star);
+                } else {
+                    self.emit(on_step, h, t1);
+                }
+                self.commit(t_star);
+                self.h_next = h_new;
+                self.fired = Some((index, t_star));
+                return Ok(Stop::Event { index, t: t_star });
+            }
+
+            self.emit(on_step, h, t1);
+            self.commit(t1);
+            if ne > 0 {
+                std::mem::swap(&mut self.g_prev, &mut self.g_new);
+                for i in 0..ne {
+                    self.zero_start[i] =
+                        self.zero_start[i] && self.g_prev[i].abs() <= EVENT_ZERO_TOL;
+                }
+            }
+            if adaptive {
+                // A step shortened to land on `t_end` says little about the
+                // step size the solution allows: keep the larger proposal.
+                if last {
+                    h_new = h_new.max(h_planned);
+                }
+                self.h_next = h_new;
+            }
+            h = h_new;
+            if last {
+                return Ok(Stop::Reached);
+            }
+        }
+    }
+
+    fn emit(&self, on_step: &mut impl FnMut(&DenseStep), h: f64, t1: f64) {
+        let view = DenseStep {
+            t0: self.t,
+            t1,
+            h,
+            dim: self.dim,
+            coef: &self.dense,
+        };
+        on_step(&view);
+    }
+
+    /// Accepts `y_new` at `t1`, with the FSAL stage as the new derivative.
+    fn commit(&mut self, t1: f64) {
+        let fsal = match self.method {
+            Method::Dop853 => DOP853_FSAL,
+            Method::Dopri5 => DOPRI5_FSAL,
+            Method::Rk4 { .. } => 4,
+        };
+        let d = self.dim;
+        self.f.copy_from_slice(&self.k[fsal * d..(fsal + 1) * d]);
+        std::mem::swap(&mut self.y, &mut self.y_new);
+        self.t = t1;
+        self.f_valid = true;
+    }
+
+    /// Locates the root of `g_i` on `[ta, tb_max]` (within the current
+    /// dense step) given the crossing `ga → gb` over `[ta, t1]`. Returns the
+    /// post-crossing end of the final bracket, or `None` if `g_i` does not
+    /// cross before `tb_max` (when `tb_max < t1`).
+    #[allow(clippy::too_many_arguments)]
+    fn locate(
+        &mut self,
+        events: &mut impl EventFunctions,
+        i: usize,
+        ta: f64,
+        ga: f64,
+        t1: f64,
+        gb: f64,
+        tb_max: f64,
+        h: f64,
+    ) -> Option<f64> {
+        let Self {
+            dense,
+            y_tmp,
+            g_tmp,
+            t,
+            dim,
+            ..
+        } = self;
+        let (t0, dim) = (*t, *dim);
+        let mut g = |tt: f64| {
+            dense_eval(dense, dim, t0, h, tt, y_tmp);
+            events.eval(tt, y_tmp, g_tmp);
+            g_tmp[i]
+        };
+        let (tb, gb) = if tb_max < t1 {
+            let gm = g(tb_max);
+            if (ga < 0.0 && gm < 0.0) || (ga > 0.0 && gm > 0.0) {
+                return None;
+            }
+            (tb_max, gm)
+        } else {
+            (t1, gb)
+        };
+        if gb == 0.0 {
+            return Some(tb);
+        }
+        let tol = 1e-13 * tb.abs().max(1.0);
+        let (x, fx, x2, _) = brent(&mut g, ta, ga, tb, gb, tol);
+        // Post-crossing side: the sign differs from `ga` (or zero).
+        if fx == 0.0 || fx.signum() != ga.signum() {
+            Some(x)
+        } else {
+            Some(x2)
+        }
+    }
+
+    /// Hairer's initial step-size heuristic.
+    fn initial_step(&mut self, sys: &mut impl OdeSystem) -> Result<f64, SolveError> {
+        let order = match self.method {
+            Method::Dop853 => 8.0,
+            _ => 5.0,
+        };
+        let d = self.dim;
+        let (rtol, atol) = (self.opts.rtol, self.opts.atol);
+        let (mut dnf, mut dny) = (0.0, 0.0);
+        for i in 0..d {
+            let sk = atol + rtol * self.y[i].abs();
+            dnf += (self.f[i] / sk).powi(2);
+            dny += (self.y[i] / sk).powi(2);
+        }
+        let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
+            1e-6
+        } else {
+            (dny / dnf).sqrt() * 0.01
+        };
+        h = h.min(self.opts.h_max);
+        for i in 0..d {
+            self.y_tmp[i] = self.y[i] + h * self.f[i];
+        }
+        let (k1, _) = self.k.split_at_mut(d);
+        call_rhs(sys, &mut self.stats, self.t + h, &self.y_tmp, k1)?;
+        let mut der2 = 0.0;
+        for i in 0..d {
+            let sk = atol + rtol * self.y[i].abs();
+            der2 += ((k1[i] - self.f[i]) / sk).powi(2);
+        }
+        let der2 = der2.sqrt() / h;
+        let der12 = der2.abs().max(dnf.sqrt());
+        let h1 = if der12 <= 1e-15 {
+            (h * 1e-3).max(1e-6)
+        } else {
+            (0.01 / der12).powf(1.0 / order)
+        };
+        let h = (100.0 * h).min(h1).min(self.opts.h_max);
+        Ok(if h > 0.0 && h.is_finite() { h } else { 1e-6 })
+    }
+
+    /// Computes one step of size `h` from `(t, y)` with derivative `f` into
+    /// `y_new` (ending at `t1`, which is `t + h` up to rounding). Returns
+    /// the scaled error norm (0 for RK4).
+    fn rk_step(&mut self, sys: &mut impl OdeSystem, h: f64, t1: f64) -> Result<f64, SolveError> {
+        let Self {
+            method,
+            opts,
+            dim,
+            t,
+            y,
+            f,
+            y_new,
+            y_tmp,
+            k,
+            stats,
+            ..
+        } = self;
+        let (d, t) = (*dim, *t);
+        k[..d].copy_from_slice(f);
+        let stage_t = |c: f64| if c == 1.0 { t1 } else { t + c * h };
+        match *method {
+            Method::Dop853 => {
+                for s in 1..DOP853_MAIN {
+                    stage_input(y, k, d, h, DOP853_A[s], y_tmp);
+                    let (_, ks) = k.split_at_mut(s * d);
+                    call_rhs(sys, stats, stage_t(DOP853_C[s]), y_tmp, &mut ks[..d])?;
+                }
+                stage_input(y, k, d, h, &DOP853_B, y_new);
+                let (mut err5, mut err3) = (0.0, 0.0);
+                for i in 0..d {
+                    let sk = opts.atol + opts.rtol * y[i].abs().max(y_new[i].abs());
+                    let mut e5 = 0.0;
+                    let mut bk = 0.0;
+                    for j in 0..DOP853_MAIN {
+                        let kj = k[j * d + i];
+                        e5 += DOP853_ER[j] * kj;
+                        bk += DOP853_B[j] * kj;
+                    }
+                    let e3 = bk
+                        - DOP853_BHH[0] * k[i]
+                        - DOP853_BHH[1] * k[8 * d + i]
+                        - DOP853_BHH[2] * k[11 * d + i];
+                    err5 += (e5 / sk).powi(2);
+                    err3 += (e3 / sk).powi(2);
+                }
+                if d == 0 {
+                    return Ok(0.0);
+                }
+                let mut deno = err5 + 0.01 * err3;
+                if deno <= 0.0 {
+                    deno = 1.0;
+                }
+                Ok(h.abs() * err5 * (1.0 / (deno * d as f64)).sqrt())
+            }
+            Method::Dopri5 => {
+                for s in 1..DOPRI5_STAGES {
+                    stage_input(y, k, d, h, DOPRI5_A[s], y_tmp);
+                    let (_, ks) = k.split_at_mut(s * d);
+                    call_rhs(sys, stats, stage_t(DOPRI5_C[s]), y_tmp, &mut ks[..d])?;
+                }
+                // The last stage input is the 5th-order solution (FSAL).
+                y_new.copy_from_slice(y_tmp);
+                let mut err = 0.0;
+                for i in 0..d {
+                    let sk = opts.atol + opts.rtol * y[i].abs().max(y_new[i].abs());
+                    let mut e = 0.0;
+                    for j in 0..DOPRI5_STAGES {
+                        e += DOPRI5_E[j] * k[j * d + i];
+                    }
+                    err += (h * e / sk).powi(2);
+                }
+                if d == 0 {
+                    return Ok(0.0);
+                }
+                Ok((err / d as f64).sqrt())
+            }
+            Method::Rk4 { .. } => {
+                let half = 0.5 * h;
+                let tm = t + half;
+                stage_input(y, k, d, half, &[1.0], y_tmp);
+                call_rhs(sys, stats, tm, y_tmp, &mut k[d..2 * d])?;
+                stage_input(y, k, d, half, &[0.0, 1.0], y_tmp);
+                call_rhs(sys, stats, tm, y_tmp, &mut k[2 * d..3 * d])?;
+                stage_input(y, k, d, h, &[0.0, 0.0, 1.0], y_tmp);
+                call_rhs(sys, stats, t1, y_tmp, &mut k[3 * d..4 * d])?;
+                const W: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+                stage_input(y, k, d, h, &W, y_new);
+                Ok(0.0)
+            }
+        }
+    }
+
+    /// After a step accepted into `y_new`: computes the FSAL stage (where
+    /// not yet done) and the dense-output coefficients.
+    fn finish_step(&mut self, sys: &mut impl OdeSystem, h: f64, t1: f64) -> Result<(), SolveError> {
+        let ncoef = self.ncoef();
+        let Self {
+            method,
+            dim,
+            t,
+            y,
+            y_new,
+            y_tmp,
+            k,
+            dense,
+            stats,
+            ..
+        } = self;
+        let (d, t) = (*dim, *t);
+        let fsal = match *method {
+            Method::Dop853 => DOP853_FSAL,
+            Method::Dopri5 => DOPRI5_FSAL,
+            Method::Rk4 { .. } => 4,
+        };
+        if !matches!(method, Method::Dopri5) {
+            call_rhs(sys, stats, t1, y_new, &mut k[fsal * d..(fsal + 1) * d])?;
+        }
+        if let Method::Dop853 = method {
+            for s in DOP853_FSAL + 1..DOP853_STAGES {
+                stage_input(y, k, d, h, DOP853_A[s], y_tmp);
+                let (_, ks) = k.split_at_mut(s * d);
+                call_rhs(sys, stats, t + DOP853_C[s] * h, y_tmp, &mut ks[..d])?;
+            }
+        }
+        for i in 0..d {
+            let ydiff = y_new[i] - y[i];
+            let bspl = h * k[i] - ydiff;
+            dense[i] = y[i];
+            dense[d + i] = ydiff;
+            dense[2 * d + i] = bspl;
+            dense[3 * d + i] = ydiff - h * k[fsal * d + i] - bspl;
+        }
+        match *method {
+            Method::Dop853 => {
+                for (r, row) in DOP853_D.iter().enumerate() {
+                    for i in 0..d {
+                        let mut s = 0.0;
+                        for (j, &dj) in row.iter().enumerate() {
+                            if dj != 0.0 {
+                                s += dj * k[j * d + i];
+                            }
+                        }
+                        dense[(4 + r) * d + i] = h * s;
+                    }
+                }
+            }
+            Method::Dopri5 => {
+                for i in 0..d {
+                    let mut s = 0.0;
+                    for (j, &dj) in DOPRI5_D.iter().enumerate() {
+                        s += dj * k[j * d + i];
+                    }
+                    dense[4 * d + i] = h * s;
+                }
+            }
+            Method::Rk4 { .. } => {}
+        }
+        debug_assert_eq!(dense.len(), ncoef * d);
+        Ok(())
+    }
+}

@@ -1,0 +1,725 @@
+//! Tests of the ODE integrators: convergence orders, dense output, adaptive
+//! accuracy, event location, restart semantics, breakpoints and errors.
+
+use crr_dynamics::integrator::{
+    DenseStep, Direction, EventFunctions, Method, NoEvents, OdeSystem, Options, RhsError,
+    SolveError, Solver, Stop,
+};
+use std::f64::consts::PI;
+
+// ------------------------------------------------------------------ systems
+
+/// x' = v, v' = -x; from (1, 0): x = cos t, v = -sin t.
+struct Oscillator;
+impl OdeSystem for Oscillator {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        dydt[0] = y[1];
+        dydt[1] = -y[0];
+        Ok(())
+    }
+}
+
+/// Non-autonomous scalar problem y' = y cos t with solution exp(sin t)
+/// (for y(0) = 1): no special symmetry that could hide error terms.
+struct ExpSin;
+impl OdeSystem for ExpSin {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        dydt[0] = y[0] * t.cos();
+        Ok(())
+    }
+}
+
+/// Rocking block (Housner): θ'' = -p² sin(α sgn θ - θ), state (θ, θ').
+struct Block {
+    p: f64,
+    alpha: f64,
+}
+impl OdeSystem for Block {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        let s = if y[0] > 0.0 {
+            1.0
+        } else if y[0] < 0.0 {
+            -1.0
+        } else {
+            y[1].signum()
+        };
+        dydt[0] = y[1];
+        dydt[1] = -self.p * self.p * (self.alpha * s - y[0]).sin();
+        Ok(())
+    }
+}
+
+/// One event function g = y[component].
+struct Zero {
+    component: usize,
+    dir: Direction,
+}
+impl EventFunctions for Zero {
+    fn count(&self) -> usize {
+        1
+    }
+    fn eval(&mut self, _t: f64, y: &[f64], g: &mut [f64]) {
+        g[0] = y[self.component];
+    }
+    fn direction(&self, _i: usize) -> Direction {
+        self.dir
+    }
+}
+
+// ------------------------------------------------------------------ helpers
+
+/// Options that force a fixed step `h` on the adaptive methods: the
+/// tolerance is so loose that every step is accepted and `h_max = h`.
+fn fixed(h: f64) -> Options {
+    Options {
+        rtol: 1e6,
+        atol: 1e6,
+        h_init: Some(h),
+        h_max: h,
+        max_steps: 10_000_000,
+    }
+}
+
+fn method_fixed(m: &str, h: f64) -> (Method, Options) {
+    match m {
+        "dop853" => (Method::Dop853, fixed(h)),
+        "dopri5" => (Method::Dopri5, fixed(h)),
+        _ => (Method::Rk4 { step: h }, Options::default()),
+    }
+}
+
+/// Least-squares slope of log(err) against log(h).
+fn slope(hs: &[f64], errs: &[f64]) -> f64 {
+    let n = hs.len() as f64;
+    let xs: Vec<f64> = hs.iter().map(|h| h.ln()).collect();
+    let ys: Vec<f64> = errs.iter().map(|e| e.ln()).collect();
+    let mx = xs.iter().sum::<f64>() / n;
+    let my = ys.iter().sum::<f64>() / n;
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = xs.iter().map(|x| (x - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+fn ignore(_: &DenseStep) {}
+
+/// Global error at t = 2 of y' = y cos t, y(0) = 1 with fixed step h.
+fn global_error(m: &str, h: f64) -> f64 {
+    let (method, opts) = method_fixed(m, h);
+    let mut s = Solver::new(method, opts, 1).unwrap();
+    s.reset(0.0, &[1.0]);
+    let stop = s
+        .advance(&mut ExpSin, 2.0, &mut NoEvents, &mut ignore)
+        .unwrap();
+    assert_eq!(stop, Stop::Reached);
+    (s.y()[0] - 2f64.sin().exp()).abs()
+}
+
+// ------------------------------------------------------------------ orders
+
+#[test]
+fn observed_orders_of_the_methods() {
+    // Step sizes chosen so the global errors stay well above round-off
+    // (≥ 1e-13) and in the asymptotic regime; see the printed values.
+    // All h divide the interval [0, 2] exactly (no shortened last step).
+    let cases: [(&str, f64, [f64; 4]); 3] = [
+        ("dop853", 8.0, [0.5, 0.4, 0.25, 0.2]),
+        ("dopri5", 5.0, [0.2, 0.1, 0.05, 0.025]),
+        ("rk4", 4.0, [0.1, 0.05, 0.025, 0.0125]),
+    ];
+    for (m, p, hs) in cases {
+        let errs: Vec<f64> = hs.iter().map(|&h| global_error(m, h)).collect();
+        let q = slope(&hs, &errs);
+        println!("{m}: h = {hs:?}, err = {errs:?}, observed order = {q:.3}");
+        assert!(
+            errs.iter().all(|&e| e > 1e-13),
+            "{m}: errors near round-off"
+        );
+        assert!((q - p).abs() < 0.3, "{m}: observed order {q} vs {p}");
+    }
+}
+
+#[test]
+fn dense_output_orders() {
+    // One step of size h from t0 = 0.3; interpolation error at mid-step.
+    // A dense output of order q has a local error O(h^{q+1}), which
+    // dominates the step's own local error O(h^{p+1}) (p > q), so the
+    // measured slope is q + 1: 8 (DOP853), 5 (Dopri5), 4 (cubic Hermite).
+    let t0 = 0.3;
+    let exact = |t: f64| t.sin().exp();
+    let cases: [(&str, f64, [f64; 4]); 3] = [
+        ("dop853", 7.0, [0.8, 0.4, 0.2, 0.1]),
+        ("dopri5", 4.0, [0.2, 0.1, 0.05, 0.025]),
+        ("rk4", 3.0, [0.2, 0.1, 0.05, 0.025]),
+    ];
+    for (m, q, hs) in cases {
+        let mut errs = Vec::new();
+        for &h in &hs {
+            let (method, opts) = method_fixed(m, h);
+            let mut s = Solver::new(method, opts, 1).unwrap();
+            s.reset(t0, &[exact(t0)]);
+            let mut mid = f64::NAN;
+            let mut calls = 0;
+            s.advance(&mut ExpSin, t0 + h, &mut NoEvents, &mut |d: &DenseStep| {
+                calls += 1;
+                mid = d.eval_component(0.5 * (d.t0() + d.t1()), 0);
+            })
+            .unwrap();
+            assert_eq!(calls, 1);
+            errs.push((mid - exact(t0 + 0.5 * h)).abs());
+        }
+        let obs = slope(&hs, &errs);
+        println!("{m} dense: h = {hs:?}, mid-step err = {errs:?}, slope = {obs:.3}");
+        assert!(errs.iter().all(|&e| e > 1e-14));
+        assert!(
+            (obs - (q + 1.0)).abs() < 0.3,
+            "{m}: dense slope {obs} vs {}",
+            q + 1.0
+        );
+    }
+}
+
+#[test]
+fn dense_output_interpolates_step_ends() {
+    // RK4 global error ≈ t·h⁴/120 ≈ 2e-7 for h = 0.05 on [0, 3].
+    for method in [Method::Dop853, Method::Dopri5, Method::Rk4 { step: 0.05 }] {
+        let mut s = Solver::new(method, Options::default(), 2).unwrap();
+        s.reset(0.0, &[1.0, 0.0]);
+        let mut worst: f64 = 0.0;
+        let mut prev_end = vec![1.0, 0.0];
+        let mut buf = [0.0; 2];
+        s.advance(&mut Oscillator, 3.0, &mut NoEvents, &mut |d: &DenseStep| {
+            d.eval(d.t0(), &mut buf);
+            // Continuity: the start of this step's interpolant (the exact
+            // state) equals the end of the previous one up to the rounding
+            // of y0 + (y1 - y0).
+            for (a, b) in buf.iter().zip(&prev_end) {
+                assert!((a - b).abs() <= 4.0 * f64::EPSILON, "{a} vs {b}");
+            }
+            d.eval(d.t1(), &mut buf);
+            prev_end = buf.to_vec();
+            worst = worst.max((buf[0] - d.t1().cos()).abs());
+        })
+        .unwrap();
+        // The end value of the interpolant equals the new state up to
+        // rounding of (y0 + (y1 - y0)).
+        assert!((prev_end[0] - s.y()[0]).abs() <= 4.0 * f64::EPSILON);
+        assert!(worst < 1e-6, "{method:?}: {worst}");
+    }
+}
+
+// ------------------------------------------------------------------ adaptive
+
+#[test]
+fn adaptive_accuracy_on_oscillator() {
+    for method in [Method::Dop853, Method::Dopri5] {
+        let opts = Options {
+            rtol: 1e-10,
+            atol: 1e-10,
+            ..Options::default()
+        };
+        let mut s = Solver::new(method, opts, 2).unwrap();
+        s.reset(0.0, &[1.0, 0.0]);
+        let mut max_drift: f64 = 0.0;
+        let mut buf = [0.0; 2];
+        s.advance(
+            &mut Oscillator,
+            10.0,
+            &mut NoEvents,
+            &mut |d: &DenseStep| {
+                d.eval(d.t1(), &mut buf);
+                let e = 0.5 * (buf[0] * buf[0] + buf[1] * buf[1]);
+                max_drift = max_drift.max((e - 0.5).abs());
+            },
+        )
+        .unwrap();
+        assert_eq!(s.t(), 10.0);
+        let err = (s.y()[0] - 10f64.cos())
+            .abs()
+            .max((s.y()[1] + 10f64.sin()).abs());
+        let st = s.stats();
+        println!("{method:?}: err(10) = {err:e}, energy drift = {max_drift:e}, {st:?}");
+        // Global error ~ (number of steps) × tolerance-level local errors.
+        assert!(err < 1e-8, "{method:?}: {err}");
+        assert!(max_drift < 1e-8, "{method:?}: {max_drift}");
+        assert_eq!(st.steps, st.accepted + st.rejected);
+    }
+}
+
+#[test]
+fn dopri5_rhs_count_uses_fsal() {
+    let mut s = Solver::new(Method::Dopri5, fixed(0.1), 2).unwrap();
+    s.reset(0.0, &[1.0, 0.0]);
+    s.advance(&mut Oscillator, 1.0, &mut NoEvents, &mut ignore)
+        .unwrap();
+    let st = s.stats();
+    assert_eq!(st.accepted, 10);
+    // 1 initial derivative + 6 new stages per step (the 7th is reused).
+    assert_eq!(st.rhs_evals, 1 + 6 * 10);
+}
+
+// ------------------------------------------------------------------ events
+
+#[test]
+fn event_location_on_cosine() {
+    let opts = Options {
+        rtol: 1e-12,
+        atol: 1e-14,
+        ..Options::default()
+    };
+    let mut s = Solver::new(Method::Dop853, opts, 2).unwrap();
+    s.reset(0.0, &[1.0, 0.0]);
+    let mut ev = Zero {
+        component: 0,
+        dir: Direction::Falling,
+    };
+    let mut last_t1 = 0.0;
+    let stop = s
+        .advance(&mut Oscillator, 10.0, &mut ev, &mut |d: &DenseStep| {
+            last_t1 = d.t1()
+        })
+        .unwrap();
+    let Stop::Event { index, t } = stop else {
+        panic!("no event: {stop:?}")
+    };
+    assert_eq!(index, 0);
+    assert_eq!(s.t(), t);
+    assert_eq!(
+        last_t1, t,
+        "the partial step ending at the event is emitted"
+    );
+    assert!(
+        (t - PI / 2.0).abs() < 1e-12,
+        "t* - π/2 = {:e}",
+        t - PI / 2.0
+    );
+    // State from a real step: g(y(t*)) is at the root-finder resolution
+    // (|Δt| ≤ 1e-13 times |g'| = 1) plus the global error (~1e-13).
+    assert!(s.y()[0].abs() <= 1e-12, "g(y(t*)) = {:e}", s.y()[0]);
+    assert!((s.y()[1] + 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn event_state_comes_from_a_real_step() {
+    // Loose tolerance: the interpolant and a step differ noticeably; the
+    // solver state at the event must be bitwise that of a genuine step of
+    // the method from the last step's start to t*.
+    let opts = Options {
+        rtol: 1e-4,
+        atol: 1e-6,
+        ..Options::default()
+    };
+    for method in [Method::Dop853, Method::Dopri5, Method::Rk4 { step: 0.3 }] {
+        let mut s = Solver::new(method, opts, 2).unwrap();
+        s.reset(0.0, &[1.0, 0.0]);
+        let mut ev = Zero {
+            component: 0,
+            dir: Direction::Any,
+        };
+        let mut start = (0.0, [0.0; 2]);
+        let stop = s
+            .advance(&mut Oscillator, 10.0, &mut ev, &mut |d: &DenseStep| {
+                let mut y = [0.0; 2];
+                d.eval(d.t0(), &mut y);
+                start = (d.t0(), y);
+            })
+            .unwrap();
+        let Stop::Event { t, .. } = stop else {
+            panic!()
+        };
+        // The same step, taken by a fresh solver forced to one step.
+        let h = t - start.0;
+        let (m2, o2) = match method {
+            Method::Rk4 { .. } => (Method::Rk4 { step: h }, Options::default()),
+            m => (m, fixed(h)),
+        };
+        let mut fresh = Solver::new(m2, o2, 2).unwrap();
+        fresh.reset(start.0, &start.1);
+        fresh
+            .advance(&mut Oscillator, t, &mut NoEvents, &mut ignore)
+            .unwrap();
+        assert_eq!(fresh.t(), t);
+        assert_eq!(fresh.y(), s.y(), "{method:?}");
+        assert!((t - PI / 2.0).abs() < 1e-3);
+    }
+}
+
+/// Exact time for the block released at rest from θ0 (0 < θ0 < α) to reach
+/// θ = 0: T = ∫_0^θ0 dθ / |θ'| with θ'² = 2p²(cos(α-θ0) - cos(α-θ)).
+/// Substituting θ = θ0 - u² removes the endpoint singularity:
+/// T = ∫_0^{√θ0} u du / (p √(sin(a + u²/2) sin(u²/2))), a = α - θ0,
+/// using cos A - cos B = 2 sin((A+B)/2) sin((B-A)/2) to avoid cancellation.
+/// The integrand is analytic; composite Gauss–Legendre converges fast.
+fn block_quadrature(p: f64, alpha: f64, theta0: f64, panels: usize) -> f64 {
+    let a = alpha - theta0;
+    let f = |u: f64| {
+        if u == 0.0 {
+            (2.0 / a.sin()).sqrt() / p
+        } else {
+            u / (p * ((a + 0.5 * u * u).sin() * (0.5 * u * u).sin()).sqrt())
+        }
+    };
+    let gl = gauss_legendre(20);
+    let len = theta0.sqrt() / panels as f64;
+    let mut sum = 0.0;
+    for k in 0..panels {
+        let (lo, hi) = (k as f64 * len, (k + 1) as f64 * len);
+        for &(x, w) in &gl {
+            sum += 0.5 * (hi - lo) * w * f(0.5 * (hi + lo) + 0.5 * (hi - lo) * x);
+        }
+    }
+    sum
+}
+
+/// Nodes and weights of n-point Gauss–Legendre quadrature on [-1, 1].
+fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 0.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let k = k as f64;
+                    let p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
+fn block_solver() -> Solver {
+    let opts = Options {
+        rtol: 1e-12,
+        atol: 1e-14,
+        ..Options::default()
+    };
+    Solver::new(Method::Dop853, opts, 2).unwrap()
+}
+
+#[test]
+fn rocking_block_first_impact_matches_quadrature() {
+    let (p, alpha) = (2.0, 0.2);
+    let theta0 = alpha / 2.0;
+    let t_exact = block_quadrature(p, alpha, theta0, 8);
+    let t_check = block_quadrature(p, alpha, theta0, 16);
+    assert!(
+        (t_exact - t_check).abs() < 1e-14,
+        "quadrature not converged"
+    );
+    let mut s = block_solver();
+    s.reset(0.0, &[theta0, 0.0]);
+    let mut ev = Zero {
+        component: 0,
+        dir: Direction::Falling,
+    };
+    let stop = s
+        .advance(&mut Block { p, alpha }, 10.0, &mut ev, &mut ignore)
+        .unwrap();
+    let Stop::Event { index: 0, t } = stop else {
+        panic!("{stop:?}")
+    };
+    println!("block impact: t* = {t:.15}, quadrature = {t_exact:.15}");
+    assert!((t - t_exact).abs() < 1e-10, "Δt = {:e}", t - t_exact);
+    // Energy: θ'² = 2p²(cos(α-θ0) - cos α) at θ = 0.
+    let v_exact = -(2.0 * p * p * ((alpha - theta0).cos() - alpha.cos())).sqrt();
+    assert!((s.y()[1] - v_exact).abs() < 1e-10);
+}
+
+#[test]
+fn no_refire_after_restart_at_event() {
+    // After the impact, restart with θ = 0 exactly and the velocity
+    // reversed (perfectly elastic). By symmetry the block rises to θ0 and
+    // falls back: the next crossing is at t* + 2T, not at t*.
+    let (p, alpha) = (2.0, 0.2);
+    let theta0 = alpha / 2.0;
+    let big_t = block_quadrature(p, alpha, theta0, 8);
+    for exact_zero in [true, false] {
+        let mut s = block_solver();
+        s.reset(0.0, &[theta0, 0.0]);
+        let mut sys = Block { p, alpha };
+        let mut ev = Zero {
+            component: 0,
+            dir: Direction::Any,
+        };
+        let Stop::Event { t: t1, .. } = s.advance(&mut sys, 10.0, &mut ev, &mut ignore).unwrap()
+        else {
+            panic!()
+        };
+        // Either θ = 0 exactly, or the solver's own (tiny, post-crossing)
+        // θ: both must not re-fire at t1.
+        let theta = if exact_zero { 0.0 } else { s.y()[0] };
+        let v = -s.y()[1];
+        s.reset(t1, &[theta, v]);
+        let Stop::Event { t: t2, .. } = s.advance(&mut sys, 10.0, &mut ev, &mut ignore).unwrap()
+        else {
+            panic!()
+        };
+        println!(
+            "restart (θ exactly 0: {exact_zero}): t2 - t1 = {:.15}",
+            t2 - t1
+        );
+        assert!(t2 - t1 > big_t, "re-fired at {t2} after {t1}");
+        assert!(
+            (t2 - (t1 + 2.0 * big_t)).abs() < 1e-9,
+            "t2 - t1 - 2T = {:e}",
+            t2 - t1 - 2.0 * big_t
+        );
+    }
+}
+
+#[test]
+fn no_refire_when_advancing_again_without_reset() {
+    // Calling advance again at an event time must continue to the next
+    // crossing of cos t (3π/2), not stop again at π/2.
+    let mut s = Solver::new(Method::Dopri5, Options::default(), 2).unwrap();
+    s.reset(0.0, &[1.0, 0.0]);
+    let mut ev = Zero {
+        component: 0,
+        dir: Direction::Any,
+    };
+    let mut times = Vec::new();
+    for _ in 0..3 {
+        match s
+            .advance(&mut Oscillator, 10.0, &mut ev, &mut ignore)
+            .unwrap()
+        {
+            Stop::Event { t, .. } => times.push(t),
+            Stop::Reached => break,
+        }
+    }
+    for (k, t) in times.iter().enumerate() {
+        let expect = PI / 2.0 + k as f64 * PI;
+        assert!((t - expect).abs() < 1e-7, "event {k}: {t} vs {expect}");
+    }
+    assert_eq!(times.len(), 3);
+}
+
+/// Two event functions: g0 = x - 0.5 (falling), g1 = v + 0.9 (falling);
+/// both cross within the same step at large tolerance. The earliest wins.
+struct Two;
+impl EventFunctions for Two {
+    fn count(&self) -> usize {
+        2
+    }
+    fn eval(&mut self, _t: f64, y: &[f64], g: &mut [f64]) {
+        g[0] = y[1] + 0.9;
+        g[1] = y[0] - 0.5;
+    }
+    fn direction(&self, _i: usize) -> Direction {
+        Direction::Falling
+    }
+}
+
+#[test]
+fn earliest_of_several_events_wins() {
+    // cos t = 0.5 at π/3 ≈ 1.047; -sin t = -0.9 at asin 0.9 ≈ 1.120.
+    let mut s = Solver::new(Method::Rk4 { step: 0.5 }, Options::default(), 2).unwrap();
+    s.reset(0.0, &[1.0, 0.0]);
+    let stop = s
+        .advance(&mut Oscillator, 10.0, &mut Two, &mut ignore)
+        .unwrap();
+    let Stop::Event { index, t } = stop else {
+        panic!()
+    };
+    assert_eq!(index, 1);
+    // RK4 with h = 0.5: interpolation error ~1e-3.
+    assert!((t - PI / 3.0).abs() < 1e-2, "{t}");
+    let stop = s
+        .advance(&mut Oscillator, 10.0, &mut Two, &mut ignore)
+        .unwrap();
+    let Stop::Event { index, t } = stop else {
+        panic!()
+    };
+    assert_eq!(index, 0);
+    assert!((t - 0.9f64.asin()).abs() < 1e-2, "{t}");
+}
+
+// ------------------------------------------------------------------ breakpoints
+
+#[test]
+fn lands_exactly_on_breakpoints() {
+    for method in [Method::Dop853, Method::Dopri5, Method::Rk4 { step: 0.003 }] {
+        let mut s = Solver::new(method, Options::default(), 2).unwrap();
+        s.reset(0.0, &[1.0, 0.0]);
+        let mut last_t1 = 0.0;
+        let mut prev_t1 = 0.0;
+        for k in 1..=200 {
+            let bp = 0.01 * k as f64 + if k % 7 == 0 { 1e-9 } else { 0.0 };
+            let stop = s
+                .advance(&mut Oscillator, bp, &mut NoEvents, &mut |d: &DenseStep| {
+                    assert_eq!(d.t0(), prev_t1, "steps are contiguous");
+                    assert!(d.t1() <= bp, "stepped past the breakpoint");
+                    prev_t1 = d.t1();
+                    last_t1 = d.t1();
+                })
+                .unwrap();
+            assert_eq!(stop, Stop::Reached);
+            assert_eq!(s.t(), bp);
+            assert_eq!(last_t1, bp);
+        }
+        assert!((s.y()[0] - s.t().cos()).abs() < 1e-8, "{method:?}");
+        // Advancing to the current time is a no-op.
+        let before = s.stats();
+        assert_eq!(
+            s.advance(&mut Oscillator, s.t(), &mut NoEvents, &mut ignore),
+            Ok(Stop::Reached)
+        );
+        assert_eq!(s.stats(), before);
+    }
+}
+
+// ------------------------------------------------------------------ errors
+
+struct NanAfter(f64);
+impl OdeSystem for NanAfter {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&mut self, t: f64, _y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        dydt[0] = if t > self.0 { f64::NAN } else { 1.0 };
+        Ok(())
+    }
+}
+
+struct FailAfter(f64);
+impl OdeSystem for FailAfter {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&mut self, t: f64, _y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        if t > self.0 {
+            return Err(RhsError("mechanism locked".into()));
+        }
+        dydt[0] = 1.0;
+        Ok(())
+    }
+}
+
+#[test]
+fn nan_rhs_is_an_error_naming_t() {
+    for method in [Method::Dop853, Method::Dopri5, Method::Rk4 { step: 0.1 }] {
+        let mut s = Solver::new(method, Options::default(), 1).unwrap();
+        s.reset(0.0, &[0.0]);
+        let err = s
+            .advance(&mut NanAfter(1.0), 5.0, &mut NoEvents, &mut ignore)
+            .unwrap_err();
+        let SolveError::NonFinite { t, h } = err else {
+            panic!("{err:?}")
+        };
+        // The failing step starts before t = 1 and reaches beyond it.
+        assert!(t <= 1.0 && t + h > 1.0, "t = {t}, h = {h}");
+        assert!(err.to_string().contains(&format!("t = {t}")));
+        // The state was not overwritten by NaN.
+        assert!(s.y()[0].is_finite());
+    }
+}
+
+#[test]
+fn rhs_error_is_reported_with_t() {
+    let mut s = Solver::new(Method::Dop853, Options::default(), 1).unwrap();
+    s.reset(0.0, &[0.0]);
+    let err = s
+        .advance(&mut FailAfter(0.5), 5.0, &mut NoEvents, &mut ignore)
+        .unwrap_err();
+    let SolveError::Rhs { t, ref source } = err else {
+        panic!("{err:?}")
+    };
+    assert!(t > 0.5);
+    assert_eq!(source.0, "mechanism locked");
+    assert!(err.to_string().contains("mechanism locked"));
+}
+
+#[test]
+fn max_steps_is_an_error() {
+    let opts = Options {
+        max_steps: 10,
+        h_max: 0.01,
+        ..Options::default()
+    };
+    let mut s = Solver::new(Method::Dopri5, opts, 2).unwrap();
+    s.reset(0.0, &[1.0, 0.0]);
+    let err = s
+        .advance(&mut Oscillator, 1.0, &mut NoEvents, &mut ignore)
+        .unwrap_err();
+    assert!(
+        matches!(err, SolveError::TooManySteps { max_steps: 10, t } if t > 0.0 && t < 1.0),
+        "{err:?}"
+    );
+}
+
+/// y' = y², y(0) = 1: y = 1/(1-t) blows up at t = 1.
+struct BlowUp;
+impl OdeSystem for BlowUp {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        dydt[0] = y[0] * y[0];
+        Ok(())
+    }
+}
+
+#[test]
+fn singularity_gives_an_error_not_a_hang() {
+    for method in [Method::Dop853, Method::Dopri5] {
+        let mut s = Solver::new(method, Options::default(), 1).unwrap();
+        s.reset(0.0, &[1.0]);
+        let err = s
+            .advance(&mut BlowUp, 2.0, &mut NoEvents, &mut ignore)
+            .unwrap_err();
+        println!("{method:?}: {err}");
+        match err {
+            SolveError::StepSizeUnderflow { t, .. }
+            | SolveError::NonFinite { t, .. }
+            | SolveError::TooManySteps { t, .. } => assert!((t - 1.0).abs() < 1e-3, "{t}"),
+            e => panic!("{e:?}"),
+        }
+    }
+}
+
+#[test]
+fn invalid_options_are_rejected() {
+    let bad = Options {
+        rtol: -1.0,
+        ..Options::default()
+    };
+    assert!(Solver::new(Method::Dop853, bad, 1).is_err());
+    assert!(Solver::new(Method::Rk4 { step: 0.0 }, Options::default(), 1).is_err());
+    let mut s = Solver::new(Method::Dop853, Options::default(), 1).unwrap();
+    s.reset(1.0, &[0.0]);
+    assert!(matches!(
+        s.advance(&mut ExpSin, 0.5, &mut NoEvents, &mut ignore),
+        Err(SolveError::BackwardEnd { .. })
+    ));
+}
+
+#[test]
+fn options_deserialize_with_defaults_and_deny_unknown() {
+    use serde::Deserialize;
+    use serde::de::value::{Error, MapDeserializer};
+    let m = MapDeserializer::<_, Error>::new([("rtol", 1e-6)].into_iter());
+    let o = Options::deserialize(m).unwrap();
+    assert_eq!(o.rtol, 1e-6);
+    assert_eq!(o.atol, Options::default().atol);
+    assert_eq!(o.max_steps, Options::default().max_steps);
+    let m = MapDeserializer::<_, Error>::new([("rtoll", 1e-6)].into_iter());
+    assert!(Options::deserialize(m).is_err());
+}
