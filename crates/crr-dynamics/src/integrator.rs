@@ -60,6 +60,13 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Evaluates `dydt = f(t, y)`. Both slices have length [`Self::dim`].
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError>;
+    /// Called after every accepted step (and after the step that lands on an event) with the new
+    /// state; may move it back onto an invariant manifold (e.g. loop closures Φ = 0 and
+    /// Φ_q q̇ = 0). Returns whether `y` was changed (then f(t, y) is evaluated again before the
+    /// next step). The default does nothing.
+    fn project(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool, RhsError> {
+        Ok(false)
+    }
 }
 
 /// Allowed crossing direction of an event function.
@@ -647,6 +654,10 @@ impl Solver {
                 self.t + h
             };
 
+            if !self.f_valid {
+                call_rhs(sys, &mut self.stats, self.t, &self.y, &mut self.f)?;
+                self.f_valid = true;
+            }
             let err = self.rk_step(sys, h, t1)?;
             self.stats.steps += 1;
             if !err.is_finite() || self.y_new.iter().any(|v| !v.is_finite()) {
@@ -735,6 +746,7 @@ impl Solver {
                     self.emit(on_step, h, t1);
                 }
                 self.commit(t_star);
+                self.project(sys)?;
                 self.h_next = h_new;
                 self.fired = Some((index, t_star));
                 return Ok(Stop::Event { index, t: t_star });
@@ -742,8 +754,12 @@ impl Solver {
 
             self.emit(on_step, h, t1);
             self.commit(t1);
+            let projected = self.project(sys)?;
             if ne > 0 {
                 std::mem::swap(&mut self.g_prev, &mut self.g_new);
+                if projected {
+                    events.eval(self.t, &self.y, &mut self.g_prev);
+                }
                 for i in 0..ne {
                     self.zero_start[i] =
                         self.zero_start[i] && self.g_prev[i].abs() <= EVENT_ZERO_TOL;
@@ -776,6 +792,21 @@ impl Solver {
     }
 
     /// Accepts `y_new` at `t1`, with the FSAL stage as the new derivative.
+    /// Lets the system project the committed state; invalidates f(t, y) when it moved.
+    fn project(&mut self, sys: &mut impl OdeSystem) -> Result<bool, SolveError> {
+        let t = self.t;
+        let moved = sys
+            .project(t, &mut self.y)
+            .map_err(|source| SolveError::Rhs { t, source })?;
+        if moved {
+            if self.y.iter().any(|v| !v.is_finite()) {
+                return Err(SolveError::NonFinite { t, h: 0.0 });
+            }
+            self.f_valid = false;
+        }
+        Ok(moved)
+    }
+
     fn commit(&mut self, t1: f64) {
         let fsal = match self.method {
             Method::Dop853 => DOP853_FSAL,

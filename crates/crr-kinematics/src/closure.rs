@@ -25,7 +25,7 @@ pub fn perpendicular(u: &Vector3<f64>) -> Vector3<f64> {
     u.cross(&e).normalize()
 }
 
-fn frame_rot(data: &Data, k: Option<usize>) -> Matrix3<f64> {
+pub(crate) fn frame_rot(data: &Data, k: Option<usize>) -> Matrix3<f64> {
     k.map_or_else(Matrix3::identity, |k| data.rot_ops[k])
 }
 
@@ -38,9 +38,9 @@ fn closure_frames(model: &Model, interface: usize) -> (Option<usize>, Option<usi
 /// The two unit vectors whose dot products are the orientation rows of a closure:
 /// pairs (a on A, b on B) with rows (Γ_A a)·(Γ_B b).
 /// A pair (a on frame A, b on frame B) whose dot product (Γ_A a)·(Γ_B b) is one orientation row.
-type OrientationPair = (Vector3<f64>, Vector3<f64>);
+pub(crate) type OrientationPair = (Vector3<f64>, Vector3<f64>);
 
-fn orientation_pairs(kind: &InterfaceKind) -> ([OrientationPair; 2], usize) {
+pub(crate) fn orientation_pairs(kind: &InterfaceKind) -> ([OrientationPair; 2], usize) {
     match kind {
         InterfaceKind::Hinge { axis, .. } => {
             let v1 = perpendicular(axis);

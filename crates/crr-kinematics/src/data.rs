@@ -3,7 +3,7 @@
 //! Fields are grouped by the function that fills them (as MuJoCo's `mjData`). All vectors are in
 //! world coordinates of the current configuration unless a field says "rest".
 
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Vector3, Vector6};
 
 use crate::model::Model;
 
@@ -44,6 +44,22 @@ pub struct Data {
     /// Subtree first moment Σ m c of each coordinate (kg m).
     pub subtree_moment: Vec<Vector3<f64>>,
 
+    // --- filled by `velocities` ---
+    /// Vₖ = [ωₖ; v₀ₖ]: spatial velocity of frame k (rad/s; m/s of the frame point at the origin).
+    pub spatial_velocity: Vec<Vector6<f64>>,
+    /// Aₖ: spatial bias acceleration J̇q̇ of frame k (the acceleration when q̈ = 0).
+    pub bias_acceleration: Vec<Vector6<f64>>,
+
+    // --- filled by `velocity_product` ---
+    /// Fₖ: spatial force of the subtree of coordinate k (N m about the origin; N).
+    pub subtree_force: Vec<Vector6<f64>>,
+    /// h(q, q̇): velocity-product generalized forces (N m), M q̈ + h = Q.
+    pub velocity_product: DVector<f64>,
+
+    // --- filled by `constraint_bias` ---
+    /// Φ̇_q q̇: constraint bias, so that Φ_q q̈ + Φ̇_q q̇ = 0.
+    pub phi_bias: DVector<f64>,
+
     // --- filled by `constraint_residual` / `constraint_jacobian` ---
     /// Φ(q): loop-closure residuals (m for point rows, dimensionless for axis rows).
     pub phi: DVector<f64>,
@@ -69,6 +85,11 @@ impl Data {
             mass_matrix: DMatrix::zeros(n, n),
             subtree_mass: vec![0.0; n],
             subtree_moment: vec![Vector3::zeros(); n],
+            spatial_velocity: vec![Vector6::zeros(); n],
+            bias_acceleration: vec![Vector6::zeros(); n],
+            subtree_force: vec![Vector6::zeros(); n],
+            velocity_product: DVector::zeros(n),
+            phi_bias: DVector::zeros(model.constraint_rows),
             phi: DVector::zeros(model.constraint_rows),
             phi_q: DMatrix::zeros(model.constraint_rows, n),
         }

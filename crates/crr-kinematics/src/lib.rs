@@ -44,6 +44,7 @@ pub mod potential;
 pub mod rotation;
 pub mod shapes;
 pub mod spec;
+pub mod velocity;
 
 pub use closure::{closure_angles, constraint_jacobian, constraint_residual};
 pub use data::Data;
@@ -55,3 +56,4 @@ pub use model::{Body, Closure, Coordinate, Interface, InterfaceKind, Model, Pare
 pub use pivots::ActivePivots;
 pub use potential::{generalized_gravity, potential_energy};
 pub use spec::{BodySpec, ImpactLaw, InterfaceSpec, PivotSpec, RockingBaseSpec, StructureSpec};
+pub use velocity::{constraint_bias, velocities, velocity_product};
