@@ -1,3 +1,23 @@
-//! x
+//! # crr-dynamics
+//!
+//! Equations of motion of coupled rocking rotations for multi-DOF chains, open and closed:
+//! M(q) q̈ + h(q, q̇) = Q(q, t) + Φ_qᵀ λ with the ground motion as an effective gravity
+//! ([`eom`]); ground motions, analytic and recorded ([`ground_motion`]); closed chains (mobility,
+//! projection, consistent initial conditions, coordinate partitioning: [`closed_chain`]); the two
+//! ODE forms that must agree, constrained and reduced ([`system`]); integrators of our own with
+//! exact event location ([`integrator`]); and energy bookkeeping ([`energy`]).
+
+pub mod closed_chain;
+pub mod energy;
+pub mod eom;
 pub mod ground_motion;
 pub mod integrator;
+pub mod linalg;
+pub mod system;
+
+pub use closed_chain::{
+    InitialSpec, InitialState, Mobility, Partition, mobility, partition, solve_initial,
+};
+pub use energy::{Energies, energies};
+pub use eom::{Dynamics, DynamicsError, effective_gravity};
+pub use system::{ConstrainedSystem, ReducedSystem};

@@ -291,3 +291,343 @@ pub fn transformed(spec: &StructureSpec, rot: &Matrix3<f64>, t: &Vector3<f64>) -
     }
     out
 }
+
+/// A hinge with two pivot points `a`, `b`, oriented by the rule the model checks: P⁺ is the one
+/// about which a positive rotation lifts the other towards the child's centre `child_com`.
+pub fn oriented_hinge(
+    name: &str,
+    parent: &str,
+    child: &str,
+    axis: Vector3<f64>,
+    a: Vector3<f64>,
+    b: Vector3<f64>,
+    child_com: Vector3<f64>,
+) -> InterfaceSpec {
+    let (pos, neg) = if axis.cross(&(b - a)).dot(&(child_com - a)) > 0.0 {
+        (a, b)
+    } else {
+        (b, a)
+    };
+    hinge(name, parent, child, axis.into(), pos.into(), neg.into())
+}
+
+fn centroid(b: &BodySpec) -> Vector3<f64> {
+    let shape = if let Some(s) = &b.box_shape {
+        crate::shapes::Shape::Box(s.clone())
+    } else if let Some(s) = &b.annular_sector {
+        crate::shapes::Shape::AnnularSector(s.clone())
+    } else if let Some(s) = &b.prism {
+        crate::shapes::Shape::Prism(s.clone())
+    } else {
+        crate::shapes::Shape::Polyhedron(b.polyhedron.clone().expect("a shape"))
+    };
+    shape
+        .mass_properties()
+        .expect("fixture shapes are valid")
+        .centroid
+}
+
+/// A trilithon (Greek temple front, Makris & Vassiliou 2013): two identical columns 2b × 2h (depth
+/// 2b) with centres `spacing` apart, and an architrave of height `beam_height` resting on their top
+/// corners, spanning their outer faces, with mass ratio γ = m_beam / (2 m_column). All interfaces
+/// rock about y with P⁺ on the +x edge. Coordinates: `base_left`, `top_left` (architrave on the
+/// left column), `base_right`; `top_right` closes the loop.
+pub fn trilithon(b: f64, h: f64, spacing: f64, beam_height: f64, gamma: f64) -> StructureSpec {
+    let rho = 2500.0;
+    let (xl, xr) = (-spacing / 2.0, spacing / 2.0);
+    let d = 2.0 * b;
+    let m_col = rho * 2.0 * b * 2.0 * h * d;
+    let span = spacing + 2.0 * b;
+    let rho_beam = gamma * 2.0 * m_col / (span * beam_height * d);
+    let body = vec![
+        box_body("column_left", rho, [xl, 0.0, h], [2.0 * b, d, 2.0 * h]),
+        box_body("column_right", rho, [xr, 0.0, h], [2.0 * b, d, 2.0 * h]),
+        box_body(
+            "architrave",
+            rho_beam,
+            [0.0, 0.0, 2.0 * h + beam_height / 2.0],
+            [span, d, beam_height],
+        ),
+    ];
+    let y = [0.0, 1.0, 0.0];
+    let interface = vec![
+        hinge(
+            "base_left",
+            "ground",
+            "column_left",
+            y,
+            [xl + b, 0.0, 0.0],
+            [xl - b, 0.0, 0.0],
+        ),
+        hinge(
+            "base_right",
+            "ground",
+            "column_right",
+            y,
+            [xr + b, 0.0, 0.0],
+            [xr - b, 0.0, 0.0],
+        ),
+        hinge(
+            "top_left",
+            "column_left",
+            "architrave",
+            y,
+            [xl + b, 0.0, 2.0 * h],
+            [xl - b, 0.0, 2.0 * h],
+        ),
+        hinge(
+            "top_right",
+            "column_right",
+            "architrave",
+            y,
+            [xr + b, 0.0, 2.0 * h],
+            [xr - b, 0.0, 2.0 * h],
+        ),
+    ];
+    StructureSpec {
+        name: "trilithon".into(),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+    }
+}
+
+/// A semicircular arch of three voussoirs (annular sectors of radii `r_in`, `r_out`, depth
+/// `depth` along y, springings on z = 0 at x = ±r) with joints at 0°, 60°, 120° and 180° from
+/// the +x springing. With `two_sided`, every joint can pivot on its intrados or extrados (P⁺ and
+/// P⁻ assigned by the sign rule); otherwise each is a plain hinge alternating extrados, intrados,
+/// extrados, intrados — the four-hinge mechanism. Coordinates: `springing_right`, `joint_60`,
+/// `joint_120`; `springing_left` closes the loop.
+pub fn four_hinge_arch(r_in: f64, r_out: f64, depth: f64, two_sided: bool) -> StructureSpec {
+    let deg = std::f64::consts::PI / 180.0;
+    let names = ["v1", "v2", "v3"];
+    let body: Vec<BodySpec> = (0..3)
+        .map(|k| BodySpec {
+            name: names[k].into(),
+            density: Some(2200.0),
+            mass: None,
+            box_shape: None,
+            polyhedron: None,
+            prism: None,
+            annular_sector: Some(AnnularSectorShape {
+                center: [0.0, 0.0, 0.0],
+                axis: [0.0, -1.0, 0.0],
+                inner_radius: r_in,
+                outer_radius: r_out,
+                start: [1.0, 0.0, 0.0],
+                from_angle: 60.0 * deg * k as f64,
+                to_angle: 60.0 * deg * (k + 1) as f64,
+                thickness: depth,
+            }),
+        })
+        .collect();
+    let coms: Vec<Vector3<f64>> = body.iter().map(centroid).collect();
+    let at = |beta: f64, r: f64| Vector3::new(r * (beta * deg).cos(), 0.0, r * (beta * deg).sin());
+    let joints = [
+        ("springing_right", "ground", 0usize, 0.0, true),
+        ("joint_60", "v1", 1, 60.0, false),
+        ("joint_120", "v2", 2, 120.0, true),
+        ("springing_left", "ground", 2, 180.0, false),
+    ];
+    let interface = joints
+        .iter()
+        .map(|&(name, parent, child, beta, extrados)| {
+            let (inn, out) = (at(beta, r_in), at(beta, r_out));
+            if two_sided {
+                oriented_hinge(
+                    name,
+                    parent,
+                    names[child],
+                    Vector3::y(),
+                    inn,
+                    out,
+                    coms[child],
+                )
+            } else {
+                let p: [f64; 3] = if extrados { out.into() } else { inn.into() };
+                hinge(name, parent, names[child], [0.0, 1.0, 0.0], p, p)
+            }
+        })
+        .collect();
+    StructureSpec {
+        name: "four_hinge_arch".into(),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+    }
+}
+
+/// A 2×2 colonnade (baldachin): four identical columns 2b × 2b × 2h at (±s, ±s) on rocking bases,
+/// under a slab of thickness `slab` joined to each column top by a rocking base. Coordinates: the
+/// four bases' tilts and the slab's on the first column; three top contacts close loops.
+pub fn colonnade(b: f64, h: f64, s: f64, slab: f64) -> StructureSpec {
+    let square = |x: f64, y: f64, z: f64| -> [[f64; 3]; 4] {
+        [
+            [x - b, y - b, z],
+            [x + b, y - b, z],
+            [x + b, y + b, z],
+            [x - b, y + b, z],
+        ]
+    };
+    let pos = [(-s, -s), (s, -s), (s, s), (-s, s)];
+    let mut body: Vec<BodySpec> = pos
+        .iter()
+        .enumerate()
+        .map(|(k, &(x, y))| {
+            box_body(
+                &format!("column_{}", k + 1),
+                2500.0,
+                [x, y, h],
+                [2.0 * b, 2.0 * b, 2.0 * h],
+            )
+        })
+        .collect();
+    let w = 2.0 * (s + b);
+    body.push(box_body(
+        "slab",
+        2500.0,
+        [0.0, 0.0, 2.0 * h + slab / 2.0],
+        [w, w, slab],
+    ));
+    let mut interface: Vec<InterfaceSpec> = pos
+        .iter()
+        .enumerate()
+        .map(|(k, &(x, y))| {
+            rocking_base(
+                &format!("base_{}", k + 1),
+                "ground",
+                &format!("column_{}", k + 1),
+                square(x, y, 0.0),
+            )
+        })
+        .collect();
+    interface.extend(pos.iter().enumerate().map(|(k, &(x, y))| {
+        rocking_base(
+            &format!("top_{}", k + 1),
+            &format!("column_{}", k + 1),
+            "slab",
+            square(x, y, 2.0 * h),
+        )
+    }));
+    StructureSpec {
+        name: "colonnade".into(),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+    }
+}
+
+/// A spatial loop of three bodies and four plain hinges with non-parallel axes: rigid (DOF(2) = 0).
+pub fn skew_four_hinge_loop() -> StructureSpec {
+    let body = vec![
+        box_body("a", 2000.0, [0.0, 0.0, 0.5], [0.2, 0.2, 1.0]),
+        box_body("b", 2000.0, [0.5, 0.0, 1.0], [1.0, 0.2, 0.2]),
+        box_body("c", 2000.0, [1.0, 0.0, 0.5], [0.2, 0.2, 1.0]),
+    ];
+    let interface = vec![
+        hinge(
+            "h1",
+            "ground",
+            "a",
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0],
+        ),
+        hinge(
+            "h2",
+            "a",
+            "b",
+            [0.3, 1.0, 0.2],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, 1.0],
+        ),
+        hinge(
+            "h3",
+            "b",
+            "c",
+            [-0.2, 1.0, 0.4],
+            [1.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+        ),
+        hinge(
+            "h4",
+            "ground",
+            "c",
+            [0.1, 1.0, -0.3],
+            [1.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+        ),
+    ];
+    StructureSpec {
+        name: "skew_loop".into(),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+    }
+}
+
+/// A double pendulum of two boxes 0.1 × 0.1 × 1 m hanging from plain hinges about y.
+pub fn double_pendulum() -> StructureSpec {
+    StructureSpec {
+        name: "double_pendulum".into(),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body: vec![
+            box_body("upper", 1000.0, [0.0, 0.0, -0.5], [0.1, 0.1, 1.0]),
+            box_body("lower", 1000.0, [0.0, 0.0, -1.5], [0.1, 0.1, 1.0]),
+        ],
+        interface: vec![
+            hinge(
+                "shoulder",
+                "ground",
+                "upper",
+                [0.0, 1.0, 0.0],
+                [0.0; 3],
+                [0.0; 3],
+            ),
+            hinge(
+                "elbow",
+                "upper",
+                "lower",
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, -1.0],
+                [0.0, 0.0, -1.0],
+            ),
+        ],
+    }
+}
+
+/// A serial chain of `n` boxes stacked along z, each on a plain hinge whose axis turns by 40°
+/// about z from one to the next (non-parallel axes), hanging below the ground so that it swings.
+pub fn serial_chain(n: usize) -> StructureSpec {
+    let mut body = Vec::new();
+    let mut interface = Vec::new();
+    for k in 0..n {
+        let z = -(k as f64) * 0.5;
+        body.push(box_body(
+            &format!("link{k}"),
+            1000.0,
+            [0.05 * (k % 3) as f64, 0.0, z - 0.25],
+            [0.2, 0.15, 0.5],
+        ));
+        let a = 40f64.to_radians() * k as f64;
+        let parent = if k == 0 {
+            "ground".to_string()
+        } else {
+            format!("link{}", k - 1)
+        };
+        interface.push(hinge(
+            &format!("j{k}"),
+            &parent,
+            &format!("link{k}"),
+            [a.cos(), a.sin(), 0.0],
+            [0.0, 0.0, z],
+            [0.0, 0.0, z],
+        ));
+    }
+    StructureSpec {
+        name: format!("serial_chain_{n}"),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+    }
+}

@@ -1,0 +1,305 @@
+//! Closed kinematic chains: mobility (DOF(2)), projection onto Φ = 0 and Φ_q q̇ = 0, consistent
+//! initial conditions, and coordinate partitioning for the reduced form.
+
+use std::collections::BTreeMap;
+
+use nalgebra::{DMatrix, DVector};
+
+use crr_kinematics::{
+    ActivePivots, Data, Model, Side, closure_angles, constraint_jacobian, constraint_residual,
+    forward_kinematics,
+};
+
+use crate::eom::{DynamicsError, constraint_row_scale};
+use crate::linalg::{pinv_solve, pivot_columns, rank};
+
+/// Convergence threshold of the Newton projections, relative to the model size for point rows.
+pub const CLOSURE_TOLERANCE: f64 = 1e-13;
+const NEWTON_ITERATIONS: usize = 30;
+
+/// Mobility of a structure at a configuration: DOF(2) = DOF(1) − rank Φ_q.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Mobility {
+    /// DOF(1): tree coordinates.
+    pub dof1: usize,
+    /// Number of loop closures.
+    pub closures: usize,
+    /// Rows of Φ.
+    pub constraint_rows: usize,
+    /// Numerical rank of Φ_q (independent constraints).
+    pub rank: usize,
+    /// Redundant rows: rows − rank.
+    pub redundant: usize,
+    /// DOF(2) = DOF(1) − rank.
+    pub dof2: usize,
+    /// DOF(2) = 0: the mechanism is locked.
+    pub locked: bool,
+}
+
+/// Row-scaled Φ(q) and Φ_q at q (fills `kin`).
+fn scaled(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+) -> (DVector<f64>, DMatrix<f64>) {
+    let s = constraint_row_scale(model);
+    forward_kinematics(model, kin, q, pivots);
+    constraint_residual(model, kin, pivots);
+    constraint_jacobian(model, kin, pivots);
+    let phi = kin.phi.component_mul(&s);
+    let jac = DMatrix::from_fn(model.constraint_rows, model.dof(), |i, j| {
+        s[i] * kin.phi_q[(i, j)]
+    });
+    (phi, jac)
+}
+
+/// DOF(1), closures, rank of Φ_q and DOF(2) at configuration q with the given pivots.
+pub fn mobility(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) -> Mobility {
+    let mut kin = Data::new(model);
+    let (_, jac) = scaled(model, &mut kin, q, pivots);
+    let r = rank(&jac);
+    let dof2 = model.dof() - r;
+    Mobility {
+        dof1: model.dof(),
+        closures: model.closures.len(),
+        constraint_rows: model.constraint_rows,
+        rank: r,
+        redundant: model.constraint_rows - r,
+        dof2,
+        locked: dof2 == 0,
+    }
+}
+
+/// Newton projection of q onto Φ(q) = 0, changing only the coordinates in `free` (all when None)
+/// by minimum-norm steps. Returns the final scaled residual norm.
+pub fn project_positions(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    q: &mut DVector<f64>,
+    free: Option<&[usize]>,
+) -> Result<f64, DynamicsError> {
+    let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
+    let mut last = f64::INFINITY;
+    for _ in 0..NEWTON_ITERATIONS {
+        let (phi, jac) = scaled(model, kin, q, pivots);
+        let norm = phi.amax();
+        if norm <= CLOSURE_TOLERANCE {
+            return Ok(norm);
+        }
+        if !norm.is_finite() {
+            return Err(DynamicsError::Closure(
+                "the closure residual is not finite".into(),
+            ));
+        }
+        if norm > 0.5 * last && last < 1e-9 {
+            // Converged as far as round-off allows.
+            return Ok(norm);
+        }
+        last = norm;
+        let sub = DMatrix::from_fn(jac.nrows(), cols.len(), |i, j| jac[(i, cols[j])]);
+        let (dx, _) = pinv_solve(&sub, &phi);
+        for (j, &c) in cols.iter().enumerate() {
+            q[c] -= dx[j];
+        }
+    }
+    let (phi, _) = scaled(model, kin, q, pivots);
+    let norm = phi.amax();
+    if norm <= 1e-8 {
+        Ok(norm)
+    } else {
+        Err(DynamicsError::Closure(format!(
+            "Newton did not bring the closure residual below tolerance (still {norm:.3e} relative)"
+        )))
+    }
+}
+
+/// Projects q̇ onto Φ_q q̇ = 0 (orthogonally, changing only `free` coordinates when given), at the q
+/// last passed to the kinematics in `kin`. Returns the residual before projection.
+pub fn project_velocities(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    q: &DVector<f64>,
+    qdot: &mut DVector<f64>,
+    free: Option<&[usize]>,
+) -> f64 {
+    let (_, jac) = scaled(model, kin, q, pivots);
+    let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
+    let res = &jac * &*qdot;
+    let sub = DMatrix::from_fn(jac.nrows(), cols.len(), |i, j| jac[(i, cols[j])]);
+    let (dx, _) = pinv_solve(&sub, &res);
+    for (j, &c) in cols.iter().enumerate() {
+        qdot[c] -= dx[j];
+    }
+    res.amax()
+}
+
+/// Sets closure pivot sides from the current closure angles (ties keep their side) and tree sides
+/// from the signs of q.
+pub fn follow_signs(model: &Model, kin: &mut Data, q: &DVector<f64>, pivots: &mut ActivePivots) {
+    pivots.follow_coordinates(q);
+    forward_kinematics(model, kin, q, pivots);
+    let mut ang = vec![0.0; model.slot_count - model.dof()];
+    closure_angles(model, kin, &mut ang);
+    for (k, a) in ang.iter().enumerate() {
+        let s = &mut pivots.sides[model.dof() + k];
+        *s = Side::of(*a, *s);
+    }
+}
+
+/// Initial conditions given by the user: some angles and rates by coordinate name; the others are
+/// solved so that Φ = 0 and Φ_q q̇ = 0 hold.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InitialSpec {
+    /// Angles (rad) by coordinate name.
+    pub angles: BTreeMap<String, f64>,
+    /// Rates (rad/s) by coordinate name.
+    pub rates: BTreeMap<String, f64>,
+}
+
+/// A consistent initial state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialState {
+    /// q (rad).
+    pub q: DVector<f64>,
+    /// q̇ (rad/s).
+    pub qdot: DVector<f64>,
+    /// Active pivots following the signs of q and of the closure angles.
+    pub pivots: ActivePivots,
+}
+
+fn lookup(
+    model: &Model,
+    table: &BTreeMap<String, f64>,
+    what: &str,
+) -> Result<Vec<(usize, f64)>, DynamicsError> {
+    table
+        .iter()
+        .map(|(name, v)| {
+            let k = model.coord_index(name).ok_or_else(|| {
+                let names: Vec<_> = model.coords.iter().map(|c| c.name.as_str()).collect();
+                DynamicsError::Initial(format!(
+                    "{what}: no coordinate named \"{name}\"; coordinates are: {}",
+                    names.join(", ")
+                ))
+            })?;
+            if !v.is_finite() {
+                return Err(DynamicsError::Initial(format!(
+                    "{what}.{name}: {v} is not a finite number"
+                )));
+            }
+            Ok((k, *v))
+        })
+        .collect()
+}
+
+/// Solves the initial state: the given angles and rates are kept, the other coordinates are found
+/// by Newton from the rest configuration (minimum-norm steps) so that Φ = 0 and Φ_q q̇ = 0.
+/// The pivots follow the signs of the solution (re-solved until they agree). Errors when the given
+/// values admit no consistent state.
+pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, DynamicsError> {
+    let angles = lookup(model, &spec.angles, "initial.angles")?;
+    let rates = lookup(model, &spec.rates, "initial.rates")?;
+    let n = model.dof();
+    let mut q = DVector::zeros(n);
+    for &(k, v) in &angles {
+        q[k] = v;
+    }
+    let given: Vec<usize> = angles.iter().map(|a| a.0).collect();
+    let free: Vec<usize> = (0..n).filter(|k| !given.contains(k)).collect();
+    let mut kin = Data::new(model);
+    let mut pivots = ActivePivots::uniform(model, Side::Positive);
+    let rest = ActivePivots::uniform(model, Side::Positive);
+    let mob = mobility(model, &DVector::zeros(n), &rest);
+    let explain = |extra: &str| {
+        let over = if given.len() > mob.dof2 {
+            format!(
+                " ({} angle(s) given but the mechanism has DOF(2) = {}: give at most {})",
+                given.len(),
+                mob.dof2,
+                mob.dof2
+            )
+        } else {
+            String::new()
+        };
+        DynamicsError::Initial(format!(
+            "the given angles admit no configuration that closes the loops{over}{extra}"
+        ))
+    };
+    if !model.closures.is_empty() {
+        let mut previous = None;
+        for _ in 0..6 {
+            follow_signs(model, &mut kin, &q, &mut pivots);
+            if previous.as_ref() == Some(&pivots) {
+                break;
+            }
+            previous = Some(pivots.clone());
+            let mut trial = q.clone();
+            for &k in &free {
+                trial[k] = 0.0;
+            }
+            project_positions(model, &mut kin, &pivots, &mut trial, Some(&free))
+                .map_err(|e| explain(&format!(": {e}")))?;
+            q = trial;
+        }
+        let (phi, _) = scaled(model, &mut kin, &q, &pivots);
+        if phi.amax() > 1e-9 {
+            return Err(explain(&format!(": residual {:.3e}", phi.amax())));
+        }
+    } else {
+        pivots.follow_coordinates(&q);
+    }
+    let mut qdot = DVector::zeros(n);
+    for &(k, v) in &rates {
+        qdot[k] = v;
+    }
+    if !model.closures.is_empty() {
+        let given_r: Vec<usize> = rates.iter().map(|a| a.0).collect();
+        let free_r: Vec<usize> = (0..n).filter(|k| !given_r.contains(k)).collect();
+        for &k in &free_r {
+            qdot[k] = 0.0;
+        }
+        project_velocities(model, &mut kin, &pivots, &q, &mut qdot, Some(&free_r));
+        let (_, jac) = scaled(model, &mut kin, &q, &pivots);
+        let res = (&jac * &qdot).amax();
+        if res > 1e-9 * (1.0 + qdot.amax()) {
+            return Err(DynamicsError::Initial(format!(
+                "the given rates admit no velocity that keeps the loops closed (residual {res:.3e}); \
+                 give at most DOF(2) = {} rate(s) that are compatible",
+                mob.dof2
+            )));
+        }
+    }
+    Ok(InitialState { q, qdot, pivots })
+}
+
+/// Coordinate partitioning: the dependent coordinates (one per independent constraint, the
+/// columns of a pivoted factorisation of Φ_q) and the independent ones (the reduced form's
+/// coordinates, DOF(2) of them).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Partition {
+    /// Independent coordinates, increasing.
+    pub independent: Vec<usize>,
+    /// Dependent coordinates, increasing.
+    pub dependent: Vec<usize>,
+}
+
+/// Chooses the partition at configuration q: r = rank Φ_q dependent coordinates by column pivoting
+/// (the best-conditioned dependent block), the rest independent.
+pub fn partition(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) -> Partition {
+    let mut kin = Data::new(model);
+    let (_, jac) = scaled(model, &mut kin, q, pivots);
+    let r = rank(&jac);
+    let mut dependent = pivot_columns(&jac, r);
+    dependent.sort_unstable();
+    let independent = (0..model.dof())
+        .filter(|k| !dependent.contains(k))
+        .collect();
+    Partition {
+        independent,
+        dependent,
+    }
+}

@@ -1,0 +1,194 @@
+//! Equations of motion of the multi-DOF chain:
+//! M(q) q̈ + h(q, q̇) = Q(q, t) + Φ_qᵀ λ,  Φ_q q̈ + Φ̇_q q̇ = 0,
+//! with the ground motion as the effective gravity g_eff(t) = (−a_x, −a_y, −g − a_z) on every body
+//! (the equations are written in the frame of the ground): Q = Σₙ Mⁿ J_cₙᵀ g_eff.
+//!
+//! Closed chains are solved with explicit multipliers: with x₀ = M⁻¹(Q − h) and Y = M⁻¹Φ_qᵀ,
+//! (Φ_q Y) λ = −Φ̇_q q̇ − Φ_q x₀, q̈ = x₀ + Y λ. Redundant closures (a colonnade under a rigid slab)
+//! make Φ_q Y singular: λ is then the minimum-norm solution (singular values below
+//! [`RANK_TOLERANCE`](crate::linalg::RANK_TOLERANCE)·σ_max dropped), q̈ is unique.
+
+use nalgebra::{DMatrix, DVector, Vector3};
+
+use crr_kinematics::{
+    ActivePivots, Data, Model, constraint_bias, constraint_jacobian, forward_kinematics,
+    generalized_gravity, mass_matrix, velocities, velocity_product,
+};
+
+use crate::ground_motion::GroundMotion;
+use crate::linalg::{cholesky_in_place, cholesky_solve, pinv_solve};
+
+/// A failure of the equations of motion at some state.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DynamicsError {
+    /// M(q) is not positive definite (a body of zero inertia about its axis, or a NaN state).
+    #[error(
+        "the mass matrix is singular at coordinate \"{coordinate}\" (is the body's inertia about that axis zero, or the state NaN?)"
+    )]
+    SingularMassMatrix {
+        /// Name of the coordinate whose pivot failed.
+        coordinate: String,
+    },
+    /// The loop closures cannot be satisfied from this state.
+    #[error("the loop closures cannot be satisfied: {0}")]
+    Closure(String),
+    /// Inconsistent or impossible initial conditions.
+    #[error("initial conditions: {0}")]
+    Initial(String),
+    /// A NaN or infinite value appeared.
+    #[error("non-finite {what} at t = {t}")]
+    NonFinite {
+        /// Which quantity.
+        what: &'static str,
+        /// Time (s).
+        t: f64,
+    },
+}
+
+/// g_eff(t) = (−a_x, −a_y, −g − a_z) (m/s²), the load of gravity and ground motion in the frame of
+/// the ground.
+pub fn effective_gravity(model: &Model, ground: &GroundMotion, t: f64) -> Vector3<f64> {
+    let a = ground.acceleration(t);
+    Vector3::new(-a.x, -a.y, -model.gravity - a.z)
+}
+
+/// Weights that make the rows of Φ comparable: 1/size for point rows (m), 1 for axis rows.
+pub fn constraint_row_scale(model: &Model) -> DVector<f64> {
+    let mut s = DVector::from_element(model.constraint_rows, 1.0);
+    for cl in &model.closures {
+        for r in 0..3 {
+            s[cl.first_row + r] = 1.0 / model.size;
+        }
+    }
+    s
+}
+
+/// Workspace and results of one evaluation of the equations of motion (allocated once).
+#[derive(Clone, Debug)]
+pub struct Dynamics {
+    /// The kinematics workspace (Γ, M, h, Φ_q …).
+    pub kin: Data,
+    /// The dynamic chain: the active pivots, held fixed between impacts.
+    pub pivots: ActivePivots,
+    /// Q(q, t) = Σ Mⁿ J_cᵀ g_eff (N m).
+    pub load: DVector<f64>,
+    /// Generalized force of the ground-motion part alone, Σ Mⁿ J_cᵀ(−a_g) (N m): its power
+    /// Q_gᵀq̇ is the rate of work done by the ground motion.
+    pub ground_force: DVector<f64>,
+    /// q̈ (rad/s²).
+    pub qddot: DVector<f64>,
+    /// λ, closure multipliers (N for point rows, N m for axis rows); Φ_qᵀλ is the generalized
+    /// constraint force.
+    pub lambda: DVector<f64>,
+    factor: DMatrix<f64>,
+    row_scale: DVector<f64>,
+}
+
+impl Dynamics {
+    /// Allocates the workspace for `model` with the given dynamic chain.
+    pub fn new(model: &Model, pivots: ActivePivots) -> Self {
+        let n = model.dof();
+        Self {
+            kin: Data::new(model),
+            pivots,
+            load: DVector::zeros(n),
+            ground_force: DVector::zeros(n),
+            qddot: DVector::zeros(n),
+            lambda: DVector::zeros(model.constraint_rows),
+            factor: DMatrix::zeros(n, n),
+            row_scale: constraint_row_scale(model),
+        }
+    }
+
+    /// Evaluates kinematics, M(q), h(q, q̇), Q(q, t) and the ground force at (t, q, q̇), without
+    /// solving for q̈.
+    pub fn evaluate(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+    ) {
+        forward_kinematics(model, &mut self.kin, q, &self.pivots);
+        mass_matrix(model, &mut self.kin);
+        velocities(model, &mut self.kin, qdot);
+        velocity_product(model, &mut self.kin);
+        let a = ground.acceleration(t);
+        generalized_gravity(
+            model,
+            &mut self.kin,
+            &effective_gravity(model, ground, t),
+            &mut self.load,
+        );
+        generalized_gravity(model, &mut self.kin, &(-a), &mut self.ground_force);
+        if !model.closures.is_empty() {
+            constraint_jacobian(model, &mut self.kin, &self.pivots);
+            constraint_bias(model, &mut self.kin, &self.pivots);
+        }
+    }
+
+    /// Factorises M (after [`Self::evaluate`]).
+    fn factorise(&mut self, model: &Model) -> Result<(), DynamicsError> {
+        self.factor.copy_from(&self.kin.mass_matrix);
+        cholesky_in_place(&mut self.factor).map_err(|k| DynamicsError::SingularMassMatrix {
+            coordinate: model.coords[k].name.clone(),
+        })
+    }
+
+    /// Solves M x = b with the current factor.
+    pub fn solve_mass(&self, b: &mut DVector<f64>) {
+        cholesky_solve(&self.factor, b.as_mut_slice());
+    }
+
+    /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains do not allocate.
+    pub fn accelerations(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        self.evaluate(model, ground, t, q, qdot);
+        self.factorise(model)?;
+        self.qddot.copy_from(&self.load);
+        self.qddot -= &self.kin.velocity_product;
+        cholesky_solve(&self.factor, self.qddot.as_mut_slice());
+        if model.closures.is_empty() {
+            return Ok(());
+        }
+        // Row-scaled closures: Φ' = S Φ_q, c' = S Φ̇_q q̇.
+        let phi_q = DMatrix::from_fn(model.constraint_rows, model.dof(), |i, j| {
+            self.row_scale[i] * self.kin.phi_q[(i, j)]
+        });
+        let mut y = phi_q.transpose();
+        for mut col in y.column_iter_mut() {
+            cholesky_solve(&self.factor, col.as_mut_slice());
+        }
+        let a = &phi_q * &y;
+        let rhs = -self.kin.phi_bias.component_mul(&self.row_scale) - &phi_q * &self.qddot;
+        let (lambda_scaled, _) = pinv_solve(&a, &rhs);
+        self.qddot += &y * &lambda_scaled;
+        self.lambda = lambda_scaled.component_mul(&self.row_scale);
+        if self.qddot.iter().any(|x| !x.is_finite()) {
+            return Err(DynamicsError::NonFinite {
+                what: "acceleration",
+                t,
+            });
+        }
+        Ok(())
+    }
+
+    /// Row-scaled Φ_q (after [`Self::evaluate`] or a kinematics call filling `kin.phi_q`).
+    pub fn scaled_jacobian(&self) -> DMatrix<f64> {
+        DMatrix::from_fn(self.kin.phi_q.nrows(), self.kin.phi_q.ncols(), |i, j| {
+            self.row_scale[i] * self.kin.phi_q[(i, j)]
+        })
+    }
+
+    /// The row weights used for Φ.
+    pub fn row_scale(&self) -> &DVector<f64> {
+        &self.row_scale
+    }
+}

@@ -1,0 +1,223 @@
+//! The equations of motion as first-order ODE systems for the integrators, in the two forms that
+//! must agree on every closed chain:
+//! - [`ConstrainedSystem`]: the multi-DOF form, y = [q, q̇, W] over all DOF(1) coordinates, with
+//!   multipliers (index-reduced to the acceleration level) and projection back onto Φ = 0 and
+//!   Φ_q q̇ = 0 after every step;
+//! - [`ReducedSystem`]: coordinate partitioning, y = [z, ż, W] over the DOF(2) independent
+//!   coordinates, the dependent ones solved by Newton at every evaluation.
+//!
+//! W is the work done by the ground motion, Ẇ = Q_gᵀq̇ with Q_g = Σ Mⁿ J_cᵀ(−a_g).
+
+use nalgebra::{DMatrix, DVector};
+
+use crr_kinematics::Model;
+
+use crate::closed_chain::{Partition, project_positions, project_velocities};
+use crate::eom::Dynamics;
+use crate::ground_motion::GroundMotion;
+use crate::integrator::{OdeSystem, RhsError};
+use crate::linalg::{cholesky_in_place, cholesky_solve, pseudo_inverse};
+
+/// The multi-DOF constrained form.
+pub struct ConstrainedSystem<'a> {
+    /// The structure.
+    pub model: &'a Model,
+    /// The ground motion.
+    pub ground: &'a GroundMotion,
+    /// Equations-of-motion workspace, with the dynamic chain (pivots).
+    pub dynamics: &'a mut Dynamics,
+    q: DVector<f64>,
+    qdot: DVector<f64>,
+}
+
+impl<'a> ConstrainedSystem<'a> {
+    /// Wraps the model, ground motion and workspace.
+    pub fn new(model: &'a Model, ground: &'a GroundMotion, dynamics: &'a mut Dynamics) -> Self {
+        let n = model.dof();
+        Self {
+            model,
+            ground,
+            dynamics,
+            q: DVector::zeros(n),
+            qdot: DVector::zeros(n),
+        }
+    }
+
+    /// State vector [q, q̇, W].
+    pub fn pack(q: &DVector<f64>, qdot: &DVector<f64>, work: f64) -> Vec<f64> {
+        q.iter()
+            .chain(qdot.iter())
+            .copied()
+            .chain(std::iter::once(work))
+            .collect()
+    }
+}
+
+impl OdeSystem for ConstrainedSystem<'_> {
+    fn dim(&self) -> usize {
+        2 * self.model.dof() + 1
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        let n = self.model.dof();
+        self.q.as_mut_slice().copy_from_slice(&y[..n]);
+        self.qdot.as_mut_slice().copy_from_slice(&y[n..2 * n]);
+        self.dynamics
+            .accelerations(self.model, self.ground, t, &self.q, &self.qdot)
+            .map_err(|e| RhsError(e.to_string()))?;
+        dydt[..n].copy_from_slice(&y[n..2 * n]);
+        dydt[n..2 * n].copy_from_slice(self.dynamics.qddot.as_slice());
+        dydt[2 * n] = self.dynamics.ground_force.dot(&self.qdot);
+        Ok(())
+    }
+
+    fn project(&mut self, _t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
+        if self.model.closures.is_empty() {
+            return Ok(false);
+        }
+        let n = self.model.dof();
+        self.q.as_mut_slice().copy_from_slice(&y[..n]);
+        self.qdot.as_mut_slice().copy_from_slice(&y[n..2 * n]);
+        let d = &mut *self.dynamics;
+        project_positions(self.model, &mut d.kin, &d.pivots, &mut self.q, None)
+            .map_err(|e| RhsError(e.to_string()))?;
+        project_velocities(
+            self.model,
+            &mut d.kin,
+            &d.pivots,
+            &self.q,
+            &mut self.qdot,
+            None,
+        );
+        y[..n].copy_from_slice(self.q.as_slice());
+        y[n..2 * n].copy_from_slice(self.qdot.as_slice());
+        Ok(true)
+    }
+}
+
+/// The reduced form by coordinate partitioning.
+pub struct ReducedSystem<'a> {
+    /// The structure.
+    pub model: &'a Model,
+    /// The ground motion.
+    pub ground: &'a GroundMotion,
+    /// Equations-of-motion workspace, with the dynamic chain (pivots).
+    pub dynamics: &'a mut Dynamics,
+    /// Independent / dependent coordinates.
+    pub partition: Partition,
+    /// The full q of the last evaluation (warm start of the Newton solve for the dependent ones).
+    pub q: DVector<f64>,
+    /// The full q̇ of the last evaluation.
+    pub qdot: DVector<f64>,
+    /// The full q̈ of the last evaluation.
+    pub qddot: DVector<f64>,
+}
+
+impl<'a> ReducedSystem<'a> {
+    /// Wraps the model, ground motion and workspace; `q_start` is a closed configuration used as the
+    /// first Newton guess.
+    pub fn new(
+        model: &'a Model,
+        ground: &'a GroundMotion,
+        dynamics: &'a mut Dynamics,
+        partition: Partition,
+        q_start: &DVector<f64>,
+    ) -> Self {
+        let n = model.dof();
+        Self {
+            model,
+            ground,
+            dynamics,
+            partition,
+            q: q_start.clone(),
+            qdot: DVector::zeros(n),
+            qddot: DVector::zeros(n),
+        }
+    }
+
+    /// Number of independent coordinates, DOF(2).
+    pub fn reduced_dof(&self) -> usize {
+        self.partition.independent.len()
+    }
+
+    /// State vector [z, ż, W] from full q, q̇.
+    pub fn pack(&self, q: &DVector<f64>, qdot: &DVector<f64>, work: f64) -> Vec<f64> {
+        let ind = &self.partition.independent;
+        ind.iter()
+            .map(|&k| q[k])
+            .chain(ind.iter().map(|&k| qdot[k]))
+            .chain(std::iter::once(work))
+            .collect()
+    }
+
+    /// Expands a reduced state into full q and q̇ (stored in `self.q`, `self.qdot`), returning B, the
+    /// map q̇ = B ż.
+    pub fn expand(&mut self, y: &[f64]) -> Result<DMatrix<f64>, RhsError> {
+        let ind = self.partition.independent.clone();
+        let dep = self.partition.dependent.clone();
+        let k = ind.len();
+        for (j, &c) in ind.iter().enumerate() {
+            self.q[c] = y[j];
+        }
+        let d = &mut *self.dynamics;
+        project_positions(self.model, &mut d.kin, &d.pivots, &mut self.q, Some(&dep))
+            .map_err(|e| RhsError(e.to_string()))?;
+        // Φ_d q̇_d = −Φ_i ż  ⇒  B = [I; −Φ_d⁺ Φ_i].
+        crr_kinematics::forward_kinematics(self.model, &mut d.kin, &self.q, &d.pivots);
+        crr_kinematics::constraint_jacobian(self.model, &mut d.kin, &d.pivots);
+        let jac = d.scaled_jacobian();
+        let phi_d = DMatrix::from_fn(jac.nrows(), dep.len(), |i, j| jac[(i, dep[j])]);
+        let phi_i = DMatrix::from_fn(jac.nrows(), k, |i, j| jac[(i, ind[j])]);
+        let pinv = pseudo_inverse(&phi_d);
+        let dep_map = -(&pinv * &phi_i);
+        let mut b = DMatrix::zeros(self.model.dof(), k);
+        for (j, &c) in ind.iter().enumerate() {
+            b[(c, j)] = 1.0;
+        }
+        for (i, &c) in dep.iter().enumerate() {
+            for j in 0..k {
+                b[(c, j)] = dep_map[(i, j)];
+            }
+        }
+        let zdot = DVector::from_column_slice(&y[k..2 * k]);
+        self.qdot = &b * zdot;
+        Ok(b)
+    }
+}
+
+impl OdeSystem for ReducedSystem<'_> {
+    fn dim(&self) -> usize {
+        2 * self.reduced_dof() + 1
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        let k = self.reduced_dof();
+        let b = self.expand(y)?;
+        let d = &mut *self.dynamics;
+        d.evaluate(self.model, self.ground, t, &self.q, &self.qdot);
+        // q̈ = B z̈ + β with β_d = −Φ_d⁺ Φ̇_q q̇ (β_i = 0).
+        let dep = &self.partition.dependent;
+        let jac = d.scaled_jacobian();
+        let phi_d = DMatrix::from_fn(jac.nrows(), dep.len(), |i, j| jac[(i, dep[j])]);
+        let bias = d.kin.phi_bias.component_mul(d.row_scale());
+        let pinv = pseudo_inverse(&phi_d);
+        let beta_d = -(&pinv * bias);
+        let mut beta = DVector::zeros(self.model.dof());
+        for (i, &c) in dep.iter().enumerate() {
+            beta[c] = beta_d[i];
+        }
+        // (Bᵀ M B) z̈ = Bᵀ (Q − h − M β).
+        let m = &d.kin.mass_matrix;
+        let mut m_red = b.transpose() * m * &b;
+        let f = &d.load - &d.kin.velocity_product - m * &beta;
+        let mut zdd: Vec<f64> = (b.transpose() * f).iter().copied().collect();
+        cholesky_in_place(&mut m_red)
+            .map_err(|_| RhsError("the reduced mass matrix is singular".into()))?;
+        cholesky_solve(&m_red, &mut zdd);
+        self.qddot = &b * DVector::from_column_slice(&zdd) + beta;
+        dydt[..k].copy_from_slice(&y[k..2 * k]);
+        dydt[k..2 * k].copy_from_slice(&zdd);
+        dydt[2 * k] = d.ground_force.dot(&self.qdot);
+        Ok(())
+    }
+}
