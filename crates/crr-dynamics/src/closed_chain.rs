@@ -303,3 +303,30 @@ pub fn partition(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) -> Part
         dependent,
     }
 }
+
+/// Conditioning of the dependent block of a partition at q: σ_min/σ_max of the row-scaled
+/// Φ_q restricted to the dependent columns (1 is perfect, 0 singular). Below
+/// [`REPARTITION_THRESHOLD`] the reduced form chooses its coordinates again.
+pub fn partition_condition(
+    model: &Model,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+    part: &Partition,
+) -> f64 {
+    if part.dependent.is_empty() {
+        return 1.0;
+    }
+    let mut kin = Data::new(model);
+    let (_, jac) = scaled(model, &mut kin, q, pivots);
+    let sub = DMatrix::from_fn(jac.nrows(), part.dependent.len(), |i, j| {
+        jac[(i, part.dependent[j])]
+    });
+    let s = sub.singular_values();
+    let r = part.dependent.len();
+    let mut v: Vec<f64> = s.iter().copied().collect();
+    v.sort_by(|a, b| b.total_cmp(a));
+    if v[0] <= 0.0 { 0.0 } else { v[r - 1] / v[0] }
+}
+
+/// The dependent block's conditioning below which the reduced form re-partitions.
+pub const REPARTITION_THRESHOLD: f64 = 0.2;

@@ -13,6 +13,7 @@ pub mod eom;
 pub mod ground_motion;
 pub mod integrator;
 pub mod linalg;
+pub mod run;
 pub mod system;
 
 pub use closed_chain::{
@@ -20,4 +21,5 @@ pub use closed_chain::{
 };
 pub use energy::{Energies, energies};
 pub use eom::{Dynamics, DynamicsError, effective_gravity};
+pub use run::{Form, Sample, integrate_smooth};
 pub use system::{ConstrainedSystem, ReducedSystem};
