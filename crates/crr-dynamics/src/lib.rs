@@ -13,6 +13,7 @@ pub mod eom;
 pub mod ground_motion;
 pub mod integrator;
 pub mod linalg;
+pub mod mechanism;
 pub mod run;
 pub mod system;
 
@@ -21,5 +22,6 @@ pub use closed_chain::{
 };
 pub use energy::{Energies, energies};
 pub use eom::{Dynamics, DynamicsError, effective_gravity};
+pub use mechanism::{EquivalentBlock, equivalent_block};
 pub use run::{Form, Sample, integrate_smooth};
 pub use system::{ConstrainedSystem, ReducedSystem};

@@ -1,0 +1,1 @@
+//! Pivot switching, impact laws and the event-driven simulation of coupled rocking rotations.
