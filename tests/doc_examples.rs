@@ -122,7 +122,7 @@ fn check_facts(at: &str, spec: &StructureSpec, m: &Model) -> bool {
             // I₀ = (4/3) m R², R² = 0.2² + 1².
             let i0 = 4.0 / 3.0 * mass * (0.04 + 1.0);
             assert!(close(m00, i0, 1e-12), "{at}: M(0) = {m00}, I₀ = {i0}");
-            assert!(close(i0, 1109.333_333_333_333, 1e-12));
+            assert!(close(i0, 1_109.333_333_333_333, 1e-12));
         }
         "frustum" => {
             assert_eq!(m.dof(), 1, "{at}");
@@ -149,7 +149,7 @@ fn check_facts(at: &str, spec: &StructureSpec, m: &Model) -> bool {
                 assert_eq!(b.shape.kind(), "annular_sector");
                 assert!(close(b.volume, v, 1e-12), "{at}: {}", b.name);
                 assert!(close(b.mass, 2000.0 * v, 1e-12), "{at}");
-                assert!(close(b.mass, 2356.194_490_192_345, 1e-9), "{at}");
+                assert!(close(b.mass, 2_356.194_490_192_345, 1e-9), "{at}");
             }
             // The voussoirs run from +x up through +z: the crown's centre is on +z.
             let crown = &m.bodies[m.body_index("crown").unwrap()];
