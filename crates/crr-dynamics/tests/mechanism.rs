@@ -14,7 +14,7 @@ const G: f64 = 9.81;
 
 #[test]
 fn block_activation_multiplier_is_tan_alpha_and_p_squared_is_3g_over_4r() {
-    let (b, h) = (0.2, 1.0);
+    let (b, h): (f64, f64) = (0.2, 1.0);
     let model = Model::from_spec(&single_block(b, h, 2500.0)).unwrap();
     let init = solve_initial(
         &model,
@@ -25,7 +25,7 @@ fn block_activation_multiplier_is_tan_alpha_and_p_squared_is_3g_over_4r() {
     )
     .unwrap();
     let eq = equivalent_block(&model, &init.pivots, 0, &Vector3::x()).unwrap();
-    let (r, alpha) = ((b * b + h * h as f64).sqrt(), (b / h as f64).atan());
+    let (r, alpha) = ((b * b + h * h).sqrt(), (b / h).atan());
     // λ is a ratio of exact quantities: round-off only.
     assert!(
         (eq.lambda - alpha.tan()).abs() < 1e-13,
@@ -48,8 +48,8 @@ fn block_activation_multiplier_is_tan_alpha_and_p_squared_is_3g_over_4r() {
 
 #[test]
 fn trilithon_reduced_equation_is_makris_vassiliou() {
-    let (b, h) = (0.25, 1.5);
-    let (r, alpha) = ((b * b + h * h as f64).sqrt(), (b / h as f64).atan());
+    let (b, h): (f64, f64) = (0.25, 1.5);
+    let (r, alpha) = ((b * b + h * h).sqrt(), (b / h).atan());
     let p2 = 3.0 * G / (4.0 * r);
     for gamma in [0.5, 1.0, 2.0] {
         let model = Model::from_spec(&trilithon(b, h, 2.0, 0.5, gamma)).unwrap();

@@ -9,7 +9,7 @@
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use crate::data::Data;
-use crate::kinematics::{for_each_point_column, frame_point};
+use crate::kinematics::frame_point;
 use crate::model::{InterfaceKind, Model};
 use crate::pivots::ActivePivots;
 
@@ -35,11 +35,11 @@ fn closure_frames(model: &Model, interface: usize) -> (Option<usize>, Option<usi
     (model.frame_of(i.parent), Some(model.body_coord[i.child]))
 }
 
-/// The two unit vectors whose dot products are the orientation rows of a closure:
-/// pairs (a on A, b on B) with rows (Γ_A a)·(Γ_B b).
 /// A pair (a on frame A, b on frame B) whose dot product (Γ_A a)·(Γ_B b) is one orientation row.
 pub(crate) type OrientationPair = (Vector3<f64>, Vector3<f64>);
 
+/// The pairs whose dot products are the orientation rows of a closure, and how many rows there
+/// are (2 for a hinge, 1 for a rocking base).
 pub(crate) fn orientation_pairs(kind: &InterfaceKind) -> ([OrientationPair; 2], usize) {
     match kind {
         InterfaceKind::Hinge { axis, .. } => {
@@ -77,12 +77,14 @@ pub fn constraint_jacobian(model: &Model, data: &mut Data, pivots: &ActivePivots
         let p = iface.kind.pivot(pivots.of_interface(model, cl.interface));
         let r0 = cl.first_row;
         let (xa, xb) = (frame_point(data, a, &p), frame_point(data, b, &p));
-        let mut cols: Vec<(usize, Vector3<f64>, f64)> = Vec::new();
-        for_each_point_column(model, data, a, &xa, |j, c| cols.push((j, c, 1.0)));
-        for_each_point_column(model, data, b, &xb, |j, c| cols.push((j, c, -1.0)));
-        for (j, c, s) in &cols {
-            for r in 0..3 {
-                data.phi_q[(r0 + r, *j)] += s * c[r];
+        for (frame, x, sign) in [(a, xa, 1.0), (b, xb, -1.0)] {
+            let mut j = frame;
+            while let Some(jj) = j {
+                let c = data.axis[jj].cross(&(x - data.pivot[jj]));
+                for r in 0..3 {
+                    data.phi_q[(r0 + r, jj)] += sign * c[r];
+                }
+                j = model.coords[jj].parent;
             }
         }
         // d/dt (Γ_A a)·(Γ_B b) = (ω_A − ω_B)·((Γ_A a) × (Γ_B b)).

@@ -103,9 +103,8 @@ pub fn rocking_base(
 }
 
 /// Housner's block: half-width b (x), half-height h, depth 2b along y, on the ground, rocking about
-/// y with P⁺ = (b, 0, 0) (a positive angle about +y tips the block towards +x... see
-/// `docs/model-format.md`: a positive rotation about +y moves +x points down, so the block rocks
-/// on its +x edge).
+/// y with P⁺ = (b, 0, 0): a positive rotation about +y moves +x points down, so for a positive
+/// angle the block rocks on its +x edge.
 pub fn single_block(b: f64, h: f64, density: f64) -> StructureSpec {
     StructureSpec {
         name: "single_block".into(),
