@@ -10,6 +10,8 @@
 //! - [`model_file`]: TOML/JSON model files with errors naming the file, item and problem.
 //! - [`inspect`]: the report of `crr inspect`.
 
+pub use crr_dynamics as dynamics;
+pub use crr_impact as impact;
 pub use crr_kinematics as kinematics;
 
 pub mod inspect;

@@ -3,7 +3,56 @@
 
 use std::path::{Path, PathBuf};
 
+use serde::{Deserialize, Serialize};
+
+use crr_dynamics::ground_motion::GroundMotionSpec;
+use crr_dynamics::{AnalysisSpec, InitialSpec};
+use crr_kinematics::spec::{BodySpec, DEFAULT_GRAVITY, InterfaceSpec};
 use crr_kinematics::{Model, ModelError, StructureSpec};
+
+fn default_gravity() -> f64 {
+    DEFAULT_GRAVITY
+}
+
+/// A whole model file: the structure (`name`, `gravity`, `[[body]]`, `[[interface]]`, documented in
+/// `docs/model-format.md`) and the optional `[ground_motion]` (`docs/ground-motion.md`),
+/// `[initial]` and `[analysis]` tables.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// Name of the structure.
+    pub name: String,
+    /// g (m/s²), default 9.81.
+    #[serde(default = "default_gravity")]
+    pub gravity: f64,
+    /// Bodies.
+    #[serde(default)]
+    pub body: Vec<BodySpec>,
+    /// Interfaces.
+    #[serde(default)]
+    pub interface: Vec<InterfaceSpec>,
+    /// Ground motion, per component.
+    #[serde(default)]
+    pub ground_motion: Option<GroundMotionSpec>,
+    /// Initial angles and rates by coordinate name.
+    #[serde(default)]
+    pub initial: Option<InitialSpec>,
+    /// Duration, output interval, integrator settings.
+    #[serde(default)]
+    pub analysis: Option<AnalysisSpec>,
+}
+
+impl ModelFile {
+    /// The structure part.
+    pub fn structure(&self) -> StructureSpec {
+        StructureSpec {
+            name: self.name.clone(),
+            gravity: self.gravity,
+            body: self.body.clone(),
+            interface: self.interface.clone(),
+        }
+    }
+}
 
 /// Any failure to read or understand an input file.
 #[derive(Debug, thiserror::Error)]
@@ -38,7 +87,7 @@ pub enum InputError {
 }
 
 /// Parses the text of a model file; JSON when the file name ends in `.json`, TOML otherwise.
-pub fn parse_structure(path: &Path, text: &str) -> Result<StructureSpec, InputError> {
+pub fn parse_model_file(path: &Path, text: &str) -> Result<ModelFile, InputError> {
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
@@ -53,16 +102,17 @@ pub fn parse_structure(path: &Path, text: &str) -> Result<StructureSpec, InputEr
     })
 }
 
-/// Reads, parses and validates a model file.
-pub fn load_model(path: &Path) -> Result<(StructureSpec, Model), InputError> {
+/// Reads, parses and validates a model file (the structure; the other tables are checked where
+/// they are used).
+pub fn load_model(path: &Path) -> Result<(ModelFile, Model), InputError> {
     let text = std::fs::read_to_string(path).map_err(|source| InputError::Io {
         file: path.to_path_buf(),
         source,
     })?;
-    let spec = parse_structure(path, &text)?;
-    let model = Model::from_spec(&spec).map_err(|source| InputError::Model {
+    let file = parse_model_file(path, &text)?;
+    let model = Model::from_spec(&file.structure()).map_err(|source| InputError::Model {
         file: path.to_path_buf(),
         source,
     })?;
-    Ok((spec, model))
+    Ok((file, model))
 }

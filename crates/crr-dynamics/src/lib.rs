@@ -7,6 +7,7 @@
 //! ODE forms that must agree, constrained and reduced ([`system`]); integrators of our own with
 //! exact event location ([`integrator`]); and energy bookkeeping ([`energy`]).
 
+pub mod analysis;
 pub mod closed_chain;
 pub mod energy;
 pub mod eom;
@@ -17,6 +18,7 @@ pub mod mechanism;
 pub mod run;
 pub mod system;
 
+pub use analysis::{AnalysisSpec, MethodName};
 pub use closed_chain::{
     InitialSpec, InitialState, Mobility, Partition, mobility, partition, solve_initial,
 };

@@ -17,7 +17,7 @@ use crate::linalg::pinv_solve;
 /// The reduced one-coordinate quantities at a closed configuration.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReducedPoint {
-    /// dq/dθ: the mechanism's velocity map (B, with B[coordinate] = 1).
+    /// dq/dθ: the mechanism's velocity map (B, with `B[coordinate] = 1`).
     pub velocity_map: DVector<f64>,
     /// M(θ) = Bᵀ M B (kg m²).
     pub mass: f64,

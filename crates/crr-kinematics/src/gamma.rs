@@ -40,7 +40,7 @@ pub fn rot_ops_along_path(model: &Model, q: &DVector<f64>, b: usize) -> Vec<Matr
         .collect()
 }
 
-/// ∂Γⁱ/∂q_{path[a]} for all a, i on the path of body `b` (zero for a > i), indexed `[a][i]`.
+/// ∂Γⁱ/∂q_{`path[a]`} for all a, i on the path of body `b` (zero for a > i), indexed `[a][i]`.
 pub fn rot_op_partials(model: &Model, q: &DVector<f64>, path: &[usize]) -> Vec<Vec<Matrix3<f64>>> {
     let m = path.len();
     let rots: Vec<_> = path
@@ -70,7 +70,7 @@ pub fn rot_op_partials(model: &Model, q: &DVector<f64>, path: &[usize]) -> Vec<V
 }
 
 /// M(q) assembled from the γ inner products exactly as in eq 2 (an independent check of
-/// [`crate::mass_matrix`]; allocates).
+/// [`crate::mass_matrix()`]; allocates).
 #[doc(alias = "γ")]
 pub fn mass_matrix_gamma(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) -> DMatrix<f64> {
     let n = model.dof();

@@ -10,7 +10,7 @@ use crate::rotation::skew;
 
 /// Spatial inertia about the world origin of a body with world centre `c` and world inertia
 /// `i_c` about its centre, acting on [ω; v₀] (v₀ the velocity of the body point at the origin):
-/// [[I_c − m[c]×², m[c]×], [−m[c]×, m 1]].
+/// `[[I_c − m[c]×², m[c]×], [−m[c]×, m 1]]`.
 pub fn spatial_inertia(mass: f64, c: &nalgebra::Vector3<f64>, i_c: &Matrix3<f64>) -> Matrix6<f64> {
     let cx = skew(c);
     let mut s = Matrix6::zeros();

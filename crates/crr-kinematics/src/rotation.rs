@@ -8,7 +8,7 @@ pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// Rotation by `angle` (rad, right-handed) about the unit vector `axis` (Rodrigues' formula):
-/// R = I + sin θ [u]× + (1 − cos θ) [u]×².
+/// `R = I + sin θ [u]× + (1 − cos θ) [u]×²`.
 pub fn axis_angle(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
     let k = skew(axis);
     let (s, c) = angle.sin_cos();

@@ -1,0 +1,92 @@
+//! Solver settings a user gives in the `[analysis]` table of a model file.
+
+use serde::{Deserialize, Serialize};
+
+use crate::integrator::{Method, Options};
+
+/// Integration method by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum MethodName {
+    /// Dormand–Prince 8(5,3) with 7th-order dense output (default).
+    #[default]
+    Dop853,
+    /// Dormand–Prince 5(4) with 4th-order dense output.
+    Dopri5,
+    /// Classical fixed-step Runge–Kutta 4 (step `rk4_step`).
+    Rk4,
+}
+
+/// `[analysis]`: duration, output interval and integrator settings, with documented defaults.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AnalysisSpec {
+    /// Simulated time (s). Default 10, or the ground motion's duration plus 5 s when it ends.
+    pub duration: Option<f64>,
+    /// Interval between output samples (s). Default 0.01.
+    pub output_interval: f64,
+    /// `"dop853"` (default), `"dopri5"` or `"rk4"`.
+    pub method: MethodName,
+    /// Fixed step of `"rk4"` (s). Default 1e-4.
+    pub rk4_step: f64,
+    /// Relative tolerance of the adaptive methods. Default 1e-10.
+    pub rtol: f64,
+    /// Absolute tolerance (rad, rad/s). Default 1e-12.
+    pub atol: f64,
+    /// Largest step (s). Default: unlimited.
+    pub max_step: Option<f64>,
+}
+
+impl Default for AnalysisSpec {
+    fn default() -> Self {
+        Self {
+            duration: None,
+            output_interval: 0.01,
+            method: MethodName::Dop853,
+            rk4_step: 1e-4,
+            rtol: 1e-10,
+            atol: 1e-12,
+            max_step: None,
+        }
+    }
+}
+
+impl AnalysisSpec {
+    /// The integrator method and options, or a message naming the bad field.
+    pub fn solver(&self) -> Result<(Method, Options), String> {
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!(
+                    "analysis.{name} must be a positive number, got {v}"
+                ))
+            }
+        };
+        positive("output_interval", self.output_interval)?;
+        positive("rtol", self.rtol)?;
+        positive("atol", self.atol)?;
+        positive("rk4_step", self.rk4_step)?;
+        if let Some(d) = self.duration {
+            positive("duration", d)?;
+        }
+        if let Some(h) = self.max_step {
+            positive("max_step", h)?;
+        }
+        let method = match self.method {
+            MethodName::Dop853 => Method::Dop853,
+            MethodName::Dopri5 => Method::Dopri5,
+            MethodName::Rk4 => Method::Rk4 {
+                step: self.rk4_step,
+            },
+        };
+        let options = Options {
+            rtol: self.rtol,
+            atol: self.atol,
+            h_max: self.max_step.unwrap_or(f64::INFINITY),
+            ..Options::default()
+        };
+        options.validate().map_err(|e| format!("analysis: {e}"))?;
+        Ok((method, options))
+    }
+}
