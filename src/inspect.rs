@@ -160,9 +160,9 @@ pub fn inspect(model: &Model, q: &DVector<f64>) -> InspectReport {
         &Vector3::new(0.0, 0.0, -model.gravity),
         &mut qg,
     );
-    let has_closures = !model.closures.is_empty();
+    let has_closures = model.constraint_rows > 0;
     if has_closures {
-        constraint_residual(model, &mut data, &pivots);
+        constraint_residual(model, &mut data, &pivots, q);
         constraint_jacobian(model, &mut data, &pivots);
     }
     InspectReport {

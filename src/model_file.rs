@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crr_dynamics::ground_motion::GroundMotionSpec;
 use crr_dynamics::{AnalysisSpec, InitialSpec};
-use crr_kinematics::spec::{BodySpec, DEFAULT_GRAVITY, InterfaceSpec};
+use crr_kinematics::spec::{BodySpec, DEFAULT_GRAVITY, InterfaceSpec, SymmetrySpec};
 use crr_kinematics::{Model, ModelError, StructureSpec};
 
 fn default_gravity() -> f64 {
@@ -31,6 +31,9 @@ pub struct ModelFile {
     /// Interfaces.
     #[serde(default)]
     pub interface: Vec<InterfaceSpec>,
+    /// User or symmetry constraints (DOF(3)).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub symmetry: Vec<SymmetrySpec>,
     /// Ground motion, per component.
     #[serde(default)]
     pub ground_motion: Option<GroundMotionSpec>,
@@ -50,6 +53,7 @@ impl ModelFile {
             gravity: self.gravity,
             body: self.body.clone(),
             interface: self.interface.clone(),
+            symmetry: self.symmetry.clone(),
         }
     }
 }

@@ -93,7 +93,7 @@ fn at_rest(m: &Model) -> Data {
     let pivots = ActivePivots::uniform(m, Side::Positive);
     forward_kinematics(m, &mut data, &q, &pivots);
     mass_matrix(m, &mut data);
-    constraint_residual(m, &mut data, &pivots);
+    constraint_residual(m, &mut data, &pivots, &q);
     data
 }
 

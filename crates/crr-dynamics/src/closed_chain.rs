@@ -17,7 +17,8 @@ use crate::linalg::{pinv_solve, pivot_columns, rank};
 pub const CLOSURE_TOLERANCE: f64 = 1e-13;
 const NEWTON_ITERATIONS: usize = 30;
 
-/// Mobility of a structure at a configuration: DOF(2) = DOF(1) − rank Φ_q.
+/// Mobility of a structure at a configuration: DOF(2) = DOF(1) − rank Φ_q of the loop closures,
+/// DOF(3) with the user/symmetry constraints too.
 #[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct Mobility {
     /// DOF(1): tree coordinates.
@@ -34,6 +35,10 @@ pub struct Mobility {
     pub dof2: usize,
     /// DOF(2) = 0: the mechanism is locked.
     pub locked: bool,
+    /// User/symmetry constraints φₐ = ±φ_b.
+    pub symmetries: usize,
+    /// DOF(3) = DOF(1) − rank of Φ_q with the symmetry rows (equals DOF(2) without symmetries).
+    pub dof3: usize,
 }
 
 /// Row-scaled Φ(q) and Φ_q at q (fills `kin`).
@@ -45,7 +50,7 @@ fn scaled(
 ) -> (DVector<f64>, DMatrix<f64>) {
     let s = constraint_row_scale(model);
     forward_kinematics(model, kin, q, pivots);
-    constraint_residual(model, kin, pivots);
+    constraint_residual(model, kin, pivots, q);
     constraint_jacobian(model, kin, pivots);
     let phi = kin.phi.component_mul(&s);
     let jac = DMatrix::from_fn(model.constraint_rows, model.dof(), |i, j| {
@@ -58,16 +63,19 @@ fn scaled(
 pub fn mobility(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) -> Mobility {
     let mut kin = Data::new(model);
     let (_, jac) = scaled(model, &mut kin, q, pivots);
-    let r = rank(&jac);
+    let r = rank(&jac.rows(0, model.closure_rows).into_owned());
+    let r3 = rank(&jac);
     let dof2 = model.dof() - r;
     Mobility {
         dof1: model.dof(),
         closures: model.closures.len(),
-        constraint_rows: model.constraint_rows,
+        constraint_rows: model.closure_rows,
         rank: r,
-        redundant: model.constraint_rows - r,
+        redundant: model.closure_rows - r,
         dof2,
         locked: dof2 == 0,
+        symmetries: model.symmetries.len(),
+        dof3: model.dof() - r3,
     }
 }
 
@@ -229,7 +237,7 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
             "the given angles admit no configuration that closes the loops{over}{extra}"
         ))
     };
-    if !model.closures.is_empty() {
+    if model.constraint_rows > 0 {
         let mut previous = None;
         for _ in 0..6 {
             follow_signs(model, &mut kin, &q, &mut pivots);
@@ -256,7 +264,7 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
     for &(k, v) in &rates {
         qdot[k] = v;
     }
-    if !model.closures.is_empty() {
+    if model.constraint_rows > 0 {
         let given_r: Vec<usize> = rates.iter().map(|a| a.0).collect();
         let free_r: Vec<usize> = (0..n).filter(|k| !given_r.contains(k)).collect();
         for &k in &free_r {

@@ -122,7 +122,7 @@ impl Dynamics {
             &mut self.load,
         );
         generalized_gravity(model, &mut self.kin, &(-a), &mut self.ground_force);
-        if !model.closures.is_empty() {
+        if model.constraint_rows > 0 {
             constraint_jacobian(model, &mut self.kin, &self.pivots);
             constraint_bias(model, &mut self.kin, &self.pivots);
         }
@@ -155,7 +155,7 @@ impl Dynamics {
         self.qddot.copy_from(&self.load);
         self.qddot -= &self.kin.velocity_product;
         cholesky_solve(&self.factor, self.qddot.as_mut_slice());
-        if model.closures.is_empty() {
+        if model.constraint_rows == 0 {
             return Ok(());
         }
         // Row-scaled closures: Φ' = S Φ_q, c' = S Φ̇_q q̇.

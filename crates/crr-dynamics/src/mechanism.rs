@@ -43,7 +43,7 @@ pub fn reduce_at(
     mass_matrix(model, &mut kin);
     let mut b = DVector::zeros(n);
     b[coordinate] = 1.0;
-    if !model.closures.is_empty() {
+    if model.constraint_rows > 0 {
         constraint_jacobian(model, &mut kin, pivots);
         let s = constraint_row_scale(model);
         let others: Vec<usize> = (0..n).filter(|&k| k != coordinate).collect();
@@ -91,7 +91,7 @@ pub fn configuration(
 ) -> Result<DVector<f64>, DynamicsError> {
     let mut q = q0.clone();
     q[coordinate] = theta;
-    if !model.closures.is_empty() {
+    if model.constraint_rows > 0 {
         let free: Vec<usize> = (0..model.dof()).filter(|&k| k != coordinate).collect();
         let mut kin = Data::new(model);
         project_positions(model, &mut kin, pivots, &mut q, Some(&free))?;

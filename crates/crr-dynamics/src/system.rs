@@ -72,7 +72,7 @@ impl OdeSystem for ConstrainedSystem<'_> {
     }
 
     fn project(&mut self, _t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
-        if self.model.closures.is_empty() {
+        if self.model.constraint_rows == 0 {
             return Ok(false);
         }
         let n = self.model.dof();

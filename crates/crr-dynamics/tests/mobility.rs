@@ -61,3 +61,142 @@ fn skew_four_hinge_loop_is_locked() {
     let m = mobility_at_rest(&skew_four_hinge_loop());
     assert_eq!((m.dof1, m.dof2, m.locked), (3, 0, true), "{m:?}");
 }
+
+/// DOF(3): a symmetry constraint between the two base tilts of a rocking base fixes the diagonal
+/// direction (DOF(1) = 2 → DOF(3) = 1); on the colonnade, tying the two slab tilts leaves 1; an
+/// unknown coordinate in a symmetry is an error naming it.
+#[test]
+fn symmetry_constraints_give_dof3() {
+    use crr_kinematics::{SymmetryRelation, SymmetrySpec};
+    let mut spec = colonnade(0.2, 1.5, 1.0, 0.3);
+    spec.symmetry.push(SymmetrySpec {
+        coordinates: ["base_1.1".into(), "base_1.2".into()],
+        relation: SymmetryRelation::Opposite,
+    });
+    let m = mobility_at_rest(&spec);
+    assert_eq!((m.dof2, m.symmetries, m.dof3), (2, 1, 1), "{m:?}");
+    spec.symmetry[0].coordinates[1] = "base_9.2".into();
+    let e = Model::from_spec(&spec).unwrap_err();
+    assert!(
+        e.item.contains("symmetry #1") && e.problem.contains("base_9.2"),
+        "{e}"
+    );
+}
+
+/// A symmetric motion integrated with the symmetry row as a constraint keeps φₐ = −φ_b exactly
+/// (to the projection tolerance) while the structure moves.
+#[test]
+fn symmetry_constraint_holds_along_a_run() {
+    use crr_dynamics::ground_motion::GroundMotion;
+    use crr_dynamics::integrator::{Method, Options};
+    use crr_dynamics::{Form, InitialSpec, integrate_smooth, solve_initial};
+    use crr_kinematics::{SymmetryRelation, SymmetrySpec};
+    let mut spec = crr_kinematics::fixtures::double_pendulum();
+    spec.symmetry.push(SymmetrySpec {
+        coordinates: ["shoulder".into(), "elbow".into()],
+        relation: SymmetryRelation::Opposite,
+    });
+    let model = Model::from_spec(&spec).unwrap();
+    let init = solve_initial(
+        &model,
+        &InitialSpec {
+            angles: [("shoulder".to_string(), 0.5)].into(),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(
+        (init.q[1] + 0.5).abs() < 1e-12,
+        "the elbow follows: {}",
+        init.q[1]
+    );
+    let run = integrate_smooth(
+        &model,
+        &GroundMotion::none(),
+        &init,
+        2.0,
+        0.1,
+        Method::Dop853,
+        Options::default(),
+        Form::Constrained,
+    )
+    .unwrap();
+    let travel = run.iter().map(|s| (s.q[0] - 0.5).abs()).fold(0.0, f64::max);
+    assert!(travel > 0.1);
+    for s in &run {
+        assert!(
+            (s.q[0] + s.q[1]).abs() < 1e-10,
+            "t = {}: {:?}",
+            s.t,
+            s.q.as_slice()
+        );
+    }
+}
+
+/// Initial conditions on a closed chain: given values are kept and the rest solved so that Φ = 0
+/// and Φ_q q̇ = 0; values that admit no closed state, or unknown names, are clear errors.
+#[test]
+fn initial_conditions_on_the_trilithon() {
+    use crr_dynamics::{InitialSpec, solve_initial};
+    let model = Model::from_spec(&trilithon(0.25, 1.5, 2.0, 0.5, 1.0)).unwrap();
+    let spec = |angles: &[(&str, f64)], rates: &[(&str, f64)]| InitialSpec {
+        angles: angles.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+        rates: rates.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+    };
+    // One angle and one rate (DOF(2) = 1): the parallelogram, both columns equal, beam −θ.
+    let s = solve_initial(
+        &model,
+        &spec(&[("base_left", 0.05)], &[("base_left", -0.3)]),
+    )
+    .unwrap();
+    let (l, t, r) = (
+        model.coord_index("base_left").unwrap(),
+        model.coord_index("top_left").unwrap(),
+        model.coord_index("base_right").unwrap(),
+    );
+    assert!(
+        (s.q[r] - 0.05).abs() < 1e-12 && (s.q[t] + 0.05).abs() < 1e-12,
+        "{:?}",
+        s.q.as_slice()
+    );
+    assert!((s.qdot[r] + 0.3).abs() < 1e-12 && (s.qdot[t] - 0.3).abs() < 1e-12);
+    assert_eq!(s.pivots.sides[l], crr_kinematics::Side::Positive);
+    assert_eq!(s.pivots.sides[t], crr_kinematics::Side::Negative);
+    // Two consistent angles are accepted.
+    assert!(
+        solve_initial(
+            &model,
+            &spec(&[("base_left", 0.05), ("base_right", 0.05)], &[])
+        )
+        .is_ok()
+    );
+    // Two inconsistent angles are not, and the message says the mobility.
+    let e = solve_initial(
+        &model,
+        &spec(&[("base_left", 0.05), ("base_right", 0.1)], &[]),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("admit no configuration") && e.contains("DOF(2) = 1"),
+        "{e}"
+    );
+    let e = solve_initial(
+        &model,
+        &spec(
+            &[("base_left", 0.05)],
+            &[("base_left", 1.0), ("base_right", 2.0)],
+        ),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("rates") && e.contains("DOF(2) = 1"), "{e}");
+    let e = solve_initial(&model, &spec(&[("base_lft", 0.05)], &[]))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("base_lft") && e.contains("base_left"), "{e}");
+    let e = solve_initial(&model, &spec(&[("base_left", f64::NAN)], &[]))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not a finite number"), "{e}");
+}

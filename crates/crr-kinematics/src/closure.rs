@@ -6,7 +6,7 @@
 //! coincidence and (Γ_A e₁)·(Γ_B e₂) = 0, the condition of two tilts in series (a Hooke joint):
 //! 4 rows.
 
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{DVector, Matrix3, UnitQuaternion, Vector3};
 
 use crate::data::Data;
 use crate::kinematics::frame_point;
@@ -51,8 +51,17 @@ pub(crate) fn orientation_pairs(kind: &InterfaceKind) -> ([OrientationPair; 2], 
     }
 }
 
-/// Fills `data.phi` with Φ(q). Requires [`crate::forward_kinematics`].
-pub fn constraint_residual(model: &Model, data: &mut Data, pivots: &ActivePivots) {
+/// Fills `data.phi` with Φ(q): closure rows, then symmetry rows qₐ − s q_b.
+/// Requires [`crate::forward_kinematics`].
+pub fn constraint_residual(
+    model: &Model,
+    data: &mut Data,
+    pivots: &ActivePivots,
+    q: &DVector<f64>,
+) {
+    for (k, &(a, b, s)) in model.symmetries.iter().enumerate() {
+        data.phi[model.closure_rows + k] = q[a] - s * q[b];
+    }
     for cl in &model.closures {
         let iface = &model.interfaces[cl.interface];
         let (a, b) = closure_frames(model, cl.interface);
@@ -71,6 +80,10 @@ pub fn constraint_residual(model: &Model, data: &mut Data, pivots: &ActivePivots
 /// Fills `data.phi_q` with Φ_q = ∂Φ/∂q. Requires [`crate::forward_kinematics`].
 pub fn constraint_jacobian(model: &Model, data: &mut Data, pivots: &ActivePivots) {
     data.phi_q.fill(0.0);
+    for (k, &(a, b, s)) in model.symmetries.iter().enumerate() {
+        data.phi_q[(model.closure_rows + k, a)] = 1.0;
+        data.phi_q[(model.closure_rows + k, b)] -= s;
+    }
     for cl in &model.closures {
         let iface = &model.interfaces[cl.interface];
         let (a, b) = closure_frames(model, cl.interface);

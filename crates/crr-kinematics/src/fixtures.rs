@@ -123,6 +123,7 @@ pub fn single_block(b: f64, h: f64, density: f64) -> StructureSpec {
             [b, 0.0, 0.0],
             [-b, 0.0, 0.0],
         )],
+        symmetry: Vec::new(),
     }
 }
 
@@ -198,6 +199,7 @@ pub fn random_chain(seed: u64, n: usize, closures: usize) -> StructureSpec {
         gravity: 9.81,
         body,
         interface,
+        symmetry: Vec::new(),
     }
 }
 
@@ -388,6 +390,7 @@ pub fn trilithon(b: f64, h: f64, spacing: f64, beam_height: f64, gamma: f64) -> 
         gravity: crate::spec::DEFAULT_GRAVITY,
         body,
         interface,
+        symmetry: Vec::new(),
     }
 }
 
@@ -453,6 +456,7 @@ pub fn four_hinge_arch(r_in: f64, r_out: f64, depth: f64, two_sided: bool) -> St
         gravity: crate::spec::DEFAULT_GRAVITY,
         body,
         interface,
+        symmetry: Vec::new(),
     }
 }
 
@@ -513,6 +517,7 @@ pub fn colonnade(b: f64, h: f64, s: f64, slab: f64) -> StructureSpec {
         gravity: crate::spec::DEFAULT_GRAVITY,
         body,
         interface,
+        symmetry: Vec::new(),
     }
 }
 
@@ -562,6 +567,7 @@ pub fn skew_four_hinge_loop() -> StructureSpec {
         gravity: crate::spec::DEFAULT_GRAVITY,
         body,
         interface,
+        symmetry: Vec::new(),
     }
 }
 
@@ -592,6 +598,7 @@ pub fn double_pendulum() -> StructureSpec {
                 [0.0, 0.0, -1.0],
             ),
         ],
+        symmetry: Vec::new(),
     }
 }
 
@@ -628,5 +635,6 @@ pub fn serial_chain(n: usize) -> StructureSpec {
         gravity: crate::spec::DEFAULT_GRAVITY,
         body,
         interface,
+        symmetry: Vec::new(),
     }
 }

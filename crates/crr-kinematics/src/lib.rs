@@ -55,5 +55,8 @@ pub use mass_matrix::{kinetic_energy, mass_matrix, mass_matrix_from_jacobians};
 pub use model::{Body, Closure, Coordinate, Interface, InterfaceKind, Model, Parent, Role, Side};
 pub use pivots::ActivePivots;
 pub use potential::{generalized_gravity, potential_energy};
-pub use spec::{BodySpec, ImpactLaw, InterfaceSpec, PivotSpec, RockingBaseSpec, StructureSpec};
+pub use spec::{
+    BodySpec, ImpactLaw, InterfaceSpec, PivotSpec, RockingBaseSpec, StructureSpec,
+    SymmetryRelation, SymmetrySpec,
+};
 pub use velocity::{constraint_bias, velocities, velocity_product};

@@ -241,7 +241,11 @@ pub struct Model {
     /// For each body, the coordinate whose frame it moves with (the last angle of the tree interface
     /// whose child it is).
     pub body_coord: Vec<usize>,
-    /// Total rows of Φ.
+    /// User/symmetry constraints φₐ − s φ_b = 0 as (a, b, s), rows after the closures' in Φ.
+    pub symmetries: Vec<(usize, usize, f64)>,
+    /// Rows of Φ from the loop closures (the symmetry rows follow them).
+    pub closure_rows: usize,
+    /// Total rows of Φ: closures, then symmetries.
     pub constraint_rows: usize,
     /// Total pivot-side slots: one per tree coordinate (slot k = coordinate k), then one per closure
     /// angle.
@@ -700,6 +704,46 @@ impl Model {
             });
             row += rows;
         }
+        let mut symmetries = Vec::new();
+        for (k, sy) in spec.symmetry.iter().enumerate() {
+            let item = format!(
+                "symmetry #{} ({} = {}{})",
+                k + 1,
+                sy.coordinates[0],
+                if sy.relation == crate::spec::SymmetryRelation::Opposite {
+                    "−"
+                } else {
+                    ""
+                },
+                sy.coordinates[1]
+            );
+            let find = |name: &str| {
+                coords
+                    .iter()
+                    .position(|c: &Coordinate| c.name == name)
+                    .ok_or_else(|| {
+                        let names: Vec<_> = coords.iter().map(|c| c.name.as_str()).collect();
+                        ModelError::new(
+                            item.clone(),
+                            format!(
+                                "no coordinate named \"{name}\"; coordinates are: {}",
+                                names.join(", ")
+                            ),
+                        )
+                    })
+            };
+            let (a, b) = (find(&sy.coordinates[0])?, find(&sy.coordinates[1])?);
+            if a == b {
+                return Err(ModelError::new(item, "relates a coordinate to itself"));
+            }
+            let sign = match sy.relation {
+                crate::spec::SymmetryRelation::Equal => 1.0,
+                crate::spec::SymmetryRelation::Opposite => -1.0,
+            };
+            symmetries.push((a, b, sign));
+        }
+        let closure_rows = row;
+        let row = row + symmetries.len();
         let interfaces = ends
             .into_iter()
             .enumerate()
@@ -721,6 +765,8 @@ impl Model {
             coords,
             closures,
             body_coord,
+            symmetries,
+            closure_rows,
             constraint_rows: row,
             slot_count: slot,
             size,

@@ -29,6 +29,29 @@ pub struct StructureSpec {
     /// The interfaces (`[[interface]]` tables).
     #[serde(default)]
     pub interface: Vec<InterfaceSpec>,
+    /// User or symmetry constraints between coordinates (`[[symmetry]]` tables), giving DOF(3).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub symmetry: Vec<SymmetrySpec>,
+}
+
+/// A user constraint between two coordinates: φₐ = φ_b (`"equal"`) or φₐ = −φ_b (`"opposite"`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SymmetrySpec {
+    /// The two coordinate names [a, b].
+    pub coordinates: [String; 2],
+    /// `"equal"` (φₐ = φ_b) or `"opposite"` (φₐ = −φ_b).
+    pub relation: SymmetryRelation,
+}
+
+/// The relation of a [`SymmetrySpec`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SymmetryRelation {
+    /// φₐ = φ_b.
+    Equal,
+    /// φₐ = −φ_b.
+    Opposite,
 }
 
 /// One rigid body: a name, its density or mass, and exactly one shape in world coordinates at rest.

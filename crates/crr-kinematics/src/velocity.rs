@@ -99,6 +99,10 @@ pub fn velocity_product(model: &Model, data: &mut Data) {
 /// points; orientation rows r = A·B with Ȧ = ω × A: r̈ = Ä·B + 2Ȧ·Ḃ + A·B̈ at q̈ = 0.
 /// Requires [`velocities`].
 pub fn constraint_bias(model: &Model, data: &mut Data, pivots: &ActivePivots) {
+    // Symmetry rows are linear in q: no bias.
+    for k in 0..model.symmetries.len() {
+        data.phi_bias[model.closure_rows + k] = 0.0;
+    }
     for cl in &model.closures {
         let iface = &model.interfaces[cl.interface];
         let (a, b) = (
