@@ -249,7 +249,7 @@ fn solve_projected(
     }
     let res = (&sys * &x - &rhs).norm();
     let size = rhs.norm().max(f64::MIN_POSITIVE) + (sys.norm() * x.norm());
-    if !(res <= RESIDUAL_TOLERANCE * size) {
+    if res.is_nan() || res > RESIDUAL_TOLERANCE * size {
         return Err(ImpactError::Residual {
             law,
             residual: res / size,
@@ -507,7 +507,7 @@ pub fn dirac_regularised_force(
             None => pinv_solve(&kin.mass_matrix, &a).0,
         };
         let denom = a.dot(&minv_a);
-        if !(denom > 0.0) {
+        if denom.is_nan() || denom <= 0.0 {
             continue;
         }
         *out += a * (c * r.ln() * rate * rate.abs() * d / denom);
