@@ -96,7 +96,12 @@ fn symmetric_shape_coefficient_uses_inertia_about_the_pivot() {
         let model = Model::from_spec(&trapezoid(b, bt, height, 0.6)).unwrap();
         let mut kin = Data::new(&model);
         let q = DVector::zeros(1);
-        forward_kinematics(&model, &mut kin, &q, &ActivePivots::uniform(&model, Side::Positive));
+        forward_kinematics(
+            &model,
+            &mut kin,
+            &q,
+            &ActivePivots::uniform(&model, Side::Positive),
+        );
         mass_matrix(&model, &mut kin);
         let i0 = kin.mass_matrix[(0, 0)];
         let r = 1.0 - 2.0 * model.bodies[0].mass * b * b / i0;
@@ -105,7 +110,11 @@ fn symmetric_shape_coefficient_uses_inertia_about_the_pivot() {
             let res =
                 momentum_law(&model, &mut kin, &q, &qd, &sides(&[s0]), &sides(&[s1])).unwrap();
             // Same scalar arithmetic as the block: round-off only.
-            assert!((res.qdot[0] / w - r).abs() < 1e-12, "{} vs {r}", res.qdot[0] / w);
+            assert!(
+                (res.qdot[0] / w - r).abs() < 1e-12,
+                "{} vs {r}",
+                res.qdot[0] / w
+            );
         }
     }
 }
@@ -206,10 +215,22 @@ fn two_block_stack() -> StructureSpec {
         gravity: DEFAULT_GRAVITY,
         body: vec![
             box_body("lower", 2500.0, [0.0, 0.0, h1], [2.0 * b1, d, 2.0 * h1]),
-            box_body("upper", 2300.0, [0.0, 0.0, 2.0 * h1 + h2], [2.0 * b2, d, 2.0 * h2]),
+            box_body(
+                "upper",
+                2300.0,
+                [0.0, 0.0, 2.0 * h1 + h2],
+                [2.0 * b2, d, 2.0 * h2],
+            ),
         ],
         interface: vec![
-            hinge("base", "ground", "lower", [0.0, 1.0, 0.0], [b1, 0.0, 0.0], [-b1, 0.0, 0.0]),
+            hinge(
+                "base",
+                "ground",
+                "lower",
+                [0.0, 1.0, 0.0],
+                [b1, 0.0, 0.0],
+                [-b1, 0.0, 0.0],
+            ),
             hinge(
                 "joint",
                 "lower",
@@ -345,7 +366,9 @@ impl EventFunctions for Level {
 }
 
 fn run_to(solver: &mut Solver, sys: &mut Block, level: f64) -> Vec<f64> {
-    let stop = solver.advance(sys, 10.0, &mut Level(level), &mut |_| {}).unwrap();
+    let stop = solver
+        .advance(sys, 10.0, &mut Level(level), &mut |_| {})
+        .unwrap();
     assert!(matches!(stop, Stop::Event { .. }));
     solver.y().to_vec()
 }
@@ -366,7 +389,13 @@ fn regularised_dirac_converges_to_the_exact_impulse_at_first_order() {
             h_max: eps / w0.abs() / 200.0,
             ..Options::default()
         };
-        let mut sys = Block { p2, alpha, r, c, eps: Some(eps) };
+        let mut sys = Block {
+            p2,
+            alpha,
+            r,
+            c,
+            eps: Some(eps),
+        };
         let mut solver = Solver::new(Method::Dop853, opts, 2).unwrap();
         solver.reset(0.0, &[2.0 * eps, w0]);
         let y = run_to(&mut solver, &mut sys, -2.0 * eps);
@@ -401,7 +430,12 @@ fn regularised_force_matches_the_scalar_formula_on_the_block() {
     let model = block_model(0.2, 1.0);
     let mut kin = Data::new(&model);
     let q = DVector::from_element(1, 1e-3);
-    forward_kinematics(&model, &mut kin, &q, &ActivePivots::uniform(&model, Side::Positive));
+    forward_kinematics(
+        &model,
+        &mut kin,
+        &q,
+        &ActivePivots::uniform(&model, Side::Positive),
+    );
     mass_matrix(&model, &mut kin);
     let qd = DVector::from_element(1, -0.5);
     let mut out = DVector::zeros(1);
@@ -422,13 +456,34 @@ fn random_stack(n: usize, dims: &[(f64, f64, f64, f64, bool)]) -> StructureSpec 
     for (i, &(bx, by, h, off, about_x)) in dims.iter().take(n).enumerate() {
         let name = format!("b{i}");
         let c = Vector3::new(off, 0.0, z + h);
-        body.push(box_body(&name, 2000.0 + 300.0 * i as f64, c.into(), [2.0 * bx, 2.0 * by, 2.0 * h]));
+        body.push(box_body(
+            &name,
+            2000.0 + 300.0 * i as f64,
+            c.into(),
+            [2.0 * bx, 2.0 * by, 2.0 * h],
+        ));
         let (axis, pa, pb) = if about_x {
-            (Vector3::x(), Vector3::new(off, by, z), Vector3::new(off, -by, z))
+            (
+                Vector3::x(),
+                Vector3::new(off, by, z),
+                Vector3::new(off, -by, z),
+            )
         } else {
-            (Vector3::y(), Vector3::new(off + bx, 0.0, z), Vector3::new(off - bx, 0.0, z))
+            (
+                Vector3::y(),
+                Vector3::new(off + bx, 0.0, z),
+                Vector3::new(off - bx, 0.0, z),
+            )
         };
-        interface.push(oriented_hinge(&format!("h{i}"), &parent, &name, axis, pa, pb, c));
+        interface.push(oriented_hinge(
+            &format!("h{i}"),
+            &parent,
+            &name,
+            axis,
+            pa,
+            pb,
+            c,
+        ));
         z += 2.0 * h;
         parent = name;
     }
@@ -455,8 +510,14 @@ fn body_momentum_rhs(
     jacobians(model, &mut kp);
     let mut b = DVector::zeros(model.dof());
     for (i, body) in model.bodies.iter().enumerate() {
-        let (jcm, jwm) = (km.com_jacobian.rows(3 * i, 3), km.angular_jacobian.rows(3 * i, 3));
-        let (jcp, jwp) = (kp.com_jacobian.rows(3 * i, 3), kp.angular_jacobian.rows(3 * i, 3));
+        let (jcm, jwm) = (
+            km.com_jacobian.rows(3 * i, 3),
+            km.angular_jacobian.rows(3 * i, 3),
+        );
+        let (jcp, jwp) = (
+            kp.com_jacobian.rows(3 * i, 3),
+            kp.angular_jacobian.rows(3 * i, 3),
+        );
         let iw = world_inertia(body, &kp.rot_ops[model.body_coord[i]]);
         b += jcp.transpose() * (jcm * qd) * body.mass + jwp.transpose() * (iw * (jwm * qd));
     }
@@ -511,4 +572,108 @@ proptest! {
         let lhs = &kin.mass_matrix * &res.qdot;
         prop_assert!((&lhs - &b).norm() <= 1e-10 * b.norm().max(1e-300), "{lhs} vs {b}");
     }
+}
+
+#[test]
+fn closure_slot_rates_match_the_closure_angles() {
+    use crr_kinematics::closure_angles;
+    use crr_kinematics::fixtures::{colonnade, random_chain};
+    for spec in [
+        colonnade(0.3, 2.0, 1.5, 0.4),
+        random_chain(7, 4, 2),
+        random_chain(11, 5, 2),
+        trilithon(0.3, 2.0, 3.0, 0.5, 1.0),
+    ] {
+        let model = Model::from_spec(&spec).unwrap();
+        let n = model.dof();
+        let pivots = ActivePivots::uniform(&model, Side::Positive);
+        let q = DVector::zeros(n);
+        let qd = DVector::from_fn(n, |i, _| 0.3 + 0.17 * i as f64 - 0.05 * (i * i) as f64);
+        let mut kin = Data::new(&model);
+        forward_kinematics(&model, &mut kin, &q, &pivots);
+        let nc = model.slot_count - n;
+        let angles_at = |x: &DVector<f64>| {
+            let mut k = Data::new(&model);
+            forward_kinematics(&model, &mut k, x, &pivots);
+            let mut out = vec![0.0; nc];
+            closure_angles(&model, &k, &mut out);
+            out
+        };
+        let hs = 1e-6;
+        let (ap, am) = (angles_at(&(&q + &qd * hs)), angles_at(&(&q - &qd * hs)));
+        for s in n..model.slot_count {
+            let fd = (ap[s - n] - am[s - n]) / (2.0 * hs);
+            let a = slot_rate_direction(&model, &kin, s);
+            // Central difference: O(h²) ≈ 1e-12 truncation, round-off ε/h ≈ 1e-10.
+            assert!(
+                (a.dot(&qd) - fd).abs() < 1e-8,
+                "{}: slot {s}: {} vs {fd}",
+                model.name,
+                a.dot(&qd)
+            );
+        }
+    }
+}
+
+#[test]
+fn redundant_closures_colonnade_momentum_law() {
+    use crr_kinematics::fixtures::colonnade;
+    // Four columns under a rigid slab: 3 rocking-base closures (12 rows), many redundant.
+    let model = Model::from_spec(&colonnade(0.3, 2.0, 1.5, 0.4)).unwrap();
+    let n = model.dof();
+    let before = ActivePivots::uniform(&model, Side::Positive);
+    let after = ActivePivots::uniform(&model, Side::Negative);
+    let q = DVector::zeros(n);
+    let mut kin = Data::new(&model);
+    forward_kinematics(&model, &mut kin, &q, &before);
+    constraint_jacobian(&model, &mut kin, &before);
+    // q̇⁻ = the projection of an arbitrary vector on ker Φ_q⁻.
+    let phi = kin.phi_q.clone();
+    let v = DVector::from_fn(n, |i, _| (i as f64 * 0.7).sin());
+    let (x, _) = pinv_solve(&phi, &(&phi * &v));
+    let qd = &v - x;
+    assert!(scaled_phi_rate(&model, &mut kin, &before, &qd) < 1e-12);
+    let res = momentum_law(&model, &mut kin, &q, &qd, &before, &after).unwrap();
+    assert!(scaled_phi_rate(&model, &mut kin, &after, &res.qdot) < 1e-12);
+    assert!(res.kinetic_after <= res.kinetic_before * (1.0 + 1e-12));
+    assert!(res.kinetic_after > 0.0);
+}
+
+#[test]
+fn closed_chain_dirac_and_restitution_on_a_closure_slot() {
+    let model = Model::from_spec(&trilithon(0.3, 2.0, 3.0, 0.5, 1.0)).unwrap();
+    let mut before = ActivePivots::uniform(&model, Side::Positive);
+    let slot = |name: &str| {
+        model.interfaces[model.interface_index(name).unwrap()]
+            .slots
+            .start
+    };
+    for name in ["top_left", "top_right"] {
+        before.sides[slot(name)] = Side::Negative;
+    }
+    let after = ActivePivots {
+        sides: before.sides.iter().map(|s| s.flipped()).collect(),
+    };
+    let q = DVector::zeros(model.dof());
+    let qd = mechanism_velocity(&model, &q, &before);
+    let mut kin = Data::new(&model);
+    forward_kinematics(&model, &mut kin, &q, &before);
+    let s = slot("top_right");
+    let a = slot_rate_direction(&model, &kin, s);
+    let (r, c) = (0.8, 1.7);
+    let res = dirac_law(&model, &mut kin, &q, &qd, &before, &after, &[(s, r, c)]).unwrap();
+    // DOF(2) = 1: the closure slot's rate fixes the whole motion; round-off only.
+    assert!((a.dot(&res.qdot) / a.dot(&qd) - r.powf(c)).abs() < 1e-12);
+    assert!(scaled_phi_rate(&model, &mut kin, &after, &res.qdot) < 1e-12);
+    // Two independent prescriptions on a one-DOF mechanism: singular, reported as an error.
+    let e = restitution_law(
+        &model,
+        &mut kin,
+        &q,
+        &qd,
+        &before,
+        &after,
+        &[(s, r), (0, r)],
+    );
+    assert!(matches!(e, Err(ImpactError::Singular { .. })), "{e:?}");
 }
