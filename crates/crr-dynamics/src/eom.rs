@@ -80,8 +80,80 @@ pub struct Dynamics {
     /// λ, closure multipliers (N for point rows, N m for axis rows); Φ_qᵀλ is the generalized
     /// constraint force.
     pub lambda: DVector<f64>,
+    /// Angle slots held at φ = 0 (seated interfaces): extra constraint rows after Φ's.
+    pub seated: Vec<usize>,
+    /// Generalized reaction moments holding the seated slots (N m), in the order of `seated`.
+    pub seat_reactions: DVector<f64>,
+    /// Extra generalized force added to Q at the last evaluation (e.g. a regularised impact law).
+    pub extra_force: DVector<f64>,
     factor: DMatrix<f64>,
     row_scale: DVector<f64>,
+}
+
+/// A generalized force added to the equations of motion (e.g. the regularised Dirac-delta law).
+pub trait GeneralizedForce {
+    /// Adds the force at (t, q, q̇) to `out`; `kin` holds the kinematics and M of that state.
+    fn add(
+        &mut self,
+        model: &Model,
+        kin: &Data,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        out: &mut DVector<f64>,
+    );
+}
+
+/// The constraint row of an angle slot: the generalized direction a with φ̇ = aᵀq̇ (eₖ for a tree
+/// coordinate; for a closure angle the relative angular velocity of child and parent frames along
+/// the angle's world axis), and its bias ȧᵀq̇. Requires kinematics and velocities in `kin`.
+pub fn slot_row(model: &Model, kin: &Data, slot: usize, row: &mut DVector<f64>) -> f64 {
+    row.fill(0.0);
+    if slot < model.dof() {
+        row[slot] = 1.0;
+        return 0.0;
+    }
+    let (iface, component) = model
+        .interfaces
+        .iter()
+        .find_map(|i| i.slots.clone().position(|s| s == slot).map(|c| (i, c)))
+        .expect("slot of a closure interface");
+    let (a, b) = (
+        model.frame_of(iface.parent),
+        Some(model.body_coord[iface.child]),
+    );
+    let rot = |k: Option<usize>| k.map_or_else(nalgebra::Matrix3::identity, |k| kin.rot_ops[k]);
+    let ang = |k: Option<usize>, part: usize| -> Vector3<f64> {
+        k.map_or_else(Vector3::zeros, |k| {
+            let v = if part == 0 {
+                &kin.spatial_velocity[k]
+            } else {
+                &kin.bias_acceleration[k]
+            };
+            Vector3::new(v[0], v[1], v[2])
+        })
+    };
+    // The axis is attached to the parent, except a rocking base's second tilt (child).
+    let (w, on_child) = match &iface.kind {
+        crr_kinematics::InterfaceKind::Hinge { axis, .. } => (rot(a) * axis, false),
+        crr_kinematics::InterfaceKind::RockingBase { e1, e2, .. } => {
+            if component == 0 {
+                (rot(a) * e1, false)
+            } else {
+                (rot(b) * e2, true)
+            }
+        }
+    };
+    for (frame, sign) in [(b, 1.0), (a, -1.0)] {
+        let mut j = frame;
+        while let Some(jj) = j {
+            row[jj] += sign * w.dot(&kin.axis[jj]);
+            j = model.coords[jj].parent;
+        }
+    }
+    let (wa, wb) = (ang(a, 0), ang(b, 0));
+    let w_dot = if on_child { wb.cross(&w) } else { wa.cross(&w) };
+    w.dot(&(ang(b, 1) - ang(a, 1))) + (wb - wa).dot(&w_dot)
 }
 
 impl Dynamics {
@@ -97,6 +169,9 @@ impl Dynamics {
             lambda: DVector::zeros(model.constraint_rows),
             factor: DMatrix::zeros(n, n),
             row_scale: constraint_row_scale(model),
+            seated: Vec::new(),
+            seat_reactions: DVector::zeros(0),
+            extra_force: DVector::zeros(n),
         }
     }
 
@@ -141,7 +216,8 @@ impl Dynamics {
         cholesky_solve(&self.factor, b.as_mut_slice());
     }
 
-    /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains do not allocate.
+    /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains with nothing seated do not
+    /// allocate.
     pub fn accelerations(
         &mut self,
         model: &Model,
@@ -150,27 +226,63 @@ impl Dynamics {
         q: &DVector<f64>,
         qdot: &DVector<f64>,
     ) -> Result<(), DynamicsError> {
+        self.accelerations_with(model, ground, t, q, qdot, None)
+    }
+
+    /// [`Self::accelerations`] with an extra generalized force.
+    pub fn accelerations_with(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) -> Result<(), DynamicsError> {
         self.evaluate(model, ground, t, q, qdot);
         self.factorise(model)?;
+        self.extra_force.fill(0.0);
+        if let Some(f) = extra {
+            f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
+        }
         self.qddot.copy_from(&self.load);
+        self.qddot += &self.extra_force;
         self.qddot -= &self.kin.velocity_product;
         cholesky_solve(&self.factor, self.qddot.as_mut_slice());
-        if model.constraint_rows == 0 {
+        let rows = model.constraint_rows + self.seated.len();
+        if rows == 0 {
             return Ok(());
         }
-        // Row-scaled closures: Φ' = S Φ_q, c' = S Φ̇_q q̇.
-        let phi_q = DMatrix::from_fn(model.constraint_rows, model.dof(), |i, j| {
-            self.row_scale[i] * self.kin.phi_q[(i, j)]
-        });
+        // Row-scaled closures Φ' = S Φ_q, c' = S Φ̇_q q̇, then one row per seated slot.
+        let mut phi_q = DMatrix::zeros(rows, model.dof());
+        let mut bias = DVector::zeros(rows);
+        for i in 0..model.constraint_rows {
+            for j in 0..model.dof() {
+                phi_q[(i, j)] = self.row_scale[i] * self.kin.phi_q[(i, j)];
+            }
+            bias[i] = self.row_scale[i] * self.kin.phi_bias[i];
+        }
+        let mut row = DVector::zeros(model.dof());
+        for (k, &slot) in self.seated.iter().enumerate() {
+            bias[model.constraint_rows + k] = slot_row(model, &self.kin, slot, &mut row);
+            phi_q
+                .row_mut(model.constraint_rows + k)
+                .copy_from(&row.transpose());
+        }
         let mut y = phi_q.transpose();
         for mut col in y.column_iter_mut() {
             cholesky_solve(&self.factor, col.as_mut_slice());
         }
         let a = &phi_q * &y;
-        let rhs = -self.kin.phi_bias.component_mul(&self.row_scale) - &phi_q * &self.qddot;
+        let rhs = -bias - &phi_q * &self.qddot;
         let (lambda_scaled, _) = pinv_solve(&a, &rhs);
         self.qddot += &y * &lambda_scaled;
-        self.lambda = lambda_scaled.component_mul(&self.row_scale);
+        self.lambda = lambda_scaled
+            .rows(0, model.constraint_rows)
+            .component_mul(&self.row_scale);
+        self.seat_reactions = lambda_scaled
+            .rows(model.constraint_rows, self.seated.len())
+            .into_owned();
         if self.qddot.iter().any(|x| !x.is_finite()) {
             return Err(DynamicsError::NonFinite {
                 what: "acceleration",

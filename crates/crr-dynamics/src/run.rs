@@ -62,8 +62,8 @@ pub fn integrate_smooth(
     match form {
         Form::Constrained => {
             let mut sys = ConstrainedSystem::new(model, ground, &mut dynamics);
-            let mut solver = Solver::new(method, options, 2 * model.dof() + 1)?;
-            solver.reset(0.0, &ConstrainedSystem::pack(&init.q, &init.qdot, 0.0));
+            let mut solver = Solver::new(method, options, 2 * model.dof() + 2)?;
+            solver.reset(0.0, &ConstrainedSystem::pack(&init.q, &init.qdot, 0.0, 0.0));
             for k in 1..=n_samples {
                 while solver.t() < (k as f64 * dt).min(t_end) {
                     let target = stops(solver.t(), k);

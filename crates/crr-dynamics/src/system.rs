@@ -13,19 +13,22 @@ use nalgebra::{DMatrix, DVector};
 use crr_kinematics::Model;
 
 use crate::closed_chain::{Partition, project_positions, project_velocities};
-use crate::eom::Dynamics;
+use crate::eom::{Dynamics, GeneralizedForce};
 use crate::ground_motion::GroundMotion;
 use crate::integrator::{OdeSystem, RhsError};
 use crate::linalg::{cholesky_in_place, cholesky_solve, pseudo_inverse};
 
-/// The multi-DOF constrained form.
+/// The multi-DOF constrained form: y = [q, q̇, W, D] with W the work of the ground motion and D
+/// the energy dissipated by the extra force (if any), Ḋ = −F_extraᵀq̇.
 pub struct ConstrainedSystem<'a> {
     /// The structure.
     pub model: &'a Model,
     /// The ground motion.
     pub ground: &'a GroundMotion,
-    /// Equations-of-motion workspace, with the dynamic chain (pivots).
+    /// Equations-of-motion workspace, with the dynamic chain (pivots) and seated slots.
     pub dynamics: &'a mut Dynamics,
+    /// An extra generalized force (e.g. a regularised impact law).
+    pub extra: Option<&'a mut dyn GeneralizedForce>,
     q: DVector<f64>,
     qdot: DVector<f64>,
 }
@@ -38,57 +41,78 @@ impl<'a> ConstrainedSystem<'a> {
             model,
             ground,
             dynamics,
+            extra: None,
             q: DVector::zeros(n),
             qdot: DVector::zeros(n),
         }
     }
 
-    /// State vector [q, q̇, W].
-    pub fn pack(q: &DVector<f64>, qdot: &DVector<f64>, work: f64) -> Vec<f64> {
+    /// State vector [q, q̇, W, D].
+    pub fn pack(q: &DVector<f64>, qdot: &DVector<f64>, work: f64, dissipated: f64) -> Vec<f64> {
         q.iter()
             .chain(qdot.iter())
             .copied()
-            .chain(std::iter::once(work))
+            .chain([work, dissipated])
             .collect()
     }
 }
 
 impl OdeSystem for ConstrainedSystem<'_> {
     fn dim(&self) -> usize {
-        2 * self.model.dof() + 1
+        2 * self.model.dof() + 2
     }
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
         let n = self.model.dof();
         self.q.as_mut_slice().copy_from_slice(&y[..n]);
         self.qdot.as_mut_slice().copy_from_slice(&y[n..2 * n]);
+        let extra: Option<&mut dyn GeneralizedForce> = match &mut self.extra {
+            Some(f) => Some(&mut **f),
+            None => None,
+        };
         self.dynamics
-            .accelerations(self.model, self.ground, t, &self.q, &self.qdot)
+            .accelerations_with(self.model, self.ground, t, &self.q, &self.qdot, extra)
             .map_err(|e| RhsError(e.to_string()))?;
         dydt[..n].copy_from_slice(&y[n..2 * n]);
         dydt[n..2 * n].copy_from_slice(self.dynamics.qddot.as_slice());
         dydt[2 * n] = self.dynamics.ground_force.dot(&self.qdot);
+        dydt[2 * n + 1] = -self.dynamics.extra_force.dot(&self.qdot);
         Ok(())
     }
 
     fn project(&mut self, _t: f64, y: &mut [f64]) -> Result<bool, RhsError> {
-        if self.model.constraint_rows == 0 {
+        let seated_tree: Vec<usize> = self
+            .dynamics
+            .seated
+            .iter()
+            .copied()
+            .filter(|&s| s < self.model.dof())
+            .collect();
+        if self.model.constraint_rows == 0 && seated_tree.is_empty() {
             return Ok(false);
         }
         let n = self.model.dof();
         self.q.as_mut_slice().copy_from_slice(&y[..n]);
         self.qdot.as_mut_slice().copy_from_slice(&y[n..2 * n]);
-        let d = &mut *self.dynamics;
-        project_positions(self.model, &mut d.kin, &d.pivots, &mut self.q, None)
-            .map_err(|e| RhsError(e.to_string()))?;
-        project_velocities(
-            self.model,
-            &mut d.kin,
-            &d.pivots,
-            &self.q,
-            &mut self.qdot,
-            None,
-        );
+        // Seated tree coordinates are exactly 0; the others close the loops.
+        for &k in &seated_tree {
+            self.q[k] = 0.0;
+            self.qdot[k] = 0.0;
+        }
+        if self.model.constraint_rows > 0 {
+            let free: Vec<usize> = (0..n).filter(|k| !seated_tree.contains(k)).collect();
+            let d = &mut *self.dynamics;
+            project_positions(self.model, &mut d.kin, &d.pivots, &mut self.q, Some(&free))
+                .map_err(|e| RhsError(e.to_string()))?;
+            project_velocities(
+                self.model,
+                &mut d.kin,
+                &d.pivots,
+                &self.q,
+                &mut self.qdot,
+                Some(&free),
+            );
+        }
         y[..n].copy_from_slice(self.q.as_slice());
         y[n..2 * n].copy_from_slice(self.qdot.as_slice());
         Ok(true)

@@ -87,6 +87,7 @@ fn trapezoid(b: f64, bt: f64, height: f64, d: f64) -> StructureSpec {
             [b, 0.0, 0.0],
             [-b, 0.0, 0.0],
         )],
+        symmetry: Vec::new(),
     }
 }
 
@@ -240,6 +241,7 @@ fn two_block_stack() -> StructureSpec {
                 [-b2, 0.0, 2.0 * h1],
             ),
         ],
+        symmetry: Vec::new(),
     }
 }
 
@@ -492,6 +494,7 @@ fn random_stack(n: usize, dims: &[(f64, f64, f64, f64, bool)]) -> StructureSpec 
         gravity: DEFAULT_GRAVITY,
         body,
         interface,
+        symmetry: Vec::new(),
     }
 }
 
