@@ -1,3 +1,6 @@
 //! Pivot switching, impact laws and the event-driven simulation of coupled rocking rotations.
 
 pub mod laws;
+pub mod simulation;
+
+pub use simulation::{Parameters, Simulation, SlotState, StopReason, Trajectory};

@@ -1,0 +1,999 @@
+//! The event-driven simulation: rocking, impacts, seating, uplift and collapse.
+//!
+//! Every interface angle slot is **seated** (φ = 0 held by a constraint row) or **rocking** about
+//! P⁺ or P⁻ (its side in the dynamic chain). Between events the constrained equations of motion are
+//! integrated with DOP853 (or the method chosen), never stepping across a breakpoint of the ground
+//! motion. Events, located on the dense output and then reached by a real step:
+//! - a rocking angle crossing 0: an **impact** (all rocking angles within
+//!   [`Parameters::simultaneity`] of 0 and moving towards it impact together, as the four hinges of
+//!   an arch); the pivots switch and the interface's impact law maps q̇⁻ to q̇⁺;
+//! - **uplift** of seated interfaces, when keeping them seated would need tension (see
+//!   [`opening_mode`]);
+//! - **collapse**: the potential energy falls below its value at rest by more than
+//!   [`Parameters::collapse_drop`]·W·L (W the weight, L the model size) while the rotations grow
+//!   (q·q̇ > 0): the structure is past its point of no return (for a block, beyond θ = 2α); the run
+//!   stops with the time and the body whose centre has dropped most.
+//!
+//! **Seating** (the Zeno limit of free rocking, infinitely many impacts in finite time): after an
+//! impact, an interface whose rate is below [`Parameters::seat_rate`], or that impacted less than
+//! [`Parameters::min_impact_interval`] before, is seated with a plastic impulse on that angle alone
+//! (its rate set to 0, the other generalized momenta kept); the run continues seated until uplift.
+
+use nalgebra::DVector;
+use serde::Serialize;
+
+use crr_dynamics::eom::{Dynamics, GeneralizedForce, slot_row};
+use crr_dynamics::ground_motion::GroundMotion;
+use crr_dynamics::integrator::{
+    DenseStep, Direction, EventFunctions, Method, Options, SolveError, Solver, Stop,
+};
+use crr_dynamics::{ConstrainedSystem, InitialState};
+use crr_kinematics::spec::ImpactLaw;
+use crr_kinematics::{
+    ActivePivots, Data, Model, Side, closure_angles, forward_kinematics, mass_matrix,
+    potential_energy,
+};
+
+use crate::laws::{ImpactError, dirac_law, dirac_regularised_force, momentum_law, restitution_law};
+
+/// Tunable parameters of a simulation, with documented defaults.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Parameters {
+    /// End time of the run (s).
+    pub duration: f64,
+    /// Interval between output samples (s). Default 0.01.
+    pub output_interval: f64,
+    /// Integration method. Default DOP853.
+    #[serde(skip)]
+    pub method: Method,
+    /// Integrator tolerances. Default rtol 1e-10, atol 1e-12.
+    pub options: Options,
+    /// An interface whose rate after an impact is below this seats (rad/s). Default 1e-4.
+    pub seat_rate: f64,
+    /// An interface impacting again within this time seats (s). Default 1e-6.
+    pub min_impact_interval: f64,
+    /// Rocking angles within this of 0 at an impact impact together (rad). Default 1e-8.
+    pub simultaneity: f64,
+    /// Largest number of impacts before the run stops with an error. Default 1 000 000.
+    pub max_impacts: usize,
+    /// Friction coefficient μ of every contact for the hypotheses monitor (None: not checked).
+    pub friction: Option<f64>,
+    /// Collapse is declared when U falls below its rest value by this fraction of W·L (total
+    /// weight times the model size) while the rotations grow. Default 1e-3.
+    pub collapse_drop: f64,
+}
+
+impl Default for Parameters {
+    fn default() -> Self {
+        Self {
+            duration: 10.0,
+            output_interval: 0.01,
+            method: Method::Dop853,
+            options: Options {
+                rtol: 1e-10,
+                atol: 1e-12,
+                ..Options::default()
+            },
+            seat_rate: 1e-4,
+            min_impact_interval: 1e-6,
+            simultaneity: 1e-8,
+            max_impacts: 1_000_000,
+            friction: None,
+            collapse_drop: 1e-3,
+        }
+    }
+}
+
+/// The state of one angle slot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum SlotState {
+    /// Held at φ = 0.
+    Seated,
+    /// Rocking about P⁺.
+    Positive,
+    /// Rocking about P⁻.
+    Negative,
+}
+
+impl SlotState {
+    /// `seated`, `+` or `-` (the history file's codes).
+    pub fn code(self) -> &'static str {
+        match self {
+            SlotState::Seated => "seated",
+            SlotState::Positive => "+",
+            SlotState::Negative => "-",
+        }
+    }
+}
+
+/// One output sample.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sample {
+    /// Time (s).
+    pub t: f64,
+    /// q (rad).
+    pub q: Vec<f64>,
+    /// q̇ (rad/s).
+    pub qdot: Vec<f64>,
+    /// Kinetic energy T (J).
+    pub kinetic: f64,
+    /// U − U(rest) (J).
+    pub potential: f64,
+    /// Work done by the ground motion since the start (J).
+    pub work_in: f64,
+    /// Energy dissipated since the start, at impacts and by regularised laws (J).
+    pub dissipated: f64,
+    /// State of every angle slot.
+    pub states: Vec<SlotState>,
+}
+
+/// One impact.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ImpactRecord {
+    /// Time (s).
+    pub t: f64,
+    /// Names of the impacting interfaces.
+    pub interfaces: Vec<String>,
+    /// The impacting angle slots.
+    pub slots: Vec<usize>,
+    /// Their rates before (rad/s).
+    pub rates_before: Vec<f64>,
+    /// Their rates after (rad/s).
+    pub rates_after: Vec<f64>,
+    /// T⁻ − T⁺ (J), including the seating of interfaces that came to rest.
+    pub energy_lost: f64,
+    /// The law would have raised the kinetic energy.
+    pub energy_gain: bool,
+    /// Slots seated at this impact.
+    pub seated: Vec<usize>,
+}
+
+/// A local extremum of a rocking coordinate (q̇ = 0), located on the dense output.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Peak {
+    /// Time (s).
+    pub t: f64,
+    /// Coordinate index.
+    pub coordinate: usize,
+    /// Its value (rad).
+    pub value: f64,
+}
+
+/// A collapse.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Collapse {
+    /// Time (s).
+    pub t: f64,
+    /// The body whose centre has dropped most below its rest height.
+    pub body: String,
+}
+
+/// Why [`Simulation::step`] returned.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StopReason {
+    /// A breakpoint of the ground motion was reached; nothing else happened.
+    Breakpoint(f64),
+    /// An impact (index into [`Simulation::impacts`]).
+    Impact(usize),
+    /// Seated interfaces uplifted: (slot, side).
+    Uplift(f64, Vec<(usize, Side)>),
+    /// The structure collapsed.
+    Collapse(Collapse),
+    /// The end time was reached.
+    End(f64),
+}
+
+/// A failure of a simulation (the results computed so far stay available).
+#[derive(Debug, thiserror::Error)]
+pub enum SimulationError {
+    /// The integrator failed.
+    #[error("integration failed: {0}")]
+    Solve(#[from] SolveError),
+    /// An impact law failed.
+    #[error("impact at t = {t}: {source}")]
+    Impact {
+        /// Time (s).
+        t: f64,
+        /// The law's error.
+        source: ImpactError,
+    },
+    /// Too many impacts.
+    #[error("more than {0} impacts: raise analysis.max_impacts or check the seating parameters")]
+    TooManyImpacts(usize),
+    /// A bad parameter.
+    #[error("{0}")]
+    Parameter(String),
+}
+
+/// Regularised Dirac-delta laws acting as a continuous generalized force.
+struct Regularised {
+    slots: Vec<(usize, f64, f64, f64)>,
+    angles: Vec<f64>,
+}
+
+impl GeneralizedForce for Regularised {
+    fn add(
+        &mut self,
+        model: &Model,
+        kin: &Data,
+        _t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) {
+        let n = model.dof();
+        self.angles[..n].copy_from_slice(q.as_slice());
+        closure_angles(model, kin, &mut self.angles[n..]);
+        let mut f = DVector::zeros(n);
+        dirac_regularised_force(model, kin, qdot, &self.angles, &self.slots, &mut f);
+        *out += f;
+    }
+}
+
+/// Angle of every slot at q (tree coordinates, then closure angles). Fills `kin`.
+fn slot_angles(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+    out: &mut [f64],
+) {
+    let n = model.dof();
+    out[..n].copy_from_slice(q.as_slice());
+    forward_kinematics(model, kin, q, pivots);
+    closure_angles(model, kin, &mut out[n..]);
+}
+
+/// Rate ψ̇ = aᵀq̇ of every slot. Needs kinematics and velocities in `kin`.
+fn slot_rates(model: &Model, kin: &Data, qdot: &DVector<f64>, out: &mut [f64]) {
+    let mut row = DVector::zeros(model.dof());
+    for (s, o) in out.iter_mut().enumerate() {
+        slot_row(model, kin, s, &mut row);
+        *o = row.dot(qdot);
+    }
+}
+
+/// Finds the interfaces that open from a seated state at (t, q, q̇): releasing a seated slot on a
+/// side must give it an opening acceleration on that side. First every single release is tried
+/// (the strongest opening wins); if none opens and the structure has loops, all seated slots are
+/// released together and their sides adjusted to the signs of their accelerations (an active-set
+/// iteration that finds one-DOF mechanisms such as a trilithon's or an arch's). Returns the slots
+/// to release with their sides, or None when the seated state holds.
+pub fn opening_mode(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<Vec<(usize, Side)>> {
+    let seated = template.seated.clone();
+    if seated.is_empty() {
+        return None;
+    }
+    let tol = 1e-9 * model.gravity / model.size;
+    let mut row = DVector::zeros(model.dof());
+    let mut trial = template.clone();
+    let mut accel = |trial: &mut Dynamics, slot: usize| -> Option<f64> {
+        trial.accelerations(model, ground, t, q, qdot).ok()?;
+        let bias = slot_row(model, &trial.kin, slot, &mut row);
+        Some(row.dot(&trial.qddot) + bias)
+    };
+    let mut best: Option<(usize, Side, f64)> = None;
+    for &k in &seated {
+        for side in [Side::Positive, Side::Negative] {
+            trial.seated = seated.iter().copied().filter(|&s| s != k).collect();
+            trial.pivots = template.pivots.clone();
+            trial.pivots.sides[k] = side;
+            if let Some(a) = accel(&mut trial, k) {
+                let opening = side.sign() * a;
+                if opening > tol && best.is_none_or(|b| opening > b.2) {
+                    best = Some((k, side, opening));
+                }
+            }
+        }
+    }
+    if let Some((k, side, _)) = best {
+        return Some(vec![(k, side)]);
+    }
+    if model.constraint_rows == 0 || seated.len() < 2 {
+        return None;
+    }
+    let mut released: Vec<(usize, Side)> = seated
+        .iter()
+        .map(|&s| (s, template.pivots.sides[s]))
+        .collect();
+    for _ in 0..2 * seated.len() + 2 {
+        trial.seated = seated
+            .iter()
+            .copied()
+            .filter(|s| !released.iter().any(|r| r.0 == *s))
+            .collect();
+        trial.pivots = template.pivots.clone();
+        for &(s, side) in &released {
+            trial.pivots.sides[s] = side;
+        }
+        trial.accelerations(model, ground, t, q, qdot).ok()?;
+        let mut consistent = true;
+        let mut next = Vec::new();
+        for &(s, side) in &released {
+            let bias = slot_row(model, &trial.kin, s, &mut row);
+            let a = row.dot(&trial.qddot) + bias;
+            if side.sign() * a > tol {
+                next.push((s, side));
+            } else {
+                consistent = false;
+                if a.abs() > tol {
+                    next.push((s, side.flipped()));
+                }
+            }
+        }
+        if consistent {
+            return (!released.is_empty()).then_some(released);
+        }
+        if next.is_empty() {
+            return None;
+        }
+        released = next;
+    }
+    None
+}
+
+/// Event functions of one integration segment.
+struct SegmentEvents<'b> {
+    model: &'b Model,
+    ground: &'b GroundMotion,
+    /// Rocking slots watched for a zero crossing, with their sides.
+    rocking: Vec<(usize, Side)>,
+    kin: Data,
+    pivots: ActivePivots,
+    angles: Vec<f64>,
+    /// Present when some slot is seated: the dynamics to test releases with.
+    uplift: Option<Dynamics>,
+    u_rest: f64,
+    energy_scale: f64,
+    collapse_drop: f64,
+}
+
+impl SegmentEvents<'_> {
+    fn collapse_index(&self) -> usize {
+        self.rocking.len()
+    }
+    fn uplift_index(&self) -> usize {
+        self.rocking.len() + 1
+    }
+}
+
+impl EventFunctions for SegmentEvents<'_> {
+    fn count(&self) -> usize {
+        self.rocking.len() + 1 + usize::from(self.uplift.is_some())
+    }
+
+    fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
+        let n = self.model.dof();
+        let q = DVector::from_column_slice(&y[..n]);
+        slot_angles(
+            self.model,
+            &mut self.kin,
+            &q,
+            &self.pivots,
+            &mut self.angles,
+        );
+        for (i, &(s, _)) in self.rocking.iter().enumerate() {
+            g[i] = self.angles[s];
+        }
+        let ci = self.collapse_index();
+        g[ci] = if self.rocking.is_empty() {
+            1.0
+        } else {
+            (potential_energy(self.model, &self.kin) - self.u_rest) / self.energy_scale
+                + self.collapse_drop
+        };
+        if let Some(template) = &self.uplift {
+            let qdot = DVector::from_column_slice(&y[n..2 * n]);
+            let opens = opening_mode(self.model, self.ground, template, t, &q, &qdot).is_some();
+            g[self.uplift_index()] = if opens { 1.0 } else { -1.0 };
+        }
+    }
+
+    fn direction(&self, i: usize) -> Direction {
+        if i < self.rocking.len() {
+            match self.rocking[i].1 {
+                Side::Positive => Direction::Falling,
+                Side::Negative => Direction::Rising,
+            }
+        } else if i == self.collapse_index() {
+            Direction::Falling
+        } else {
+            Direction::Rising
+        }
+    }
+}
+
+/// An event-driven simulation of one structure under one ground motion.
+pub struct Simulation<'a> {
+    model: &'a Model,
+    ground: &'a GroundMotion,
+    params: Parameters,
+    dynamics: Dynamics,
+    solver: Solver,
+    regularised: Option<Regularised>,
+    out_kin: Data,
+    /// State [q, q̇, W, D] at the current time.
+    y: Vec<f64>,
+    t: f64,
+    seated: Vec<bool>,
+    last_impact: Vec<f64>,
+    dissipated_at_impacts: f64,
+    u_rest: f64,
+    energy_start: f64,
+    next_sample: usize,
+    finished: bool,
+    /// Output samples at the output interval, plus the instants just before and after impacts.
+    pub samples: Vec<Sample>,
+    /// Every impact, in time order.
+    pub impacts: Vec<ImpactRecord>,
+    /// Local extrema of the rocking coordinates.
+    pub peaks: Vec<Peak>,
+    /// First uplift from a seated state.
+    pub uplift_time: Option<f64>,
+    /// The collapse, if the structure collapsed.
+    pub collapse: Option<Collapse>,
+}
+
+fn slot_interface(model: &Model, slot: usize) -> usize {
+    model
+        .interfaces
+        .iter()
+        .position(|i| i.slots.contains(&slot))
+        .expect("every slot belongs to an interface")
+}
+
+impl<'a> Simulation<'a> {
+    /// Builds a simulation from a consistent initial state. Slots whose angle and rate are both 0
+    /// start seated; the others rock on the side of their angle (or of their rate when the angle
+    /// is 0).
+    pub fn new(
+        model: &'a Model,
+        ground: &'a GroundMotion,
+        initial: &InitialState,
+        params: Parameters,
+    ) -> Result<Self, SimulationError> {
+        for (name, v) in [
+            ("duration", params.duration),
+            ("output_interval", params.output_interval),
+            ("seat_rate", params.seat_rate),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(SimulationError::Parameter(format!(
+                    "{name} must be a positive number, got {v}"
+                )));
+            }
+        }
+        let n = model.dof();
+        let mut pivots = initial.pivots.clone();
+        let mut kin = Data::new(model);
+        let mut angles = vec![0.0; model.slot_count];
+        slot_angles(model, &mut kin, &initial.q, &pivots, &mut angles);
+        crr_kinematics::velocities(model, &mut kin, &initial.qdot);
+        let mut rates = vec![0.0; model.slot_count];
+        slot_rates(model, &kin, &initial.qdot, &mut rates);
+        let tiny = 1e-14;
+        let mut seated = vec![false; model.slot_count];
+        for s in 0..model.slot_count {
+            if angles[s].abs() <= tiny && rates[s].abs() <= tiny {
+                seated[s] = true;
+            } else if angles[s].abs() > tiny {
+                pivots.sides[s] = Side::of(angles[s], pivots.sides[s]);
+            } else {
+                pivots.sides[s] = Side::of(rates[s], pivots.sides[s]);
+            }
+        }
+        let mut dynamics = Dynamics::new(model, pivots);
+        dynamics.seated = (0..model.slot_count).filter(|&s| seated[s]).collect();
+        let regularised_slots: Vec<(usize, f64, f64, f64)> = (0..model.slot_count)
+            .filter_map(
+                |s| match model.interfaces[slot_interface(model, s)].impact {
+                    ImpactLaw::DiracRegularised { r, c, width } => Some((s, r, c, width)),
+                    _ => None,
+                },
+            )
+            .collect();
+        let regularised = (!regularised_slots.is_empty()).then(|| Regularised {
+            slots: regularised_slots,
+            angles: vec![0.0; model.slot_count],
+        });
+        let mut solver = Solver::new(params.method, params.options, 2 * n + 2)?;
+        let y = ConstrainedSystem::pack(&initial.q, &initial.qdot, 0.0, 0.0);
+        solver.reset(0.0, &y);
+        let u_rest = crr_dynamics::energy::rest_potential(model);
+        let mut sim = Self {
+            model,
+            ground,
+            params,
+            dynamics,
+            solver,
+            regularised,
+            out_kin: Data::new(model),
+            y,
+            t: 0.0,
+            seated,
+            last_impact: vec![f64::NEG_INFINITY; model.slot_count],
+            dissipated_at_impacts: 0.0,
+            u_rest,
+            energy_start: 0.0,
+            next_sample: 0,
+            finished: false,
+            samples: Vec::new(),
+            impacts: Vec::new(),
+            peaks: Vec::new(),
+            uplift_time: None,
+            collapse: None,
+        };
+        let first = sim.sample_at(0.0, &sim.y.clone());
+        sim.energy_start = first.kinetic + first.potential;
+        sim.samples.push(first);
+        sim.next_sample = 1;
+        // A seated structure that cannot hold at t = 0 uplifts at once.
+        sim.release_if_opening()?;
+        Ok(sim)
+    }
+
+    /// Current time (s).
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+
+    /// Current q.
+    pub fn q(&self) -> DVector<f64> {
+        DVector::from_column_slice(&self.y[..self.model.dof()])
+    }
+
+    /// Current q̇.
+    pub fn qdot(&self) -> DVector<f64> {
+        let n = self.model.dof();
+        DVector::from_column_slice(&self.y[n..2 * n])
+    }
+
+    /// Current state of every slot.
+    pub fn states(&self) -> Vec<SlotState> {
+        (0..self.model.slot_count)
+            .map(|s| {
+                if self.seated[s] {
+                    SlotState::Seated
+                } else if self.dynamics.pivots.sides[s] == Side::Positive {
+                    SlotState::Positive
+                } else {
+                    SlotState::Negative
+                }
+            })
+            .collect()
+    }
+
+    /// The current dynamic chain.
+    pub fn pivots(&self) -> &ActivePivots {
+        &self.dynamics.pivots
+    }
+
+    /// T + U − W + D − E(0): the energy-balance error (J), zero up to the integration tolerance.
+    pub fn energy_balance_error(&self) -> f64 {
+        self.samples
+            .iter()
+            .map(|s| (s.kinetic + s.potential - s.work_in + s.dissipated - self.energy_start).abs())
+            .fold(0.0, f64::max)
+    }
+
+    fn sample_at(&mut self, t: f64, y: &[f64]) -> Sample {
+        let n = self.model.dof();
+        let q = DVector::from_column_slice(&y[..n]);
+        let qdot = DVector::from_column_slice(&y[n..2 * n]);
+        forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        mass_matrix(self.model, &mut self.out_kin);
+        Sample {
+            t,
+            kinetic: 0.5 * qdot.dot(&(&self.out_kin.mass_matrix * &qdot)),
+            potential: potential_energy(self.model, &self.out_kin) - self.u_rest,
+            work_in: y[2 * n],
+            dissipated: self.dissipated_at_impacts + y[2 * n + 1],
+            q: q.iter().copied().collect(),
+            qdot: qdot.iter().copied().collect(),
+            states: self.states(),
+        }
+    }
+
+    fn reset_solver(&mut self) {
+        self.solver.reset(self.t, &self.y);
+    }
+
+    /// Releases seated slots if the seated state cannot hold now.
+    fn release_if_opening(&mut self) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
+        if self.dynamics.seated.is_empty() {
+            return Ok(None);
+        }
+        let (q, qdot) = (self.q(), self.qdot());
+        let mode = opening_mode(self.model, self.ground, &self.dynamics, self.t, &q, &qdot);
+        if let Some(mode) = &mode {
+            for &(s, side) in mode {
+                self.seated[s] = false;
+                self.dynamics.pivots.sides[s] = side;
+            }
+            self.dynamics.seated = (0..self.model.slot_count)
+                .filter(|&s| self.seated[s])
+                .collect();
+            self.uplift_time.get_or_insert(self.t);
+            self.reset_solver();
+        }
+        Ok(mode)
+    }
+
+    /// Integrates to the next event, breakpoint or the end.
+    pub fn step(&mut self) -> Result<StopReason, SimulationError> {
+        if self.finished {
+            return Ok(StopReason::End(self.t));
+        }
+        let model = self.model;
+        let n = model.dof();
+        let t_stop = self
+            .ground
+            .next_breakpoint(self.t)
+            .map_or(self.params.duration, |b| b.min(self.params.duration));
+        let rocking: Vec<(usize, Side)> = (0..model.slot_count)
+            .filter(|&s| !self.seated[s])
+            .map(|s| (s, self.dynamics.pivots.sides[s]))
+            .collect();
+        let mut events = SegmentEvents {
+            model,
+            ground: self.ground,
+            rocking,
+            kin: Data::new(model),
+            pivots: self.dynamics.pivots.clone(),
+            angles: vec![0.0; model.slot_count],
+            uplift: (!self.dynamics.seated.is_empty()).then(|| self.dynamics.clone()),
+            u_rest: self.u_rest,
+            energy_scale: model.total_mass() * model.gravity * model.size,
+            collapse_drop: self.params.collapse_drop,
+        };
+        // Dense-output sampling and peak detection, on copies so that the system can borrow the
+        // dynamics.
+        let dt = self.params.output_interval;
+        let mut next_sample = self.next_sample;
+        let mut pending: Vec<(f64, Vec<f64>)> = Vec::new();
+        let mut peaks: Vec<Peak> = Vec::new();
+        let rocking_coords: Vec<usize> = (0..n).filter(|&k| !self.seated[k]).collect();
+        let mut buf = vec![0.0; 2 * n + 2];
+        let mut on_step = |step: &DenseStep| {
+            while (next_sample as f64) * dt <= step.t1() + 1e-12 * dt
+                && (next_sample as f64) * dt <= self.params.duration + 1e-12 * dt
+            {
+                let ts = (next_sample as f64 * dt).min(step.t1());
+                step.eval(ts, &mut buf);
+                pending.push((next_sample as f64 * dt, buf.clone()));
+                next_sample += 1;
+            }
+            for &k in &rocking_coords {
+                let (a, b) = (
+                    step.eval_component(step.t0(), n + k),
+                    step.eval_component(step.t1(), n + k),
+                );
+                if a != 0.0 && b != 0.0 && a.signum() != b.signum() {
+                    // Bisection on q̇ₖ(t) of the dense output.
+                    let (mut lo, mut hi) = (step.t0(), step.t1());
+                    for _ in 0..60 {
+                        let mid = 0.5 * (lo + hi);
+                        if step.eval_component(mid, n + k).signum() == a.signum() {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    let tp = 0.5 * (lo + hi);
+                    peaks.push(Peak {
+                        t: tp,
+                        coordinate: k,
+                        value: step.eval_component(tp, k),
+                    });
+                }
+            }
+        };
+        let mut sys = ConstrainedSystem::new(model, self.ground, &mut self.dynamics);
+        if let Some(r) = self.regularised.as_mut() {
+            sys.extra = Some(r);
+        }
+        let stop = self
+            .solver
+            .advance(&mut sys, t_stop, &mut events, &mut on_step);
+        drop(sys);
+        self.next_sample = next_sample;
+        self.peaks.extend(peaks);
+        for (t, y) in pending {
+            let s = self.sample_at(t, &y);
+            self.samples.push(s);
+        }
+        let stop = stop?;
+        self.t = self.solver.t();
+        self.y.copy_from_slice(self.solver.y());
+        match stop {
+            Stop::Reached => {
+                if self.t >= self.params.duration {
+                    self.finished = true;
+                    if self.samples.last().is_none_or(|s| s.t < self.t) {
+                        let s = self.sample_at(self.t, &self.y.clone());
+                        self.samples.push(s);
+                    }
+                    return Ok(StopReason::End(self.t));
+                }
+                Ok(StopReason::Breakpoint(self.t))
+            }
+            Stop::Event { index, .. } => {
+                if index < events.rocking.len() {
+                    let slot = events.rocking[index].0;
+                    self.impact(slot).map(StopReason::Impact)
+                } else if index == events.collapse_index() {
+                    let (q, qdot) = (self.q(), self.qdot());
+                    if q.dot(&qdot) > 0.0 {
+                        let c = self.collapse_record();
+                        self.collapse = Some(c.clone());
+                        self.finished = true;
+                        let s = self.sample_at(self.t, &self.y.clone());
+                        self.samples.push(s);
+                        Ok(StopReason::Collapse(c))
+                    } else {
+                        self.reset_solver();
+                        Ok(StopReason::Breakpoint(self.t))
+                    }
+                } else {
+                    let mode = self.release_if_opening()?;
+                    Ok(match mode {
+                        Some(m) => StopReason::Uplift(self.t, m),
+                        None => {
+                            self.reset_solver();
+                            StopReason::Breakpoint(self.t)
+                        }
+                    })
+                }
+            }
+        }
+    }
+
+    fn collapse_record(&mut self) -> Collapse {
+        let q = self.q();
+        forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        let (b, _) = self
+            .model
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| (b, self.out_kin.com[b].z - body.com.z))
+            .fold(
+                (0, f64::INFINITY),
+                |acc, x| if x.1 < acc.1 { x } else { acc },
+            );
+        Collapse {
+            t: self.t,
+            body: self.model.bodies[b].name.clone(),
+        }
+    }
+
+    /// Handles an impact fired by `slot` at the current time.
+    fn impact(&mut self, slot: usize) -> Result<usize, SimulationError> {
+        if self.impacts.len() >= self.params.max_impacts {
+            return Err(SimulationError::TooManyImpacts(self.params.max_impacts));
+        }
+        let model = self.model;
+        let (t, q, qdot) = (self.t, self.q(), self.qdot());
+        let before = self.dynamics.pivots.clone();
+        let mut kin = Data::new(model);
+        let mut angles = vec![0.0; model.slot_count];
+        slot_angles(model, &mut kin, &q, &before, &mut angles);
+        crr_kinematics::velocities(model, &mut kin, &qdot);
+        let mut rates = vec![0.0; model.slot_count];
+        slot_rates(model, &kin, &qdot, &mut rates);
+        let impacting: Vec<usize> = (0..model.slot_count)
+            .filter(|&s| {
+                s == slot
+                    || (!self.seated[s]
+                        && angles[s].abs() <= self.params.simultaneity
+                        && rates[s] * before.sides[s].sign() < 0.0)
+            })
+            .collect();
+        let mut after = before.clone();
+        for &s in &impacting {
+            after.sides[s] = before.sides[s].flipped();
+        }
+        let laws: Vec<ImpactLaw> = impacting
+            .iter()
+            .map(|&s| model.interfaces[slot_interface(model, s)].impact)
+            .collect();
+        let err = |source| SimulationError::Impact { t, source };
+        let result = if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
+            momentum_law(model, &mut kin, &q, &qdot, &before, &after).map_err(err)?
+        } else {
+            let rest: Vec<(usize, f64)> = impacting
+                .iter()
+                .zip(&laws)
+                .filter_map(|(&s, l)| {
+                    if let ImpactLaw::Restitution(r) = l {
+                        Some((s, *r))
+                    } else {
+                        None
+                    }
+                })
+                .collect();
+            let dirac: Vec<(usize, f64, f64)> = impacting
+                .iter()
+                .zip(&laws)
+                .filter_map(|(&s, l)| {
+                    if let ImpactLaw::Dirac { r, c } = l {
+                        Some((s, *r, *c))
+                    } else {
+                        None
+                    }
+                })
+                .collect();
+            // Regularised laws switch pivots with continuous rates (r = 1, the force does the rest).
+            let plain: Vec<(usize, f64)> = impacting
+                .iter()
+                .zip(&laws)
+                .filter_map(|(&s, l)| {
+                    matches!(l, ImpactLaw::DiracRegularised { .. }).then_some((s, 1.0))
+                })
+                .collect();
+            let mut res = restitution_law(
+                model,
+                &mut kin,
+                &q,
+                &qdot,
+                &before,
+                &after,
+                &[rest.as_slice(), plain.as_slice()].concat(),
+            )
+            .map_err(err)?;
+            if !dirac.is_empty() {
+                let t_before = res.kinetic_before;
+                res = dirac_law(model, &mut kin, &q, &res.qdot, &after, &after, &dirac)
+                    .map_err(err)?;
+                res.kinetic_before = t_before;
+            }
+            res
+        };
+        let mut qdot_after = result.qdot.clone();
+        let mut kinetic_after = result.kinetic_after;
+        // Rates after, and seating of the interfaces that come to rest.
+        forward_kinematics(model, &mut kin, &q, &after);
+        crr_kinematics::velocities(model, &mut kin, &qdot_after);
+        slot_rates(model, &kin, &qdot_after, &mut rates);
+        let to_seat: Vec<usize> = impacting
+            .iter()
+            .copied()
+            .filter(|&s| {
+                rates[s].abs() < self.params.seat_rate
+                    || t - self.last_impact[s] < self.params.min_impact_interval
+            })
+            .collect();
+        let rates_after: Vec<f64> = impacting.iter().map(|&s| rates[s]).collect();
+        if !to_seat.is_empty() {
+            let zero: Vec<(usize, f64)> = to_seat.iter().map(|&s| (s, 0.0)).collect();
+            let seat = restitution_law(model, &mut kin, &q, &qdot_after, &after, &after, &zero)
+                .map_err(err)?;
+            qdot_after = seat.qdot;
+            kinetic_after = seat.kinetic_after;
+        }
+        let before_rates: Vec<f64> = {
+            forward_kinematics(model, &mut kin, &q, &before);
+            crr_kinematics::velocities(model, &mut kin, &qdot);
+            let mut r = vec![0.0; model.slot_count];
+            slot_rates(model, &kin, &qdot, &mut r);
+            impacting.iter().map(|&s| r[s]).collect()
+        };
+        let lost = result.kinetic_before - kinetic_after;
+        let record = ImpactRecord {
+            t,
+            interfaces: {
+                let mut names: Vec<String> = impacting
+                    .iter()
+                    .map(|&s| model.interfaces[slot_interface(model, s)].name.clone())
+                    .collect();
+                names.dedup();
+                names
+            },
+            slots: impacting.clone(),
+            rates_before: before_rates,
+            rates_after,
+            energy_lost: lost,
+            energy_gain: result.kinetic_after > result.kinetic_before * (1.0 + 1e-9) + 1e-12,
+            seated: to_seat.clone(),
+        };
+        // Sample just before the impact, then switch.
+        let pre = self.sample_at(t, &self.y.clone());
+        self.samples.push(pre);
+        for &s in &impacting {
+            self.last_impact[s] = t;
+        }
+        for &s in &to_seat {
+            self.seated[s] = true;
+        }
+        // The impact happens at φ = 0: the located state is within the event tolerance of it.
+        let mut q_new = q.clone();
+        for &s in &impacting {
+            if s < model.dof() {
+                q_new[s] = 0.0;
+            }
+        }
+        self.dynamics.pivots = after;
+        self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        self.dissipated_at_impacts += lost;
+        let n = model.dof();
+        self.y[..n].copy_from_slice(q_new.as_slice());
+        self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
+        let post = self.sample_at(t, &self.y.clone());
+        self.samples.push(post);
+        self.impacts.push(record);
+        self.reset_solver();
+        if !to_seat.is_empty() {
+            self.release_if_opening()?;
+        }
+        Ok(self.impacts.len() - 1)
+    }
+
+    /// Runs to the end (or collapse) and returns the trajectory.
+    pub fn run(mut self) -> Result<Trajectory, (SimulationError, Trajectory)> {
+        loop {
+            match self.step() {
+                Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => {
+                    return Ok(self.into_trajectory());
+                }
+                Ok(_) => {}
+                Err(e) => return Err((e, self.into_trajectory())),
+            }
+        }
+    }
+
+    /// The results so far.
+    pub fn into_trajectory(self) -> Trajectory {
+        let n = self.model.dof();
+        let mut peak_abs = vec![0.0f64; n];
+        for s in &self.samples {
+            for k in 0..n {
+                peak_abs[k] = peak_abs[k].max(s.q[k].abs());
+            }
+        }
+        for p in &self.peaks {
+            peak_abs[p.coordinate] = peak_abs[p.coordinate].max(p.value.abs());
+        }
+        let balance = self.energy_balance_error();
+        Trajectory {
+            coordinates: self.model.coords.iter().map(|c| c.name.clone()).collect(),
+            samples: self.samples,
+            impacts: self.impacts,
+            peaks: self.peaks,
+            peak_abs,
+            uplift_time: self.uplift_time,
+            collapse: self.collapse,
+            energy_balance_error: balance,
+            end_time: self.t,
+        }
+    }
+}
+
+/// The results of a run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Trajectory {
+    /// Coordinate names in the order of q.
+    pub coordinates: Vec<String>,
+    /// Output samples (and the instants just before and after each impact).
+    pub samples: Vec<Sample>,
+    /// Impact log.
+    pub impacts: Vec<ImpactRecord>,
+    /// Local extrema of the rocking coordinates.
+    pub peaks: Vec<Peak>,
+    /// Peak |φ| per coordinate (rad).
+    pub peak_abs: Vec<f64>,
+    /// First uplift from a seated state (s).
+    pub uplift_time: Option<f64>,
+    /// Collapse, if any.
+    pub collapse: Option<Collapse>,
+    /// Largest |T + U − W + D − E(0)| over the samples (J).
+    pub energy_balance_error: f64,
+    /// Time reached (s).
+    pub end_time: f64,
+}
