@@ -3,4 +3,6 @@
 pub mod laws;
 pub mod simulation;
 
-pub use simulation::{Parameters, Simulation, SlotState, StopReason, Trajectory};
+pub use simulation::{
+    Interrupted, Parameters, Simulation, SimulationError, SlotState, StopReason, Trajectory,
+};

@@ -205,6 +205,15 @@ pub enum SimulationError {
     Parameter(String),
 }
 
+/// A run that failed part-way: the error and everything computed before it.
+#[derive(Debug)]
+pub struct Interrupted {
+    /// What went wrong.
+    pub error: SimulationError,
+    /// The results up to the failure.
+    pub partial: Trajectory,
+}
+
 /// Regularised Dirac-delta laws acting as a continuous generalized force.
 struct Regularised {
     slots: Vec<(usize, f64, f64, f64)>,
