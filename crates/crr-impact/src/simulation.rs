@@ -944,15 +944,21 @@ impl<'a> Simulation<'a> {
         Ok(self.impacts.len() - 1)
     }
 
-    /// Runs to the end (or collapse) and returns the trajectory.
-    pub fn run(mut self) -> Result<Trajectory, (SimulationError, Trajectory)> {
+    /// Runs to the end (or collapse) and returns the trajectory; on failure, the error with the
+    /// results computed until then.
+    pub fn run(mut self) -> Result<Trajectory, Box<Interrupted>> {
         loop {
             match self.step() {
                 Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => {
                     return Ok(self.into_trajectory());
                 }
                 Ok(_) => {}
-                Err(e) => return Err((e, self.into_trajectory())),
+                Err(error) => {
+                    return Err(Box::new(Interrupted {
+                        error,
+                        partial: self.into_trajectory(),
+                    }));
+                }
             }
         }
     }
