@@ -37,7 +37,7 @@ fn free_run(b: f64, h: f64, duration: f64) -> (crr_impact::Trajectory, f64, f64)
     let traj = Simulation::new(&model, &ground, &init, params)
         .unwrap()
         .run()
-        .map_err(|(e, _)| e)
+        .map_err(|f| f.error)
         .unwrap();
     let p = (3.0 * 9.81 / (4.0 * (b * b + h * h).sqrt())).sqrt();
     (traj, alpha, p)
