@@ -35,6 +35,18 @@ pub struct AnalysisSpec {
     pub atol: f64,
     /// Largest step (s). Default: unlimited.
     pub max_step: Option<f64>,
+    /// An interface whose rate after an impact is below this seats (rad/s). Default 1e-4.
+    pub seat_rate: f64,
+    /// An interface impacting again within this time seats (s). Default 1e-6.
+    pub min_impact_interval: f64,
+    /// Rocking angles within this of 0 at an impact impact together (rad). Default 1e-8.
+    pub simultaneity: f64,
+    /// Largest number of impacts before the run stops with an error. Default 1 000 000.
+    pub max_impacts: usize,
+    /// Friction coefficient μ of every contact, for the hypotheses monitor (none: not checked).
+    pub friction: Option<f64>,
+    /// Collapse when U drops below rest by this fraction of weight × model size. Default 1e-3.
+    pub collapse_drop: f64,
 }
 
 impl Default for AnalysisSpec {
@@ -67,6 +79,13 @@ impl AnalysisSpec {
         positive("rtol", self.rtol)?;
         positive("atol", self.atol)?;
         positive("rk4_step", self.rk4_step)?;
+        positive("seat_rate", self.seat_rate)?;
+        positive("min_impact_interval", self.min_impact_interval)?;
+        positive("simultaneity", self.simultaneity)?;
+        positive("collapse_drop", self.collapse_drop)?;
+        if let Some(mu) = self.friction {
+            positive("friction", mu)?;
+        }
         if let Some(d) = self.duration {
             positive("duration", d)?;
         }

@@ -84,6 +84,29 @@ impl Default for Parameters {
     }
 }
 
+impl Parameters {
+    /// Parameters from a model file's `[analysis]` table; `default_duration` applies when it gives
+    /// none. Errors name the bad field.
+    pub fn from_analysis(
+        a: &crr_dynamics::AnalysisSpec,
+        default_duration: f64,
+    ) -> Result<Self, String> {
+        let (method, options) = a.solver()?;
+        Ok(Self {
+            duration: a.duration.unwrap_or(default_duration),
+            output_interval: a.output_interval,
+            method,
+            options,
+            seat_rate: a.seat_rate,
+            min_impact_interval: a.min_impact_interval,
+            simultaneity: a.simultaneity,
+            max_impacts: a.max_impacts,
+            friction: a.friction,
+            collapse_drop: a.collapse_drop,
+        })
+    }
+}
+
 /// The state of one angle slot.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum SlotState {
