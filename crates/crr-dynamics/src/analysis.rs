@@ -59,6 +59,12 @@ impl Default for AnalysisSpec {
             rtol: 1e-10,
             atol: 1e-12,
             max_step: None,
+            seat_rate: 1e-4,
+            min_impact_interval: 1e-6,
+            simultaneity: 1e-8,
+            max_impacts: 1_000_000,
+            friction: None,
+            collapse_drop: 1e-3,
         }
     }
 }
