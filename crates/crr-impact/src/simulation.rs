@@ -894,7 +894,7 @@ impl<'a> Simulation<'a> {
         forward_kinematics(model, &mut kin, &q, &after);
         crr_kinematics::velocities(model, &mut kin, &qdot_after);
         slot_rates(model, &kin, &qdot_after, &mut rates);
-        let to_seat: Vec<usize> = impacting
+        let mut to_seat: Vec<usize> = impacting
             .iter()
             .copied()
             .filter(|&s| {
@@ -903,12 +903,31 @@ impl<'a> Simulation<'a> {
             })
             .collect();
         let rates_after: Vec<f64> = impacting.iter().map(|&s| rates[s]).collect();
-        if !to_seat.is_empty() {
-            let zero: Vec<(usize, f64)> = to_seat.iter().map(|&s| (s, 0.0)).collect();
-            let seat = restitution_law(model, &mut kin, &q, &qdot_after, &after, &after, &zero)
-                .map_err(err)?;
-            qdot_after = seat.qdot;
-            kinetic_after = seat.kinetic_after;
+        // Seating one joint of a loop can lock the others: seat, recompute the rates, and seat
+        // every impacting slot brought below the threshold, until nothing changes.
+        let mut pending = to_seat.clone();
+        while !pending.is_empty() {
+            // Only slots still moving need the plastic impulse; the others are already at rest.
+            let zero: Vec<(usize, f64)> = pending
+                .iter()
+                .filter(|&&s| rates[s].abs() > 1e-14)
+                .map(|&s| (s, 0.0))
+                .collect();
+            if !zero.is_empty() {
+                let seat = restitution_law(model, &mut kin, &q, &qdot_after, &after, &after, &zero)
+                    .map_err(err)?;
+                qdot_after = seat.qdot;
+                kinetic_after = seat.kinetic_after;
+            }
+            forward_kinematics(model, &mut kin, &q, &after);
+            crr_kinematics::velocities(model, &mut kin, &qdot_after);
+            slot_rates(model, &kin, &qdot_after, &mut rates);
+            pending = impacting
+                .iter()
+                .copied()
+                .filter(|s| !to_seat.contains(s) && rates[*s].abs() < self.params.seat_rate)
+                .collect();
+            to_seat.extend(pending.iter().copied());
         }
         let before_rates: Vec<f64> = {
             forward_kinematics(model, &mut kin, &q, &before);
