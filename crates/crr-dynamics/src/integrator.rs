@@ -513,6 +513,15 @@ impl Solver {
         })
     }
 
+    /// Changes the largest step (s), e.g. while a narrow forcing feature is active. Positive or
+    /// infinite; other values are ignored.
+    pub fn set_h_max(&mut self, h_max: f64) {
+        if h_max > 0.0 {
+            self.opts.h_max = h_max;
+            self.h_next = self.h_next.min(h_max);
+        }
+    }
+
     /// Sets the state to `(t0, y0)`, e.g. after an impact. Forgets the FSAL
     /// derivative and the step-size controller history but keeps the last
     /// proposed step size as the initial guess. If `t0` equals the time of
@@ -730,18 +739,47 @@ impl Solver {
 
             if let Some((index, t_star)) = found {
                 if t_star != t1 {
-                    // Integrate exactly to the event time from the step start.
-                    let h_star = t_star - self.t;
-                    self.rk_step(sys, h_star, t_star)?;
-                    self.stats.steps += 1;
-                    if self.y_new.iter().any(|v| !v.is_finite()) {
-                        return Err(SolveError::NonFinite {
-                            t: self.t,
-                            h: h_star,
-                        });
+                    // Integrate exactly to the event time from the step start, with error control:
+                    // the landing step is checked, and if it fails (a narrow feature inside the
+                    // step) t* is reached by adaptive sub-steps that land on it exactly.
+                    let mut h_sub = t_star - self.t;
+                    loop {
+                        let last_sub = self.t + h_sub >= t_star;
+                        let t_sub = if last_sub { t_star } else { self.t + h_sub };
+                        let h_try = t_sub - self.t;
+                        if !self.f_valid {
+                            call_rhs(sys, &mut self.stats, self.t, &self.y, &mut self.f)?;
+                            self.f_valid = true;
+                        }
+                        let err = self.rk_step(sys, h_try, t_sub)?;
+                        self.stats.steps += 1;
+                        if !err.is_finite() || self.y_new.iter().any(|v| !v.is_finite()) {
+                            return Err(SolveError::NonFinite {
+                                t: self.t,
+                                h: h_try,
+                            });
+                        }
+                        if adaptive && err > 1.0 {
+                            self.stats.rejected += 1;
+                            h_sub = h_try * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9);
+                            if h_sub <= 10.0 * f64::EPSILON * self.t.abs().max(1.0) {
+                                return Err(SolveError::StepSizeUnderflow {
+                                    t: self.t,
+                                    h: h_sub,
+                                });
+                            }
+                            continue;
+                        }
+                        self.finish_step(sys, h_try, t_sub)?;
+                        self.emit(on_step, h_try, t_sub);
+                        if last_sub {
+                            break;
+                        }
+                        self.commit(t_sub);
+                        self.project(sys)?;
+                        h_sub = (h_try * (0.9 * err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0))
+                            .min(t_star - self.t);
                     }
-                    self.finish_step(sys, h_star, t_star)?;
-                    self.emit(on_step, h_star, t_star);
                 } else {
                     self.emit(on_step, h, t1);
                 }

@@ -385,6 +385,9 @@ struct SegmentEvents<'b> {
     u_rest: f64,
     energy_scale: f64,
     collapse_drop: f64,
+    /// Regularised-law zones |φ| < ε/2 (slot, ε/2): their edges stop the integration so that the
+    /// narrow δ_ε is resolved by a fresh step-size selection.
+    zones: Vec<(usize, f64)>,
 }
 
 impl SegmentEvents<'_> {
@@ -394,11 +397,14 @@ impl SegmentEvents<'_> {
     fn uplift_index(&self) -> usize {
         self.rocking.len() + 1
     }
+    fn first_zone_index(&self) -> usize {
+        self.rocking.len() + 1 + usize::from(self.uplift.is_some())
+    }
 }
 
 impl EventFunctions for SegmentEvents<'_> {
     fn count(&self) -> usize {
-        self.rocking.len() + 1 + usize::from(self.uplift.is_some())
+        self.first_zone_index() + 2 * self.zones.len()
     }
 
     fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
@@ -426,6 +432,11 @@ impl EventFunctions for SegmentEvents<'_> {
             let opens = opening_mode(self.model, self.ground, template, t, &q, &qdot).is_some();
             g[self.uplift_index()] = if opens { 1.0 } else { -1.0 };
         }
+        let z0 = self.first_zone_index();
+        for (i, &(slot, half)) in self.zones.iter().enumerate() {
+            g[z0 + 2 * i] = self.angles[slot] - half;
+            g[z0 + 2 * i + 1] = self.angles[slot] + half;
+        }
     }
 
     fn direction(&self, i: usize) -> Direction {
@@ -436,8 +447,10 @@ impl EventFunctions for SegmentEvents<'_> {
             }
         } else if i == self.collapse_index() {
             Direction::Falling
-        } else {
+        } else if self.uplift.is_some() && i == self.uplift_index() {
             Direction::Rising
+        } else {
+            Direction::Any
         }
     }
 }
@@ -684,6 +697,17 @@ impl<'a> Simulation<'a> {
             u_rest: self.u_rest,
             energy_scale: model.total_mass() * model.gravity * model.size,
             collapse_drop: self.params.collapse_drop,
+            zones: self
+                .regularised
+                .as_ref()
+                .map(|r| {
+                    r.slots
+                        .iter()
+                        .filter(|z| !self.seated[z.0])
+                        .map(|z| (z.0, 0.5 * z.3))
+                        .collect()
+                })
+                .unwrap_or_default(),
         };
         // Dense-output sampling and peak detection, on copies so that the system can borrow the
         // dynamics.
@@ -727,6 +751,29 @@ impl<'a> Simulation<'a> {
                 }
             }
         };
+        // Inside a regularised δ zone the step is limited to an eighth of the zone's crossing time,
+        // so that the bump is resolved by the steps and their dense output.
+        let mut h_max = self.params.options.h_max;
+        if let Some(r) = &self.regularised {
+            let mut angles = vec![0.0; model.slot_count];
+            let (q, qdot) = (self.q(), self.qdot());
+            slot_angles(
+                model,
+                &mut self.out_kin,
+                &q,
+                &self.dynamics.pivots,
+                &mut angles,
+            );
+            crr_kinematics::velocities(model, &mut self.out_kin, &qdot);
+            let mut rates = vec![0.0; model.slot_count];
+            slot_rates(model, &self.out_kin, &qdot, &mut rates);
+            for &(s, _, _, width) in &r.slots {
+                if !self.seated[s] && angles[s].abs() < 0.5 * width * (1.0 + 1e-9) {
+                    h_max = h_max.min(width / (8.0 * rates[s].abs().max(1e-12)));
+                }
+            }
+        }
+        self.solver.set_h_max(h_max);
         let mut sys = ConstrainedSystem::new(model, self.ground, &mut self.dynamics);
         if let Some(r) = self.regularised.as_mut() {
             sys.extra = Some(r);
@@ -773,6 +820,10 @@ impl<'a> Simulation<'a> {
                         self.reset_solver();
                         Ok(StopReason::Breakpoint(self.t))
                     }
+                } else if index >= events.first_zone_index() {
+                    // Entering or leaving a regularised δ zone: restart with a fresh step size.
+                    self.reset_solver();
+                    Ok(StopReason::Breakpoint(self.t))
                 } else {
                     let mode = self.release_if_opening()?;
                     Ok(match mode {
