@@ -1,6 +1,7 @@
 //! Pivot switching, impact laws and the event-driven simulation of coupled rocking rotations.
 
 pub mod laws;
+pub mod monitor;
 pub mod simulation;
 
 pub use simulation::{

@@ -484,6 +484,9 @@ pub struct Simulation<'a> {
     pub uplift_time: Option<f64>,
     /// The collapse, if the structure collapsed.
     pub collapse: Option<Collapse>,
+    /// First failure of the no-flight (compressive contact) or no-slip hypothesis, checked at
+    /// every output sample and impact instant.
+    pub violation: Option<crate::monitor::Violation>,
 }
 
 fn slot_interface(model: &Model, slot: usize) -> usize {
@@ -574,6 +577,7 @@ impl<'a> Simulation<'a> {
             peaks: Vec::new(),
             uplift_time: None,
             collapse: None,
+            violation: None,
         };
         let first = sim.sample_at(0.0, &sim.y.clone());
         sim.energy_start = first.kinetic + first.potential;
@@ -632,6 +636,16 @@ impl<'a> Simulation<'a> {
         let n = self.model.dof();
         let q = DVector::from_column_slice(&y[..n]);
         let qdot = DVector::from_column_slice(&y[n..2 * n]);
+        if self.violation.is_none() {
+            let mut d = self.dynamics.clone();
+            if let Ok(forces) =
+                crate::monitor::contact_forces(self.model, &mut d, self.ground, t, &q, &qdot)
+            {
+                let tol = 1e-9 * self.model.total_mass() * self.model.gravity;
+                self.violation =
+                    crate::monitor::check(self.model, &forces, t, self.params.friction, tol);
+            }
+        }
         forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
         mass_matrix(self.model, &mut self.out_kin);
         Sample {
@@ -1077,6 +1091,7 @@ impl<'a> Simulation<'a> {
             peak_abs,
             uplift_time: self.uplift_time,
             collapse: self.collapse,
+            violation: self.violation,
             energy_balance_error: balance,
             end_time: self.t,
         }
@@ -1100,6 +1115,8 @@ pub struct Trajectory {
     pub uplift_time: Option<f64>,
     /// Collapse, if any.
     pub collapse: Option<Collapse>,
+    /// First failure of a hypothesis (no flight, no sliding), if any.
+    pub violation: Option<crate::monitor::Violation>,
     /// Largest |T + U − W + D − E(0)| over the samples (J).
     pub energy_balance_error: f64,
     /// Time reached (s).

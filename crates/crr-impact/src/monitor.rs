@@ -1,0 +1,218 @@
+//! The hypotheses monitor: the force every contact transmits, its normal part N (must stay
+//! compressive: no flight) and the friction demand |F_t|/N (must stay below μ: no sliding).
+//!
+//! The force that a tree interface transmits from its parent to the child side is the rate of
+//! change of momentum of the child's subtree minus the loads on it (weight and ground-motion
+//! pseudo-force, m g_eff) minus the closure forces reaching the subtree from outside:
+//! f = Σ m (a_c − g_eff) − Σ f_closure. A closure interface transmits the force of its point
+//! multipliers (−λ on the child). N = f·n with n the contact normal (towards the child: for a hinge
+//! with two pivot lines n ∝ u × (P⁻ − P⁺); for a rocking base its normal), rotated with the parent.
+//! Plain hinges (one pivot line) are joints that can hold tension and are not monitored.
+
+use nalgebra::{DVector, Vector3, Vector6};
+use serde::Serialize;
+
+use crr_dynamics::DynamicsError;
+use crr_dynamics::eom::{Dynamics, effective_gravity};
+use crr_dynamics::ground_motion::GroundMotion;
+use crr_kinematics::{InterfaceKind, Model, Role};
+
+/// The force a contact transmits to its child side.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ContactForce {
+    /// Force on the child side, world axes (N).
+    pub force: [f64; 3],
+    /// Normal component N (N); negative is tension.
+    pub normal: f64,
+    /// Tangential magnitude |F_t| (N).
+    pub tangential: f64,
+}
+
+impl ContactForce {
+    /// |F_t|/N (infinite when N ≤ 0).
+    pub fn friction_demand(&self) -> f64 {
+        if self.normal > 0.0 {
+            self.tangential / self.normal
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// The first failure of a hypothesis.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Violation {
+    /// Time (s).
+    pub t: f64,
+    /// Interface name.
+    pub interface: String,
+    /// `"tension"` (N < 0: flight) or `"sliding"` (|F_t| > μN).
+    pub kind: String,
+    /// N at that time (N).
+    pub normal: f64,
+    /// |F_t|/N at that time.
+    pub friction_demand: f64,
+}
+
+fn top(v: &Vector6<f64>) -> Vector3<f64> {
+    Vector3::new(v[0], v[1], v[2])
+}
+fn bottom(v: &Vector6<f64>) -> Vector3<f64> {
+    Vector3::new(v[3], v[4], v[5])
+}
+
+/// Unit contact normal of an interface at rest (None for a plain hinge).
+fn rest_normal(kind: &InterfaceKind, size: f64) -> Option<Vector3<f64>> {
+    match kind {
+        InterfaceKind::Hinge {
+            axis,
+            pivot_positive,
+            pivot_negative,
+        } => {
+            let lift = axis.cross(&(pivot_negative - pivot_positive));
+            (lift.norm() > 1e-9 * size).then(|| lift.normalize())
+        }
+        InterfaceKind::RockingBase { normal, .. } => Some(*normal),
+    }
+}
+
+/// Contact forces of every interface at (t, q, q̇) with the dynamics' pivots and seated slots
+/// (None for plain hinges). Solves the accelerations first.
+pub fn contact_forces(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    ground: &GroundMotion,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Result<Vec<Option<ContactForce>>, DynamicsError> {
+    dynamics.accelerations(model, ground, t, q, qdot)?;
+    let kin = &dynamics.kin;
+    let n = model.dof();
+    // Total spatial accelerations A = A_bias + Σ sⱼ q̈ⱼ along each path.
+    let mut acc = vec![Vector6::zeros(); n];
+    for k in 0..n {
+        let s = crr_kinematics::mass_matrix::spatial_axis(kin, k) * dynamics.qddot[k];
+        let parent = model.coords[k]
+            .parent
+            .map_or(Vector6::zeros(), |p| acc[p] - kin.bias_acceleration[p]);
+        acc[k] = kin.bias_acceleration[k] + parent + s;
+    }
+    let g_eff = effective_gravity(model, ground, t);
+    // Net force on each body beyond its load: m (a_c − g_eff).
+    let body_force: Vec<Vector3<f64>> = model
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(b, body)| {
+            let k = model.body_coord[b];
+            let (w, v0) = (
+                top(&kin.spatial_velocity[k]),
+                bottom(&kin.spatial_velocity[k]),
+            );
+            let (al, a0) = (top(&acc[k]), bottom(&acc[k]));
+            let c = kin.com[b];
+            let a_c = a0 + al.cross(&c) + w.cross(&(v0 + w.cross(&c)));
+            (a_c - g_eff) * body.mass
+        })
+        .collect();
+    // Closure point forces: λ on the parent side, −λ on the child side.
+    let mut closure_on: Vec<(Option<usize>, Vector3<f64>)> = Vec::new();
+    for cl in &model.closures {
+        let iface = &model.interfaces[cl.interface];
+        let lam = Vector3::new(
+            dynamics.lambda[cl.first_row],
+            dynamics.lambda[cl.first_row + 1],
+            dynamics.lambda[cl.first_row + 2],
+        );
+        closure_on.push((model.frame_of(iface.parent), lam));
+        closure_on.push((Some(model.body_coord[iface.child]), -lam));
+    }
+    let in_subtree = |frame: Option<usize>, root: usize| -> bool {
+        let mut j = frame;
+        while let Some(jj) = j {
+            if jj == root {
+                return true;
+            }
+            j = model.coords[jj].parent;
+        }
+        false
+    };
+    let out = model
+        .interfaces
+        .iter()
+        .map(|iface| {
+            let n_rest = rest_normal(&iface.kind, model.size)?;
+            let parent_rot = model
+                .frame_of(iface.parent)
+                .map_or_else(nalgebra::Matrix3::identity, |k| kin.rot_ops[k]);
+            let normal = parent_rot * n_rest;
+            let force = match iface.role {
+                Role::Tree { first_coord } => {
+                    let mut f = Vector3::zeros();
+                    for (b, fb) in body_force.iter().enumerate() {
+                        if in_subtree(Some(model.body_coord[b]), first_coord) {
+                            f += fb;
+                        }
+                    }
+                    for (frame, fc) in &closure_on {
+                        if in_subtree(*frame, first_coord) {
+                            f -= fc;
+                        }
+                    }
+                    f
+                }
+                Role::Closure { index } => {
+                    let cl = &model.closures[index];
+                    -Vector3::new(
+                        dynamics.lambda[cl.first_row],
+                        dynamics.lambda[cl.first_row + 1],
+                        dynamics.lambda[cl.first_row + 2],
+                    )
+                }
+            };
+            let nf = force.dot(&normal);
+            Some(ContactForce {
+                force: force.into(),
+                normal: nf,
+                tangential: (force - normal * nf).norm(),
+            })
+        })
+        .collect();
+    Ok(out)
+}
+
+/// The first violation among the given contact forces at time t (tension first, then sliding
+/// when μ is given). A tension smaller than `tolerance` (N) is round-off, not flight.
+pub fn check(
+    model: &Model,
+    forces: &[Option<ContactForce>],
+    t: f64,
+    friction: Option<f64>,
+    tolerance: f64,
+) -> Option<Violation> {
+    for (i, f) in forces.iter().enumerate() {
+        let Some(f) = f else { continue };
+        if f.normal < -tolerance {
+            return Some(Violation {
+                t,
+                interface: model.interfaces[i].name.clone(),
+                kind: "tension".into(),
+                normal: f.normal,
+                friction_demand: f.friction_demand(),
+            });
+        }
+        if let Some(mu) = friction
+            && f.tangential > mu * f.normal.max(0.0) + tolerance
+        {
+            return Some(Violation {
+                t,
+                interface: model.interfaces[i].name.clone(),
+                kind: "sliding".into(),
+                normal: f.normal,
+                friction_demand: f.friction_demand(),
+            });
+        }
+    }
+    None
+}

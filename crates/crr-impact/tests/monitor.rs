@@ -1,0 +1,171 @@
+//! The hypotheses monitor against closed forms for a single block: contact force at rest and
+//! under a horizontal acceleration (friction demand a_x/g), and at θ = 0 while rocking with rate
+//! θ̇₀ (N = m(g + z̈_c), F_x = m ẍ_c), with flight and sliding reported at the first sample.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crr_dynamics::eom::Dynamics;
+use crr_dynamics::ground_motion::{Axis, ComponentSpec, ConstantSpec, GroundMotion, SignalSpec};
+use crr_dynamics::{InitialSpec, solve_initial};
+use crr_impact::monitor::contact_forces;
+use crr_impact::{Parameters, Simulation};
+use crr_kinematics::fixtures::single_block;
+use crr_kinematics::{ActivePivots, Model, Side};
+use nalgebra::DVector;
+
+const G: f64 = 9.81;
+
+#[test]
+fn seated_block_force_and_sliding_demand() {
+    let model = Model::from_spec(&single_block(0.2, 1.0, 2500.0)).unwrap();
+    let m = model.total_mass();
+    let ax = 0.15 * G;
+    let ground = GroundMotion::none()
+        .with_component(
+            Axis::X,
+            &ComponentSpec::new(SignalSpec::Constant(ConstantSpec { value: ax })),
+            Path::new("."),
+        )
+        .unwrap();
+    let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+    d.seated = vec![0];
+    let f = contact_forces(
+        &model,
+        &mut d,
+        &ground,
+        0.0,
+        &DVector::zeros(1),
+        &DVector::zeros(1),
+    )
+    .unwrap()[0]
+        .unwrap();
+    // The ground holds the weight and pushes the block with the ground: F = m (a_x, 0, g).
+    assert!((f.normal - m * G).abs() < 1e-9 * m * G, "N = {}", f.normal);
+    assert!(
+        (f.force[0] - m * ax).abs() < 1e-9 * m * G && (f.tangential - m * ax).abs() < 1e-9 * m * G
+    );
+    assert!((f.friction_demand() - 0.15).abs() < 1e-12);
+    // Below uplift (0.15 < tan α = 0.2), the monitor reports sliding for μ = 0.1, nothing for 0.3.
+    let init = solve_initial(&model, &InitialSpec::default()).unwrap();
+    for (mu, slides) in [(0.1, true), (0.3, false)] {
+        let params = Parameters {
+            duration: 0.1,
+            friction: Some(mu),
+            ..Parameters::default()
+        };
+        let traj = Simulation::new(&model, &ground, &init, params)
+            .unwrap()
+            .run()
+            .map_err(|f| f.error)
+            .unwrap();
+        assert!(traj.uplift_time.is_none());
+        assert_eq!(
+            traj.violation.is_some(),
+            slides,
+            "μ = {mu}: {:?}",
+            traj.violation
+        );
+        if let Some(v) = traj.violation {
+            assert_eq!(
+                (v.t, v.kind.as_str(), v.interface.as_str()),
+                (0.0, "sliding", "base")
+            );
+        }
+    }
+}
+
+#[test]
+fn rocking_block_contact_force_and_flight() {
+    let (b, h): (f64, f64) = (0.2, 1.0);
+    let model = Model::from_spec(&single_block(b, h, 2500.0)).unwrap();
+    let m = model.total_mass();
+    let (r, alpha) = ((b * b + h * h).sqrt(), (b / h).atan());
+    let p2 = 3.0 * G / (4.0 * r);
+    let ground = GroundMotion::none();
+    for rate in [0.5, 2.5, 3.5] {
+        let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+        let f = contact_forces(
+            &model,
+            &mut d,
+            &ground,
+            0.0,
+            &DVector::zeros(1),
+            &DVector::from_element(1, rate),
+        )
+        .unwrap()[0]
+            .unwrap();
+        let theta_dd = -p2 * alpha.sin();
+        let z_dd = r * alpha.sin() * theta_dd - r * alpha.cos() * rate * rate;
+        let x_dd = r * alpha.cos() * theta_dd + r * alpha.sin() * rate * rate;
+        assert!(
+            (f.normal - m * (G + z_dd)).abs() < 1e-9 * m * G,
+            "θ̇ = {rate}: N {} vs {}",
+            f.normal,
+            m * (G + z_dd)
+        );
+        assert!((f.force[0] - m * x_dd).abs() < 1e-9 * m * G);
+        // Flight at the first sample iff N < 0, i.e. θ̇² > (g − R p² sin²α)/(R cos α) ≈ 3.09².
+        let init = solve_initial(
+            &model,
+            &InitialSpec {
+                rates: BTreeMap::from([("base".into(), rate)]),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let traj = Simulation::new(
+            &model,
+            &ground,
+            &init,
+            Parameters {
+                duration: 0.05,
+                ..Parameters::default()
+            },
+        )
+        .unwrap()
+        .run()
+        .map_err(|f| f.error)
+        .unwrap();
+        let flies = G + z_dd < 0.0;
+        assert_eq!(rate > 3.09, flies);
+        match &traj.violation {
+            Some(v) if flies => assert_eq!((v.t, v.kind.as_str()), (0.0, "tension")),
+            None if !flies => {}
+            other => panic!("θ̇ = {rate}: {other:?}"),
+        }
+    }
+}
+
+/// On a closed chain the reactions come from the loop's multipliers too: the seated trilithon's
+/// two base contacts carry its whole weight, and each top contact carries the architrave's
+/// weight split between them (N_top_left + N_top_right = m_beam g).
+#[test]
+fn trilithon_reactions_balance_the_weight() {
+    let model = Model::from_spec(&crr_kinematics::fixtures::trilithon(
+        0.25, 1.5, 2.0, 0.5, 1.0,
+    ))
+    .unwrap();
+    let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+    d.seated = (0..model.slot_count).collect();
+    let n = model.dof();
+    let f = contact_forces(
+        &model,
+        &mut d,
+        &GroundMotion::none(),
+        0.0,
+        &DVector::zeros(n),
+        &DVector::zeros(n),
+    )
+    .unwrap();
+    let normal = |name: &str| f[model.interface_index(name).unwrap()].unwrap().normal;
+    let w = model.total_mass() * G;
+    let w_beam = model.bodies[model.body_index("architrave").unwrap()].mass * G;
+    assert!((normal("base_left") + normal("base_right") - w).abs() < 1e-9 * w);
+    assert!((normal("top_left") + normal("top_right") - w_beam).abs() < 1e-9 * w);
+    assert!(
+        ["base_left", "base_right", "top_left", "top_right"]
+            .iter()
+            .all(|i| normal(i) > 0.0)
+    );
+}
