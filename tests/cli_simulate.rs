@@ -84,7 +84,7 @@ fn single_block_files_columns_and_closed_forms() {
         "t,interfaces,rates_before,rates_after,energy_lost"
     );
     // Closed forms: θ̈ = −p² sin(α − θ) for θ > 0; a quarter cycle from θm takes
-    // τ = ∫₀^θm dθ / √(2p²(cos(α − θ) − cos(α − θm))); at each impact θ̇⁺ = r θ̇⁻ with
+    // τ = ∫₀^θm dθ / √(2p²(cos(α − θm) − cos(α − θ))); at each impact θ̇⁺ = r θ̇⁻ with
     // r = 1 − 1.5 sin²α, so cos(α − θₙ₊₁) − cos α = r²(cos(α − θₙ) − cos α).
     let (b, h, g): (f64, f64, f64) = (0.2, 1.0, 9.81);
     let alpha = (b / h).atan();
@@ -94,7 +94,7 @@ fn single_block_files_columns_and_closed_forms() {
         // θ = θm − u²: the integrand 2u/√(…) is smooth; Simpson with 2000 intervals.
         let f = |u: f64| {
             let th = tm - u * u;
-            let d = 2.0 * p2 * ((alpha - th).cos() - (alpha - tm).cos());
+            let d = 2.0 * p2 * ((alpha - tm).cos() - (alpha - th).cos());
             if u == 0.0 {
                 2.0 / (2.0 * p2 * (alpha - tm).sin()).sqrt()
             } else {
@@ -276,10 +276,7 @@ fn errors_name_the_file_or_item_and_exit_2() {
         ],
         "--format",
     );
-    fails(
-        &["simulate", m, "--out", o, "--duration", "-1"],
-        "--duration",
-    );
+    fails(&["simulate", m, "--out", o, "--duration=-1"], "--duration");
     fails(&["check", "no/such/model.toml"], "no/such/model.toml");
     // clap's own usage errors also exit with 2.
     assert_eq!(crr(&["simulate"]).status.code(), Some(2));
