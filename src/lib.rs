@@ -9,12 +9,16 @@
 //!   M(q), U(q), loop closures Φ(q).
 //! - [`model_file`]: TOML/JSON model files with errors naming the file, item and problem.
 //! - [`inspect`]: the report of `crr inspect`.
+//! - [`simulate`]: `crr simulate` (history, impacts and summary files, `docs/outputs.md`).
+//! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
 
 pub use crr_dynamics as dynamics;
 pub use crr_impact as impact;
 pub use crr_kinematics as kinematics;
 
+pub mod check;
 pub mod inspect;
 pub mod model_file;
+pub mod simulate;
 
 pub use model_file::{InputError, load_model};

@@ -5,7 +5,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use crr::dynamics::ground_motion::{Axis, RecordFormat, Units};
 use crr::inspect::{configuration, inspect, to_text};
+use crr::simulate::{RecordArg, SimulateOptions, SimulateResult, simulate};
 use crr::{InputError, load_model};
 
 /// crr: dynamics of rigid-block masonry structures by coupled rocking rotations.
@@ -29,9 +31,98 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Run the simulation and write history.csv, impacts.csv and summary.json
+    /// (docs/outputs.md).
+    Simulate {
+        /// Model file (TOML, or JSON when it ends in .json).
+        model: PathBuf,
+        /// Output folder (default results/<model name>).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Simulated time (s); default [analysis].duration, else the ground motion's duration
+        /// + 5 s, else 10 s.
+        #[arg(long, value_name = "T")]
+        duration: Option<f64>,
+        /// Accelerogram file driving one component (overrides the model's component).
+        #[arg(long, value_name = "FILE")]
+        record: Option<PathBuf>,
+        /// Record format: peer-at2, csv or text.
+        #[arg(long, value_name = "FORMAT", requires = "record")]
+        format: Option<String>,
+        /// Record units: g, m/s2 or cm/s2 (required for csv/text).
+        #[arg(long, value_name = "UNITS", requires = "record")]
+        units: Option<String>,
+        /// Ground-motion component the record drives: x, y or z.
+        #[arg(long, value_name = "AXIS", default_value = "x", requires = "record")]
+        component: String,
+        /// Factor on the record's accelerations.
+        #[arg(long, value_name = "S", default_value_t = 1.0, requires = "record")]
+        scale: f64,
+        /// No progress indication.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Mobility report; for a one-DOF mechanism λ, the equivalent block, r and the free-rocking
+    /// frequencies (docs/outputs.md).
+    Check {
+        /// Model file (TOML, or JSON when it ends in .json).
+        model: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
-fn run(cli: Cli) -> Result<(), InputError> {
+/// Input problems exit with 2, a simulation that failed part-way with 1.
+enum Failure {
+    Input(InputError),
+    Simulation(String),
+}
+
+impl From<InputError> for Failure {
+    fn from(e: InputError) -> Self {
+        Failure::Input(e)
+    }
+}
+
+fn record_arg(
+    record: Option<PathBuf>,
+    format: Option<String>,
+    units: Option<String>,
+    component: &str,
+    scale: f64,
+) -> Result<Option<RecordArg>, InputError> {
+    let Some(file) = record else {
+        return Ok(None);
+    };
+    let arg = |e: String| InputError::Argument(e);
+    let format: RecordFormat = match format {
+        Some(f) => f.parse().map_err(|e| arg(format!("--format: {e}")))?,
+        None => {
+            return Err(arg(
+                "--record needs --format peer-at2, csv or text".to_string()
+            ));
+        }
+    };
+    let units: Option<Units> = units
+        .map(|u| u.parse().map_err(|e| arg(format!("--units: {e}"))))
+        .transpose()?;
+    let component: Axis = component
+        .parse()
+        .map_err(|e| arg(format!("--component: {e}")))?;
+    if !scale.is_finite() {
+        return Err(arg(format!("--scale must be finite, got {scale}")));
+    }
+    Ok(Some(RecordArg {
+        file,
+        format,
+        units,
+        component,
+        scale,
+    }))
+}
+
+fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Inspect { model, q, json } => {
             let (_, m) = load_model(&model)?;
@@ -46,6 +137,64 @@ fn run(cli: Cli) -> Result<(), InputError> {
                 print!("{}", to_text(&report));
             }
         }
+        Command::Simulate {
+            model,
+            out,
+            duration,
+            record,
+            format,
+            units,
+            component,
+            scale,
+            quiet,
+        } => {
+            let opts = SimulateOptions {
+                out,
+                duration,
+                record: record_arg(record, format, units, &component, scale)?,
+                quiet,
+            };
+            match simulate(&model, &opts)? {
+                SimulateResult::Done(dir, summary) => {
+                    if !quiet {
+                        println!(
+                            "{}: {} impact(s), collapse: {}, end time {} s; results in {}",
+                            model.display(),
+                            summary["impacts"],
+                            if summary["collapse"]["collapsed"] == true {
+                                format!(
+                                    "yes at t = {} s ({})",
+                                    summary["collapse"]["time"], summary["collapse"]["body"]
+                                )
+                            } else {
+                                "no".to_string()
+                            },
+                            summary["end_time"],
+                            dir.display()
+                        );
+                    }
+                }
+                SimulateResult::Failed(dir, e) => {
+                    return Err(Failure::Simulation(format!(
+                        "{}: the simulation failed: {e} (partial results written to {}, \"completed\": false)",
+                        model.display(),
+                        dir.display()
+                    )));
+                }
+            }
+        }
+        Command::Check { model, json } => {
+            let (_, m) = load_model(&model)?;
+            let report = crr::check::check(&m);
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&report).expect("report serialises")
+                );
+            } else {
+                print!("{}", crr::check::to_text(&report));
+            }
+        }
     }
     Ok(())
 }
@@ -54,9 +203,13 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
+        Err(Failure::Input(e)) => {
             eprintln!("crr: error: {e}");
             ExitCode::from(2)
+        }
+        Err(Failure::Simulation(e)) => {
+            eprintln!("crr: error: {e}");
+            ExitCode::from(1)
         }
     }
 }

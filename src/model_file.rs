@@ -85,6 +85,14 @@ pub enum InputError {
         /// Which item is wrong and why.
         source: ModelError,
     },
+    /// The results could not be written.
+    #[error("{dir}: cannot write the results: {source}")]
+    Output {
+        /// The output folder.
+        dir: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
     /// A value given on the command line is not valid for this model.
     #[error("{0}")]
     Argument(String),

@@ -1,7 +1,8 @@
 //! Every model shown in the documentation is valid and says what the text says.
 //!
 //! Each ```` ```toml ```` block of `docs/model-format.md` (and of `README.md`, if present) is a
-//! complete model file: it must parse as a `StructureSpec` and build with `Model::from_spec`.
+//! complete model file: it must parse as a `ModelFile` (the structure plus the optional
+//! `[initial]`, `[ground_motion]` and `[analysis]` tables) and build with `Model::from_spec`.
 //! Each ```` ```json ```` block that is a whole object is checked the same way. Partial snippets
 //! are fenced `toml-fragment` and skipped. Every model is then checked against the facts the
 //! text states about it (found by the model's `name`): DOF(1), coordinate order, closure rows,
@@ -15,6 +16,7 @@ use crr::kinematics::{
     ActivePivots, Data, ImpactLaw, InterfaceKind, Model, Role, Side, StructureSpec,
     constraint_residual, forward_kinematics, mass_matrix,
 };
+use crr::model_file::ModelFile;
 use nalgebra::{DVector, Vector3};
 
 /// A fenced block: its language tag, its text and the line of its opening fence.
@@ -64,13 +66,14 @@ fn models_of(rel: &str) -> Vec<(String, StructureSpec, Model)> {
     };
     let mut out = Vec::new();
     for b in fenced_blocks(&text) {
-        let spec: StructureSpec = match b.lang.as_str() {
+        let file: ModelFile = match b.lang.as_str() {
             "toml" => toml::from_str(&b.text)
                 .unwrap_or_else(|e| panic!("{rel}:{}: toml block does not parse: {e}", b.line)),
             "json" if b.text.trim_start().starts_with('{') => serde_json::from_str(&b.text)
                 .unwrap_or_else(|e| panic!("{rel}:{}: json block does not parse: {e}", b.line)),
             _ => continue,
         };
+        let spec = file.structure();
         let model = Model::from_spec(&spec)
             .unwrap_or_else(|e| panic!("{rel}:{}: model is invalid: {e}", b.line));
         out.push((format!("{rel}:{} ({})", b.line, b.lang), spec, model));
@@ -280,8 +283,8 @@ fn quoted_error_messages_are_the_real_ones() {
     let doc = read_doc("docs/model-format.md").expect("docs/model-format.md");
     let file = read_doc("examples/models/single_block.toml").expect("the example file");
     let build = |text: &str| {
-        let spec: StructureSpec = toml::from_str(text).expect("parses");
-        Model::from_spec(&spec)
+        let file: ModelFile = toml::from_str(text).expect("parses");
+        Model::from_spec(&file.structure())
     };
     // Exchanged edges: "pivots swapped".
     let pos = "pivot_positive = [[0.2, -0.2, 0.0], [0.2, 0.2, 0.0]]";

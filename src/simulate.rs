@@ -1,0 +1,421 @@
+//! `crr simulate`: run the event-driven simulation of a model file and write `history.csv`,
+//! `impacts.csv` and `summary.json` (documented in `docs/outputs.md`).
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+use serde_json::{Value, json};
+
+use crr_dynamics::ground_motion::{Axis, GroundMotion, RecordFormat, Units, read_record};
+use crr_dynamics::{AnalysisSpec, InitialState, solve_initial};
+use crr_impact::simulation::{Parameters, Simulation, SimulationError, StopReason, Trajectory};
+use crr_kinematics::{InterfaceKind, Model};
+
+use crate::model_file::{InputError, ModelFile, load_model};
+
+/// A record given on the command line (`--record`), overriding one component.
+#[derive(Clone, Debug)]
+pub struct RecordArg {
+    /// The file.
+    pub file: PathBuf,
+    /// Its format.
+    pub format: RecordFormat,
+    /// Units (required for csv/text).
+    pub units: Option<Units>,
+    /// The component it drives.
+    pub component: Axis,
+    /// Factor on the accelerations.
+    pub scale: f64,
+}
+
+/// Options of `crr simulate`.
+#[derive(Clone, Debug, Default)]
+pub struct SimulateOptions {
+    /// Output folder (default `results/<model name>`).
+    pub out: Option<PathBuf>,
+    /// Duration (s), overriding `[analysis].duration`.
+    pub duration: Option<f64>,
+    /// A record overriding one ground-motion component.
+    pub record: Option<RecordArg>,
+    /// No progress indication.
+    pub quiet: bool,
+}
+
+/// Everything a run needs, read and checked from the inputs.
+pub struct Prepared {
+    /// The model file as read.
+    pub file: ModelFile,
+    /// The validated model.
+    pub model: Model,
+    /// The ground motion (model table plus command-line record).
+    pub ground: GroundMotion,
+    /// The consistent initial state.
+    pub initial: InitialState,
+    /// Simulation parameters.
+    pub params: Parameters,
+    /// Output folder.
+    pub out: PathBuf,
+}
+
+/// The default duration: the ground motion's duration + 5 s when it ends, else 10 s.
+pub fn default_duration(ground: &GroundMotion) -> f64 {
+    let d = ground.duration();
+    if d.is_finite() && d > 0.0 {
+        d + 5.0
+    } else {
+        10.0
+    }
+}
+
+/// Reads the model, the ground motion, the initial state and the parameters. Every failure is an
+/// input error naming the file or item.
+pub fn prepare(path: &Path, opts: &SimulateOptions) -> Result<Prepared, InputError> {
+    let (file, model) = load_model(path)?;
+    let here = |msg: String| InputError::Argument(format!("{}: {msg}", path.display()));
+    let base_dir = path.parent().unwrap_or(Path::new("."));
+    let mut ground = match &file.ground_motion {
+        Some(spec) => GroundMotion::from_spec(spec, base_dir).map_err(|e| here(e.to_string()))?,
+        None => GroundMotion::none(),
+    };
+    if let Some(r) = &opts.record {
+        let record = read_record(&r.file, r.format, r.units)
+            .map_err(|e| InputError::Argument(format!("--record: {e}")))?;
+        ground = ground
+            .with_record(r.component, record, r.scale)
+            .map_err(|e| InputError::Argument(format!("--scale: {e}")))?;
+    }
+    let initial_spec = file.initial.clone().unwrap_or_default();
+    let initial = solve_initial(&model, &initial_spec).map_err(|e| here(e.to_string()))?;
+    let analysis = file.analysis.clone().unwrap_or_default();
+    let mut params =
+        Parameters::from_analysis(&analysis, default_duration(&ground)).map_err(here)?;
+    if let Some(d) = opts.duration {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(InputError::Argument(format!(
+                "--duration must be a positive number of seconds, got {d}"
+            )));
+        }
+        params.duration = d;
+    }
+    let out = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("results").join(&file.name));
+    Ok(Prepared {
+        file,
+        model,
+        ground,
+        initial,
+        params,
+        out,
+    })
+}
+
+/// The outcome of a run: the trajectory and the error that stopped it early, if any.
+pub struct Outcome {
+    /// Results (complete or partial).
+    pub trajectory: Trajectory,
+    /// The error that interrupted the run.
+    pub error: Option<SimulationError>,
+}
+
+/// Runs the simulation, printing a percentage on stderr when `progress`.
+pub fn run(p: &Prepared, progress: bool) -> Result<Outcome, SimulationError> {
+    let mut sim = Simulation::new(&p.model, &p.ground, &p.initial, p.params.clone())?;
+    let total = p.params.duration;
+    let mut shown = -1i64;
+    let error = loop {
+        match sim.step() {
+            Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => break None,
+            Ok(_) => {}
+            Err(e) => break Some(e),
+        }
+        if progress {
+            let pct = (100.0 * sim.time() / total).floor() as i64;
+            if pct != shown {
+                shown = pct;
+                eprint!("\rcrr: simulating {:>3}% (t = {:.2} s)", pct, sim.time());
+            }
+        }
+    };
+    if progress {
+        eprintln!("\rcrr: simulating 100% (t = {:.2} s)   ", sim.time());
+    }
+    Ok(Outcome {
+        trajectory: sim.into_trajectory(),
+        error,
+    })
+}
+
+/// Slenderness α of a coordinate, when defined: for a hinge with two distinct pivot lines or a
+/// rocking base tilt, atan(b/h) with b the half-distance between the pivot lines (perpendicular
+/// to the axis) and h the height of the child's centre above the line midway between them,
+/// measured normal to the joint face. None for a plain hinge (one pivot line).
+pub fn coordinate_alpha(model: &Model, coordinate: usize) -> Option<f64> {
+    let c = &model.coords[coordinate];
+    let iface = &model.interfaces[c.interface];
+    let com = model.bodies[iface.child].com;
+    match &iface.kind {
+        InterfaceKind::Hinge {
+            axis,
+            pivot_positive,
+            pivot_negative,
+        } => {
+            let d = pivot_negative - pivot_positive;
+            let d = d - axis * axis.dot(&d);
+            let width = d.norm();
+            if width < 1e-9 * model.size {
+                return None;
+            }
+            let n = axis.cross(&d) / width;
+            let mid = (pivot_negative + pivot_positive) / 2.0;
+            let h = (com - mid).dot(&n);
+            Some((width / 2.0).atan2(h))
+        }
+        InterfaceKind::RockingBase {
+            corners,
+            normal,
+            e1,
+            e2,
+        } => {
+            let centre: Vector3<f64> = corners.iter().sum::<Vector3<f64>>() / 4.0;
+            // Tilt about e₁ pivots on edges parallel to e₁: half-extent along e₂, and vice versa.
+            let across = if c.component == 0 { e2 } else { e1 };
+            let extent = corners
+                .iter()
+                .map(|p| (p - centre).dot(across).abs())
+                .fold(0.0, f64::max);
+            let h = (com - centre).dot(normal);
+            Some(extent.atan2(h))
+        }
+    }
+}
+
+/// The `<interface>_state` code of every interface at a sample: the slot codes (`seated`, `+`,
+/// `-`), joined by `/` for a rocking base (tilt `.1` then `.2`).
+fn interface_states(model: &Model, states: &[crr_impact::simulation::SlotState]) -> Vec<String> {
+    model
+        .interfaces
+        .iter()
+        .map(|i| {
+            i.slots
+                .clone()
+                .map(|s| states.get(s).map_or("?", |st| st.code()))
+                .collect::<Vec<_>>()
+                .join("/")
+        })
+        .collect()
+}
+
+fn num(x: f64) -> String {
+    format!("{x:e}")
+}
+
+/// The text of `history.csv`.
+pub fn history_csv(model: &Model, t: &Trajectory) -> String {
+    let mut s = String::from("t");
+    for c in &t.coordinates {
+        s.push(',');
+        s.push_str(c);
+    }
+    for c in &t.coordinates {
+        s.push_str(&format!(",{c}_rate"));
+    }
+    s.push_str(",kinetic,potential,work_in,dissipated");
+    for i in &model.interfaces {
+        s.push_str(&format!(",{}_state", i.name));
+    }
+    s.push('\n');
+    for x in &t.samples {
+        s.push_str(&num(x.t));
+        for v in x.q.iter().chain(x.qdot.iter()) {
+            s.push(',');
+            s.push_str(&num(*v));
+        }
+        for v in [x.kinetic, x.potential, x.work_in, x.dissipated] {
+            s.push(',');
+            s.push_str(&num(v));
+        }
+        for st in interface_states(model, &x.states) {
+            s.push(',');
+            s.push_str(&st);
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// The text of `impacts.csv`.
+pub fn impacts_csv(t: &Trajectory) -> String {
+    let mut s = String::from("t,interfaces,rates_before,rates_after,energy_lost\n");
+    let join = |v: &[f64]| v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(";");
+    for i in &t.impacts {
+        s.push_str(&format!(
+            "{},{},{},{},{}\n",
+            num(i.t),
+            i.interfaces.join(";"),
+            join(&i.rates_before),
+            join(&i.rates_after),
+            num(i.energy_lost)
+        ));
+    }
+    s
+}
+
+fn method_name(a: &AnalysisSpec) -> &'static str {
+    match a.method {
+        crr_dynamics::MethodName::Dop853 => "dop853",
+        crr_dynamics::MethodName::Dopri5 => "dopri5",
+        crr_dynamics::MethodName::Rk4 => "rk4",
+    }
+}
+
+/// The content of `summary.json`.
+pub fn summary(
+    model_path: &Path,
+    p: &Prepared,
+    opts: &SimulateOptions,
+    t: &Trajectory,
+    error: Option<&str>,
+) -> Value {
+    let coordinates: Vec<Value> = t
+        .coordinates
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let alpha = coordinate_alpha(&p.model, k);
+            json!({
+                "name": name,
+                "peak_abs": t.peak_abs[k],
+                "alpha": alpha,
+                "peak_over_alpha": alpha.map(|a| t.peak_abs[k] / a),
+            })
+        })
+        .collect();
+    let mut echo = p.file.clone();
+    echo.gravity = p.model.gravity;
+    let analysis = p.file.analysis.clone().unwrap_or_default();
+    let pga = p.ground.pga();
+    let duration = p.ground.duration();
+    let initial = p.file.initial.clone().unwrap_or_default();
+    json!({
+        "crr_version": env!("CARGO_PKG_VERSION"),
+        "completed": error.is_none(),
+        "error": error,
+        "model_file": model_path.display().to_string(),
+        "model": echo,
+        "record": opts.record.as_ref().map(|r| json!({
+            "file": r.file.display().to_string(),
+            "format": r.format.name(),
+            "units": r.units.map(|u| u.name()),
+            "component": r.component.name(),
+            "scale": r.scale,
+        })),
+        "ground_motion": {
+            "pga": [pga.x, pga.y, pga.z],
+            "duration": if duration.is_finite() { json!(duration) } else { Value::Null },
+        },
+        "initial": {
+            "spec": initial,
+            "q": p.initial.q.as_slice(),
+            "qdot": p.initial.qdot.as_slice(),
+        },
+        "solver": {
+            "method": method_name(&analysis),
+            "duration": p.params.duration,
+            "output_interval": p.params.output_interval,
+            "rtol": p.params.options.rtol,
+            "atol": p.params.options.atol,
+            "max_step": if p.params.options.h_max.is_finite() { json!(p.params.options.h_max) } else { Value::Null },
+            "rk4_step": analysis.rk4_step,
+            "seat_rate": p.params.seat_rate,
+            "min_impact_interval": p.params.min_impact_interval,
+            "simultaneity": p.params.simultaneity,
+            "max_impacts": p.params.max_impacts,
+            "collapse_drop": p.params.collapse_drop,
+        },
+        "end_time": t.end_time,
+        "samples": t.samples.len(),
+        "coordinates": coordinates,
+        "impacts": t.impacts.len(),
+        "energy_lost_at_impacts": t.impacts.iter().map(|i| i.energy_lost).sum::<f64>(),
+        "uplift_time": t.uplift_time,
+        "collapse": {
+            "collapsed": t.collapse.is_some(),
+            "time": t.collapse.as_ref().map(|c| c.t),
+            "body": t.collapse.as_ref().map(|c| c.body.clone()),
+        },
+        "energy_balance_error": t.energy_balance_error,
+    })
+}
+
+/// Writes the three files into `dir`: each to a hidden temporary name first, renamed at the end
+/// (summary.json last), so an interrupted run never leaves a set of files that looks complete.
+pub fn write_outputs(dir: &Path, files: &[(&str, String)]) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    // Remove an older summary first: the new set is complete only when it reappears.
+    let _ = std::fs::remove_file(dir.join("summary.json"));
+    let mut temps = Vec::new();
+    for (name, text) in files {
+        let tmp = dir.join(format!(".{name}.partial"));
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(text.as_bytes())?;
+        f.sync_all()?;
+        temps.push((tmp, dir.join(name)));
+    }
+    for (tmp, dst) in temps {
+        std::fs::rename(tmp, dst)?;
+    }
+    Ok(())
+}
+
+/// What `crr simulate` did.
+pub enum SimulateResult {
+    /// The run completed; the output folder.
+    Done(PathBuf, Value),
+    /// The run failed part-way; the partial results were written to the folder.
+    Failed(PathBuf, String),
+}
+
+/// `crr simulate` end to end. Input problems are `Err`; a simulation failure is
+/// `Ok(SimulateResult::Failed)` after writing what was computed.
+pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, InputError> {
+    let p = prepare(path, opts)?;
+    let progress = !opts.quiet && std::io::stderr().is_terminal();
+    let (trajectory, error) = match run(&p, progress) {
+        Ok(o) => (o.trajectory, o.error.map(|e| e.to_string())),
+        Err(e) => {
+            // Nothing was integrated: an empty trajectory at t = 0.
+            let t = Trajectory {
+                coordinates: p.model.coords.iter().map(|c| c.name.clone()).collect(),
+                samples: Vec::new(),
+                impacts: Vec::new(),
+                peaks: Vec::new(),
+                peak_abs: vec![0.0; p.model.dof()],
+                uplift_time: None,
+                collapse: None,
+                energy_balance_error: 0.0,
+                end_time: 0.0,
+            };
+            (t, Some(e.to_string()))
+        }
+    };
+    let sum = summary(path, &p, opts, &trajectory, error.as_deref());
+    let files = [
+        ("history.csv", history_csv(&p.model, &trajectory)),
+        ("impacts.csv", impacts_csv(&trajectory)),
+        (
+            "summary.json",
+            serde_json::to_string_pretty(&sum).expect("summary serialises") + "\n",
+        ),
+    ];
+    write_outputs(&p.out, &files).map_err(|source| InputError::Output {
+        dir: p.out.clone(),
+        source,
+    })?;
+    Ok(match error {
+        None => SimulateResult::Done(p.out, sum),
+        Some(e) => SimulateResult::Failed(p.out, e),
+    })
+}
