@@ -334,6 +334,7 @@ pub fn summary(
             "simultaneity": p.params.simultaneity,
             "max_impacts": p.params.max_impacts,
             "collapse_drop": p.params.collapse_drop,
+            "friction": p.params.friction,
         },
         "end_time": t.end_time,
         "samples": t.samples.len(),
@@ -347,6 +348,13 @@ pub fn summary(
             "body": t.collapse.as_ref().map(|c| c.body.clone()),
         },
         "energy_balance_error": t.energy_balance_error,
+        "hypothesis_violation": t.violation.as_ref().map(|v| json!({
+            "time": v.t,
+            "interface": v.interface,
+            "kind": v.kind,
+            "normal_force": v.normal,
+            "friction_demand": if v.friction_demand.is_finite() { json!(v.friction_demand) } else { Value::Null },
+        })),
     })
 }
 
@@ -395,6 +403,7 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
                 peak_abs: vec![0.0; p.model.dof()],
                 uplift_time: None,
                 collapse: None,
+                violation: None,
                 energy_balance_error: 0.0,
                 end_time: 0.0,
             };

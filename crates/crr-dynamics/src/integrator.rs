@@ -513,6 +513,13 @@ impl Solver {
         })
     }
 
+    /// Forgets which event fired last. Call it when the next `advance` uses a different set of
+    /// event functions (indices then mean other functions); an event function exactly at zero
+    /// (|g| ≤ [`EVENT_ZERO_TOL`]) at the start still cannot fire there.
+    pub fn forget_last_event(&mut self) {
+        self.fired = None;
+    }
+
     /// Changes the largest step (s), e.g. while a narrow forcing feature is active. Positive or
     /// infinite; other values are ignored.
     pub fn set_h_max(&mut self, h_max: f64) {

@@ -285,6 +285,114 @@ fn slot_rates(model: &Model, kin: &Data, qdot: &DVector<f64>, out: &mut [f64]) {
     }
 }
 
+/// The plastic impulse that stops the given slots (and keeps the loops closed):
+/// q̇⁺ = q̇ − M⁻¹Cᵀ(C M⁻¹ Cᵀ)⁺ C q̇ with C the closure rows and the slots' rate rows, i.e. the
+/// impulse along those constraints only, with the smallest kinetic-energy loss. Rank-revealing:
+/// dependent rows (slots locked together in a loop) are harmless. Returns q̇⁺ and T⁺.
+fn plastic_projection(
+    model: &Model,
+    template: &Dynamics,
+    ground: &GroundMotion,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    pivots: &ActivePivots,
+    slots: &[usize],
+) -> (DVector<f64>, f64) {
+    let mut d = template.clone();
+    d.pivots = pivots.clone();
+    d.seated.clear();
+    d.evaluate(model, ground, t, q, qdot);
+    let n = model.dof();
+    let m = d.kin.mass_matrix.clone();
+    let kinetic = |v: &DVector<f64>| 0.5 * v.dot(&(&m * v));
+    if slots.is_empty() {
+        return (qdot.clone(), kinetic(qdot));
+    }
+    let phi = d.scaled_jacobian();
+    let rows = phi.nrows() + slots.len();
+    let mut c = nalgebra::DMatrix::zeros(rows, n);
+    c.rows_mut(0, phi.nrows()).copy_from(&phi);
+    let mut row = DVector::zeros(n);
+    for (i, &s) in slots.iter().enumerate() {
+        slot_row(model, &d.kin, s, &mut row);
+        c.row_mut(phi.nrows() + i).copy_from(&row.transpose());
+    }
+    let chol = m.clone().cholesky().expect("M is positive definite");
+    let y = chol.solve(&c.transpose());
+    let a = &c * &y;
+    let (lambda, _) = crr_dynamics::linalg::pinv_solve(&a, &(&c * qdot));
+    let out = qdot - y * lambda;
+    let k = kinetic(&out);
+    (out, k)
+}
+
+/// Applies the impact laws of the impacting slots (momentum if any of their interfaces uses it;
+/// otherwise restitution and exact Dirac, regularised laws switching with continuous rates).
+fn apply_law(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    before: &ActivePivots,
+    after: &ActivePivots,
+    impacting: &[usize],
+) -> Result<crate::laws::ImpactResult, ImpactError> {
+    let laws: Vec<ImpactLaw> = impacting
+        .iter()
+        .map(|&s| model.interfaces[slot_interface(model, s)].impact)
+        .collect();
+    Ok(if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
+        momentum_law(model, kin, q, qdot, before, after)?
+    } else {
+        let rest: Vec<(usize, f64)> = impacting
+            .iter()
+            .zip(&laws)
+            .filter_map(|(&s, l)| {
+                if let ImpactLaw::Restitution(r) = l {
+                    Some((s, *r))
+                } else {
+                    None
+                }
+            })
+            .collect();
+        let dirac: Vec<(usize, f64, f64)> = impacting
+            .iter()
+            .zip(&laws)
+            .filter_map(|(&s, l)| {
+                if let ImpactLaw::Dirac { r, c } = l {
+                    Some((s, *r, *c))
+                } else {
+                    None
+                }
+            })
+            .collect();
+        // Regularised laws switch pivots with continuous rates (r = 1, the force does the rest).
+        let plain: Vec<(usize, f64)> = impacting
+            .iter()
+            .zip(&laws)
+            .filter_map(|(&s, l)| {
+                matches!(l, ImpactLaw::DiracRegularised { .. }).then_some((s, 1.0))
+            })
+            .collect();
+        let mut res = restitution_law(
+            model,
+            kin,
+            q,
+            qdot,
+            before,
+            after,
+            &[rest.as_slice(), plain.as_slice()].concat(),
+        )?;
+        if !dirac.is_empty() {
+            let t_before = res.kinetic_before;
+            res = dirac_law(model, kin, q, &res.qdot, after, after, &dirac)?;
+            res.kinetic_before = t_before;
+        }
+        res
+    })
+}
+
 /// Finds the interfaces that open from a seated state at (t, q, q̇): releasing a seated slot on a
 /// side must give it an opening acceleration on that side. First every single release is tried
 /// (the strongest opening wins); if none opens and the structure has loops, all seated slots are
@@ -662,6 +770,8 @@ impl<'a> Simulation<'a> {
 
     fn reset_solver(&mut self) {
         self.solver.reset(self.t, &self.y);
+        // Every segment rebuilds its event list: an index from the last one means nothing now.
+        self.solver.forget_last_event();
     }
 
     /// Releases seated slots if the seated state cannot hold now.
@@ -685,17 +795,97 @@ impl<'a> Simulation<'a> {
         Ok(mode)
     }
 
+    /// Seats rocking joints that sit at φ ≈ 0 with a negligible rate while their acceleration
+    /// points into their closed side (they cannot open on that side; left alone they would slip
+    /// through the contact without a crossing to detect). They may then uplift on the other side.
+    fn settle_resting_joints(&mut self) -> Result<Option<f64>, SimulationError> {
+        let model = self.model;
+        let (q, qdot) = (self.q(), self.qdot());
+        let mut angles = vec![0.0; model.slot_count];
+        let mut kin = Data::new(model);
+        slot_angles(model, &mut kin, &q, &self.dynamics.pivots, &mut angles);
+        let candidates: Vec<usize> = (0..model.slot_count)
+            .filter(|&s| !self.seated[s] && angles[s].abs() <= self.params.simultaneity)
+            .collect();
+        if candidates.is_empty() {
+            return Ok(None);
+        }
+        let mut d = self.dynamics.clone();
+        d.accelerations(model, self.ground, self.t, &q, &qdot)
+            .map_err(|e| SimulationError::Parameter(e.to_string()))?;
+        let mut rates = vec![0.0; model.slot_count];
+        slot_rates(model, &d.kin, &qdot, &mut rates);
+        let mut row = DVector::zeros(model.dof());
+        // A joint leaving φ = 0 against its acceleration returns after τ = 2|φ̇|/|φ̈|: the
+        // segment is capped at τ/2 (the turning point) so the return is a plain sign change.
+        let mut cap: Option<f64> = None;
+        for &s in &candidates {
+            let bias = slot_row(model, &d.kin, s, &mut row);
+            let acc = row.dot(&d.qddot) + bias;
+            let side = self.dynamics.pivots.sides[s].sign();
+            if side * rates[s] > 0.0 && side * acc < 0.0 {
+                let tau = 2.0 * rates[s].abs() / acc.abs();
+                cap = Some(cap.map_or(0.5 * tau, |c: f64| c.min(0.5 * tau)));
+            }
+        }
+        let closing: Vec<usize> = candidates
+            .into_iter()
+            .filter(|&s| {
+                let bias = slot_row(model, &d.kin, s, &mut row);
+                let acc = row.dot(&d.qddot) + bias;
+                let side = self.dynamics.pivots.sides[s].sign();
+                rates[s].abs() < self.params.seat_rate
+                    && side * rates[s] <= 1e-12
+                    && side * acc <= 0.0
+            })
+            .collect();
+        if closing.is_empty() {
+            return Ok(cap);
+        }
+        let held: Vec<usize> = (0..model.slot_count)
+            .filter(|&s| self.seated[s] || closing.contains(&s))
+            .collect();
+        let (qd, kinetic) = plastic_projection(
+            model,
+            &self.dynamics,
+            self.ground,
+            self.t,
+            &q,
+            &qdot,
+            &self.dynamics.pivots,
+            &held,
+        );
+        let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * &qdot));
+        self.dissipated_at_impacts += before - kinetic;
+        for &s in &closing {
+            self.seated[s] = true;
+            if s < model.dof() {
+                self.y[s] = 0.0;
+            }
+        }
+        let n = model.dof();
+        self.y[n..2 * n].copy_from_slice(qd.as_slice());
+        self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        self.reset_solver();
+        self.release_if_opening()?;
+        Ok(None)
+    }
+
     /// Integrates to the next event, breakpoint or the end.
     pub fn step(&mut self) -> Result<StopReason, SimulationError> {
         if self.finished {
             return Ok(StopReason::End(self.t));
         }
+        let lift_off = self.settle_resting_joints()?;
         let model = self.model;
         let n = model.dof();
-        let t_stop = self
+        let mut t_stop = self
             .ground
             .next_breakpoint(self.t)
             .map_or(self.params.duration, |b| b.min(self.params.duration));
+        if let Some(c) = lift_off {
+            t_stop = t_stop.min(self.t + c);
+        }
         let rocking: Vec<(usize, Side)> = (0..model.slot_count)
             .filter(|&s| !self.seated[s])
             .map(|s| (s, self.dynamics.pivots.sides[s]))
@@ -768,6 +958,9 @@ impl<'a> Simulation<'a> {
         // Inside a regularised δ zone the step is limited to an eighth of the zone's crossing time,
         // so that the bump is resolved by the steps and their dense output.
         let mut h_max = self.params.options.h_max;
+        if let Some(c) = lift_off {
+            h_max = h_max.min(c / 4.0);
+        }
         if let Some(r) = &self.regularised {
             let mut angles = vec![0.0; model.slot_count];
             let (q, qdot) = (self.q(), self.qdot());
@@ -885,7 +1078,7 @@ impl<'a> Simulation<'a> {
         crr_kinematics::velocities(model, &mut kin, &qdot);
         let mut rates = vec![0.0; model.slot_count];
         slot_rates(model, &kin, &qdot, &mut rates);
-        let impacting: Vec<usize> = (0..model.slot_count)
+        let mut impacting: Vec<usize> = (0..model.slot_count)
             .filter(|&s| {
                 s == slot
                     || (!self.seated[s]
@@ -893,104 +1086,89 @@ impl<'a> Simulation<'a> {
                         && rates[s] * before.sides[s].sign() < 0.0)
             })
             .collect();
-        let mut after = before.clone();
-        for &s in &impacting {
-            after.sides[s] = before.sides[s].flipped();
-        }
-        let laws: Vec<ImpactLaw> = impacting
-            .iter()
-            .map(|&s| model.interfaces[slot_interface(model, s)].impact)
-            .collect();
-        let err = |source| SimulationError::Impact { t, source };
-        let result = if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
-            momentum_law(model, &mut kin, &q, &qdot, &before, &after).map_err(err)?
-        } else {
-            let rest: Vec<(usize, f64)> = impacting
-                .iter()
-                .zip(&laws)
-                .filter_map(|(&s, l)| {
-                    if let ImpactLaw::Restitution(r) = l {
-                        Some((s, *r))
-                    } else {
-                        None
-                    }
-                })
-                .collect();
-            let dirac: Vec<(usize, f64, f64)> = impacting
-                .iter()
-                .zip(&laws)
-                .filter_map(|(&s, l)| {
-                    if let ImpactLaw::Dirac { r, c } = l {
-                        Some((s, *r, *c))
-                    } else {
-                        None
-                    }
-                })
-                .collect();
-            // Regularised laws switch pivots with continuous rates (r = 1, the force does the rest).
-            let plain: Vec<(usize, f64)> = impacting
-                .iter()
-                .zip(&laws)
-                .filter_map(|(&s, l)| {
-                    matches!(l, ImpactLaw::DiracRegularised { .. }).then_some((s, 1.0))
-                })
-                .collect();
-            let mut res = restitution_law(
-                model,
-                &mut kin,
-                &q,
-                &qdot,
-                &before,
-                &after,
-                &[rest.as_slice(), plain.as_slice()].concat(),
-            )
-            .map_err(err)?;
-            if !dirac.is_empty() {
-                let t_before = res.kinetic_before;
-                res = dirac_law(model, &mut kin, &q, &res.qdot, &after, &after, &dirac)
-                    .map_err(err)?;
-                res.kinetic_before = t_before;
+        let held: Vec<usize> = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        // A rocking joint at φ ≈ 0 that the impact sends into its closed side impacts too (its
+        // pivot switches): enlarge the impacting set until no joint penetrates.
+        let (after, result, mut qdot_after, mut kinetic_after) = loop {
+            let mut after = before.clone();
+            for &s in &impacting {
+                after.sides[s] = before.sides[s].flipped();
             }
-            res
+            let result = apply_law(model, &mut kin, &q, &qdot, &before, &after, &impacting)
+                .map_err(|source| SimulationError::Impact { t, source })?;
+            // Joints that were seated stay seated through the impact: a plastic impulse on them
+            // (booked as dissipation), as "all other hinges persisting".
+            let (qd, k) = plastic_projection(
+                model,
+                &self.dynamics,
+                self.ground,
+                t,
+                &q,
+                &result.qdot,
+                &after,
+                &held,
+            );
+            forward_kinematics(model, &mut kin, &q, &after);
+            crr_kinematics::velocities(model, &mut kin, &qd);
+            slot_rates(model, &kin, &qd, &mut rates);
+            let wrong: Vec<usize> = (0..model.slot_count)
+                .filter(|&s| {
+                    !self.seated[s]
+                        && !impacting.contains(&s)
+                        && angles[s].abs() <= self.params.simultaneity
+                        && after.sides[s].sign() * rates[s] < -1e-12
+                })
+                .collect();
+            if wrong.is_empty() {
+                break (after, result, qd, k);
+            }
+            impacting.extend(wrong);
         };
-        let mut qdot_after = result.qdot.clone();
-        let mut kinetic_after = result.kinetic_after;
-        // Rates after, and seating of the interfaces that come to rest.
-        forward_kinematics(model, &mut kin, &q, &after);
-        crr_kinematics::velocities(model, &mut kin, &qdot_after);
-        slot_rates(model, &kin, &qdot_after, &mut rates);
-        let mut to_seat: Vec<usize> = impacting
+        let rates_after: Vec<f64> = impacting.iter().map(|&s| rates[s]).collect();
+        // Seating of the impacting interfaces that come to rest. Seating one joint of a loop can
+        // lock the others: seat, recompute the rates, and seat every impacting slot brought below
+        // the threshold, until nothing changes.
+        // Candidates: the impacting slots, and rocking slots resting at φ ≈ 0 with a negligible rate.
+        let candidates: Vec<usize> = (0..model.slot_count)
+            .filter(|&s| {
+                impacting.contains(&s)
+                    || (!self.seated[s] && angles[s].abs() <= self.params.simultaneity)
+            })
+            .collect();
+        let mut to_seat: Vec<usize> = candidates
             .iter()
             .copied()
             .filter(|&s| {
                 rates[s].abs() < self.params.seat_rate
-                    || t - self.last_impact[s] < self.params.min_impact_interval
+                    || (impacting.contains(&s) && t - self.last_impact[s] < self.params.min_impact_interval)
+                    // A joint the law sends back into its closed side cannot open: it stays closed.
+                    || after.sides[s].sign() * rates[s] < 0.0
             })
             .collect();
-        let rates_after: Vec<f64> = impacting.iter().map(|&s| rates[s]).collect();
-        // Seating one joint of a loop can lock the others: seat, recompute the rates, and seat
-        // every impacting slot brought below the threshold, until nothing changes.
         let mut pending = to_seat.clone();
         while !pending.is_empty() {
-            // Only slots still moving need the plastic impulse; the others are already at rest.
-            let zero: Vec<(usize, f64)> = pending
-                .iter()
-                .filter(|&&s| rates[s].abs() > 1e-14)
-                .map(|&s| (s, 0.0))
-                .collect();
-            if !zero.is_empty() {
-                let seat = restitution_law(model, &mut kin, &q, &qdot_after, &after, &after, &zero)
-                    .map_err(err)?;
-                qdot_after = seat.qdot;
-                kinetic_after = seat.kinetic_after;
-            }
+            let all: Vec<usize> = held.iter().chain(&to_seat).copied().collect();
+            (qdot_after, kinetic_after) = plastic_projection(
+                model,
+                &self.dynamics,
+                self.ground,
+                t,
+                &q,
+                &qdot_after,
+                &after,
+                &all,
+            );
             forward_kinematics(model, &mut kin, &q, &after);
             crr_kinematics::velocities(model, &mut kin, &qdot_after);
             slot_rates(model, &kin, &qdot_after, &mut rates);
-            pending = impacting
+            pending = candidates
                 .iter()
                 .copied()
-                .filter(|s| !to_seat.contains(s) && rates[*s].abs() < self.params.seat_rate)
+                .filter(|&s| {
+                    !to_seat.contains(&s)
+                        && (rates[s].abs() < self.params.seat_rate
+                            || after.sides[s].sign() * rates[s] < 0.0)
+                })
                 .collect();
             to_seat.extend(pending.iter().copied());
         }
@@ -1045,9 +1223,7 @@ impl<'a> Simulation<'a> {
         self.samples.push(post);
         self.impacts.push(record);
         self.reset_solver();
-        if !to_seat.is_empty() {
-            self.release_if_opening()?;
-        }
+        self.release_if_opening()?;
         Ok(self.impacts.len() - 1)
     }
 
