@@ -856,13 +856,21 @@ impl<'a> Simulation<'a> {
             &held,
         );
         let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * &qdot));
-        self.dissipated_at_impacts += before - kinetic;
+        let u_before = potential_energy(model, &d.kin);
         for &s in &closing {
             self.seated[s] = true;
             if s < model.dof() {
                 self.y[s] = 0.0;
             }
         }
+        // Seating removes the kinetic energy of the stopped joints and the potential energy of
+        // their residual angle (below `simultaneity`): both are booked as dissipated.
+        let u_after = {
+            let q_new = self.q();
+            forward_kinematics(model, &mut kin, &q_new, &self.dynamics.pivots);
+            potential_energy(model, &kin)
+        };
+        self.dissipated_at_impacts += before - kinetic + u_before - u_after;
         let n = model.dof();
         self.y[n..2 * n].copy_from_slice(qd.as_slice());
         self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
@@ -1215,7 +1223,14 @@ impl<'a> Simulation<'a> {
         }
         self.dynamics.pivots = after;
         self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
-        self.dissipated_at_impacts += lost;
+        // The snap of the impacting angles to exactly 0 changes U by round-off: booked too.
+        let u_snap = {
+            forward_kinematics(model, &mut kin, &q, &before);
+            let u0 = potential_energy(model, &kin);
+            forward_kinematics(model, &mut kin, &q_new, &self.dynamics.pivots);
+            u0 - potential_energy(model, &kin)
+        };
+        self.dissipated_at_impacts += lost + u_snap;
         let n = model.dof();
         self.y[..n].copy_from_slice(q_new.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());

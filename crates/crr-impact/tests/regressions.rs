@@ -5,6 +5,7 @@
 //! - a seated joint must stay seated through an impact elsewhere (plastic impulse, booked);
 //! - the integrator's "last fired event" memory is per event list: the simulation rebuilds the
 //!   list every segment, so the memory is cleared (a stale index hid a real crossing).
+//!
 //! The symptom of each was a joint rocking on the wrong side of its pivot, U falling below rest at
 //! small rotations, a false collapse and an energy-balance error.
 
