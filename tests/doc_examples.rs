@@ -71,13 +71,17 @@ fn build_file(at: &str, file: &ModelFile) -> Built {
     let spec = file.structure();
     let model = Model::from_spec(&spec).unwrap_or_else(|e| panic!("{at}: model is invalid: {e}"));
     let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
-    let ground = file.ground_motion.as_ref().map_or_else(GroundMotion::none, |g| {
-        GroundMotion::from_spec(g, &docs)
-            .unwrap_or_else(|e| panic!("{at}: ground motion is invalid: {e}"))
-    });
-    let initial = file.initial.as_ref().map(|i| {
-        solve_initial(&model, i).unwrap_or_else(|e| panic!("{at}: initial state: {e}"))
-    });
+    let ground = file
+        .ground_motion
+        .as_ref()
+        .map_or_else(GroundMotion::none, |g| {
+            GroundMotion::from_spec(g, &docs)
+                .unwrap_or_else(|e| panic!("{at}: ground motion is invalid: {e}"))
+        });
+    let initial = file
+        .initial
+        .as_ref()
+        .map(|i| solve_initial(&model, i).unwrap_or_else(|e| panic!("{at}: initial state: {e}")));
     let params = Parameters::from_analysis(&file.analysis.clone().unwrap_or_default(), 10.0)
         .unwrap_or_else(|e| panic!("{at}: analysis: {e}"));
     Built {
@@ -130,7 +134,10 @@ fn models_of(rel: &str) -> Vec<Built> {
                     .unwrap_or_else(|| panic!("{rel}:{}: no example \"{name}\" above", b.line));
                 let whole = format!("{base}\n{}", b.text);
                 let file: ModelFile = toml::from_str(&whole).unwrap_or_else(|e| {
-                    panic!("{rel}:{}: fragment appended to {name} does not parse: {e}", b.line)
+                    panic!(
+                        "{rel}:{}: fragment appended to {name} does not parse: {e}",
+                        b.line
+                    )
                 });
                 out.push(build_file(&format!("{rel}:{} (fragment)", b.line), &file));
                 continue;
