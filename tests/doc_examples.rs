@@ -367,7 +367,9 @@ fn every_documented_model_is_valid_and_matches_its_text() {
         "docs/model-format.md should hold its examples"
     );
     assert!(
-        models.iter().any(|b| b.at.ends_with("(fragment)") && b.initial.is_some()),
+        models
+            .iter()
+            .any(|b| b.at.ends_with("(fragment)") && b.initial.is_some()),
         "the [initial] fragment appended to the trilithon is checked"
     );
     models.extend(models_of("README.md"));
