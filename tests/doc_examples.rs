@@ -1,8 +1,11 @@
 //! Every model shown in the documentation is valid and says what the text says.
 //!
 //! Each ```` ```toml ```` block of `docs/model-format.md` (and of `README.md`, if present) is a
-//! complete model file: it must parse as a `ModelFile` (the structure plus the optional
-//! `[initial]`, `[ground_motion]` and `[analysis]` tables) and build with `Model::from_spec`.
+//! complete model file: it must parse as a `crr::model_file::ModelFile` (structure plus the optional
+//! `[ground_motion]`, `[initial]` and `[analysis]` tables) and its structure must build with
+//! `Model::from_spec`; the optional tables must be usable (ground motion built, initial state
+//! solved, analysis parameters accepted). A `toml-fragment` whose first line is
+//! `# appended to the "<name>" example` is appended to that example and checked the same way.
 //! Each ```` ```json ```` block that is a whole object is checked the same way. Partial snippets
 //! are fenced `toml-fragment` and skipped. Every model is then checked against the facts the
 //! text states about it (found by the model's `name`): DOF(1), coordinate order, closure rows,
@@ -12,6 +15,9 @@
 
 use std::path::Path;
 
+use crr::dynamics::ground_motion::GroundMotion;
+use crr::dynamics::{InitialState, solve_initial};
+use crr::impact::{Parameters, Simulation};
 use crr::kinematics::{
     ActivePivots, Data, ImpactLaw, InterfaceKind, Model, Role, Side, StructureSpec,
     constraint_residual, forward_kinematics, mass_matrix,
@@ -59,24 +65,89 @@ fn read_doc(rel: &str) -> Option<String> {
     std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).ok()
 }
 
-/// The models of the toml and whole-object json blocks of one document.
-fn models_of(rel: &str) -> Vec<(String, StructureSpec, Model)> {
+/// Parses a whole model file and checks its optional tables; the structure, its model, the ground
+/// motion, the solved initial state (if `[initial]` is given) and the simulation parameters.
+fn build_file(at: &str, file: &ModelFile) -> Built {
+    let spec = file.structure();
+    let model = Model::from_spec(&spec).unwrap_or_else(|e| panic!("{at}: model is invalid: {e}"));
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
+    let ground = file
+        .ground_motion
+        .as_ref()
+        .map_or_else(GroundMotion::none, |g| {
+            GroundMotion::from_spec(g, &docs)
+                .unwrap_or_else(|e| panic!("{at}: ground motion is invalid: {e}"))
+        });
+    let initial = file
+        .initial
+        .as_ref()
+        .map(|i| solve_initial(&model, i).unwrap_or_else(|e| panic!("{at}: initial state: {e}")));
+    let params = Parameters::from_analysis(&file.analysis.clone().unwrap_or_default(), 10.0)
+        .unwrap_or_else(|e| panic!("{at}: analysis: {e}"));
+    Built {
+        at: at.to_string(),
+        file: file.clone(),
+        spec,
+        model,
+        ground,
+        initial,
+        params,
+    }
+}
+
+/// One documented model file, built.
+struct Built {
+    at: String,
+    file: ModelFile,
+    spec: StructureSpec,
+    model: Model,
+    ground: GroundMotion,
+    initial: Option<InitialState>,
+    params: Parameters,
+}
+
+/// The models of the toml and whole-object json blocks of one document, and of the fragments
+/// appended to a named example.
+fn models_of(rel: &str) -> Vec<Built> {
     let Some(text) = read_doc(rel) else {
         return Vec::new();
     };
-    let mut out = Vec::new();
+    let mut out: Vec<Built> = Vec::new();
+    let mut sources: Vec<(String, String)> = Vec::new();
     for b in fenced_blocks(&text) {
         let file: ModelFile = match b.lang.as_str() {
             "toml" => toml::from_str(&b.text)
                 .unwrap_or_else(|e| panic!("{rel}:{}: toml block does not parse: {e}", b.line)),
             "json" if b.text.trim_start().starts_with('{') => serde_json::from_str(&b.text)
                 .unwrap_or_else(|e| panic!("{rel}:{}: json block does not parse: {e}", b.line)),
+            "toml-fragment" => {
+                let first = b.text.lines().next().unwrap_or("");
+                let Some(name) = first
+                    .strip_prefix("# appended to the \"")
+                    .and_then(|r| r.strip_suffix("\" example"))
+                else {
+                    continue;
+                };
+                let (_, base) = sources
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .unwrap_or_else(|| panic!("{rel}:{}: no example \"{name}\" above", b.line));
+                let whole = format!("{base}\n{}", b.text);
+                let file: ModelFile = toml::from_str(&whole).unwrap_or_else(|e| {
+                    panic!(
+                        "{rel}:{}: fragment appended to {name} does not parse: {e}",
+                        b.line
+                    )
+                });
+                out.push(build_file(&format!("{rel}:{} (fragment)", b.line), &file));
+                continue;
+            }
             _ => continue,
         };
-        let spec = file.structure();
-        let model = Model::from_spec(&spec)
-            .unwrap_or_else(|e| panic!("{rel}:{}: model is invalid: {e}", b.line));
-        out.push((format!("{rel}:{} ({})", b.line, b.lang), spec, model));
+        if b.lang == "toml" {
+            sources.push((file.name.clone(), b.text.clone()));
+        }
+        out.push(build_file(&format!("{rel}:{} ({})", b.line, b.lang), &file));
     }
     out
 }
@@ -108,7 +179,8 @@ fn closure_rows(m: &Model) -> Vec<(&str, usize)> {
 }
 
 /// The facts the text states about the model `name`. Returns false for an unknown name.
-fn check_facts(at: &str, spec: &StructureSpec, m: &Model) -> bool {
+fn check_facts(built: &Built) -> bool {
+    let (at, spec, m) = (built.at.as_str(), &built.spec, &built.model);
     let data = at_rest(m);
     let m00 = data.mass_matrix[(0, 0)];
     // Φ = 0 at rest for every example with loops.
@@ -223,6 +295,64 @@ fn check_facts(at: &str, spec: &StructureSpec, m: &Model) -> bool {
                 "{at}"
             );
             assert_eq!(closure_rows(m), [("right_head", 4)], "{at}");
+            if let Some(init) = &built.initial {
+                // The fragment gives left_foot.2 = 0.01: the frame sways as a parallelogram.
+                let k = |name: &str| m.coord_index(name).unwrap();
+                assert!((init.q[k("left_foot.2")] - 0.01).abs() < 1e-15, "{at}");
+                assert!((init.q[k("right_foot.2")] - 0.01).abs() < 1e-9, "{at}");
+                assert!((init.q[k("left_head.2")] + 0.01).abs() < 1e-9, "{at}");
+                assert!((init.qdot[k("right_foot.2")] - 0.2).abs() < 1e-9, "{at}");
+            }
+        }
+        "released_block" => {
+            assert_eq!(coord_names(m), ["base"], "{at}");
+            let init = built.initial.as_ref().expect("an [initial] table");
+            assert_eq!(init.q[0], 0.1, "{at}");
+            assert_eq!(
+                (built.params.duration, built.params.output_interval),
+                (2.0, 0.005),
+                "{at}"
+            );
+            let run = Simulation::new(m, &built.ground, init, built.params.clone())
+                .unwrap()
+                .run()
+                .map_err(|f| f.error)
+                .unwrap();
+            // Every impact multiplies the rate by r = 1 − 1.5 sin²α (momentum law).
+            let alpha = 0.2f64.atan();
+            let r = 1.0 - 1.5 * alpha.sin().powi(2);
+            let first = &run.impacts[0];
+            assert!(
+                (first.rates_after[0] / first.rates_before[0] - r).abs() < 1e-12,
+                "{at}"
+            );
+            assert!(run.collapse.is_none(), "{at}");
+        }
+        "block_under_sine" => {
+            assert_eq!(coord_names(m), ["base"], "{at}");
+            assert!(close(built.ground.pga().x, 2.0, 1e-12), "{at}");
+            assert!(built.initial.is_none(), "{at}");
+            assert_eq!(built.params.duration, 4.0, "{at}");
+            assert_eq!(built.params.friction, Some(0.7), "{at}");
+            // 2.0 m/s² > g tan α = 1.962 m/s²: the block uplifts during the first half cycle.
+            let rest = solve_initial(m, &Default::default()).unwrap();
+            let run = Simulation::new(m, &built.ground, &rest, built.params.clone())
+                .unwrap()
+                .run()
+                .map_err(|f| f.error)
+                .unwrap();
+            let up = run.uplift_time.expect("uplift");
+            assert!(up > 0.0 && up < 0.25, "{at}: uplift at {up}");
+        }
+        "block_3d_symmetric" => {
+            assert_eq!(coord_names(m), ["base.1", "base.2"], "{at}");
+            let mob = crr::dynamics::mobility(
+                m,
+                &DVector::zeros(2),
+                &ActivePivots::uniform(m, Side::Positive),
+            );
+            assert_eq!((mob.dof1, mob.dof2, mob.dof3), (2, 2, 1), "{at}");
+            assert!(built.file.symmetry.len() == 1, "{at}");
         }
         _ => return false,
     }
@@ -236,18 +366,25 @@ fn every_documented_model_is_valid_and_matches_its_text() {
         models.len() >= 8,
         "docs/model-format.md should hold its examples"
     );
+    assert!(
+        models
+            .iter()
+            .any(|b| b.at.ends_with("(fragment)") && b.initial.is_some()),
+        "the [initial] fragment appended to the trilithon is checked"
+    );
     models.extend(models_of("README.md"));
-    for (at, spec, model) in &models {
+    for built in &models {
         assert!(
-            check_facts(at, spec, model),
-            "{at}: model \"{}\" has no facts in tests/doc_examples.rs: add them",
-            spec.name
+            check_facts(built),
+            "{}: model \"{}\" has no facts in tests/doc_examples.rs: add them",
+            built.at,
+            built.spec.name
         );
     }
     // An example of every shape and every interface kind, tree and closure.
     let mut shapes: Vec<&str> = models
         .iter()
-        .flat_map(|(_, _, m)| m.bodies.iter().map(|b| b.shape.kind()))
+        .flat_map(|b| b.model.bodies.iter().map(|b| b.shape.kind()))
         .collect();
     shapes.sort();
     shapes.dedup();
@@ -255,7 +392,7 @@ fn every_documented_model_is_valid_and_matches_its_text() {
     let kinds = |closure: bool| -> Vec<usize> {
         let mut k: Vec<usize> = models
             .iter()
-            .flat_map(|(_, _, m)| m.interfaces.iter())
+            .flat_map(|b| b.model.interfaces.iter())
             .filter(|i| matches!(i.role, Role::Closure { .. }) == closure)
             .map(|i| i.kind.angle_count())
             .collect();
@@ -283,8 +420,8 @@ fn quoted_error_messages_are_the_real_ones() {
     let doc = read_doc("docs/model-format.md").expect("docs/model-format.md");
     let file = read_doc("examples/models/single_block.toml").expect("the example file");
     let build = |text: &str| {
-        let file: ModelFile = toml::from_str(text).expect("parses");
-        Model::from_spec(&file.structure())
+        let spec: StructureSpec = toml::from_str(text).expect("parses");
+        Model::from_spec(&spec)
     };
     // Exchanged edges: "pivots swapped".
     let pos = "pivot_positive = [[0.2, -0.2, 0.0], [0.2, 0.2, 0.0]]";
