@@ -8,12 +8,6 @@
 //! Models, ground motions and initial states are built outside the timing; each run is checked
 //! once before it is timed (it rocks, it does not collapse where it must not, no impact gains
 //! energy) and its impact count, collapse and energy-balance error are printed.
-//!
-//! Note (engine state when this bench was written): the drum column is reported as collapsing at
-//! t ≈ 2.16 s, so `drum_column` times about 2.2 s of simulated motion, not 20 s. The collapse is
-//! spurious: after a multi-joint impact a seated joint keeps a non-zero rate and a joint rocks on
-//! the pivot opposite to its angle (interpenetration), the energy balance error jumps to ≈ 9 J
-//! and U drops below rest.
 
 use std::collections::BTreeMap;
 use std::hint::black_box;

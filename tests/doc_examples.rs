@@ -420,8 +420,8 @@ fn quoted_error_messages_are_the_real_ones() {
     let doc = read_doc("docs/model-format.md").expect("docs/model-format.md");
     let file = read_doc("examples/models/single_block.toml").expect("the example file");
     let build = |text: &str| {
-        let spec: StructureSpec = toml::from_str(text).expect("parses");
-        Model::from_spec(&spec)
+        let file: ModelFile = toml::from_str(text).expect("parses");
+        Model::from_spec(&file.structure())
     };
     // Exchanged edges: "pivots swapped".
     let pos = "pivot_positive = [[0.2, -0.2, 0.0], [0.2, 0.2, 0.0]]";

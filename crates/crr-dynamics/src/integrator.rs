@@ -595,8 +595,8 @@ impl Solver {
     /// for every accepted step with its dense output (for an event, the
     /// partial step ending at the event). See the module documentation for
     /// the event semantics. The step repeated to land on an event time is
-    /// shorter than the accepted trial step it replaces, so its error
-    /// estimate is not re-checked. Interior double crossings of an event
+    /// error-checked; if it fails, the event time is reached by adaptive
+    /// sub-steps that land on it exactly. Interior double crossings of an event
     /// function within one step (no sign change at the step ends) are not
     /// detected; limit `h_max` if that matters.
     ///

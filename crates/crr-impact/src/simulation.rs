@@ -36,6 +36,10 @@ use crr_kinematics::{
 
 use crate::laws::{ImpactError, dirac_law, dirac_regularised_force, momentum_law, restitution_law};
 
+/// Largest step while joints are seated and the ground moves (s): the time resolution of the
+/// uplift test (exact location then by bisection on the release test).
+pub const SEATED_MAX_STEP: f64 = 1e-3;
+
 /// Tunable parameters of a simulation, with documented defaults.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Parameters {
@@ -966,6 +970,15 @@ impl<'a> Simulation<'a> {
         // Inside a regularised δ zone the step is limited to an eighth of the zone's crossing time,
         // so that the bump is resolved by the steps and their dense output.
         let mut h_max = self.params.options.h_max;
+        // While joints are seated the state barely changes and steps would grow up to the next
+        // breakpoint; the uplift test runs at step ends, so a short excursion of the ground motion
+        // above the threshold could be stepped over. Cap the step at `SEATED_MAX_STEP`.
+        if !self.dynamics.seated.is_empty()
+            && !self.ground.is_none()
+            && self.t < self.ground.duration()
+        {
+            h_max = h_max.min(SEATED_MAX_STEP);
+        }
         if let Some(c) = lift_off {
             h_max = h_max.min(c / 4.0);
         }
