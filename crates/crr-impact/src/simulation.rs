@@ -746,8 +746,15 @@ impl<'a> Simulation<'a> {
 
     fn sample_at(&mut self, t: f64, y: &[f64]) -> Sample {
         let n = self.model.dof();
-        let q = DVector::from_column_slice(&y[..n]);
-        let qdot = DVector::from_column_slice(&y[n..2 * n]);
+        let mut q = DVector::from_column_slice(&y[..n]);
+        let mut qdot = DVector::from_column_slice(&y[n..2 * n]);
+        // A seated coordinate is held at 0 (the dense output between projections carries round-off).
+        for k in 0..n {
+            if self.seated[k] {
+                q[k] = 0.0;
+                qdot[k] = 0.0;
+            }
+        }
         if self.violation.is_none() {
             let mut d = self.dynamics.clone();
             if let Ok(forces) =
