@@ -11,6 +11,7 @@
 //! - [`inspect`]: the report of `crr inspect`.
 //! - [`simulate`]: `crr simulate` (history, impacts and summary files, `docs/outputs.md`).
 //! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
+//! - [`synthetic`]: the reproducible synthetic accelerogram `examples/records/synthetic.AT2`.
 
 pub use crr_dynamics as dynamics;
 pub use crr_impact as impact;
@@ -20,5 +21,6 @@ pub mod check;
 pub mod inspect;
 pub mod model_file;
 pub mod simulate;
+pub mod synthetic;
 
 pub use model_file::{InputError, load_model};

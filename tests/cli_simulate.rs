@@ -144,6 +144,7 @@ fn bundled_models_write_the_three_files() {
         ("arch", "0.5"),
         ("two_block_stack", "1"),
         ("drum_column", "0.3"),
+        ("block_record", "3"),
     ] {
         let out = scratch(m);
         let s = simulate(
