@@ -11,6 +11,7 @@
 //! - [`inspect`]: the report of `crr inspect`.
 //! - [`simulate`]: `crr simulate` (history, impacts and summary files, `docs/outputs.md`).
 //! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
+//! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
 
 pub use crr_dynamics as dynamics;
 pub use crr_impact as impact;
@@ -19,6 +20,7 @@ pub use crr_kinematics as kinematics;
 pub mod check;
 pub mod inspect;
 pub mod model_file;
+pub mod plot;
 pub mod simulate;
 
 pub use model_file::{InputError, load_model};
