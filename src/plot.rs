@@ -314,12 +314,17 @@ fn padded(values: impl IntoIterator<Item = f64>) -> std::ops::Range<f64> {
     (lo - pad)..(hi + pad)
 }
 
+/// The range with its top raised by `fraction` of its span: room for the legend.
+fn headroom(r: std::ops::Range<f64>, fraction: f64) -> std::ops::Range<f64> {
+    r.start..r.end + fraction * (r.end - r.start)
+}
+
 /// Tick label text: fixed-point with as many decimals as the tick spacing needs, scientific
 /// notation for very small or large numbers.
 fn tick(v: f64, range: &std::ops::Range<f64>) -> String {
     let span = (range.end - range.start).abs();
     let big = range.start.abs().max(range.end.abs());
-    if v == 0.0 {
+    if v.abs() <= 1e-9 * span {
         return "0".into();
     }
     if span < 1e-3 || big >= 1e5 {
@@ -335,8 +340,8 @@ fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
-fn caption_style() -> TextStyle<'static> {
-    (FONT, 26).into_font().style(FontStyle::Bold).into()
+fn caption_style(k: u32) -> TextStyle<'static> {
+    (FONT, 26 * k).into_font().style(FontStyle::Bold).into()
 }
 
 /// The charts: f64 on both axes.
@@ -345,6 +350,7 @@ type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoor
 /// Axis and mesh styles shared by every chart.
 fn configure<'a, DB: DrawingBackend + 'a>(
     chart: &mut Chart<'a, DB>,
+    k: u32,
     x_desc: &str,
     y_desc: &str,
     x_fmt: &dyn Fn(&f64) -> String,
@@ -354,10 +360,13 @@ fn configure<'a, DB: DrawingBackend + 'a>(
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
-        .label_style((FONT, 17))
-        .axis_desc_style((FONT, 20))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(205, 205, 205))
+        .label_style((FONT, 17 * k))
+        .axis_desc_style((FONT, 20 * k))
+        .light_line_style(RGBColor(238, 238, 238).stroke_width(k))
+        .bold_line_style(RGBColor(205, 205, 205).stroke_width(k))
+        .axis_style(BLACK.stroke_width(k))
+        .set_all_tick_mark_size(5 * k as i32)
+        .x_label_offset(0)
         .x_labels(10)
         .y_labels(9)
         .x_label_formatter(x_fmt)
@@ -368,21 +377,31 @@ fn configure<'a, DB: DrawingBackend + 'a>(
 
 fn legend<'a, DB: DrawingBackend + 'a>(
     chart: &mut Chart<'a, DB>,
+    k: u32,
     position: SeriesLabelPosition,
 ) -> DrawResult {
     chart
         .configure_series_labels()
         .position(position)
         .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(150, 150, 150))
-        .label_font((FONT, 17))
-        .margin(12)
+        .border_style(RGBColor(150, 150, 150).stroke_width(k))
+        .label_font((FONT, 17 * k))
+        .margin(12 * k)
+        .legend_area_size(34 * k)
         .draw()
         .map_err(err)
 }
 
-fn line_key(c: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c.stroke_width(3))
+fn line_key(c: RGBColor, k: u32) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    let w = 24 * k as i32;
+    move |(x, y)| PathElement::new(vec![(x, y), (x + w, y)], c.stroke_width(3 * k))
+}
+
+/// Line width of coordinate `i` of `n`: the first ones are drawn wider, so that coordinates
+/// moving together (a symmetric mechanism) stay visible under the later ones.
+fn coordinate_width(i: usize, n: usize, k: u32) -> u32 {
+    let rank = (n - 1 - i).min(3) as u32;
+    (4 + 3 * rank) * k / 2
 }
 
 /// The value of a sampled series at time `t` (the last sample at or before `t`).
@@ -398,49 +417,58 @@ fn at_time(t: &[f64], v: &[f64], time: f64) -> f64 {
 pub fn draw_coordinates<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     r: &Results,
+    k: u32,
 ) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
     let xr = padded(r.t.iter().copied());
     let xr = 0f64.min(xr.start)..r.t.last().copied().unwrap_or(1.0).max(1e-9);
-    let yr = padded(r.q.iter().flatten().copied().chain([0.0]));
+    let yr = headroom(
+        padded(r.q.iter().flatten().copied().chain([0.0])),
+        0.06 * (r.coordinates.len() + 1) as f64,
+    );
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!("{}: coordinate time histories", r.model_name),
-            caption_style(),
+            caption_style(k),
         )
-        .margin(20)
-        .x_label_area_size(55)
-        .y_label_area_size(95)
+        .margin(20 * k)
+        .x_label_area_size(55 * k)
+        .y_label_area_size(95 * k)
         .build_cartesian_2d(xr.clone(), yr.clone())
         .map_err(err)?;
     configure(
         &mut chart,
+        k,
         "time t (s)",
         "angle (rad)",
         &|v| tick(*v, &xr),
         &|v| tick(*v, &yr),
     )?;
-    for (k, name) in r.coordinates.iter().enumerate() {
-        let c = colour(k);
+    let n = r.coordinates.len();
+    for (i, name) in r.coordinates.iter().enumerate() {
+        let c = colour(i);
         chart
             .draw_series(LineSeries::new(
-                r.t.iter().copied().zip(r.q[k].iter().copied()),
-                c.stroke_width(2),
+                r.t.iter().copied().zip(r.q[i].iter().copied()),
+                c.stroke_width(coordinate_width(i, n, k)),
             ))
             .map_err(err)?
             .label(format!("{name} (rad)"))
-            .legend(line_key(c));
+            .legend(line_key(c, k));
     }
     if !r.impacts.is_empty() {
         let mut marks = Vec::new();
         for (t, ifaces) in &r.impacts {
             let mut any = false;
-            for (k, name) in r.coordinates.iter().enumerate() {
+            for (j, name) in r.coordinates.iter().enumerate() {
                 let hit = ifaces.iter().any(|i| {
-                    name == i || name.strip_prefix(i.as_str()).is_some_and(|s| s.starts_with('.'))
+                    name == i
+                        || name
+                            .strip_prefix(i.as_str())
+                            .is_some_and(|s| s.starts_with('.'))
                 });
                 if hit {
-                    marks.push((*t, at_time(&r.t, &r.q[k], *t)));
+                    marks.push((*t, at_time(&r.t, &r.q[j], *t)));
                     any = true;
                 }
             }
@@ -452,19 +480,23 @@ pub fn draw_coordinates<DB: DrawingBackend>(
             .draw_series(
                 marks
                     .into_iter()
-                    .map(|p| Circle::new(p, 5, BLACK.stroke_width(2))),
+                    .map(|p| Circle::new(p, 5 * k, BLACK.stroke_width(2 * k))),
             )
             .map_err(err)?
             .label(format!("impact ({})", r.impacts.len()))
-            .legend(|(x, y)| Circle::new((x + 12, y), 5, BLACK.stroke_width(2)));
+            .legend(|(x, y)| Circle::new((x + 12 * k as i32, y), 5 * k, BLACK.stroke_width(2 * k)));
     }
-    legend(&mut chart, SeriesLabelPosition::UpperRight)
+    legend(&mut chart, k, SeriesLabelPosition::UpperRight)
 }
 
 /// (b) The energy balance: T, U, W, D on the upper panel, T + U − W + D − E(0) on the lower one.
-pub fn draw_energy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Results) -> DrawResult {
+pub fn draw_energy<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    r: &Results,
+    k: u32,
+) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
-    let (upper, lower) = root.split_vertically(SIZE.1 * 62 / 100);
+    let (upper, lower) = root.split_vertically(SIZE.1 * k * 62 / 100);
     let xr = 0f64..r.t.last().copied().unwrap_or(1.0).max(1e-9);
     let series: [(&str, &Vec<f64>); 4] = [
         ("kinetic T", &r.kinetic),
@@ -472,34 +504,46 @@ pub fn draw_energy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Result
         ("work in W", &r.work_in),
         ("dissipated D", &r.dissipated),
     ];
-    let yr = padded(series.iter().flat_map(|(_, v)| v.iter().copied()).chain([0.0]));
+    let yr = headroom(
+        padded(
+            series
+                .iter()
+                .flat_map(|(_, v)| v.iter().copied())
+                .chain([0.0]),
+        ),
+        0.35,
+    );
     let mut chart = ChartBuilder::on(&upper)
-        .caption(format!("{}: energy balance", r.model_name), caption_style())
-        .margin(20)
-        .margin_bottom(5)
-        .x_label_area_size(45)
-        .y_label_area_size(95)
+        .caption(
+            format!("{}: energy balance", r.model_name),
+            caption_style(k),
+        )
+        .margin(20 * k)
+        .margin_bottom(5 * k)
+        .x_label_area_size(45 * k)
+        .y_label_area_size(95 * k)
         .build_cartesian_2d(xr.clone(), yr.clone())
         .map_err(err)?;
     configure(
         &mut chart,
+        k,
         "time t (s)",
         "energy (J)",
         &|v| tick(*v, &xr),
         &|v| tick(*v, &yr),
     )?;
-    for (k, (name, v)) in series.iter().enumerate() {
-        let c = colour(k);
+    for (i, (name, v)) in series.iter().enumerate() {
+        let c = colour(i);
         chart
             .draw_series(LineSeries::new(
                 r.t.iter().copied().zip(v.iter().copied()),
-                c.stroke_width(2),
+                c.stroke_width(2 * k),
             ))
             .map_err(err)?
             .label(format!("{name} (J)"))
-            .legend(line_key(c));
+            .legend(line_key(c, k));
     }
-    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    legend(&mut chart, k, SeriesLabelPosition::UpperRight)?;
 
     let e0 = match (
         r.kinetic.first(),
@@ -522,19 +566,20 @@ pub fn draw_energy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Result
     let lim = if big > 0.0 { 1.15 * big } else { 1e-12 };
     let yr = -lim..lim;
     let mut chart = ChartBuilder::on(&lower)
-        .margin(20)
-        .margin_top(5)
-        .x_label_area_size(55)
-        .y_label_area_size(95)
+        .margin(20 * k)
+        .margin_top(5 * k)
+        .x_label_area_size(55 * k)
+        .y_label_area_size(95 * k)
         .build_cartesian_2d(xr.clone(), yr.clone())
         .map_err(err)?;
     configure(
         &mut chart,
+        k,
         "time t (s)",
         "balance error (J)",
         &|v| tick(*v, &xr),
         &|v| {
-            if *v == 0.0 {
+            if v.abs() <= 1e-9 * lim {
                 "0".into()
             } else {
                 format!("{v:.1e}")
@@ -543,18 +588,22 @@ pub fn draw_energy<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Result
     )?;
     let c = RGBColor(0, 0, 0);
     chart
-        .draw_series(LineSeries::new(balance, c.stroke_width(2)))
+        .draw_series(LineSeries::new(balance, c.stroke_width(2 * k)))
         .map_err(err)?
         .label("T + U − W + D − E(0) (J)")
-        .legend(line_key(c));
-    legend(&mut chart, SeriesLabelPosition::UpperRight)
+        .legend(line_key(c, k));
+    legend(&mut chart, k, SeriesLabelPosition::UpperRight)
 }
 
 /// The amplitudes θ_m/α of the free-rocking energy levels drawn on the phase portrait.
 pub const LEVELS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
 
 /// (c) The phase portraits θ̇ versus θ, with the free-rocking energy levels of a single block.
-pub fn draw_phase<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Results) -> DrawResult {
+pub fn draw_phase<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    r: &Results,
+    k: u32,
+) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
     // Energy level curves: the upper half from −θ_m to θ_m, then the lower half back.
     let levels: Vec<Vec<(f64, f64)>> = match r.free_rocking {
@@ -582,25 +631,29 @@ pub fn draw_phase<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Results
             .copied()
             .chain(levels.iter().flatten().map(|p| p.0)),
     );
-    let yr = padded(
-        r.qdot
-            .iter()
-            .flatten()
-            .copied()
-            .chain(levels.iter().flatten().map(|p| p.1)),
+    let yr = headroom(
+        padded(
+            r.qdot
+                .iter()
+                .flatten()
+                .copied()
+                .chain(levels.iter().flatten().map(|p| p.1)),
+        ),
+        0.1 * (r.coordinates.len() + usize::from(r.free_rocking.is_some())) as f64,
     );
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!("{}: phase portrait", r.model_name),
-            caption_style(),
+            caption_style(k),
         )
-        .margin(20)
-        .x_label_area_size(55)
-        .y_label_area_size(95)
+        .margin(20 * k)
+        .x_label_area_size(55 * k)
+        .y_label_area_size(95 * k)
         .build_cartesian_2d(xr.clone(), yr.clone())
         .map_err(err)?;
     configure(
         &mut chart,
+        k,
         "angle θ (rad)",
         "rate dθ/dt (rad/s)",
         &|v| tick(*v, &xr),
@@ -610,7 +663,12 @@ pub fn draw_phase<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Results
         let grey = RGBColor(120, 120, 120);
         for (i, curve) in levels.into_iter().enumerate() {
             let s = chart
-                .draw_series(DashedLineSeries::new(curve, 6, 4, grey.stroke_width(1)))
+                .draw_series(DashedLineSeries::new(
+                    curve,
+                    8 * k,
+                    5 * k,
+                    grey.stroke_width(k),
+                ))
                 .map_err(err)?;
             if i == 0 {
                 s.label(format!(
@@ -620,23 +678,27 @@ pub fn draw_phase<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Results
                     f.p
                 ))
                 .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], grey.stroke_width(2))
+                    PathElement::new(
+                        vec![(x, y), (x + 24 * k as i32, y)],
+                        grey.stroke_width(2 * k),
+                    )
                 });
             }
         }
     }
-    for (k, name) in r.coordinates.iter().enumerate() {
-        let c = colour(k);
+    let n = r.coordinates.len();
+    for (i, name) in r.coordinates.iter().enumerate() {
+        let c = colour(i);
         chart
             .draw_series(LineSeries::new(
-                r.q[k].iter().copied().zip(r.qdot[k].iter().copied()),
-                c.stroke_width(2),
+                r.q[i].iter().copied().zip(r.qdot[i].iter().copied()),
+                c.stroke_width(coordinate_width(i, n, k)),
             ))
             .map_err(err)?
             .label(name.clone())
-            .legend(line_key(c));
+            .legend(line_key(c, k));
     }
-    legend(&mut chart, SeriesLabelPosition::UpperRight)
+    legend(&mut chart, k, SeriesLabelPosition::UpperRight)
 }
 
 /// (d) The generalized Housner frequency versus amplitude (paper eq 6 and Fig. 10) against the
@@ -645,6 +707,7 @@ pub fn draw_phase<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, r: &Results
 pub fn draw_housner<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     report: &CheckReport,
+    k: u32,
 ) -> DrawResult {
     let m = report.mechanism.as_ref().ok_or_else(|| {
         format!(
@@ -660,7 +723,10 @@ pub fn draw_housner<DB: DrawingBackend>(
     let curve: Vec<(f64, f64)> = (0..=n)
         .map(|i| {
             let ratio = 0.05 + 0.93 * i as f64 / n as f64;
-            (ratio, housner_frequency(m.p_eq, m.alpha_eq, ratio * m.alpha_eq))
+            (
+                ratio,
+                housner_frequency(m.p_eq, m.alpha_eq, ratio * m.alpha_eq),
+            )
         })
         .collect();
     let points: Vec<(f64, f64)> = m
@@ -673,15 +739,16 @@ pub fn draw_housner<DB: DrawingBackend>(
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!("{}: free-rocking frequency versus amplitude", report.model),
-            caption_style(),
+            caption_style(k),
         )
-        .margin(20)
-        .x_label_area_size(55)
-        .y_label_area_size(95)
+        .margin(20 * k)
+        .x_label_area_size(55 * k)
+        .y_label_area_size(95 * k)
         .build_cartesian_2d(xr.clone(), yr.clone())
         .map_err(err)?;
     configure(
         &mut chart,
+        k,
         &format!("amplitude θm/α_eq (–), α_eq = {:.4} rad", m.alpha_eq),
         "frequency (Hz)",
         &|v| tick(*v, &xr),
@@ -689,49 +756,96 @@ pub fn draw_housner<DB: DrawingBackend>(
     )?;
     let c = colour(0);
     chart
-        .draw_series(LineSeries::new(curve, c.stroke_width(2)))
+        .draw_series(LineSeries::new(curve, c.stroke_width(2 * k)))
         .map_err(err)?
         .label(format!(
             "Housner F_H = p/(4 arccosh(1/(1 − θm/α))), eq 6, p = {:.4} rad/s",
             m.p_eq
         ))
-        .legend(line_key(c));
+        .legend(line_key(c, k));
     let e = colour(1);
     chart
         .draw_series(
             points
                 .into_iter()
-                .map(|p| Circle::new(p, 6, e.filled().stroke_width(2))),
+                .map(|p| Circle::new(p, 6 * k, e.filled())),
         )
         .map_err(err)?
         .label(format!("engine 1/(4τ), free rocking of {}", m.coordinate))
-        .legend(move |(x, y)| Circle::new((x + 12, y), 6, e.filled()));
-    legend(&mut chart, SeriesLabelPosition::UpperRight)
+        .legend(move |(x, y)| Circle::new((x + 12 * k as i32, y), 6 * k, e.filled()));
+    legend(&mut chart, k, SeriesLabelPosition::UpperRight)
 }
 
-/// Draws one plot into `DIR/STEM.png` and `DIR/STEM.svg`; returns the two paths.
+/// Supersampling factor of the PNG images: drawn at this scale, then averaged down, so that the
+/// lines and the text are anti-aliased.
+const SUPERSAMPLE: u32 = 3;
+
+/// Averages `k` × `k` blocks of an RGB image of `w k` × `h k` pixels.
+fn downsample(big: &[u8], w: u32, h: u32, k: u32) -> Vec<u8> {
+    let (w, h, k) = (w as usize, h as usize, k as usize);
+    let mut small = vec![0u8; w * h * 3];
+    let area = (k * k) as u32;
+    for y in 0..h {
+        for x in 0..w {
+            for c in 0..3 {
+                let mut sum = 0u32;
+                for dy in 0..k {
+                    let row = (y * k + dy) * w * k;
+                    for dx in 0..k {
+                        sum += big[(row + x * k + dx) * 3 + c] as u32;
+                    }
+                }
+                small[(y * w + x) * 3 + c] = ((sum + area / 2) / area) as u8;
+            }
+        }
+    }
+    small
+}
+
+/// Writes one PNG: drawn at `SUPERSAMPLE` times [`SIZE`] in memory, averaged down, encoded.
+fn write_png(
+    file: &Path,
+    draw: impl Fn(&DrawingArea<BitMapBackend<'_>, Shift>, u32) -> DrawResult,
+) -> Result<(), PlotError> {
+    let fail = |message: String| PlotError::Draw {
+        file: file.to_path_buf(),
+        message,
+    };
+    let (w, h, k) = (SIZE.0, SIZE.1, SUPERSAMPLE);
+    let mut big = vec![255u8; (w * k * h * k * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut big, (w * k, h * k)).into_drawing_area();
+        draw(&root, k).map_err(fail)?;
+        root.present().map_err(|e| fail(e.to_string()))?;
+    }
+    let small = downsample(&big, w, h, k);
+    let mut out = BitMapBackend::new(file, SIZE);
+    out.blit_bitmap((0, 0), SIZE, &small)
+        .map_err(|e| fail(e.to_string()))?;
+    out.present().map_err(|e| fail(e.to_string()))
+}
+
+/// Writes one SVG of [`SIZE`].
+fn write_svg(
+    file: &Path,
+    draw: impl Fn(&DrawingArea<SVGBackend<'_>, Shift>, u32) -> DrawResult,
+) -> Result<(), PlotError> {
+    let fail = |message: String| PlotError::Draw {
+        file: file.to_path_buf(),
+        message,
+    };
+    let root = SVGBackend::new(file, SIZE).into_drawing_area();
+    draw(&root, 1).map_err(fail)?;
+    root.present().map_err(|e| fail(e.to_string()))
+}
+
+/// Draws one plot into `DIR/STEM.png` and `DIR/STEM.svg`; evaluates to the two paths.
 macro_rules! both {
     ($dir:expr, $stem:expr, $draw:ident, $data:expr) => {{
         let png = $dir.join(concat!($stem, ".png"));
         let svg = $dir.join(concat!($stem, ".svg"));
-        {
-            let root = BitMapBackend::new(&png, SIZE).into_drawing_area();
-            $draw(&root, $data)
-                .and_then(|_| root.present().map_err(err))
-                .map_err(|message| PlotError::Draw {
-                    file: png.clone(),
-                    message,
-                })?;
-        }
-        {
-            let root = SVGBackend::new(&svg, SIZE).into_drawing_area();
-            $draw(&root, $data)
-                .and_then(|_| root.present().map_err(err))
-                .map_err(|message| PlotError::Draw {
-                    file: svg.clone(),
-                    message,
-                })?;
-        }
+        write_png(&png, |root, k| $draw(root, $data, k))?;
+        write_svg(&svg, |root, k| $draw(root, $data, k))?;
         [png, svg]
     }};
 }
