@@ -41,6 +41,9 @@ pub enum PlotError {
         /// What is wrong.
         message: String,
     },
+    /// `crr check --plot` on a model that is not a one-DOF mechanism.
+    #[error("no frequency plot: {0}")]
+    NoMechanism(String),
     /// An image could not be drawn or written.
     #[error("{file}: cannot draw the plot: {message}")]
     Draw {
@@ -279,7 +282,7 @@ pub fn read_results(dir: &Path) -> Result<Results, PlotError> {
 // Drawing helpers.
 
 /// Colours of the series, distinguishable on a screen and in grey print.
-const PALETTE: [RGBColor; 8] = [
+const PALETTE: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
@@ -288,6 +291,8 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(140, 86, 75),
     RGBColor(227, 119, 194),
     RGBColor(23, 190, 207),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
 ];
 
 fn colour(k: usize) -> RGBColor {
@@ -330,7 +335,7 @@ fn tick(v: f64, range: &std::ops::Range<f64>) -> String {
     if span < 1e-3 || big >= 1e5 {
         return format!("{v:.2e}");
     }
-    let decimals = (-(span / 10.0).log10().floor()).max(0.0) as usize;
+    let decimals = (-(span / 8.0).log10().floor()).max(0.0) as usize;
     format!("{v:.decimals$}")
 }
 
@@ -864,6 +869,14 @@ pub fn plot_results(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
 
 /// `crr check MODEL --plot DIR`: writes `housner.png` and `housner.svg` into `dir` (created).
 pub fn plot_check(dir: &Path, report: &CheckReport) -> Result<Vec<PathBuf>, PlotError> {
+    if report.mechanism.is_none() {
+        return Err(PlotError::NoMechanism(
+            report
+                .note
+                .clone()
+                .unwrap_or_else(|| "the model is not a one-DOF mechanism".into()),
+        ));
+    }
     register_fonts();
     std::fs::create_dir_all(dir).map_err(|e| PlotError::Draw {
         file: dir.to_path_buf(),

@@ -160,3 +160,19 @@ fn plot_of_a_folder_without_results_names_the_missing_file() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("summary.json"), "{err}");
 }
+
+#[test]
+fn check_plot_of_a_model_without_one_dof_mechanism_fails_and_writes_nothing() {
+    let out = scratch("plot_check_two_blocks");
+    // Two stacked blocks: DOF(2) = 2, no single equivalent block, so no frequency table.
+    let o = crr(&[
+        "check",
+        "examples/models/two_block_stack.toml",
+        "--plot",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("no frequency plot: DOF(2) = 2"), "{err}");
+    assert!(!out.join("housner.png").exists() && !out.join("housner.svg").exists());
+}
