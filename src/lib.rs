@@ -12,6 +12,7 @@
 //! - [`simulate`]: `crr simulate` (history, impacts and summary files, `docs/outputs.md`).
 //! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
 //! - [`synthetic`]: the reproducible synthetic accelerogram `examples/records/synthetic.AT2`.
+//! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
 
 pub use crr_dynamics as dynamics;
 pub use crr_impact as impact;
@@ -20,6 +21,7 @@ pub use crr_kinematics as kinematics;
 pub mod check;
 pub mod inspect;
 pub mod model_file;
+pub mod plot;
 pub mod simulate;
 pub mod synthetic;
 

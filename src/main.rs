@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 
 use crr::dynamics::ground_motion::{Axis, RecordFormat, Units};
 use crr::inspect::{configuration, inspect, to_text};
+use crr::plot::{PlotError, plot_check, plot_results};
 use crr::simulate::{RecordArg, SimulateOptions, SimulateResult, simulate};
 use crr::{InputError, load_model};
 
@@ -61,6 +62,15 @@ enum Command {
         /// No progress indication.
         #[arg(long)]
         quiet: bool,
+        /// Also draw coordinates, energy and phase plots (PNG and SVG) into the output folder.
+        #[arg(long)]
+        plot: bool,
+    },
+    /// Draw the plots of a results folder written by `crr simulate`: coordinates, energy and
+    /// phase (.png and .svg, docs/outputs.md).
+    Plot {
+        /// The results folder (history.csv, impacts.csv, summary.json).
+        dir: PathBuf,
     },
     /// Mobility report; for a one-DOF mechanism λ, the equivalent block, r and the free-rocking
     /// frequencies (docs/outputs.md).
@@ -70,13 +80,24 @@ enum Command {
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
+        /// Draw the frequency versus amplitude plot (housner.png, housner.svg) into DIR.
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
     },
 }
 
-/// Input problems exit with 2, a simulation that failed part-way with 1.
+/// Input problems and plots that cannot be drawn exit with 2, a simulation that failed part-way
+/// with 1.
 enum Failure {
     Input(InputError),
+    Plot(PlotError),
     Simulation(String),
+}
+
+impl From<PlotError> for Failure {
+    fn from(e: PlotError) -> Self {
+        Failure::Plot(e)
+    }
 }
 
 impl From<InputError> for Failure {
@@ -147,6 +168,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             component,
             scale,
             quiet,
+            plot,
         } => {
             let opts = SimulateOptions {
                 out,
@@ -154,7 +176,14 @@ fn run(cli: Cli) -> Result<(), Failure> {
                 record: record_arg(record, format, units, &component, scale)?,
                 quiet,
             };
-            match simulate(&model, &opts)? {
+            let result = simulate(&model, &opts)?;
+            if plot {
+                let dir = match &result {
+                    SimulateResult::Done(dir, _) | SimulateResult::Failed(dir, _) => dir,
+                };
+                plot_results(dir)?;
+            }
+            match result {
                 SimulateResult::Done(dir, summary) => {
                     if !quiet {
                         println!(
@@ -183,7 +212,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
                 }
             }
         }
-        Command::Check { model, json } => {
+        Command::Check { model, json, plot } => {
             let (_, m) = load_model(&model)?;
             let report = crr::check::check(&m);
             if json {
@@ -193,6 +222,14 @@ fn run(cli: Cli) -> Result<(), Failure> {
                 );
             } else {
                 print!("{}", crr::check::to_text(&report));
+            }
+            if let Some(dir) = plot {
+                plot_check(&dir, &report)?;
+            }
+        }
+        Command::Plot { dir } => {
+            for f in plot_results(&dir)? {
+                println!("{}", f.display());
             }
         }
     }
@@ -204,6 +241,10 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Input(e)) => {
+            eprintln!("crr: error: {e}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Plot(e)) => {
             eprintln!("crr: error: {e}");
             ExitCode::from(2)
         }
