@@ -255,13 +255,12 @@ impl Dynamics {
         }
         // Row-scaled closures Φ' = S Φ_q, c' = S Φ̇_q q̇, then one row per seated slot.
         let mut phi_q = DMatrix::zeros(rows, model.dof());
+        phi_q
+            .rows_mut(0, model.constraint_rows)
+            .copy_from(&self.scaled_jacobian());
         let mut bias = DVector::zeros(rows);
-        for i in 0..model.constraint_rows {
-            for j in 0..model.dof() {
-                phi_q[(i, j)] = self.row_scale[i] * self.kin.phi_q[(i, j)];
-            }
-            bias[i] = self.row_scale[i] * self.kin.phi_bias[i];
-        }
+        bias.rows_mut(0, model.constraint_rows)
+            .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
         let mut row = DVector::zeros(model.dof());
         for (k, &slot) in self.seated.iter().enumerate() {
             bias[model.constraint_rows + k] = slot_row(model, &self.kin, slot, &mut row);
