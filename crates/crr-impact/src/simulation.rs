@@ -379,6 +379,11 @@ fn apply_law(
                 matches!(l, ImpactLaw::DiracRegularised { .. }).then_some((s, 1.0))
             })
             .collect();
+        // Only Dirac slots: the exact law splits its impulse across the switch (half with the
+        // old chain, half with the new one). Otherwise restitution (and plain switches) first.
+        if rest.is_empty() && plain.is_empty() {
+            return dirac_law(model, kin, q, qdot, before, after, &dirac);
+        }
         let mut res = restitution_law(
             model,
             kin,
