@@ -224,6 +224,14 @@ pub enum SimulationError {
         /// The law's error.
         source: ImpactError,
     },
+    /// The equations of motion failed (e.g. a singular mass matrix).
+    #[error("equations of motion at t = {t}: {source}")]
+    Dynamics {
+        /// Time (s).
+        t: f64,
+        /// The failure.
+        source: crr_dynamics::DynamicsError,
+    },
     /// Too many impacts.
     #[error("more than {0} impacts: raise analysis.max_impacts or check the seating parameters")]
     TooManyImpacts(usize),
@@ -828,7 +836,10 @@ impl<'a> Simulation<'a> {
         }
         let mut d = self.dynamics.clone();
         d.accelerations(model, self.ground, self.t, &q, &qdot)
-            .map_err(|e| SimulationError::Parameter(e.to_string()))?;
+            .map_err(|e| SimulationError::Dynamics {
+                t: self.t,
+                source: e,
+            })?;
         let mut rates = vec![0.0; model.slot_count];
         slot_rates(model, &d.kin, &qdot, &mut rates);
         let mut row = DVector::zeros(model.dof());

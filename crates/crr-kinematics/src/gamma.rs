@@ -27,20 +27,8 @@ pub fn body_path(model: &Model, b: usize) -> Vec<usize> {
     path
 }
 
-/// Γⁱ along the path of body `b` (one per path coordinate): the rotation operators of eq 1.
-#[doc(alias = "Γ")]
-pub fn rot_ops_along_path(model: &Model, q: &DVector<f64>, b: usize) -> Vec<Matrix3<f64>> {
-    let mut g = Matrix3::identity();
-    body_path(model, b)
-        .into_iter()
-        .map(|j| {
-            g *= axis_angle(&model.coords[j].axis, q[j]);
-            g
-        })
-        .collect()
-}
-
 /// ∂Γⁱ/∂q_{`path[a]`} for all a, i on the path of body `b` (zero for a > i), indexed `[a][i]`.
+#[doc(alias = "Γ")]
 pub fn rot_op_partials(model: &Model, q: &DVector<f64>, path: &[usize]) -> Vec<Vec<Matrix3<f64>>> {
     let m = path.len();
     let rots: Vec<_> = path

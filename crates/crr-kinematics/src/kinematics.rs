@@ -60,22 +60,6 @@ pub fn frame_point(data: &Data, k: Option<usize>, x_rest: &Vector3<f64>) -> Vect
     }
 }
 
-/// Calls `f(j, column)` for every coordinate j on the tree path of frame `k`, with the column
-/// ∂x/∂qⱼ = wⱼ × (x − pⱼ) of the point Jacobian at world point `x`.
-pub fn for_each_point_column(
-    model: &Model,
-    data: &Data,
-    k: Option<usize>,
-    x: &Vector3<f64>,
-    mut f: impl FnMut(usize, Vector3<f64>),
-) {
-    let mut j = k;
-    while let Some(jj) = j {
-        f(jj, data.axis[jj].cross(&(x - data.pivot[jj])));
-        j = model.coords[jj].parent;
-    }
-}
-
 /// Fills the centre-of-mass and angular-velocity Jacobians J_c and J_ω of every body (ċ = J_c q̇,
 /// ω = J_ω q̇), after [`forward_kinematics`].
 pub fn jacobians(model: &Model, data: &mut Data) {
