@@ -336,6 +336,12 @@ pub fn summary(
             "collapse_drop": p.params.collapse_drop,
             "friction": p.params.friction,
         },
+        "solver_stats": {
+            "steps": t.solver_stats.steps,
+            "accepted": t.solver_stats.accepted,
+            "rejected": t.solver_stats.rejected,
+            "rhs_evaluations": t.solver_stats.rhs_evals,
+        },
         "end_time": t.end_time,
         "samples": t.samples.len(),
         "coordinates": coordinates,
@@ -406,6 +412,7 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
                 violation: None,
                 energy_balance_error: 0.0,
                 end_time: 0.0,
+                solver_stats: Default::default(),
             };
             (t, Some(e.to_string()))
         }

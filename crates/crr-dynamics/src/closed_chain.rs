@@ -11,7 +11,7 @@ use crr_kinematics::{
 };
 
 use crate::eom::{DynamicsError, constraint_row_scale};
-use crate::linalg::{pinv_solve, pivot_columns, rank};
+use crate::linalg::{JacobiSvd, pinv_solve, pivot_columns, rank};
 
 /// Convergence threshold of the Newton projections, relative to the model size for point rows.
 pub const CLOSURE_TOLERANCE: f64 = 1e-13;
@@ -329,7 +329,7 @@ pub fn partition_condition(
     let sub = DMatrix::from_fn(jac.nrows(), part.dependent.len(), |i, j| {
         jac[(i, part.dependent[j])]
     });
-    let s = sub.singular_values();
+    let s = JacobiSvd::new(&sub).singular_values;
     let r = part.dependent.len();
     let mut v: Vec<f64> = s.iter().copied().collect();
     v.sort_by(|a, b| b.total_cmp(a));

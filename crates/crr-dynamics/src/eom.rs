@@ -16,7 +16,10 @@ use crr_kinematics::{
 };
 
 use crate::ground_motion::GroundMotion;
-use crate::linalg::{cholesky_in_place, cholesky_solve, pinv_solve};
+use crate::linalg::{
+    JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, cholesky_solve,
+    forward_substitute,
+};
 
 /// A failure of the equations of motion at some state.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -245,37 +248,46 @@ impl Dynamics {
         if let Some(f) = extra {
             f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
         }
+        // Gauss' principle in the coordinates z = Lᵀq̈ (M = L Lᵀ): z is the point of the affine set
+        // B z = −c nearest to z_free = L⁻¹(Q − h), with B = Φ' L⁻ᵀ the row-scaled closures and
+        // seated slot rows. Decomposing B (rows × DOF(1)) rather than B Bᵀ keeps the conditioning
+        // unsquared and the matrix small when many rows are redundant.
         self.qddot.copy_from(&self.load);
         self.qddot += &self.extra_force;
         self.qddot -= &self.kin.velocity_product;
-        cholesky_solve(&self.factor, self.qddot.as_mut_slice());
+        forward_substitute(&self.factor, self.qddot.as_mut_slice());
         let rows = model.constraint_rows + self.seated.len();
         if rows == 0 {
+            back_substitute_transposed(&self.factor, self.qddot.as_mut_slice());
             return Ok(());
         }
-        // Row-scaled closures Φ' = S Φ_q, c' = S Φ̇_q q̇, then one row per seated slot.
-        let mut phi_q = DMatrix::zeros(rows, model.dof());
-        phi_q
-            .rows_mut(0, model.constraint_rows)
-            .copy_from(&self.scaled_jacobian());
+        let n = model.dof();
+        let mut bt = DMatrix::zeros(n, rows);
+        let scaled = self.scaled_jacobian();
+        for i in 0..model.constraint_rows {
+            bt.column_mut(i).copy_from(&scaled.row(i).transpose());
+        }
         let mut bias = DVector::zeros(rows);
         bias.rows_mut(0, model.constraint_rows)
             .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
-        let mut row = DVector::zeros(model.dof());
+        let mut row = DVector::zeros(n);
         for (k, &slot) in self.seated.iter().enumerate() {
             bias[model.constraint_rows + k] = slot_row(model, &self.kin, slot, &mut row);
-            phi_q
-                .row_mut(model.constraint_rows + k)
-                .copy_from(&row.transpose());
+            bt.column_mut(model.constraint_rows + k).copy_from(&row);
         }
-        let mut y = phi_q.transpose();
-        for mut col in y.column_iter_mut() {
-            cholesky_solve(&self.factor, col.as_mut_slice());
+        for mut col in bt.column_iter_mut() {
+            forward_substitute(&self.factor, col.as_mut_slice());
         }
-        let a = &phi_q * &y;
-        let rhs = -bias - &phi_q * &self.qddot;
-        let (lambda_scaled, _) = pinv_solve(&a, &rhs);
-        self.qddot += &y * &lambda_scaled;
+        let b = bt.transpose();
+        let svd = JacobiSvd::new(&b);
+        // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
+        let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt());
+        let residual = &b * &self.qddot + &bias;
+        let dz = -svd.solve_with(&residual, tol);
+        // z − z_free = Bᵀ λ': the minimum-norm multipliers.
+        let lambda_scaled = svd.solve_transposed_with(&dz, tol);
+        self.qddot += &dz;
+        back_substitute_transposed(&self.factor, self.qddot.as_mut_slice());
         self.lambda = lambda_scaled
             .rows(0, model.constraint_rows)
             .component_mul(&self.row_scale);

@@ -34,14 +34,24 @@ pub fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), usize> {
 
 /// Solves L Lᵀ x = b in place with the factor from [`cholesky_in_place`].
 pub fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
-    let n = l.nrows();
-    for i in 0..n {
+    forward_substitute(l, b);
+    back_substitute_transposed(l, b);
+}
+
+/// Solves L y = b in place (L lower triangular, from [`cholesky_in_place`]).
+pub fn forward_substitute(l: &DMatrix<f64>, b: &mut [f64]) {
+    for i in 0..l.nrows() {
         let mut s = b[i];
         for k in 0..i {
             s -= l[(i, k)] * b[k];
         }
         b[i] = s / l[(i, i)];
     }
+}
+
+/// Solves Lᵀ x = y in place (L lower triangular, from [`cholesky_in_place`]).
+pub fn back_substitute_transposed(l: &DMatrix<f64>, b: &mut [f64]) {
+    let n = l.nrows();
     for i in (0..n).rev() {
         let mut s = b[i];
         for k in i + 1..n {
@@ -51,18 +61,164 @@ pub fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
     }
 }
 
+/// Singular value decomposition A = W Vᵀ with W = U Σ (orthogonal columns of norms σⱼ) and V
+/// orthogonal (n × n), by one-sided Jacobi rotations (Hestenes).
+///
+/// Written here rather than taken from nalgebra because nalgebra's bidiagonal SVD can return a
+/// factorisation whose product is off by 1e-7 relative for rank-deficient matrices
+/// (dimforge/nalgebra#1072, #1172): the redundant closures of a colonnade hit exactly that case
+/// and the constrained accelerations became noisy. One-sided Jacobi has no such failure mode:
+/// it only applies plane rotations until every pair of columns is orthogonal to round-off, and it
+/// computes small singular values with high relative accuracy. Matrices here are at most a few
+/// tens of rows and columns, where a Jacobi sweep is cheap.
+#[derive(Clone, Debug)]
+pub struct JacobiSvd {
+    /// A V: its column j is σⱼ uⱼ (m × n).
+    pub w: DMatrix<f64>,
+    /// The right singular vectors as columns (n × n, orthogonal).
+    pub v: DMatrix<f64>,
+    /// σⱼ = |column j of W| (unsorted).
+    pub singular_values: DVector<f64>,
+}
+
+/// Largest number of Jacobi sweeps (each visits every column pair once); convergence is
+/// quadratic and takes well under 15 sweeps for the matrices of this crate.
+const JACOBI_SWEEPS: usize = 60;
+
+impl JacobiSvd {
+    /// Decomposes `a` (any shape; a wide matrix is handled as is: its W has zero columns).
+    pub fn new(a: &DMatrix<f64>) -> Self {
+        let n = a.ncols();
+        let mut w = a.clone();
+        let mut v = DMatrix::identity(n, n);
+        // A column whose norm is below ε‖A‖ is round-off (a zero singular value far under the
+        // rank threshold): rotating it against a large column only exchanges noise, so it is
+        // left alone; otherwise such pairs never pass the relative orthogonality test.
+        let negligible = (f64::EPSILON * a.norm()).powi(2);
+        for _ in 0..JACOBI_SWEEPS {
+            let mut rotated = false;
+            for p in 0..n {
+                for q in (p + 1)..n {
+                    let (mut alpha, mut beta, mut gamma) = (0.0, 0.0, 0.0);
+                    for (x, y) in w.column(p).iter().zip(w.column(q).iter()) {
+                        alpha += x * x;
+                        beta += y * y;
+                        gamma += x * y;
+                    }
+                    // Columns already orthogonal to round-off (or one of them negligible): skip.
+                    if alpha <= negligible
+                        || beta <= negligible
+                        || gamma.abs() <= f64::EPSILON * (alpha * beta).sqrt()
+                    {
+                        continue;
+                    }
+                    rotated = true;
+                    let zeta = (beta - alpha) / (2.0 * gamma);
+                    let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
+                    let t = if zeta == 0.0 { 1.0 } else { t };
+                    let c = 1.0 / (1.0 + t * t).sqrt();
+                    let s = c * t;
+                    rotate_columns(&mut w, p, q, c, s);
+                    rotate_columns(&mut v, p, q, c, s);
+                }
+            }
+            if !rotated {
+                break;
+            }
+        }
+        let singular_values = DVector::from_fn(n, |j, _| w.column(j).norm());
+        Self {
+            w,
+            v,
+            singular_values,
+        }
+    }
+
+    /// The threshold `RANK_TOLERANCE · σ_max` below which a singular value counts as zero.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance_relative(RANK_TOLERANCE)
+    }
+
+    /// `relative · σ_max`.
+    pub fn tolerance_relative(&self, relative: f64) -> f64 {
+        relative * self.singular_values.max().max(f64::MIN_POSITIVE)
+    }
+
+    /// Numerical rank: singular values above [`Self::tolerance`].
+    pub fn rank(&self) -> usize {
+        let tol = self.tolerance();
+        self.singular_values.iter().filter(|s| **s > tol).count()
+    }
+
+    /// x = A⁺ b = Σ_{σⱼ > tol} vⱼ (wⱼᵀ b)/σⱼ², the minimum-norm least-squares solution.
+    pub fn solve(&self, b: &DVector<f64>) -> DVector<f64> {
+        self.solve_with(b, self.tolerance())
+    }
+
+    /// [`Self::solve`] with singular values at or below `tol` (absolute) dropped.
+    pub fn solve_with(&self, b: &DVector<f64>, tol: f64) -> DVector<f64> {
+        let mut x = DVector::zeros(self.v.nrows());
+        for (j, &sigma) in self.singular_values.iter().enumerate() {
+            if sigma > tol {
+                let coef = self.w.column(j).dot(b) / (sigma * sigma);
+                x.axpy(coef, &self.v.column(j), 1.0);
+            }
+        }
+        x
+    }
+
+    /// y = (Aᵀ)⁺ c = Σ_{σⱼ > tol} wⱼ (vⱼᵀ c)/σⱼ², the minimum-norm least-squares solution of
+    /// Aᵀ y = c (singular values at or below `tol`, absolute, dropped).
+    pub fn solve_transposed_with(&self, c: &DVector<f64>, tol: f64) -> DVector<f64> {
+        let mut y = DVector::zeros(self.w.nrows());
+        for (j, &sigma) in self.singular_values.iter().enumerate() {
+            if sigma > tol {
+                let coef = self.v.column(j).dot(c) / (sigma * sigma);
+                y.axpy(coef, &self.w.column(j), 1.0);
+            }
+        }
+        y
+    }
+
+    /// A⁺ (n × m).
+    pub fn pseudo_inverse(&self) -> DMatrix<f64> {
+        let tol = self.tolerance();
+        let mut out = DMatrix::zeros(self.v.nrows(), self.w.nrows());
+        for (j, &sigma) in self.singular_values.iter().enumerate() {
+            if sigma > tol {
+                out += self.v.column(j) * self.w.column(j).transpose() / (sigma * sigma);
+            }
+        }
+        out
+    }
+
+    /// Orthonormal basis of the null space of A (the vⱼ with σⱼ ≤ tol), as columns.
+    pub fn null_space(&self) -> DMatrix<f64> {
+        let tol = self.tolerance();
+        let cols: Vec<usize> = (0..self.singular_values.len())
+            .filter(|&j| self.singular_values[j] <= tol)
+            .collect();
+        DMatrix::from_fn(self.v.nrows(), cols.len(), |i, c| self.v[(i, cols[c])])
+    }
+}
+
+/// Columns (p, q) ← (c p − s q, s p + c q).
+fn rotate_columns(m: &mut DMatrix<f64>, p: usize, q: usize, c: f64, s: f64) {
+    for i in 0..m.nrows() {
+        let (x, y) = (m[(i, p)], m[(i, q)]);
+        m[(i, p)] = c * x - s * y;
+        m[(i, q)] = s * x + c * y;
+    }
+}
+
 /// The minimum-norm least-squares solution x = A⁺ b with singular values below
 /// `RANK_TOLERANCE · σ_max` treated as zero, and the numerical rank of A.
 pub fn pinv_solve(a: &DMatrix<f64>, b: &DVector<f64>) -> (DVector<f64>, usize) {
     if a.nrows() == 0 || a.ncols() == 0 {
         return (DVector::zeros(a.ncols()), 0);
     }
-    let svd = a.clone().svd(true, true);
-    let smax = svd.singular_values.max();
-    let tol = RANK_TOLERANCE * smax.max(f64::MIN_POSITIVE);
-    let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
-    let x = svd.solve(b, tol).expect("U and V were computed");
-    (x, rank)
+    let svd = JacobiSvd::new(a);
+    (svd.solve(b), svd.rank())
 }
 
 /// A⁺, the pseudo-inverse with singular values below `RANK_TOLERANCE · σ_max` dropped.
@@ -70,9 +226,7 @@ pub fn pseudo_inverse(a: &DMatrix<f64>) -> DMatrix<f64> {
     if a.nrows() == 0 || a.ncols() == 0 {
         return DMatrix::zeros(a.ncols(), a.nrows());
     }
-    let svd = a.clone().svd(true, true);
-    let tol = RANK_TOLERANCE * svd.singular_values.max().max(f64::MIN_POSITIVE);
-    svd.pseudo_inverse(tol).expect("U and V were computed")
+    JacobiSvd::new(a).pseudo_inverse()
 }
 
 /// Numerical rank of A (singular values above `RANK_TOLERANCE · σ_max`).
@@ -80,9 +234,7 @@ pub fn rank(a: &DMatrix<f64>) -> usize {
     if a.nrows() == 0 || a.ncols() == 0 {
         return 0;
     }
-    let s = a.clone().singular_values();
-    let tol = RANK_TOLERANCE * s.max().max(f64::MIN_POSITIVE);
-    s.iter().filter(|x| **x > tol).count()
+    JacobiSvd::new(a).rank()
 }
 
 /// Chooses `r` columns of A that are as independent as possible (Gram–Schmidt with column
@@ -134,6 +286,70 @@ mod tests {
         // A singular matrix is reported at its failing pivot, never a NaN.
         let mut s = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]);
         assert_eq!(cholesky_in_place(&mut s), Err(1));
+    }
+
+    /// Checks A = W Vᵀ, VᵀV = I and the orthogonality of W's columns, to `tol` relative to |A|.
+    fn assert_decomposes(a: &DMatrix<f64>, tol: f64) -> JacobiSvd {
+        let svd = JacobiSvd::new(a);
+        let scale = a.norm().max(1.0);
+        assert!((&svd.w * svd.v.transpose() - a).amax() <= tol * scale);
+        let n = a.ncols();
+        assert!((svd.v.transpose() * &svd.v - DMatrix::identity(n, n)).amax() <= tol);
+        let gram = svd.w.transpose() * &svd.w;
+        for i in 0..n {
+            for j in 0..n {
+                if i != j {
+                    assert!(gram[(i, j)].abs() <= tol * scale * scale);
+                }
+            }
+        }
+        svd
+    }
+
+    #[test]
+    fn jacobi_svd_decomposes_rank_deficient_matrices_to_round_off() {
+        // nalgebra's SVD recomposes this one (dimforge/nalgebra#1072: a 2 × 2 matrix rebuilt with
+        // singular values [1, 0]) with a visible error; Jacobi gets it to round-off and rank 1.
+        let u = DMatrix::from_row_slice(2, 2, &[0.6, -0.8, 0.8, 0.6]);
+        let v = DMatrix::from_row_slice(2, 2, &[0.28, 0.96, -0.96, 0.28]);
+        let a = &u * DMatrix::from_diagonal(&DVector::from_vec(vec![1.0, 0.0])) * v.transpose();
+        let svd = assert_decomposes(&a, 1e-14);
+        assert_eq!(svd.rank(), 1);
+        // Products of random factors of known rank, tall, square and wide (rows repeated as in
+        // a colonnade's redundant closures).
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for (m, n, r) in [
+            (12, 10, 8),
+            (28, 10, 6),
+            (10, 10, 10),
+            (4, 9, 3),
+            (12, 12, 8),
+        ] {
+            let left = DMatrix::from_fn(m, r, |_, _| next());
+            let right = DMatrix::from_fn(r, n, |_, _| next());
+            let a = left * right;
+            let svd = assert_decomposes(&a, 1e-13);
+            assert_eq!(svd.rank(), r, "{m}×{n} of rank {r}");
+            // Moore–Penrose: A A⁺ A = A and A⁺ A A⁺ = A⁺.
+            let p = svd.pseudo_inverse();
+            assert!((&a * &p * &a - &a).amax() <= 1e-12 * a.norm());
+            assert!((&p * &a * &p - &p).amax() <= 1e-12 * p.norm());
+            // The minimum-norm solution lies in the row space: V_nullᵀ x = 0.
+            let b = DVector::from_fn(m, |_, _| next());
+            let x = svd.solve(&b);
+            assert!((svd.null_space().transpose() * &x).amax() <= 1e-12 * x.norm());
+            assert!((&x - &p * &b).amax() <= 1e-12 * x.norm());
+            // (Aᵀ)⁺ c agrees with (A⁺)ᵀ c.
+            let c = DVector::from_fn(n, |_, _| next());
+            let y = svd.solve_transposed_with(&c, svd.tolerance());
+            assert!((&y - p.transpose() * &c).amax() <= 1e-12 * y.norm().max(1.0));
+        }
     }
 
     #[test]

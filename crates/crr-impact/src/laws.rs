@@ -18,7 +18,7 @@
 //! an [`ImpactError`], never a panic.
 
 use crr_dynamics::eom::constraint_row_scale;
-use crr_dynamics::linalg::{RANK_TOLERANCE, cholesky_in_place, cholesky_solve, pinv_solve};
+use crr_dynamics::linalg::{JacobiSvd, cholesky_in_place, cholesky_solve, pinv_solve};
 use crr_kinematics::mass_matrix::world_inertia;
 use crr_kinematics::{
     ActivePivots, Data, InterfaceKind, Model, Role, constraint_jacobian, forward_kinematics,
@@ -175,31 +175,11 @@ fn evaluate_chain(model: &Model, kin: &mut Data, q: &DVector<f64>, pivots: &Acti
     }
 }
 
-/// Orthonormal basis of the null space of diag(scale) Φ (rank-revealing SVD, the relative
-/// threshold [`RANK_TOLERANCE`]).
+/// Orthonormal basis of the null space of diag(scale) Φ (rank-revealing Jacobi SVD, the relative
+/// threshold [`crr_dynamics::linalg::RANK_TOLERANCE`]).
 fn null_space(phi: &DMatrix<f64>, scale: &DVector<f64>) -> DMatrix<f64> {
-    let (m, n) = phi.shape();
-    // Pad with zero rows so that the SVD returns a full n × n V.
-    let mut a = DMatrix::zeros(m.max(n), n);
-    for i in 0..m {
-        for j in 0..n {
-            a[(i, j)] = scale[i] * phi[(i, j)];
-        }
-    }
-    let svd = a.svd(false, true);
-    let v_t = svd.v_t.expect("V was requested");
-    let smax = svd.singular_values.max();
-    let tol = RANK_TOLERANCE * smax.max(f64::MIN_POSITIVE);
-    let cols: Vec<usize> = (0..svd.singular_values.len())
-        .filter(|&i| svd.singular_values[i] <= tol)
-        .collect();
-    let mut out = DMatrix::zeros(n, cols.len());
-    for (c, &i) in cols.iter().enumerate() {
-        for j in 0..n {
-            out[(j, c)] = v_t[(i, j)];
-        }
-    }
-    out
+    let a = DMatrix::from_fn(phi.nrows(), phi.ncols(), |i, j| scale[i] * phi[(i, j)]);
+    JacobiSvd::new(&a).null_space()
 }
 
 /// Solves, for q̇ = N z and the impulses Π (one per column of `a`):

@@ -1321,6 +1321,7 @@ impl<'a> Simulation<'a> {
             violation: self.violation,
             energy_balance_error: balance,
             end_time: self.t,
+            solver_stats: self.solver.stats(),
         }
     }
 }
@@ -1348,4 +1349,6 @@ pub struct Trajectory {
     pub energy_balance_error: f64,
     /// Time reached (s).
     pub end_time: f64,
+    /// Integrator work over the whole run: steps, rejections, right-hand side evaluations.
+    pub solver_stats: crr_dynamics::integrator::Stats,
 }
