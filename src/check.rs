@@ -9,7 +9,10 @@ use serde::Serialize;
 
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::mechanism::reduce_at;
-use crr_dynamics::{InitialSpec, Mobility, equivalent_block, mobility, solve_initial};
+use crr_dynamics::{
+    FiniteMobility, InitialSpec, Mobility, equivalent_block, mobility, mobility_after_step,
+    solve_initial,
+};
 use crr_impact::laws::momentum_law;
 use crr_impact::simulation::{Parameters, Simulation, StopReason};
 use crr_kinematics::{ActivePivots, Data, Model, Side};
@@ -83,6 +86,9 @@ pub struct CheckReport {
     pub closures: Vec<String>,
     /// The mobility at rest (q = 0, every pivot `+`).
     pub mobility: Mobility,
+    /// DOF(2) after a finite step along the mechanism (closed chains that can move; `None`
+    /// otherwise). Smaller than at rest when the loops only close to first order.
+    pub finite_mobility: Option<FiniteMobility>,
     /// Present when DOF(2) = 1.
     pub mechanism: Option<MechanismReport>,
     /// Why the mechanism part is missing or incomplete.
@@ -203,10 +209,18 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
     })
 }
 
+/// Largest angle (rad) of the step along the mechanism used for the finite-mobility check.
+pub const FINITE_STEP: f64 = 0.01;
+
 /// Builds the report.
 pub fn check(model: &Model) -> CheckReport {
     let zero = DVector::zeros(model.dof());
     let mob = mobility(model, &zero, &ActivePivots::uniform(model, Side::Positive));
+    let finite = if model.closure_rows > 0 && !mob.locked {
+        mobility_after_step(model, FINITE_STEP).ok()
+    } else {
+        None
+    };
     let (mech, note) = if mob.dof2 == 1 {
         match mechanism(model) {
             Ok(m) => (Some(m), None),
@@ -239,6 +253,7 @@ pub fn check(model: &Model) -> CheckReport {
             .map(|c| model.interfaces[c.interface].name.clone())
             .collect(),
         mobility: mob,
+        finite_mobility: finite,
         mechanism: mech,
         note,
     }
@@ -270,6 +285,19 @@ pub fn to_text(r: &CheckReport) -> String {
         m.dof2,
         if m.locked { " (locked)" } else { "" }
     );
+    if let Some(f) = &r.finite_mobility {
+        s += &format!(
+            "DOF(2) after a {} rad step along the mechanism = {}{}\n",
+            f.step,
+            f.dof2,
+            if f.dof2 < m.dof2 {
+                " (fewer than at rest: the loops close only to first order there; \
+                 see docs/model-format.md, rocking bases in loops)"
+            } else {
+                ""
+            }
+        );
+    }
     if m.symmetries > 0 {
         s += &format!("symmetries: {}, DOF(3) = {}\n", m.symmetries, m.dof3);
     }

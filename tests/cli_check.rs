@@ -60,9 +60,18 @@ fn multi_dof_models_report_mobility_only() {
     assert_eq!(r["mobility"]["dof2"], 2);
     assert!(r["mechanism"].is_null());
     assert!(r["note"].as_str().unwrap().contains("DOF(2) = 2"));
+    // An open chain has no finite-mobility check.
+    assert!(r["finite_mobility"].is_null());
     let a = check("examples/models/arch.toml");
     assert_eq!(a["mobility"]["dof2"], 1);
     assert_eq!(a["mobility"]["rank"], 2);
+    assert_eq!(a["finite_mobility"]["dof2"], 1);
+    // The baldachin's loops close for finite tilts: still two DOF away from rest.
+    let b = check("examples/models/baldachin.toml");
+    assert_eq!(b["mobility"]["dof2"], 2);
+    assert_eq!(b["mobility"]["redundant"], 4);
+    assert_eq!(b["finite_mobility"]["dof2"], 2);
+    assert!(b["finite_mobility"]["residual"].as_f64().unwrap() < 1e-12);
 }
 
 #[test]

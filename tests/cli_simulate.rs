@@ -137,6 +137,72 @@ fn single_block_files_columns_and_closed_forms() {
     assert!(s["energy_balance_error"].as_f64().unwrap() < 1e-4);
 }
 
+/// The bundled baldachin: four identical columns under a rigid slab form a spatial parallelogram
+/// mechanism. Every column carries the same tilts, the slab translates without rotating (its
+/// tilts on column 1 undo the column's: top_1.1 = −base_1.2, top_1.2 = base_1.1), the columns
+/// uplift on their corners at the closed-form instant, every impact involves all eight contacts
+/// and dissipates, and the energy balance closes.
+#[test]
+fn baldachin_is_a_translating_parallelogram_mechanism() {
+    let out = scratch("baldachin_full");
+    let s = simulate("examples/models/baldachin.toml", &out, &[]);
+    assert_eq!(s["completed"], true);
+    assert_eq!(s["collapse"]["collapsed"], false);
+    // Uplift: each component's one-sine pulse A sin(ωt) reaches g tan α = g b/h (for a corner,
+    // tan α_diag = b√2/h against the diagonal acceleration A√2 sin(ωt): the same instant).
+    let (a, period, g, b, h): (f64, f64, f64, f64, f64) = (2.0, 0.8, 9.81, 0.2, 1.5);
+    let t_uplift = (g * b / (a * h)).asin() / (2.0 * std::f64::consts::PI / period);
+    let t_engine = s["uplift_time"].as_f64().unwrap();
+    // Uplift is located by the integrator's event search (tolerance 1e-10 relative).
+    assert!(
+        (t_engine - t_uplift).abs() < 1e-8,
+        "{t_engine} vs {t_uplift}"
+    );
+    let hist = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let header: Vec<&str> = hist.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|c| *c == name).unwrap();
+    let mut peak: f64 = 0.0;
+    let mut rows = 0;
+    for line in hist.lines().skip(1) {
+        let v: Vec<f64> = line
+            .split(',')
+            .take(21)
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let (p1, p2) = (v[col("base_1.1")], v[col("base_1.2")]);
+        peak = peak.max(p1.abs()).max(p2.abs());
+        // Projection tolerance 1e-13 on closures of 3 m lever arms: 1e-10 rad is generous.
+        for k in 2..=4 {
+            assert!(
+                (v[col(&format!("base_{k}.1"))] - p1).abs() < 1e-10,
+                "{line}"
+            );
+            assert!(
+                (v[col(&format!("base_{k}.2"))] - p2).abs() < 1e-10,
+                "{line}"
+            );
+        }
+        assert!((v[col("top_1.1")] + p2).abs() < 1e-10, "{line}");
+        assert!((v[col("top_1.2")] - p1).abs() < 1e-10, "{line}");
+        rows += 1;
+    }
+    assert!(rows > 400);
+    // It rocks (well beyond the uplift) but stays below α = 0.1326.
+    assert!(peak > 0.02 && peak < 0.1326, "peak {peak}");
+    let imp = std::fs::read_to_string(out.join("impacts.csv")).unwrap();
+    let mut impacts = 0;
+    for line in imp.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f[1].split(';').count(), 8, "{line}");
+        assert!(f[4].parse::<f64>().unwrap() > 0.0, "{line}");
+        impacts += 1;
+    }
+    assert!(impacts >= 4, "{impacts} impacts");
+    // Balance: integration tolerance 1e-10 relative on energies of order 1e3 J.
+    let balance = s["energy_balance_error"].as_f64().unwrap();
+    assert!(balance < 1e-5, "balance {balance} J");
+}
+
 #[test]
 fn bundled_models_write_the_three_files() {
     for (m, d) in [
@@ -145,6 +211,7 @@ fn bundled_models_write_the_three_files() {
         ("two_block_stack", "1"),
         ("drum_column", "0.3"),
         ("block_record", "3"),
+        ("baldachin", "1"),
     ] {
         let out = scratch(m);
         let s = simulate(

@@ -79,6 +79,76 @@ pub fn mobility(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) -> Mobil
     }
 }
 
+/// DOF(2) after a finite displacement along the mechanism: see [`mobility_after_step`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct FiniteMobility {
+    /// Largest |qₖ| of the displacement before projection (rad).
+    pub step: f64,
+    /// The closed configuration reached (rad), in the order of q.
+    pub q: Vec<f64>,
+    /// DOF(2) there.
+    pub dof2: usize,
+    /// Scaled closure residual left by the projection.
+    pub residual: f64,
+}
+
+/// Mobility after a finite step: from rest, moves by `step` (rad, largest component) along a
+/// generic combination of the first-order mechanism directions (the null space of Φ_q at rest),
+/// projects back onto Φ = 0 with the pivots following the signs, and computes DOF(2) there.
+///
+/// DOF(2) at rest counts the first-order motions. Where the closures allow fewer finite motions
+/// (a rocking-base loop whose tilts are applied in an order the loop cannot follow, or a loop
+/// that only flexes infinitesimally), DOF(2) drops after the step: the rest value overstates the
+/// mechanism, and the multiplier solve near rest is ill-conditioned. A locked structure
+/// (DOF(2) = 0 at rest) returns at once.
+pub fn mobility_after_step(model: &Model, step: f64) -> Result<FiniteMobility, DynamicsError> {
+    let n = model.dof();
+    let mut pivots = ActivePivots::uniform(model, Side::Positive);
+    let mut kin = Data::new(model);
+    let zero = DVector::zeros(n);
+    let (_, jac) = scaled(model, &mut kin, &zero, &pivots);
+    let closure_rows = jac.rows(0, model.closure_rows).into_owned();
+    let null = if model.closure_rows == 0 {
+        DMatrix::identity(n, n)
+    } else {
+        JacobiSvd::new(&closure_rows).null_space()
+    };
+    if null.ncols() == 0 {
+        return Ok(FiniteMobility {
+            step: 0.0,
+            q: vec![0.0; n],
+            dof2: 0,
+            residual: 0.0,
+        });
+    }
+    // Weights 1, 1/φ, 1/φ², … (φ the golden ratio): no two directions cancel or coincide.
+    let golden = 0.5 * (1.0 + 5f64.sqrt());
+    let mut d = DVector::zeros(n);
+    for j in 0..null.ncols() {
+        d.axpy(golden.powi(-(j as i32)), &null.column(j), 1.0);
+    }
+    let scale = step / d.amax().max(f64::EPSILON);
+    let mut q = d * scale;
+    let mut residual = 0.0;
+    // The pivots follow the signs of the configuration; re-project until they stop changing.
+    for _ in 0..4 {
+        let before = pivots.sides.clone();
+        follow_signs(model, &mut kin, &q, &mut pivots);
+        residual = project_positions(model, &mut kin, &pivots, &mut q, None)?;
+        follow_signs(model, &mut kin, &q, &mut pivots);
+        if pivots.sides == before {
+            break;
+        }
+    }
+    let dof2 = mobility(model, &q, &pivots).dof2;
+    Ok(FiniteMobility {
+        step,
+        q: q.as_slice().to_vec(),
+        dof2,
+        residual,
+    })
+}
+
 /// Newton projection of q onto Φ(q) = 0, changing only the coordinates in `free` (all when None)
 /// by minimum-norm steps. Returns the final scaled residual norm.
 pub fn project_positions(
@@ -204,6 +274,38 @@ fn lookup(
         .collect()
 }
 
+/// Newton steps on the free coordinates with the pivots following the signs of each iterate
+/// (Φ is continuous across a pivot switch, only its slope changes). It finds the pivot sides of
+/// the closed configuration when some free coordinates must become negative (a colonnade tilted in
+/// both directions: the other columns' second tilts pivot on their negative side); from rest with
+/// every pivot `+` the loops could not close. Falls back to rest on failure.
+fn warm_start_following_signs(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &mut ActivePivots,
+    q: &mut DVector<f64>,
+    free: &[usize],
+) {
+    let start = q.clone();
+    for _ in 0..NEWTON_ITERATIONS {
+        follow_signs(model, kin, q, pivots);
+        let (phi, jac) = scaled(model, kin, q, pivots);
+        let norm = phi.amax();
+        if !norm.is_finite() || norm <= CLOSURE_TOLERANCE {
+            break;
+        }
+        let sub = DMatrix::from_fn(jac.nrows(), free.len(), |i, j| jac[(i, free[j])]);
+        let (dx, _) = pinv_solve(&sub, &phi);
+        for (j, &c) in free.iter().enumerate() {
+            q[c] -= dx[j];
+        }
+    }
+    if !q.iter().all(|x| x.is_finite()) {
+        q.copy_from(&start);
+        *pivots = ActivePivots::uniform(model, Side::Positive);
+    }
+}
+
 /// Solves the initial state: the given angles and rates are kept, the other coordinates are found
 /// by Newton from the rest configuration (minimum-norm steps) so that Φ = 0 and Φ_q q̇ = 0.
 /// The pivots follow the signs of the solution (re-solved until they agree). Errors when the given
@@ -238,6 +340,7 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
         ))
     };
     if model.constraint_rows > 0 {
+        warm_start_following_signs(model, &mut kin, &mut pivots, &mut q, &free);
         let mut previous = None;
         for _ in 0..6 {
             follow_signs(model, &mut kin, &q, &mut pivots);

@@ -20,7 +20,8 @@ pub mod system;
 
 pub use analysis::{AnalysisSpec, MethodName};
 pub use closed_chain::{
-    InitialSpec, InitialState, Mobility, Partition, mobility, partition, solve_initial,
+    FiniteMobility, InitialSpec, InitialState, Mobility, Partition, mobility, mobility_after_step,
+    partition, solve_initial,
 };
 pub use energy::{Energies, energies};
 pub use eom::{Dynamics, DynamicsError, effective_gravity};

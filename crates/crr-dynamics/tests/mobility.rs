@@ -200,3 +200,46 @@ fn initial_conditions_on_the_trilithon() {
         .to_string();
     assert!(e.contains("not a finite number"), "{e}");
 }
+
+/// The colonnade's loops close for finite tilts in both directions when the tops tilt in the
+/// opposite order to the bases (the slab translates: Φ = 0 exactly at q = (φ₁, φ₂) on every base and
+/// (−φ₂, φ₁) on the top, and DOF(2) stays 2). With the same order at both ends the slab would have
+/// to twist: that configuration violates the closures, and after a finite step along the
+/// first-order mechanism DOF(2) drops to 1, though it is 2 at rest.
+#[test]
+fn colonnade_stays_a_two_dof_mechanism_for_finite_tilts() {
+    use crr_dynamics::closed_chain::follow_signs;
+    use crr_dynamics::mobility_after_step;
+    use crr_kinematics::fixtures::colonnade_with_top_order;
+    use crr_kinematics::{Data, constraint_residual, forward_kinematics};
+    let (p1, p2) = (0.05, -0.03);
+    let mut q = DVector::zeros(10);
+    for k in 0..4 {
+        q[2 * k] = p1;
+        q[2 * k + 1] = p2;
+    }
+    q[8] = -p2;
+    q[9] = p1;
+    for (swapped, dof_after) in [(true, 2), (false, 1)] {
+        let model =
+            Model::from_spec(&colonnade_with_top_order(0.2, 1.5, 1.0, 0.3, swapped)).unwrap();
+        let mut kin = Data::new(&model);
+        let mut pivots = ActivePivots::uniform(&model, Side::Positive);
+        follow_signs(&model, &mut kin, &q, &mut pivots);
+        forward_kinematics(&model, &mut kin, &q, &pivots);
+        constraint_residual(&model, &mut kin, &pivots, &q);
+        let residual = kin.phi.amax();
+        if swapped {
+            // Exact closure: round-off of 3 m lever arms.
+            assert!(residual < 1e-14, "residual {residual:e}");
+            assert_eq!(mobility(&model, &q, &pivots).dof2, 2);
+        } else {
+            // The twist the loop would need is second order: φ₁φ₂ times a lever arm.
+            assert!(residual > 1e-4, "residual {residual:e}");
+        }
+        let finite = mobility_after_step(&model, 0.02).unwrap();
+        assert!(finite.residual < 1e-12, "{finite:?}");
+        assert!(finite.q.iter().any(|x| x.abs() > 0.01), "{finite:?}");
+        assert_eq!(finite.dof2, dof_after, "swapped = {swapped}: {finite:?}");
+    }
+}

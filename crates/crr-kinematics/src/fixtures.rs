@@ -463,7 +463,19 @@ pub fn four_hinge_arch(r_in: f64, r_out: f64, depth: f64, two_sided: bool) -> St
 /// A 2×2 colonnade (baldachin): four identical columns 2b × 2b × 2h at (±s, ±s) on rocking bases,
 /// under a slab of thickness `slab` joined to each column top by a rocking base. Coordinates: the
 /// four bases' tilts and the slab's on the first column; three top contacts close loops.
+///
+/// The bases tilt about x then y (e₁ = x, e₂ = y); the tops about y then −x (first edge along y),
+/// so that the slab's rotation relative to a column, R_y(θ₁)R_x(−θ₂), can undo the column's
+/// R_x(φ₁)R_y(φ₂) exactly (θ₁ = −φ₂, θ₂ = φ₁): the slab translates without rotating, the loops
+/// close for finite tilts in both directions and DOF(2) = 2 holds away from rest too. With the
+/// same order at both ends the slab would have to twist to follow a tilt in both directions.
 pub fn colonnade(b: f64, h: f64, s: f64, slab: f64) -> StructureSpec {
+    colonnade_with_top_order(b, h, s, slab, true)
+}
+
+/// [`colonnade`] with the tops' first edge along y (`swapped`, the consistent order) or along x
+/// (the same order as the bases: the loops then close only to first order at rest).
+pub fn colonnade_with_top_order(b: f64, h: f64, s: f64, slab: f64, swapped: bool) -> StructureSpec {
     let square = |x: f64, y: f64, z: f64| -> [[f64; 3]; 4] {
         [
             [x - b, y - b, z],
@@ -471,6 +483,10 @@ pub fn colonnade(b: f64, h: f64, s: f64, slab: f64) -> StructureSpec {
             [x + b, y + b, z],
             [x - b, y + b, z],
         ]
+    };
+    let top_square = |x: f64, y: f64, z: f64| -> [[f64; 3]; 4] {
+        let c = square(x, y, z);
+        if swapped { [c[0], c[3], c[2], c[1]] } else { c }
     };
     let pos = [(-s, -s), (s, -s), (s, s), (-s, s)];
     let mut body: Vec<BodySpec> = pos
@@ -509,7 +525,7 @@ pub fn colonnade(b: f64, h: f64, s: f64, slab: f64) -> StructureSpec {
             &format!("top_{}", k + 1),
             &format!("column_{}", k + 1),
             "slab",
-            square(x, y, 2.0 * h),
+            top_square(x, y, 2.0 * h),
         )
     }));
     StructureSpec {
