@@ -3,10 +3,11 @@
 //! with the ground motion as the effective gravity g_eff(t) = (−a_x, −a_y, −g − a_z) on every body
 //! (the equations are written in the frame of the ground): Q = Σₙ Mⁿ J_cₙᵀ g_eff.
 //!
-//! Closed chains are solved with explicit multipliers: with x₀ = M⁻¹(Q − h) and Y = M⁻¹Φ_qᵀ,
-//! (Φ_q Y) λ = −Φ̇_q q̇ − Φ_q x₀, q̈ = x₀ + Y λ. Redundant closures (a colonnade under a rigid slab)
-//! make Φ_q Y singular: λ is then the minimum-norm solution (singular values below
-//! [`RANK_TOLERANCE`](crate::linalg::RANK_TOLERANCE)·σ_max dropped), q̈ is unique.
+//! Closed chains are solved with explicit multipliers by Gauss' principle: with M = L Lᵀ and
+//! z = Lᵀq̈, z is the point of B z = −Φ̇_q q̇ (B = Φ_q L⁻ᵀ) nearest to z_free = L⁻¹(Q − h), and
+//! Φ_qᵀλ = L(z − z_free). Redundant closures (a colonnade under a rigid slab) make B rank-deficient:
+//! its pseudo-inverse (one-sided Jacobi SVD, singular values below √[`RANK_TOLERANCE`]·σ_max
+//! dropped) gives the minimum-norm λ, and q̈ is unique.
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
