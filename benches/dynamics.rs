@@ -1,5 +1,5 @@
 //! Benchmarks of the dynamics: q̈ from the equations of motion on open serial chains of N bodies
-//! and on two closed chains (a trilithon and a four-hinge arch) at consistent states, and the
+//! and on three closed chains (a trilithon, a four-hinge arch, a 2×2 colonnade) at consistent states, and the
 //! smooth integration of 1 s of the closed chains (constrained form, DOP853).
 
 use std::collections::BTreeMap;
@@ -12,14 +12,14 @@ use nalgebra::DVector;
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::integrator::{Method, Options};
 use crr_dynamics::{Dynamics, Form, InitialSpec, InitialState, integrate_smooth, solve_initial};
-use crr_kinematics::fixtures::{four_hinge_arch, serial_chain, trilithon};
+use crr_kinematics::fixtures::{colonnade, four_hinge_arch, serial_chain, trilithon};
 use crr_kinematics::{ActivePivots, Model, Side, StructureSpec};
 
 /// Chain lengths of the scaling study.
 const SIZES: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
 
 /// The closed chains: name, structure, the coordinate given an angle and a rate.
-fn closed_chains() -> [(&'static str, StructureSpec, &'static str, f64, f64); 2] {
+fn closed_chains() -> [(&'static str, StructureSpec, &'static str, f64, f64); 3] {
     [
         (
             "trilithon",
@@ -34,6 +34,14 @@ fn closed_chains() -> [(&'static str, StructureSpec, &'static str, f64, f64); 2]
             "springing_right",
             0.02,
             0.05,
+        ),
+        (
+            // 2×2 colonnade: 10 coordinates, 12 closure rows of rank 8.
+            "colonnade",
+            colonnade(0.2, 1.5, 1.2, 0.4),
+            "base_1.1",
+            0.03,
+            0.1,
         ),
     ]
 }

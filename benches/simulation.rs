@@ -24,7 +24,7 @@ use crr_dynamics::integrator::Options;
 use crr_dynamics::{InitialSpec, InitialState, equivalent_block, solve_initial};
 use crr_impact::{Parameters, Simulation, Trajectory};
 use crr_kinematics::fixtures::{
-    SplitMix, box_body, four_hinge_arch, oriented_hinge, single_block, trilithon,
+    SplitMix, box_body, colonnade, four_hinge_arch, oriented_hinge, single_block, trilithon,
 };
 use crr_kinematics::spec::DEFAULT_GRAVITY;
 use crr_kinematics::{Model, StructureSpec};
@@ -92,9 +92,13 @@ fn arch_lambda() -> f64 {
 
 /// A one-sine pulse `A sin(2πt/T)` on [0, T] along x.
 fn sine_pulse_x(amplitude: f64, period: f64) -> GroundMotion {
-    GroundMotion::none()
+    sine_pulse(GroundMotion::none(), Axis::X, amplitude, period)
+}
+
+fn sine_pulse(ground: GroundMotion, axis: Axis, amplitude: f64, period: f64) -> GroundMotion {
+    ground
         .with_component(
-            Axis::X,
+            axis,
             &ComponentSpec::new(SignalSpec::OneSinePulse(PulseSpec {
                 amplitude,
                 period,
@@ -229,18 +233,29 @@ fn pulse(c: &mut Criterion) {
             "trilithon",
             trilithon(0.25, 1.5, 2.0, 0.5, 1.0),
             sine_pulse_x(1.5 * G * alpha.tan(), 0.5),
+            Parameters::default().simultaneity,
         ),
         (
             "four_hinge_arch",
             four_hinge_arch(4.0, 4.6, 1.0, true),
             sine_pulse_x(ARCH_PULSE_LAMBDAS * arch_lambda() * G, 0.5),
+            Parameters::default().simultaneity,
+        ),
+        (
+            // The bundled baldachin: its structure, diagonal pulse (2.0 m/s² on x and on y) and
+            // corner-impact simultaneity.
+            "baldachin",
+            colonnade(0.2, 1.5, 1.2, 0.4),
+            sine_pulse(sine_pulse_x(2.0, 0.8), Axis::Y, 2.0, 0.8),
+            1e-5,
         ),
     ];
-    let params = Parameters {
-        duration: 5.0,
-        ..Parameters::default()
-    };
-    for (name, spec, ground) in cases {
+    for (name, spec, ground, simultaneity) in cases {
+        let params = Parameters {
+            duration: 5.0,
+            simultaneity,
+            ..Parameters::default()
+        };
         let model = Model::from_spec(&spec).expect("valid structure");
         let init = at_rest(&model);
         eprintln!("pulse/{name}: PGA {:.4} g", ground.pga().x / G);

@@ -91,10 +91,11 @@ impl JacobiSvd {
         let n = a.ncols();
         let mut w = a.clone();
         let mut v = DMatrix::identity(n, n);
-        // A column whose norm is below ε‖A‖ is round-off (a zero singular value far under the
-        // rank threshold): rotating it against a large column only exchanges noise, so it is
-        // left alone; otherwise such pairs never pass the relative orthogonality test.
-        let negligible = (f64::EPSILON * a.norm()).powi(2);
+        // A column whose norm is below 1000 ε‖A‖ is round-off: a zero singular value far under
+        // the rank threshold (RANK_TOLERANCE σ_max ≥ 1e-9 ‖A‖/√n). Rotating it against a large
+        // column only exchanges noise and never passes the relative orthogonality test, so it is
+        // left alone; it counts as a zero singular value.
+        let negligible = (1e3 * f64::EPSILON * a.norm()).powi(2);
         for _ in 0..JACOBI_SWEEPS {
             let mut rotated = false;
             for p in 0..n {
