@@ -176,3 +176,49 @@ fn check_plot_of_a_model_without_one_dof_mechanism_fails_and_writes_nothing() {
     assert!(err.contains("no frequency plot: DOF(2) = 2"), "{err}");
     assert!(!out.join("housner.png").exists() && !out.join("housner.svg").exists());
 }
+
+/// Every bundled model simulates (a short run) and plots: three PNGs of the documented size and
+/// SVGs naming each coordinate in the legend.
+#[test]
+fn every_bundled_model_simulates_and_plots() {
+    for (m, d) in [
+        ("single_block", "1"),
+        ("trilithon", "1"),
+        ("arch", "0.5"),
+        ("two_block_stack", "1"),
+        ("baldachin", "1"),
+        ("drum_column", "0.3"),
+        ("block_record", "3"),
+    ] {
+        let out = scratch(&format!("plot_all_{m}"));
+        let o = crr(&[
+            "simulate",
+            &format!("examples/models/{m}.toml"),
+            "--duration",
+            d,
+            "--out",
+            out.to_str().unwrap(),
+            "--plot",
+            "--quiet",
+        ]);
+        assert!(
+            o.status.success(),
+            "{m}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for stem in ["coordinates", "energy", "phase"] {
+            assert_png(&out.join(format!("{stem}.png")));
+        }
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let names: Vec<String> = summary["coordinates"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| format!("{} (rad)", c["name"].as_str().unwrap()))
+            .collect();
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        assert_svg(&out.join("coordinates.svg"), &names);
+    }
+}
