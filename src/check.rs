@@ -89,6 +89,8 @@ pub struct CheckReport {
     /// DOF(2) after a finite step along the mechanism (closed chains that can move; `None`
     /// otherwise). Smaller than at rest when the loops only close to first order.
     pub finite_mobility: Option<FiniteMobility>,
+    /// Why `finite_mobility` is missing for a closed chain that can move.
+    pub finite_mobility_note: Option<String>,
     /// Present when DOF(2) = 1.
     pub mechanism: Option<MechanismReport>,
     /// Why the mechanism part is missing or incomplete.
@@ -216,10 +218,13 @@ pub const FINITE_STEP: f64 = 0.01;
 pub fn check(model: &Model) -> CheckReport {
     let zero = DVector::zeros(model.dof());
     let mob = mobility(model, &zero, &ActivePivots::uniform(model, Side::Positive));
-    let finite = if model.closure_rows > 0 && !mob.locked {
-        mobility_after_step(model, FINITE_STEP).ok()
+    let (finite, finite_note) = if model.closure_rows > 0 && !mob.locked {
+        match mobility_after_step(model, FINITE_STEP) {
+            Ok(f) => (Some(f), None),
+            Err(e) => (None, Some(format!("not evaluated: {e}"))),
+        }
     } else {
-        None
+        (None, None)
     };
     let (mech, note) = if mob.dof2 == 1 {
         match mechanism(model) {
@@ -254,6 +259,7 @@ pub fn check(model: &Model) -> CheckReport {
             .collect(),
         mobility: mob,
         finite_mobility: finite,
+        finite_mobility_note: finite_note,
         mechanism: mech,
         note,
     }
@@ -297,6 +303,9 @@ pub fn to_text(r: &CheckReport) -> String {
                 ""
             }
         );
+    }
+    if let Some(note) = &r.finite_mobility_note {
+        s += &format!("DOF(2) after a finite step along the mechanism: {note}\n");
     }
     if m.symmetries > 0 {
         s += &format!("symmetries: {}, DOF(3) = {}\n", m.symmetries, m.dof3);

@@ -102,6 +102,11 @@ pub struct FiniteMobility {
 /// mechanism, and the multiplier solve near rest is ill-conditioned. A locked structure
 /// (DOF(2) = 0 at rest) returns at once.
 pub fn mobility_after_step(model: &Model, step: f64) -> Result<FiniteMobility, DynamicsError> {
+    // Closures only: symmetry rows would pull the step back towards rest.
+    let mut closures_only = model.clone();
+    closures_only.symmetries.clear();
+    closures_only.constraint_rows = closures_only.closure_rows;
+    let model = &closures_only;
     let n = model.dof();
     let mut pivots = ActivePivots::uniform(model, Side::Positive);
     let mut kin = Data::new(model);
@@ -139,6 +144,13 @@ pub fn mobility_after_step(model: &Model, step: f64) -> Result<FiniteMobility, D
         if pivots.sides == before {
             break;
         }
+    }
+    if q.amax() < 0.1 * step {
+        return Err(DynamicsError::Closure(format!(
+            "the step of {step} rad along the first-order mechanism projected back to within \
+             {:.1e} rad of rest: no finite motion found there",
+            q.amax()
+        )));
     }
     let dof2 = mobility(model, &q, &pivots).dof2;
     Ok(FiniteMobility {
@@ -214,16 +226,42 @@ pub fn project_velocities(
     res.amax()
 }
 
-/// Sets closure pivot sides from the current closure angles (ties keep their side) and tree sides
-/// from the signs of q.
+/// Whether every slot whose angle is clearly away from 0 (beyond 1e-9 rad, the Newton tolerance
+/// on these angles) pivots on the side of its sign.
+fn signs_agree(model: &Model, kin: &mut Data, q: &DVector<f64>, pivots: &ActivePivots) -> bool {
+    forward_kinematics(model, kin, q, pivots);
+    let mut angles: Vec<f64> = q.iter().copied().collect();
+    angles.resize(model.slot_count, 0.0);
+    closure_angles(model, kin, &mut angles[model.dof()..]);
+    angles
+        .iter()
+        .zip(&pivots.sides)
+        .all(|(&a, &s)| a.abs() <= 1e-9 || Side::of(a, s) == s)
+}
+
+/// Angles within this of 0 (rad) are ties for [`follow_signs`]: round-off of a Newton solve
+/// (1e-17 rad) must not switch a pivot.
+pub const SIGN_TIE: f64 = 1e-12;
+
+/// Sets tree pivot sides from the signs of q and closure pivot sides from the current closure
+/// angles; angles within [`SIGN_TIE`] of 0 keep their side.
 pub fn follow_signs(model: &Model, kin: &mut Data, q: &DVector<f64>, pivots: &mut ActivePivots) {
-    pivots.follow_coordinates(q);
+    let side = |a: f64, s: Side| {
+        if a.abs() <= SIGN_TIE {
+            s
+        } else {
+            Side::of(a, s)
+        }
+    };
+    for (k, &a) in q.iter().enumerate() {
+        pivots.sides[k] = side(a, pivots.sides[k]);
+    }
     forward_kinematics(model, kin, q, pivots);
     let mut ang = vec![0.0; model.slot_count - model.dof()];
     closure_angles(model, kin, &mut ang);
     for (k, a) in ang.iter().enumerate() {
         let s = &mut pivots.sides[model.dof() + k];
-        *s = Side::of(*a, *s);
+        *s = side(*a, *s);
     }
 }
 
@@ -341,24 +379,46 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
     };
     if model.constraint_rows > 0 {
         warm_start_following_signs(model, &mut kin, &mut pivots, &mut q, &free);
-        let mut previous = None;
-        for _ in 0..6 {
+        // Re-solve with the pivots held until they agree with the signs of the solution. Two
+        // candidates: Newton from rest (minimum-norm steps) and from the current solution; the
+        // nearer to rest is kept and the pivots follow its signs in the next pass.
+        let mut settled = false;
+        for _ in 0..8 {
+            let before = pivots.clone();
             follow_signs(model, &mut kin, &q, &mut pivots);
-            if previous.as_ref() == Some(&pivots) {
+            let mut from_rest = q.clone();
+            for &k in &free {
+                from_rest[k] = 0.0;
+            }
+            let mut from_here = q.clone();
+            let best = [from_rest, from_here.clone()]
+                .into_iter()
+                .filter_map(|mut c| {
+                    project_positions(model, &mut kin, &pivots, &mut c, Some(&free)).ok()?;
+                    Some(c)
+                })
+                .min_by(|a, b| a.norm().total_cmp(&b.norm()));
+            match best {
+                Some(c) => q = c,
+                None => {
+                    project_positions(model, &mut kin, &pivots, &mut from_here, Some(&free))
+                        .map_err(|e| explain(&format!(": {e}")))?;
+                }
+            }
+            if signs_agree(model, &mut kin, &q, &pivots) && pivots == before {
+                settled = true;
                 break;
             }
-            previous = Some(pivots.clone());
-            let mut trial = q.clone();
-            for &k in &free {
-                trial[k] = 0.0;
-            }
-            project_positions(model, &mut kin, &pivots, &mut trial, Some(&free))
-                .map_err(|e| explain(&format!(": {e}")))?;
-            q = trial;
         }
         let (phi, _) = scaled(model, &mut kin, &q, &pivots);
         if phi.amax() > 1e-9 {
             return Err(explain(&format!(": residual {:.3e}", phi.amax())));
+        }
+        if !settled {
+            return Err(explain(
+                ": the pivot sides do not settle (the angles given put some joint on the \
+                 boundary between its pivots)",
+            ));
         }
     } else {
         pivots.follow_coordinates(&q);

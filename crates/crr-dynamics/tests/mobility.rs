@@ -243,3 +243,54 @@ fn colonnade_stays_a_two_dof_mechanism_for_finite_tilts() {
         assert_eq!(finite.dof2, dof_after, "swapped = {swapped}: {finite:?}");
     }
 }
+
+/// Initial conditions on the colonnade from one or two tilts: the other coordinates close the loops
+/// with every pivot on the side of its angle (a column tilted about x alone leaves the y tilts at 0
+/// and the slab's second tilt undoing the first; never a far branch beyond α = 0.13 rad).
+#[test]
+fn colonnade_initial_states_have_consistent_pivots() {
+    use crr_dynamics::{InitialSpec, solve_initial};
+    use crr_kinematics::{Data, closure_angles, forward_kinematics};
+    let model = Model::from_spec(&colonnade(0.2, 1.5, 1.0, 0.3)).unwrap();
+    let cases: [&[(&str, f64)]; 4] = [
+        &[("base_1.1", 0.01)],
+        &[("base_1.2", -0.05)],
+        &[("base_1.1", 0.12), ("base_1.2", -0.05)],
+        &[("base_1.1", -0.03), ("base_1.2", 0.02)],
+    ];
+    for angles in cases {
+        let spec = InitialSpec {
+            angles: angles.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+            ..Default::default()
+        };
+        let init = solve_initial(&model, &spec).unwrap();
+        let q = &init.q;
+        // Pivots follow the signs of the solution's angles (tree and closure), except within the
+        // Newton tolerance of 0 where either side is the same geometry.
+        let mut kin = Data::new(&model);
+        forward_kinematics(&model, &mut kin, q, &init.pivots);
+        let mut slots: Vec<f64> = q.iter().copied().collect();
+        slots.resize(model.slot_count, 0.0);
+        closure_angles(&model, &kin, &mut slots[model.dof()..]);
+        for (a, side) in slots.iter().zip(&init.pivots.sides) {
+            assert!(
+                a.abs() < 1e-8 || Side::of(*a, *side) == *side,
+                "{angles:?}: angle {a} on side {side:?}"
+            );
+        }
+        // A translating slab: every column as column 1, the slab's tilts undo it.
+        for k in 1..4 {
+            assert!((q[2 * k] - q[0]).abs() < 1e-9, "{angles:?}: {q}");
+            assert!((q[2 * k + 1] - q[1]).abs() < 1e-9, "{angles:?}: {q}");
+        }
+        assert!(
+            (q[8] + q[1]).abs() < 1e-9 && (q[9] - q[0]).abs() < 1e-9,
+            "{angles:?}: {q}"
+        );
+        assert!(q.amax() <= 0.12 + 1e-12, "{angles:?}: {q}");
+        if angles.len() == 1 && angles[0].0 == "base_1.1" {
+            // The y tilt is the mechanism's second, free direction: Newton lands within 1e-8 of 0.
+            assert!(q[1].abs() < 1e-7, "{angles:?}: {q}");
+        }
+    }
+}
