@@ -280,7 +280,7 @@ impl Dynamics {
             forward_substitute(&self.factor, col.as_mut_slice());
         }
         let b = bt.transpose();
-        let svd = JacobiSvd::new(&b);
+        let svd = JacobiSvd::thin(&b);
         // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
         let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt());
         let residual = &b * &self.qddot + &bias;
