@@ -188,11 +188,7 @@ pub fn project_positions(
             return Ok(norm);
         }
         last = norm;
-        let sub = DMatrix::from_fn(jac.nrows(), cols.len(), |i, j| jac[(i, cols[j])]);
-        let (dx, _) = pinv_solve(&sub, &phi);
-        for (j, &c) in cols.iter().enumerate() {
-            q[c] -= dx[j];
-        }
+        min_norm_step(&jac, &phi, &cols, q);
     }
     let (phi, _) = scaled(model, kin, q, pivots);
     let norm = phi.amax();
@@ -202,6 +198,14 @@ pub fn project_positions(
         Err(DynamicsError::Closure(format!(
             "Newton did not bring the closure residual below tolerance (still {norm:.3e} relative)"
         )))
+    }
+}
+
+/// One Newton step on Φ(q) = 0 changing only the coordinates `cols`: q_cols −= (Φ_q,cols)⁺ Φ.
+fn min_norm_step(jac: &DMatrix<f64>, phi: &DVector<f64>, cols: &[usize], q: &mut DVector<f64>) {
+    let (dx, _) = pinv_solve(&jac.select_columns(cols.iter()), phi);
+    for (j, &c) in cols.iter().enumerate() {
+        q[c] -= dx[j];
     }
 }
 
@@ -332,11 +336,7 @@ fn warm_start_following_signs(
         if !norm.is_finite() || norm <= CLOSURE_TOLERANCE {
             break;
         }
-        let sub = DMatrix::from_fn(jac.nrows(), free.len(), |i, j| jac[(i, free[j])]);
-        let (dx, _) = pinv_solve(&sub, &phi);
-        for (j, &c) in free.iter().enumerate() {
-            q[c] -= dx[j];
-        }
+        min_norm_step(&jac, &phi, free, q);
     }
     if !q.iter().all(|x| x.is_finite()) {
         q.copy_from(&start);
@@ -390,21 +390,21 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
             for &k in &free {
                 from_rest[k] = 0.0;
             }
-            let mut from_here = q.clone();
-            let best = [from_rest, from_here.clone()]
-                .into_iter()
-                .filter_map(|mut c| {
-                    project_positions(model, &mut kin, &pivots, &mut c, Some(&free)).ok()?;
-                    Some(c)
-                })
-                .min_by(|a, b| a.norm().total_cmp(&b.norm()));
-            match best {
-                Some(c) => q = c,
-                None => {
-                    project_positions(model, &mut kin, &pivots, &mut from_here, Some(&free))
-                        .map_err(|e| explain(&format!(": {e}")))?;
+            let mut closed = Vec::new();
+            let mut failure = None;
+            for mut c in [from_rest, q.clone()] {
+                match project_positions(model, &mut kin, &pivots, &mut c, Some(&free)) {
+                    Ok(_) => closed.push(c),
+                    Err(e) => failure = Some(e),
                 }
             }
+            q = match closed
+                .into_iter()
+                .min_by(|a, b| a.norm().total_cmp(&b.norm()))
+            {
+                Some(c) => c,
+                None => return Err(explain(&format!(": {}", failure.expect("both failed")))),
+            };
             if signs_agree(model, &mut kin, &q, &pivots) && pivots == before {
                 settled = true;
                 break;

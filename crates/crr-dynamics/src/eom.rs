@@ -263,10 +263,12 @@ impl Dynamics {
             return Ok(());
         }
         let n = model.dof();
+        // Bᵀ = L⁻¹ (row-scaled Φ_q, seated rows)ᵀ, filled column by column.
         let mut bt = DMatrix::zeros(n, rows);
-        let scaled = self.scaled_jacobian();
         for i in 0..model.constraint_rows {
-            bt.column_mut(i).copy_from(&scaled.row(i).transpose());
+            for j in 0..n {
+                bt[(j, i)] = self.row_scale[i] * self.kin.phi_q[(i, j)];
+            }
         }
         let mut bias = DVector::zeros(rows);
         bias.rows_mut(0, model.constraint_rows)
