@@ -2,32 +2,36 @@
 //! and their pivots switch (P⁺ ↔ P⁻). The configuration q is continuous; the body Jacobians change
 //! from J⁻ (pivots `before`) to J⁺ (pivots `after`), and q̇ jumps from q̇⁻ to q̇⁺.
 //!
-//! Three laws:
+//! Three laws (their derivation on chains: docs/simulation.md, "Impact laws on chains"):
 //! * [`momentum_law`], the generalized Housner law (the physical default): plastic impact at the
 //!   new pivots, M⁺ q̇⁺ = (J⁺)ᵀ 𝕄 J⁻ q̇⁻ + Φ_q⁺ᵀ Λ with Φ_q⁺ q̇⁺ = 0;
-//! * [`restitution_law`]: ψ̇_s⁺ = r_s ψ̇_s⁻ for each impacting slot, the impulse along a_s only;
-//! * [`dirac_law`], the paper's eq 5 integrated exactly, and its regularised form
-//!   [`dirac_regularised_force`] with [`regularised_delta`] for straight-through integration.
+//! * [`restitution_law`]: the momentum of every motion that leaves the impacting slots' rates
+//!   unchanged is conserved (from the bodies' real velocities, as in the momentum law), and the
+//!   impact mode keeps r² of its kinetic energy, with the slot rates in the ratio r ψ̇⁻;
+//! * [`dirac_law`], the paper's eq 5 integrated exactly (restitution with r^C), and its
+//!   regularised form [`dirac_regularised_force`] with [`regularised_delta`] for
+//!   straight-through integration.
 //!
 //! Loop closures are handled by the null-space method: q̇⁺ = N z with N an orthonormal basis of
 //! ker Φ_q⁺ (rank-revealing SVD of the row-scaled Φ_q, so redundant closures are harmless), and the
 //! balance of generalized momentum is projected on N (the closure impulses Φ_qᵀΛ drop out). This
 //! only needs M to be positive definite on the mechanism's velocities, so a body of negligible mass
-//! (a massless cap beam, γ → 0) does not make the system singular. The small projected systems are
-//! solved with [`crr_dynamics::linalg::pinv_solve`] and their rank is checked: a singular system is
-//! an [`ImpactError`], never a panic.
+//! (a massless cap beam, γ → 0) does not make the system singular. Slots whose rates the closures
+//! tie together (a trilithon's four hinges) form one impact mode: the laws are posed on the
+//! mechanism's velocities and are never over-determined. A singular system is an [`ImpactError`],
+//! never a panic.
 
 use crr_dynamics::eom::constraint_row_scale;
-use crr_dynamics::linalg::{JacobiSvd, cholesky_in_place, cholesky_solve, pinv_solve};
+use crr_dynamics::linalg::{
+    JacobiSvd, back_substitute_transposed, cholesky_in_place, cholesky_solve, forward_substitute,
+    pinv_solve,
+};
 use crr_kinematics::mass_matrix::world_inertia;
 use crr_kinematics::{
     ActivePivots, Data, InterfaceKind, Model, Role, constraint_jacobian, forward_kinematics,
     jacobians, mass_matrix,
 };
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
-
-/// Relative residual above which a solved impact system is reported as inconsistent.
-const RESIDUAL_TOLERANCE: f64 = 1e-8;
 
 /// The outcome of an impact map.
 #[derive(Clone, Debug, PartialEq)]
@@ -84,14 +88,6 @@ pub enum ImpactError {
         needed: usize,
         /// What the rank deficiency means.
         hint: &'static str,
-    },
-    /// The solved system does not satisfy its equations (inconsistent data).
-    #[error("{law}: the solution leaves a relative residual {residual:.3e}")]
-    Residual {
-        /// The law being evaluated.
-        law: &'static str,
-        /// Relative residual.
-        residual: f64,
     },
 }
 
@@ -182,62 +178,6 @@ fn null_space(phi: &DMatrix<f64>, scale: &DVector<f64>) -> DMatrix<f64> {
     JacobiSvd::new(&a).null_space()
 }
 
-/// Solves, for q̇ = N z and the impulses Π (one per column of `a`):
-/// Nᵀ M N z − Nᵀ A Π = Nᵀ b (momentum balance projected on the mechanism's velocities, the
-/// closure impulses Φ_qᵀΛ drop out) and Aᵀ N z = t (the prescribed slot rates).
-fn solve_projected(
-    law: &'static str,
-    chain: &Chain,
-    b: &DVector<f64>,
-    a: &DMatrix<f64>,
-    t: &DVector<f64>,
-) -> Result<DVector<f64>, ImpactError> {
-    let nn = &chain.null;
-    let d = nn.ncols();
-    let k = a.ncols();
-    let n = nn.nrows();
-    let mr = nn.transpose() * &chain.mass * nn;
-    // Balance the two blocks: Π is solved as μ Π' with μ a typical reduced inertia.
-    let mu = (0..d).map(|i| mr[(i, i)].abs()).fold(0.0, f64::max);
-    let mu = if mu > 0.0 && mu.is_finite() { mu } else { 1.0 };
-    let na = nn.transpose() * a;
-    let mut sys = DMatrix::zeros(d + k, d + k);
-    let mut rhs = DVector::zeros(d + k);
-    sys.view_mut((0, 0), (d, d)).copy_from(&mr);
-    sys.view_mut((0, d), (d, k)).copy_from(&(-&na * mu));
-    sys.view_mut((d, 0), (k, d))
-        .copy_from(&(na.transpose() * mu));
-    let ntb = nn.transpose() * b;
-    rhs.rows_mut(0, d).copy_from(&ntb);
-    rhs.rows_mut(d, k).copy_from(&(t * mu));
-    if d + k == 0 {
-        return Ok(DVector::zeros(n));
-    }
-    let (x, rank) = pinv_solve(&sys, &rhs);
-    if rank < d + k {
-        return Err(ImpactError::Singular {
-            law,
-            rank,
-            needed: d + k,
-            hint: if k == 0 {
-                "the mass matrix is not positive definite on the mechanism's velocities"
-            } else {
-                "the mass matrix is not positive definite on the mechanism's velocities, or an \
-                 impacting slot's rate is locked by the closures or depends on another's"
-            },
-        });
-    }
-    let res = (&sys * &x - &rhs).norm();
-    let size = rhs.norm().max(f64::MIN_POSITIVE) + (sys.norm() * x.norm());
-    if res.is_nan() || res > RESIDUAL_TOLERANCE * size {
-        return Err(ImpactError::Residual {
-            law,
-            residual: res / size,
-        });
-    }
-    Ok(nn * x.rows(0, d))
-}
-
 fn check_inputs(
     model: &Model,
     q: &DVector<f64>,
@@ -265,6 +205,19 @@ fn check_inputs(
         return Err(ImpactError::Invalid("q and q̇⁻ must be finite".to_string()));
     }
     Ok(())
+}
+
+/// The listed slots must be distinct: one slot cannot take two prescriptions.
+fn check_distinct(slots: impl Iterator<Item = usize>) -> Result<(), ImpactError> {
+    let mut seen: Vec<usize> = slots.collect();
+    seen.sort_unstable();
+    match seen.windows(2).find(|w| w[0] == w[1]) {
+        Some(w) => Err(ImpactError::Invalid(format!(
+            "slot {} is listed twice",
+            w[0]
+        ))),
+        None => Ok(()),
+    }
 }
 
 fn check_slot(model: &Model, slot: usize) -> Result<(), ImpactError> {
@@ -305,11 +258,31 @@ pub fn momentum_law(
     after: &ActivePivots,
 ) -> Result<ImpactResult, ImpactError> {
     check_inputs(model, q, qdot_minus, before, after)?;
+    let (minus, plus, momentum) = pre_impact_momentum(model, kin, q, qdot_minus, before, after);
+    let metric = Metric::new("momentum law", &plus)?;
+    let qdot = metric.qdot_of_w(&metric.w_of_momentum(&momentum));
+    Ok(ImpactResult {
+        kinetic_before: kinetic(&minus.mass, qdot_minus),
+        kinetic_after: kinetic(&plus.mass, &qdot),
+        qdot,
+    })
+}
+
+/// The momentum of the bodies' real motion before the impact, V⁻ = J⁻q̇⁻ (linear m ċ, angular
+/// I ω), as a generalized momentum of the `after` chain: (J⁺)ᵀ 𝕄 J⁻ q̇⁻. Evaluates both chains;
+/// `kin` is left evaluated for the `after` chain.
+fn pre_impact_momentum(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    qdot_minus: &DVector<f64>,
+    before: &ActivePivots,
+    after: &ActivePivots,
+) -> (Chain, Chain, DVector<f64>) {
     let minus = evaluate_chain(model, kin, q, before);
     let vc = &kin.com_jacobian * qdot_minus;
     let wv = &kin.angular_jacobian * qdot_minus;
     let plus = evaluate_chain(model, kin, q, after);
-    // Body momenta before the impact (linear m ċ, angular I ω), projected with (J⁺)ᵀ.
     let mut lin = DVector::zeros(vc.len());
     let mut ang = DVector::zeros(wv.len());
     for (bi, body) in model.bodies.iter().enumerate() {
@@ -320,26 +293,29 @@ pub fn momentum_law(
             ang[3 * bi + r] = w[r];
         }
     }
-    let b = kin.com_jacobian.tr_mul(&lin) + kin.angular_jacobian.tr_mul(&ang);
-    let qdot = solve_projected(
-        "momentum law",
-        &plus,
-        &b,
-        &DMatrix::zeros(model.dof(), 0),
-        &DVector::zeros(0),
-    )?;
-    Ok(ImpactResult {
-        kinetic_before: kinetic(&minus.mass, qdot_minus),
-        kinetic_after: kinetic(&plus.mass, &qdot),
-        qdot,
-    })
+    let momentum = kin.com_jacobian.tr_mul(&lin) + kin.angular_jacobian.tr_mul(&ang);
+    (minus, plus, momentum)
 }
 
-/// Classical restitution: for each impacting slot s with coefficient r_s, ψ̇_s⁺ = r_s ψ̇_s⁻
-/// (ψ̇ = aᵀq̇, [`slot_rate_direction`]); the generalized impulse acts only along the a_s:
-/// M⁺ (q̇⁺ − q̇⁻) = Σ a_s Π_s + Φ_q⁺ᵀ Λ with Φ_q⁺ q̇⁺ = 0, M⁺ the mass matrix of the `after` chain.
-/// Errors when the system for the Π_s is singular (a slot listed twice, or locked by the
-/// closures). `kin` is left evaluated for the `after` chain.
+/// Classical restitution on a chain: each impacting slot s with coefficient r_s has its rate
+/// multiplied by r_s, in the energy norm of the impact (docs/simulation.md, "Impact laws on
+/// chains"):
+///
+/// * the momentum conjugate to every motion of the `after` chain that leaves the impacting slots'
+///   rates unchanged is conserved, computed from the bodies' real velocities, J⁻q̇⁻ before and
+///   J⁺q̇⁺ after (as in [`momentum_law`]: the persisting hinges carry no moment about their
+///   axes);
+/// * the rest of the motion, the impact mode, has its slot rates ψ̇ = aᵀq̇
+///   ([`slot_rate_direction`]) set to r_s ψ̇_s⁻, scaled by the one factor that makes the mode's
+///   kinetic energy r² times its value before: E⁺ = r² E⁻. For one slot this is
+///   ψ̇⁺ = r √(κ⁺/κ⁻) ψ̇⁻ with κ = aᵀM⁻¹a (on the mechanism's velocities); κ⁺ = κ⁻ for one
+///   block and for symmetric mechanisms, where ψ̇⁺ = r ψ̇⁻ exactly.
+///
+/// Hence T⁻ − T⁺ = (1 − r²) E⁻ ≥ 0 for r ≤ 1, and r = 1 is an elastic pivot switch. In loops the
+/// law is posed on the mechanism's velocities (null space of Φ_q⁺), so slots tied by the closures
+/// (a trilithon's four hinges) are one impact mode, never an over-determined system. With
+/// different r_s in one simultaneous impact, E⁺ is the energy of the slot rates r_s ψ̇_s⁻ on the
+/// `before` chain, capped at r_max² E⁻. `kin` is left evaluated for the `after` chain.
 pub fn restitution_law(
     model: &Model,
     kin: &mut Data,
@@ -352,39 +328,34 @@ pub fn restitution_law(
     check_inputs(model, q, qdot_minus, before, after)?;
     for &(s, r) in slots {
         check_slot(model, s)?;
-        if !r.is_finite() {
+        if !(r.is_finite() && r >= 0.0) {
             return Err(ImpactError::Invalid(format!(
-                "restitution coefficient {r} of slot {s} is not finite"
+                "restitution coefficient {r} of slot {s} must be finite and ≥ 0"
             )));
         }
     }
-    let minus = evaluate_chain(model, kin, q, before);
-    let plus = evaluate_chain(model, kin, q, after);
-    let a = directions(model, kin, slots.iter().map(|x| x.0));
-    let rates = a.tr_mul(qdot_minus);
-    let t = DVector::from_iterator(
-        slots.len(),
-        slots.iter().zip(rates.iter()).map(|(s, v)| s.1 * v),
-    );
-    let b = &plus.mass * qdot_minus;
-    let qdot = solve_projected("restitution law", &plus, &b, &a, &t)?;
-    Ok(ImpactResult {
-        kinetic_before: kinetic(&minus.mass, qdot_minus),
-        kinetic_after: kinetic(&plus.mass, &qdot),
-        qdot,
-    })
+    check_distinct(slots.iter().map(|s| s.0))?;
+    rate_law(
+        "restitution law",
+        model,
+        kin,
+        q,
+        qdot_minus,
+        before,
+        after,
+        slots,
+    )
 }
 
 /// The paper's eq 5, F = C ln(r) ψ̇|ψ̇| δ(ψ) on each listed slot `(s, r, C)`, integrated exactly
-/// across ψ = 0: ψ̇_s is multiplied by r^C, the change distributed along M⁻¹a_s (C normalised by
-/// the effective inertia 1/(a_sᵀM⁻¹a_s), so that C = 1 gives r).
+/// across ψ = 0: ψ̇_s is multiplied by r^C (C normalised by the effective inertia 1/(aᵀM⁻¹a), so
+/// that C = 1 gives r and one block gives θ̇⁺ = r^C θ̇⁻ exactly).
 ///
-/// The δ straddles the pivot switch, so the map is the limit of a symmetric regularised δ: half
-/// the impulse (factor r^(C/2)) with the `before` chain's M⁻ and Φ_q⁻, then the pivot switch
-/// (q̇ unchanged), then the other half with the `after` chain's M⁺ and Φ_q⁺. On each side the
-/// impulse is projected with closure multipliers so that Φ_q q̇ = 0 holds there. Several slots
-/// impact simultaneously (their impulses are solved together). `kin` is left evaluated for the
-/// `after` chain.
+/// The δ straddles the pivot switch. The switch itself moves no momentum about the persisting
+/// hinges and, like the rest of the motion away from the δ, dissipates nothing (hypothesis 3:
+/// energy is lost only by the impulsive force); the force then takes the impact mode's rates
+/// by r^C. Both together are [`restitution_law`] with r_s^(C_s): T⁺ = T⁻ − (1 − r^(2C)) E⁻.
+/// `kin` is left evaluated for the `after` chain.
 pub fn dirac_law(
     model: &Model,
     kin: &mut Data,
@@ -403,32 +374,166 @@ pub fn dirac_law(
             )));
         }
     }
-    let half: Vec<f64> = slots.iter().map(|&(_, r, c)| r.powf(0.5 * c)).collect();
-    let targets = |a: &DMatrix<f64>, v: &DVector<f64>| {
-        DVector::from_iterator(
-            half.len(),
-            a.tr_mul(v).iter().zip(&half).map(|(x, f)| x * f),
-        )
-    };
-    let minus = evaluate_chain(model, kin, q, before);
+    check_distinct(slots.iter().map(|s| s.0))?;
+    let factors: Vec<(usize, f64)> = slots.iter().map(|&(s, r, c)| (s, r.powf(c))).collect();
+    rate_law(
+        "Dirac law",
+        model,
+        kin,
+        q,
+        qdot_minus,
+        before,
+        after,
+        &factors,
+    )
+}
+
+/// The kinetic metric of one chain on its mechanism's velocities: q̇ = N z, T = ½ zᵀ(NᵀMN)z
+/// = ½|w|² with w = Lᵀz, L the Cholesky factor of NᵀMN.
+struct Metric {
+    null: DMatrix<f64>,
+    chol: DMatrix<f64>,
+}
+
+impl Metric {
+    fn new(law: &'static str, chain: &Chain) -> Result<Self, ImpactError> {
+        let mut chol = chain.null.transpose() * &chain.mass * &chain.null;
+        let d = chol.nrows();
+        cholesky_in_place(&mut chol).map_err(|col| ImpactError::Singular {
+            law,
+            rank: col,
+            needed: d,
+            hint: "the mass matrix is not positive definite on the mechanism's velocities",
+        })?;
+        // cholesky_in_place leaves the strict upper triangle as it was: clear it, Lᵀ is used.
+        chol.fill_upper_triangle(0.0, 1);
+        Ok(Self {
+            null: chain.null.clone(),
+            chol,
+        })
+    }
+
+    /// w = Lᵀ Nᵀ q̇ for a velocity q̇ of this chain (Φ_q q̇ = 0).
+    fn w_of_qdot(&self, qdot: &DVector<f64>) -> DVector<f64> {
+        self.chol.tr_mul(&self.null.tr_mul(qdot))
+    }
+
+    /// w = L⁻¹ Nᵀ p for a generalized momentum p (the momentum's components along the
+    /// mechanism's motions, in the energy-normalised coordinates).
+    fn w_of_momentum(&self, p: &DVector<f64>) -> DVector<f64> {
+        let mut w = self.null.tr_mul(p);
+        forward_substitute(&self.chol, w.as_mut_slice());
+        w
+    }
+
+    /// q̇ = N L⁻ᵀ w.
+    fn qdot_of_w(&self, w: &DVector<f64>) -> DVector<f64> {
+        let mut z = w.clone();
+        back_substitute_transposed(&self.chol, z.as_mut_slice());
+        &self.null * z
+    }
+
+    /// C = L⁻¹ Nᵀ A, so that the slot rates are ψ̇ = Aᵀq̇ = Cᵀw.
+    fn slot_map(&self, a: &DMatrix<f64>) -> DMatrix<f64> {
+        let mut c = self.null.tr_mul(a);
+        for mut col in c.column_iter_mut() {
+            let mut v = col.clone_owned();
+            forward_substitute(&self.chol, v.as_mut_slice());
+            col.copy_from(&v);
+        }
+        c
+    }
+}
+
+/// Orthonormal basis of the range of C (d × k): the directions of w that change the slot rates
+/// (the impact modes). Its complement, ker Cᵀ, holds the motions that leave them unchanged.
+fn range_basis(c: &DMatrix<f64>) -> DMatrix<f64> {
+    if c.nrows() == 0 || c.ncols() == 0 {
+        return DMatrix::zeros(c.nrows(), 0);
+    }
+    let svd = JacobiSvd::new(c);
+    let tol = svd.tolerance();
+    let cols: Vec<DVector<f64>> = (0..svd.singular_values.len())
+        .filter(|&j| svd.singular_values[j] > tol)
+        .map(|j| svd.w.column(j) / svd.singular_values[j])
+        .collect();
+    if cols.is_empty() {
+        DMatrix::zeros(c.nrows(), 0)
+    } else {
+        DMatrix::from_columns(&cols)
+    }
+}
+
+/// y minimising |(CᵀQ) y − t| (CᵀQ has full column rank: Q spans the range of C).
+fn mode_coordinates(c: &DMatrix<f64>, basis: &DMatrix<f64>, t: &DVector<f64>) -> DVector<f64> {
+    if basis.ncols() == 0 {
+        return DVector::zeros(0);
+    }
+    pinv_solve(&(c.transpose() * basis), t).0
+}
+
+/// The restitution / exact Dirac map with a rate factor f_s per impacting slot (see
+/// [`restitution_law`]): conserve the momenta of the motions that leave the slot rates unchanged
+/// (from the bodies' real velocities), and give the impact mode the slot-rate direction
+/// f_s ψ̇_s⁻ with the energy of those rates on the `before` chain (capped at f_max² E⁻).
+fn rate_law(
+    law: &'static str,
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    qdot_minus: &DVector<f64>,
+    before: &ActivePivots,
+    after: &ActivePivots,
+    slots: &[(usize, f64)],
+) -> Result<ImpactResult, ImpactError> {
+    let (minus, plus, momentum) = pre_impact_momentum(model, kin, q, qdot_minus, before, after);
+    // The slot directions do not depend on the pivots (only on the Γ's).
     let a = directions(model, kin, slots.iter().map(|x| x.0));
-    let b = &minus.mass * qdot_minus;
-    let mid = solve_projected(
-        "Dirac law (before the switch)",
-        &minus,
-        &b,
-        &a,
-        &targets(&a, qdot_minus),
-    )?;
-    let plus = evaluate_chain(model, kin, q, after);
-    let b = &plus.mass * &mid;
-    let qdot = solve_projected(
-        "Dirac law (after the switch)",
-        &plus,
-        &b,
-        &a,
-        &targets(&a, &mid),
-    )?;
+    let rates = a.tr_mul(qdot_minus);
+    let targets = DVector::from_iterator(
+        slots.len(),
+        slots.iter().zip(rates.iter()).map(|(s, v)| s.1 * v),
+    );
+    let f_max = slots.iter().map(|s| s.1).fold(0.0, f64::max);
+
+    // Before: the impact mode's energy E⁻ and the energy of the target rates.
+    let metric_minus = Metric::new(law, &minus)?;
+    let c_minus = metric_minus.slot_map(&a);
+    let q_minus = range_basis(&c_minus);
+    let mode_energy = 0.5
+        * q_minus
+            .tr_mul(&metric_minus.w_of_qdot(qdot_minus))
+            .norm_squared();
+    let target_energy = (0.5 * mode_coordinates(&c_minus, &q_minus, &targets).norm_squared())
+        .min(f_max * f_max * mode_energy);
+
+    // After: keep the momentum along ker Cᵀ, set the impact mode.
+    let metric_plus = Metric::new(law, &plus)?;
+    let c_plus = metric_plus.slot_map(&a);
+    let q_plus = range_basis(&c_plus);
+    if q_plus.ncols() < q_minus.ncols() {
+        return Err(ImpactError::Singular {
+            law,
+            rank: q_plus.ncols(),
+            needed: q_minus.ncols(),
+            hint: "an impacting slot's rate is locked by the closures of the new chain",
+        });
+    }
+    let w_momentum = metric_plus.w_of_momentum(&momentum);
+    let y = mode_coordinates(&c_plus, &q_plus, &targets);
+    let y_energy = 0.5 * y.norm_squared();
+    let scale = if y_energy > 0.0 {
+        (target_energy / y_energy).sqrt()
+    } else {
+        0.0
+    };
+    let w = &w_momentum - &q_plus * q_plus.tr_mul(&w_momentum) + &q_plus * (y * scale);
+    let qdot = metric_plus.qdot_of_w(&w);
+    if !qdot.iter().all(|x| x.is_finite()) {
+        return Err(ImpactError::Invalid(format!(
+            "{law}: non-finite rates after the impact"
+        )));
+    }
     Ok(ImpactResult {
         kinetic_before: kinetic(&minus.mass, qdot_minus),
         kinetic_after: kinetic(&plus.mass, &qdot),

@@ -339,8 +339,10 @@ fn plastic_projection(
     (out, k)
 }
 
-/// Applies the impact laws of the impacting slots (momentum if any of their interfaces uses it;
-/// otherwise restitution and exact Dirac, regularised laws switching with continuous rates).
+/// Applies the impact laws of the impacting slots: the momentum law if any of their interfaces
+/// uses it; otherwise one rate law ([`restitution_law`]) with a factor per slot: r for
+/// restitution, r^C for the exact Dirac law, and 1 for a regularised Dirac law (an elastic pivot
+/// switch: its force does the dissipation on either side of the switch).
 fn apply_law(
     model: &Model,
     kin: &mut Data,
@@ -354,60 +356,30 @@ fn apply_law(
         .iter()
         .map(|&s| model.interfaces[slot_interface(model, s)].impact)
         .collect();
-    Ok(if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
-        momentum_law(model, kin, q, qdot, before, after)?
-    } else {
-        let rest: Vec<(usize, f64)> = impacting
-            .iter()
-            .zip(&laws)
-            .filter_map(|(&s, l)| {
-                if let ImpactLaw::Restitution(r) = l {
-                    Some((s, *r))
-                } else {
-                    None
-                }
-            })
-            .collect();
-        let dirac: Vec<(usize, f64, f64)> = impacting
-            .iter()
-            .zip(&laws)
-            .filter_map(|(&s, l)| {
-                if let ImpactLaw::Dirac { r, c } = l {
-                    Some((s, *r, *c))
-                } else {
-                    None
-                }
-            })
-            .collect();
-        // Regularised laws switch pivots with continuous rates (r = 1, the force does the rest).
-        let plain: Vec<(usize, f64)> = impacting
-            .iter()
-            .zip(&laws)
-            .filter_map(|(&s, l)| {
-                matches!(l, ImpactLaw::DiracRegularised { .. }).then_some((s, 1.0))
-            })
-            .collect();
-        // Only Dirac slots: the exact law splits its impulse across the switch (half with the
-        // old chain, half with the new one). Otherwise restitution (and plain switches) first.
-        if rest.is_empty() && plain.is_empty() {
-            return dirac_law(model, kin, q, qdot, before, after, &dirac);
-        }
-        let mut res = restitution_law(
-            model,
-            kin,
-            q,
-            qdot,
-            before,
-            after,
-            &[rest.as_slice(), plain.as_slice()].concat(),
-        )?;
-        if !dirac.is_empty() {
-            let t_before = res.kinetic_before;
-            res = dirac_law(model, kin, q, &res.qdot, after, after, &dirac)?;
-            res.kinetic_before = t_before;
-        }
-        res
-    })
+    if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
+        return momentum_law(model, kin, q, qdot, before, after);
+    }
+    if let Some(dirac) = laws
+        .iter()
+        .zip(impacting)
+        .map(|(l, &s)| match *l {
+            ImpactLaw::Dirac { r, c } => Some((s, r, c)),
+            _ => None,
+        })
+        .collect::<Option<Vec<_>>>()
+    {
+        return dirac_law(model, kin, q, qdot, before, after, &dirac);
+    }
+    let factors: Vec<(usize, f64)> = laws
+        .iter()
+        .zip(impacting)
+        .map(|(l, &s)| match *l {
+            ImpactLaw::Restitution(r) => (s, r),
+            ImpactLaw::Dirac { r, c } => (s, r.powf(c)),
+            _ => (s, 1.0),
+        })
+        .collect();
+    restitution_law(model, kin, q, qdot, before, after, &factors)
 }
 
 /// Finds the interfaces that open from a seated state at (t, q, q̇): releasing a seated slot on a

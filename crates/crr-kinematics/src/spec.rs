@@ -107,9 +107,12 @@ pub enum ImpactLaw {
     #[default]
     Momentum,
     /// Classical restitution: the impacting coordinate's rate is multiplied by `r` (a ratio of
-    /// angular velocities, 0 < r ≤ 1); all other generalized momenta are conserved.
+    /// angular velocities, 0 < r ≤ 1) in the energy norm of the impact mode (its kinetic energy
+    /// becomes r² times its value; exactly φ̇⁺ = r φ̇⁻ on one block); the momentum of every motion
+    /// that leaves the impacting rates unchanged is conserved, from the bodies' real velocities.
     Restitution(f64),
-    /// The paper's eq (5), F = C ln(r) φ̇|φ̇| δ(φ), integrated exactly across φ = 0.
+    /// The paper's eq (5), F = C ln(r) φ̇|φ̇| δ(φ), integrated exactly across φ = 0: restitution
+    /// with r^C (an elastic pivot switch, then the impulsive force).
     Dirac {
         /// Restitution-like ratio r of angular velocities, 0 < r ≤ 1.
         r: f64,
