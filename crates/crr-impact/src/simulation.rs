@@ -1105,11 +1105,22 @@ impl<'a> Simulation<'a> {
         let held: Vec<usize> = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
         // A rocking joint at φ ≈ 0 that the impact sends into its closed side impacts too (its
         // pivot switches): enlarge the impacting set until no joint penetrates.
-        let (after, result, mut qdot_after, mut kinetic_after) = loop {
+        let (after, q_new, result, mut qdot_after, mut kinetic_after) = loop {
             let mut after = before.clone();
             for &s in &impacting {
                 after.sides[s] = before.sides[s].flipped();
             }
+            // The impact happens at φ = 0: the located state is within the event tolerance of it
+            // (and a joint impacting with it within `simultaneity`). The laws act at φ = 0
+            // exactly, where the two chains place every body identically; at the located
+            // angle the pivot switch would move the bodies above by φ·|P⁺ − P⁻|.
+            let mut q_at = q.clone();
+            for &s in &impacting {
+                if s < model.dof() {
+                    q_at[s] = 0.0;
+                }
+            }
+            let q = q_at;
             let result = apply_law(model, &mut kin, &q, &qdot, &before, &after, &impacting)
                 .map_err(|source| SimulationError::Impact { t, source })?;
             // Joints that were seated stay seated through the impact: a plastic impulse on them
@@ -1136,7 +1147,7 @@ impl<'a> Simulation<'a> {
                 })
                 .collect();
             if wrong.is_empty() {
-                break (after, result, qd, k);
+                break (after, q, result, qd, k);
             }
             impacting.extend(wrong);
         };
@@ -1169,12 +1180,12 @@ impl<'a> Simulation<'a> {
                 &self.dynamics,
                 self.ground,
                 t,
-                &q,
+                &q_new,
                 &qdot_after,
                 &after,
                 &all,
             );
-            forward_kinematics(model, &mut kin, &q, &after);
+            forward_kinematics(model, &mut kin, &q_new, &after);
             crr_kinematics::velocities(model, &mut kin, &qdot_after);
             slot_rates(model, &kin, &qdot_after, &mut rates);
             pending = candidates
@@ -1221,13 +1232,6 @@ impl<'a> Simulation<'a> {
         }
         for &s in &to_seat {
             self.seated[s] = true;
-        }
-        // The impact happens at φ = 0: the located state is within the event tolerance of it.
-        let mut q_new = q.clone();
-        for &s in &impacting {
-            if s < model.dof() {
-                q_new[s] = 0.0;
-            }
         }
         self.dynamics.pivots = after;
         self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
