@@ -202,6 +202,17 @@ fn run(cli: Cli) -> Result<(), Failure> {
                             dir.display()
                         );
                     }
+                    let warnings = summary["warnings"].as_array().cloned().unwrap_or_default();
+                    for w in &warnings {
+                        eprintln!("crr: warning: {}", w.as_str().unwrap_or_default());
+                    }
+                    if !warnings.is_empty() {
+                        eprintln!(
+                            "crr: the run completed with {} warning(s), listed in {}",
+                            warnings.len(),
+                            dir.join("summary.json").display()
+                        );
+                    }
                 }
                 SimulateResult::Failed(dir, e) => {
                     return Err(Failure::Simulation(format!(

@@ -9,7 +9,9 @@ use serde_json::{Value, json};
 
 use crr_dynamics::ground_motion::{Axis, GroundMotion, RecordFormat, Units, read_record};
 use crr_dynamics::{AnalysisSpec, InitialState, solve_initial};
-use crr_impact::simulation::{Parameters, Simulation, SimulationError, StopReason, Trajectory};
+use crr_impact::simulation::{
+    ImpactRecord, Parameters, Simulation, SimulationError, StopReason, Trajectory,
+};
 use crr_kinematics::{InterfaceKind, Model};
 
 use crate::model_file::{InputError, ModelFile, load_model};
@@ -271,6 +273,26 @@ fn method_name(a: &AnalysisSpec) -> &'static str {
     }
 }
 
+/// What a user must know before trusting the results (`warnings` in summary.json, also printed
+/// on stderr by `crr simulate`).
+fn warnings(gains: &[&ImpactRecord]) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(worst) = gains
+        .iter()
+        .min_by(|a, b| a.energy_lost.total_cmp(&b.energy_lost))
+    {
+        out.push(format!(
+            "{} impact(s) raised the kinetic energy (the largest by {:.3e} J at t = {} s, {}); \
+             the impact laws never do so for r ≤ 1: the impact map failed numerically",
+            gains.len(),
+            -worst.energy_lost,
+            worst.t,
+            worst.interfaces.join(", ")
+        ));
+    }
+    out
+}
+
 /// The content of `summary.json`.
 pub fn summary(
     model_path: &Path,
@@ -299,6 +321,7 @@ pub fn summary(
     let pga = p.ground.pga();
     let duration = p.ground.duration();
     let initial = p.file.initial.clone().unwrap_or_default();
+    let gains: Vec<&ImpactRecord> = t.impacts.iter().filter(|i| i.energy_gain).collect();
     json!({
         "crr_version": env!("CARGO_PKG_VERSION"),
         "completed": error.is_none(),
@@ -347,6 +370,8 @@ pub fn summary(
         "coordinates": coordinates,
         "impacts": t.impacts.len(),
         "energy_lost_at_impacts": t.impacts.iter().map(|i| i.energy_lost).sum::<f64>(),
+        "impacts_with_energy_gain": gains.len(),
+        "warnings": warnings(&gains),
         "uplift_time": t.uplift_time,
         "collapse": {
             "collapsed": t.collapse.is_some(),
@@ -434,4 +459,32 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
         None => SimulateResult::Done(p.out, sum),
         Some(e) => SimulateResult::Failed(p.out, e),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(t: f64, lost: f64, gain: bool) -> ImpactRecord {
+        ImpactRecord {
+            t,
+            interfaces: vec!["base".into()],
+            slots: vec![0],
+            rates_before: vec![-1.0],
+            rates_after: vec![0.5],
+            energy_lost: lost,
+            energy_gain: gain,
+            seated: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn an_energy_gain_is_a_warning_naming_the_worst_impact() {
+        assert!(warnings(&[]).is_empty());
+        let (a, b) = (record(0.5, -2.0, true), record(1.5, -7.0, true));
+        let w = warnings(&[&a, &b]);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("2 impact(s) raised"), "{}", w[0]);
+        assert!(w[0].contains("7.000e0 J at t = 1.5 s, base"), "{}", w[0]);
+    }
 }

@@ -189,6 +189,8 @@ fn every_bundled_model_simulates_and_plots() {
         ("baldachin", "1"),
         ("drum_column", "0.3"),
         ("block_record", "3"),
+        ("trilithon_dirac", "1"),
+        ("arch_dirac", "0.5"),
     ] {
         let out = scratch(&format!("plot_all_{m}"));
         let o = crr(&[

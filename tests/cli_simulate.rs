@@ -212,6 +212,8 @@ fn bundled_models_write_the_three_files() {
         ("drum_column", "0.3"),
         ("block_record", "3"),
         ("baldachin", "1"),
+        ("trilithon_dirac", "2"),
+        ("arch_dirac", "0.5"),
     ] {
         let out = scratch(m);
         let s = simulate(

@@ -552,13 +552,21 @@ pub fn regularised_delta(x: f64, width: f64) -> f64 {
 }
 
 /// Generalized force of the regularised eq 5 for the listed slots `(s, r, C, ε)` at the current
-/// state: F = Σ_s a_s C ln(r) ψ̇_s|ψ̇_s| δ_ε(ψ_s) / (a_sᵀ M⁻¹ a_s), ψ̇_s = a_sᵀq̇, written into `out`
-/// (overwritten). `angles[s]` are the slot angles (q, then the closure angles). `kin` must hold
-/// the forward kinematics and M of the current chain. A slot outside its δ support costs nothing.
+/// state, written into `out` (overwritten):
+/// F = Σ_s a_s C ln(r) ψ̇_s|ψ̇_s| δ_ε(ψ_s) / D_s, ψ̇_s = a_sᵀq̇ ([`slot_rate_direction`]).
 ///
-/// Note: the normalisation uses the unconstrained M⁻¹; in a closed chain integrated with
-/// closure multipliers the crossing then multiplies ψ̇_s by r^(Cκ), κ = a_sᵀ P a_s / a_sᵀM⁻¹a_s ≤ 1
-/// (P the constrained inverse), whereas [`dirac_law`] imposes r^C.
+/// The normalisation D_s makes a crossing multiply the rate by r^C, as [`dirac_law`] does:
+/// with P the inverse of M on the mechanism's velocities (P = N(NᵀMN)⁻¹Nᵀ, N a basis of ker Φ_q;
+/// M⁻¹ on an open chain) the force gives ψ̈_s = aᵀPF, so a slot alone needs D_s = κ_s = a_sᵀPa_s.
+/// Slots whose rates the loops tie together (Nᵀa_t ∥ Nᵀa_s: a trilithon's four hinges, an arch's
+/// four joints) cross as one impact mode and each of their forces acts on the whole mode: D_s is
+/// the sum of κ_t over the slots tied to s, so that the mode's rate is multiplied by r^C in all
+/// (for tied slots with the same r and C). On an open chain no two slots are tied and D_s = κ_s
+/// = (M⁻¹)_ss.
+///
+/// `angles[s]` are the slot angles (q, then the closure angles). `kin` must hold the forward
+/// kinematics, M and (for loops) Φ_q of the current chain. Slots outside their δ support cost
+/// nothing.
 ///
 /// # Panics
 /// If a slot index is out of range of `angles` or of the model's slots.
@@ -571,30 +579,68 @@ pub fn dirac_regularised_force(
     out: &mut DVector<f64>,
 ) {
     out.fill(0.0);
-    let mut factor: Option<Option<DMatrix<f64>>> = None;
-    for &(s, r, c, width) in slots {
-        let d = regularised_delta(angles[s], width);
-        if d == 0.0 {
-            continue;
-        }
-        let a = slot_rate_direction(model, kin, s);
-        let rate = a.dot(qdot);
-        let l = factor.get_or_insert_with(|| {
-            let mut l = kin.mass_matrix.clone();
-            cholesky_in_place(&mut l).ok().map(|_| l)
-        });
-        let minv_a = match l {
-            Some(l) => {
-                let mut x = a.clone();
-                cholesky_solve(l, x.as_mut_slice());
-                x
-            }
-            None => pinv_solve(&kin.mass_matrix, &a).0,
-        };
-        let denom = a.dot(&minv_a);
-        if denom.is_nan() || denom <= 0.0 {
-            continue;
-        }
-        *out += a * (c * r.ln() * rate * rate.abs() * d / denom);
+    let active: Vec<(usize, f64)> = slots
+        .iter()
+        .enumerate()
+        .filter_map(|(i, z)| {
+            let d = regularised_delta(angles[z.0], z.3);
+            (d != 0.0).then_some((i, d))
+        })
+        .collect();
+    if active.is_empty() {
+        return;
     }
+    let Some(inverse) = mechanism_inverse(model, kin) else {
+        return;
+    };
+    let directions: Vec<DVector<f64>> = slots
+        .iter()
+        .map(|z| slot_rate_direction(model, kin, z.0))
+        .collect();
+    let p_dirs: Vec<DVector<f64>> = directions.iter().map(|a| &inverse * a).collect();
+    let kappa: Vec<f64> = directions
+        .iter()
+        .zip(&p_dirs)
+        .map(|(a, pa)| a.dot(pa))
+        .collect();
+    for (i, delta) in active {
+        let (_, r, c, _) = slots[i];
+        if !(kappa[i] > 0.0 && kappa[i].is_finite()) {
+            continue;
+        }
+        // Tied: |cos| = 1 in the metric P (Cauchy–Schwarz is strict otherwise).
+        let denom: f64 = (0..slots.len())
+            .filter(|&t| {
+                let k_st = directions[i].dot(&p_dirs[t]);
+                k_st * k_st >= (1.0 - TIE_TOLERANCE) * kappa[i] * kappa[t]
+            })
+            .map(|t| kappa[t])
+            .sum();
+        let rate = directions[i].dot(qdot);
+        *out += &directions[i] * (c * r.ln() * rate * rate.abs() * delta / denom);
+    }
+}
+
+/// Two slots count as tied by the loops when the cosine of their rate directions in the
+/// mechanism's metric is 1 within this (squared) tolerance.
+const TIE_TOLERANCE: f64 = 1e-9;
+
+/// P = N(NᵀMN)⁻¹Nᵀ, the inverse of M on the mechanism's velocities (M⁻¹ on an open chain), or
+/// None when M is not positive definite there.
+fn mechanism_inverse(model: &Model, kin: &Data) -> Option<DMatrix<f64>> {
+    let n = model.dof();
+    let null = if model.constraint_rows == 0 {
+        DMatrix::identity(n, n)
+    } else {
+        null_space(&kin.phi_q, &constraint_row_scale(model))
+    };
+    let mut l = null.transpose() * &kin.mass_matrix * &null;
+    cholesky_in_place(&mut l).ok()?;
+    let mut inv_nt = null.transpose();
+    for mut col in inv_nt.column_iter_mut() {
+        let mut v = col.clone_owned();
+        cholesky_solve(&l, v.as_mut_slice());
+        col.copy_from(&v);
+    }
+    Some(&null * inv_nt)
 }
