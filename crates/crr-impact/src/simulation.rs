@@ -428,40 +428,51 @@ pub fn opening_mode(
     if model.constraint_rows == 0 || seated.len() < 2 {
         return None;
     }
-    let mut released: Vec<(usize, Side)> = seated
+    // Active set over the seated slots released together: a slot closing on its side is tried
+    // once on the other side; closing on both, it stays seated (the tilts of a loop of rocking
+    // bases that the excitation does not drive: under x only, the y tilts). Whenever a slot
+    // goes back to its seat the mechanism changes, so the others get their second try again.
+    // Each return to a seat shrinks the set, and between two of them each slot flips at most
+    // once: the iteration ends within (|seated| + 1)² evaluations.
+    let mut released: Vec<(usize, Side, bool)> = seated
         .iter()
-        .map(|&s| (s, template.pivots.sides[s]))
+        .map(|&s| (s, template.pivots.sides[s], false))
         .collect();
-    for _ in 0..2 * seated.len() + 2 {
+    let bound = (seated.len() + 1) * (seated.len() + 1);
+    for _ in 0..bound {
         trial.seated = seated
             .iter()
             .copied()
             .filter(|s| !released.iter().any(|r| r.0 == *s))
             .collect();
         trial.pivots = template.pivots.clone();
-        for &(s, side) in &released {
+        for &(s, side, _) in &released {
             trial.pivots.sides[s] = side;
         }
         trial.accelerations(model, ground, t, q, qdot).ok()?;
-        let mut consistent = true;
-        let mut next = Vec::new();
-        for &(s, side) in &released {
+        let mut next = Vec::with_capacity(released.len());
+        let mut reseated = false;
+        for &(s, side, tried) in &released {
             let bias = slot_row(model, &trial.kin, s, &mut row);
             let a = row.dot(&trial.qddot) + bias;
             if side.sign() * a > tol {
-                next.push((s, side));
+                next.push((s, side, tried));
+            } else if !tried && a.abs() > tol {
+                next.push((s, side.flipped(), true));
             } else {
-                consistent = false;
-                if a.abs() > tol {
-                    next.push((s, side.flipped()));
-                }
+                reseated = true;
             }
         }
-        if consistent {
-            return (!released.is_empty()).then_some(released);
+        if next.len() == released.len() && next.iter().zip(&released).all(|(a, b)| a.1 == b.1) {
+            return Some(released.into_iter().map(|(s, side, _)| (s, side)).collect());
         }
         if next.is_empty() {
             return None;
+        }
+        if reseated {
+            for r in &mut next {
+                r.2 = false;
+            }
         }
         released = next;
     }
