@@ -62,6 +62,10 @@ enum Command {
         /// No progress indication.
         #[arg(long)]
         quiet: bool,
+        /// Replace the results of an earlier run in the output folder (by default such a folder
+        /// is left alone and the run refused).
+        #[arg(long)]
+        force: bool,
         /// Also draw coordinates, energy and phase plots (PNG and SVG) into the output folder.
         #[arg(long)]
         plot: bool,
@@ -168,6 +172,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             component,
             scale,
             quiet,
+            force,
             plot,
         } => {
             let opts = SimulateOptions {
@@ -175,6 +180,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
                 duration,
                 record: record_arg(record, format, units, &component, scale)?,
                 quiet,
+                force,
             };
             let result = simulate(&model, &opts)?;
             if plot {

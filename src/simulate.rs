@@ -34,7 +34,7 @@ pub struct RecordArg {
 /// Options of `crr simulate`.
 #[derive(Clone, Debug, Default)]
 pub struct SimulateOptions {
-    /// Output folder (default `results/<model name>`).
+    /// Output folder (default [`default_out_dir`] of the model's name).
     pub out: Option<PathBuf>,
     /// Duration (s), overriding `[analysis].duration`.
     pub duration: Option<f64>,
@@ -42,6 +42,71 @@ pub struct SimulateOptions {
     pub record: Option<RecordArg>,
     /// No progress indication.
     pub quiet: bool,
+    /// Replace the results of an earlier run in the output folder.
+    pub force: bool,
+}
+
+/// The files `crr simulate` writes, and those `--plot` adds: an earlier run's set is replaced
+/// whole (with `--force`), never mixed with a new one.
+const RESULT_FILES: [&str; 9] = [
+    "history.csv",
+    "impacts.csv",
+    "summary.json",
+    "coordinates.png",
+    "coordinates.svg",
+    "energy.png",
+    "energy.svg",
+    "phase.png",
+    "phase.svg",
+];
+
+/// The default output folder `results/<name>`: the model's name with every character outside
+/// `A–Z a–z 0–9 _ - .` replaced by `_` and leading dots too, so that a name can never lead out of
+/// `results/` (`..`, `/`, an absolute path) or hide the folder.
+pub fn default_out_dir(model_name: &str) -> PathBuf {
+    let mut name: String = model_name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let dots = name.len() - name.trim_start_matches('.').len();
+    name.replace_range(..dots, &"_".repeat(dots));
+    if name.is_empty() {
+        name.push_str("model");
+    }
+    Path::new("results").join(name)
+}
+
+/// An output folder that already holds results is only written to with `force`.
+fn check_out_dir(out: &Path, force: bool) -> Result<(), InputError> {
+    if !out.exists() {
+        return Ok(());
+    }
+    if !out.is_dir() {
+        return Err(InputError::Argument(format!(
+            "{}: the output path exists and is not a folder",
+            out.display()
+        )));
+    }
+    let earlier: Vec<&str> = RESULT_FILES
+        .iter()
+        .copied()
+        .filter(|f| out.join(f).exists())
+        .collect();
+    if earlier.is_empty() || force {
+        return Ok(());
+    }
+    Err(InputError::Argument(format!(
+        "{}: the folder holds the results of an earlier run ({}): pass --force to replace them, \
+         or --out DIR for another folder",
+        out.display(),
+        earlier.join(", ")
+    )))
 }
 
 /// Everything a run needs, read and checked from the inputs.
@@ -103,7 +168,8 @@ pub fn prepare(path: &Path, opts: &SimulateOptions) -> Result<Prepared, InputErr
     let out = opts
         .out
         .clone()
-        .unwrap_or_else(|| Path::new("results").join(&file.name));
+        .unwrap_or_else(|| default_out_dir(&file.name));
+    check_out_dir(&out, opts.force)?;
     Ok(Prepared {
         file,
         model,
@@ -389,12 +455,12 @@ pub fn summary(
     })
 }
 
-/// Writes the three files into `dir`: each to a hidden temporary name first, renamed at the end
-/// (summary.json last), so an interrupted run never leaves a set of files that looks complete.
+/// Writes the files into `dir`: each to a hidden temporary name first; only when all are written
+/// are the earlier run's files (data and plots) removed and the new ones renamed into place
+/// (summary.json last), so an interrupted run never leaves a set of files that looks complete
+/// and never mixes two runs.
 pub fn write_outputs(dir: &Path, files: &[(&str, String)]) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
-    // Remove an older summary first: the new set is complete only when it reappears.
-    let _ = std::fs::remove_file(dir.join("summary.json"));
     let mut temps = Vec::new();
     for (name, text) in files {
         let tmp = dir.join(format!(".{name}.partial"));
@@ -402,6 +468,12 @@ pub fn write_outputs(dir: &Path, files: &[(&str, String)]) -> std::io::Result<()
         f.write_all(text.as_bytes())?;
         f.sync_all()?;
         temps.push((tmp, dir.join(name)));
+    }
+    for stale in RESULT_FILES {
+        match std::fs::remove_file(dir.join(stale)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
+            _ => {}
+        }
     }
     for (tmp, dst) in temps {
         std::fs::rename(tmp, dst)?;
