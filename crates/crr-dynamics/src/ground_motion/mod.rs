@@ -403,6 +403,39 @@ impl GroundMotion {
             .fold(0.0, f64::max)
     }
 
+    /// The warnings of the records read (e.g. extra values ignored), each prefixed with its
+    /// component.
+    pub fn record_warnings(&self) -> Vec<String> {
+        Axis::ALL
+            .iter()
+            .filter_map(|&axis| match &self.components[axis.index()] {
+                Some(Component {
+                    signal: Signal::Record(r),
+                    ..
+                }) => Some((axis, r)),
+                _ => None,
+            })
+            .flat_map(|(axis, r)| {
+                r.warnings()
+                    .iter()
+                    .map(move |w| format!("ground motion {}: {w}", axis.name()))
+            })
+            .collect()
+    }
+
+    /// The shortest sample interval of the records (s), or None without a uniformly sampled
+    /// record.
+    pub fn record_sample_interval(&self) -> Option<f64> {
+        self.components
+            .iter()
+            .flatten()
+            .filter_map(|c| match &c.signal {
+                Signal::Record(r) => r.dt(),
+                _ => None,
+            })
+            .reduce(f64::min)
+    }
+
     /// Peak ground acceleration per component, m/s² (|scale| applied): exact for the
     /// analytic signals, the largest |sample| for records.
     pub fn pga(&self) -> Vector3<f64> {

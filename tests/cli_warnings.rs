@@ -1,0 +1,169 @@
+//! Runs whose results cannot be fully trusted say so: `warnings` in summary.json, each printed on
+//! stderr, and a last line counting them. The bundled models run clean.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn crr(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("crr runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("warnings_{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `model_text` (written into a scratch folder) and returns (summary, stderr).
+fn run(tag: &str, model_text: &str, extra: &[&str]) -> (serde_json::Value, String) {
+    let dir = scratch(tag);
+    let model = dir.join("model.toml");
+    std::fs::write(&model, model_text).unwrap();
+    let out = dir.join("out");
+    let mut args = vec![
+        "simulate",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = crr(&args);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "{tag}: {err}");
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    (serde_json::from_str(&summary).unwrap(), err)
+}
+
+fn single_block_with(analysis: &str) -> String {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml"),
+    )
+    .unwrap();
+    let cut = text.find("[analysis]").unwrap_or(text.len());
+    format!("{}[analysis]\n{analysis}\n", &text[..cut])
+}
+
+fn warnings(summary: &serde_json::Value) -> Vec<String> {
+    summary["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap().to_string())
+        .collect()
+}
+
+/// Every warning is on stderr and the last line counts them.
+fn assert_reported(tag: &str, summary: &serde_json::Value, stderr: &str) {
+    let w = warnings(summary);
+    assert!(!w.is_empty(), "{tag}: no warning");
+    for x in &w {
+        assert!(
+            stderr.contains(&format!("crr: warning: {x}")),
+            "{tag}: {stderr}"
+        );
+    }
+    let last = stderr.lines().last().unwrap();
+    assert!(
+        last.starts_with(&format!(
+            "crr: the run completed with {} warning(s)",
+            w.len()
+        )),
+        "{tag}: {last}"
+    );
+}
+
+#[test]
+fn a_long_rk4_step_breaks_the_energy_balance_and_says_so() {
+    let (s, err) = run(
+        "rk4",
+        &single_block_with("duration = 5.0\nmethod = \"rk4\"\nrk4_step = 10.0"),
+        &["--quiet"],
+    );
+    assert_reported("rk4", &s, &err);
+    let w = warnings(&s);
+    assert!(
+        w.iter()
+            .any(|x| x.starts_with("rk4_step = 1e1 s is longer")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter().any(|x| x.starts_with("the energy balance is off")),
+        "{w:?}"
+    );
+}
+
+#[test]
+fn a_simultaneity_as_large_as_the_angles_is_a_warning() {
+    let (s, err) = run(
+        "simultaneity",
+        &single_block_with("duration = 2.0\nsimultaneity = 1e300"),
+        &["--quiet"],
+    );
+    assert_reported("simultaneity", &s, &err);
+    assert!(warnings(&s)[0].starts_with("simultaneity = 1e300 rad"));
+}
+
+#[test]
+fn extra_values_in_a_record_are_a_warning() {
+    let dir = scratch("record_file");
+    let at2 = dir.join("extra.AT2");
+    // NPTS = 4 but 5 values: the fifth is ignored, and the run says so.
+    std::fs::write(
+        &at2,
+        "TEST\nTEST\nACCELERATION IN G\nNPTS=    4, DT= .0100 SEC\n 0.0 0.1 0.2 0.1 0.3\n",
+    )
+    .unwrap();
+    let (s, err) = run(
+        "record",
+        &single_block_with("duration = 0.5"),
+        &[
+            "--quiet",
+            "--record",
+            at2.to_str().unwrap(),
+            "--format",
+            "peer-at2",
+        ],
+    );
+    assert_reported("record", &s, &err);
+    assert!(
+        warnings(&s)
+            .iter()
+            .any(|x| x.starts_with("ground motion x:")),
+        "{s}"
+    );
+}
+
+#[test]
+fn the_bundled_models_run_without_warnings() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    names.sort();
+    for model in names {
+        let stem = model.file_stem().unwrap().to_str().unwrap().to_string();
+        let out = scratch(&format!("bundled_{stem}"));
+        let o = crr(&[
+            "simulate",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+            "--force",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stem}: {err}");
+        let s: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert!(warnings(&s).is_empty(), "{stem}: {s}");
+        assert!(!err.contains("warning"), "{stem}: {err}");
+    }
+}
