@@ -11,6 +11,7 @@ use crr_dynamics::ground_motion::{Axis, GroundMotion, RecordFormat, Units, read_
 use crr_dynamics::{AnalysisSpec, InitialState, solve_initial};
 use crr_impact::simulation::{
     ImpactRecord, Parameters, Simulation, SimulationError, StopReason, Trajectory,
+    check_initial_state,
 };
 use crr_kinematics::{InterfaceKind, Model};
 
@@ -154,6 +155,7 @@ pub fn prepare(path: &Path, opts: &SimulateOptions) -> Result<Prepared, InputErr
     }
     let initial_spec = file.initial.clone().unwrap_or_default();
     let initial = solve_initial(&model, &initial_spec).map_err(|e| here(e.to_string()))?;
+    check_initial_state(&model, &initial).map_err(here)?;
     let analysis = file.analysis.clone().unwrap_or_default();
     let mut params =
         Parameters::from_analysis(&analysis, default_duration(&ground)).map_err(here)?;
@@ -340,7 +342,8 @@ fn method_name(a: &AnalysisSpec) -> &'static str {
 }
 
 /// A run's energy balance T + U − W + D − E(0) larger than this fraction of its energy scale
-/// (the largest of T, |U|, |W| and D over the samples) is a warning.
+/// (the largest of T, |U|, |W| and D over the samples), and than the round-off 1e-9 W L, is a
+/// warning.
 pub const ENERGY_BALANCE_WARNING: f64 = 1e-3;
 
 /// An RK4 step longer than this fraction of the structure's time scale √(L/g) (L the model size)
@@ -377,7 +380,9 @@ fn warnings(p: &Prepared, t: &Trajectory, gains: &[&ImpactRecord]) -> Vec<String
                 .max(s.dissipated)
         })
         .fold(0.0, f64::max);
-    if scale > 0.0 && t.energy_balance_error > ENERGY_BALANCE_WARNING * scale {
+    // Below 1e-9 W L (W the weight, L the model size) an error is round-off of the energies.
+    let round_off = 1e-9 * p.model.total_mass() * p.model.gravity * p.model.size;
+    if t.energy_balance_error > (ENERGY_BALANCE_WARNING * scale).max(round_off) {
         out.push(format!(
             "the energy balance is off by {:.3e} J, {:.2} % of the run's energy scale {:.3e} J \
              (more than {} %): tighten rtol/atol or shorten the step",

@@ -30,8 +30,8 @@ use crr_dynamics::integrator::{
 use crr_dynamics::{ConstrainedSystem, InitialState};
 use crr_kinematics::spec::ImpactLaw;
 use crr_kinematics::{
-    ActivePivots, Data, Model, Side, closure_angles, forward_kinematics, mass_matrix,
-    potential_energy,
+    ActivePivots, Data, InterfaceKind, Model, Side, closure_angles, forward_kinematics,
+    mass_matrix, potential_energy,
 };
 
 use crate::laws::{ImpactError, dirac_law, dirac_regularised_force, momentum_law, restitution_law};
@@ -271,6 +271,54 @@ impl GeneralizedForce for Regularised {
         let mut f = DVector::zeros(n);
         dirac_regularised_force(model, kin, qdot, &self.angles, &self.slots, &mut f);
         *out += f;
+    }
+}
+
+/// Checks that an initial state can be simulated: finite, and no rocking joint turned beyond
+/// ±π/2 (its body would be through its support). The message names the joint.
+pub fn check_initial_state(model: &Model, initial: &InitialState) -> Result<(), String> {
+    let mut kin = Data::new(model);
+    let mut angles = vec![0.0; model.slot_count];
+    slot_angles(model, &mut kin, &initial.q, &initial.pivots, &mut angles);
+    crr_kinematics::velocities(model, &mut kin, &initial.qdot);
+    let mut rates = vec![0.0; model.slot_count];
+    slot_rates(model, &kin, &initial.qdot, &mut rates);
+    for s in 0..model.slot_count {
+        let iface = &model.interfaces[slot_interface(model, s)];
+        if !(angles[s].is_finite() && rates[s].is_finite()) {
+            return Err(format!(
+                "the initial state of {} is not finite (angle {:e} rad, rate {:e} rad/s)",
+                iface.name, angles[s], rates[s]
+            ));
+        }
+        if is_contact(&iface.kind) && angles[s].abs() >= 0.5 * std::f64::consts::PI {
+            return Err(format!(
+                "the initial angle of {} is {:e} rad: a rocking joint turned beyond ±π/2 puts \
+                 its body through its support",
+                iface.name, angles[s]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The impact event of a rocking slot is g = sign(side)·φ + this margin (rad), falling through 0.
+/// A slot that starts a segment at φ = 0 exactly (just released, or just impacted) then starts
+/// with g > 0 rather than at its root: the integrator takes the sign of a function that starts at
+/// its root from its first values, so a joint released by a pulse too short to open it, sinking
+/// back through its seat, would never have fired and would have rocked through its support. The
+/// impact is located 1e-13 rad past φ = 0 (1e-12 s at 0.1 rad/s), and the impact sets φ = 0.
+const ROCKING_EVENT_MARGIN: f64 = 10.0 * crr_dynamics::integrator::EVENT_ZERO_TOL;
+
+/// A joint with two distinct pivots (a rocking contact), as opposed to a plain hinge.
+fn is_contact(kind: &InterfaceKind) -> bool {
+    match kind {
+        InterfaceKind::Hinge {
+            axis,
+            pivot_positive,
+            pivot_negative,
+        } => (pivot_positive - pivot_negative).cross(axis).norm() > 0.0,
+        InterfaceKind::RockingBase { .. } => true,
     }
 }
 
@@ -525,8 +573,8 @@ impl EventFunctions for SegmentEvents<'_> {
             &self.pivots,
             &mut self.angles,
         );
-        for (i, &(s, _)) in self.rocking.iter().enumerate() {
-            g[i] = self.angles[s];
+        for (i, &(s, side)) in self.rocking.iter().enumerate() {
+            g[i] = side.sign() * self.angles[s] + ROCKING_EVENT_MARGIN;
         }
         let ci = self.collapse_index();
         g[ci] = if self.rocking.is_empty() {
@@ -548,12 +596,8 @@ impl EventFunctions for SegmentEvents<'_> {
     }
 
     fn direction(&self, i: usize) -> Direction {
-        if i < self.rocking.len() {
-            match self.rocking[i].1 {
-                Side::Positive => Direction::Falling,
-                Side::Negative => Direction::Rising,
-            }
-        } else if i == self.collapse_index() {
+        // Impacts (sign(side)·φ + margin) and collapse (U past its threshold) fall through 0.
+        if i < self.rocking.len() || i == self.collapse_index() {
             Direction::Falling
         } else if self.uplift.is_some() && i == self.uplift_index() {
             Direction::Rising
@@ -634,6 +678,7 @@ impl<'a> Simulation<'a> {
         crr_kinematics::velocities(model, &mut kin, &initial.qdot);
         let mut rates = vec![0.0; model.slot_count];
         slot_rates(model, &kin, &initial.qdot, &mut rates);
+        check_initial_state(model, initial).map_err(SimulationError::Parameter)?;
         let tiny = 1e-14;
         let mut seated = vec![false; model.slot_count];
         for s in 0..model.slot_count {
@@ -689,8 +734,19 @@ impl<'a> Simulation<'a> {
         };
         let first = sim.sample_at(0.0, &sim.y.clone());
         sim.energy_start = first.kinetic + first.potential;
+        // Released beyond the point of no return (its potential energy already below the rest
+        // level by the collapse margin, e.g. a block tilted past 2α): collapsed at t = 0. The
+        // event only sees U falling through the threshold, which such a start never does.
+        let energy_scale = model.total_mass() * model.gravity * model.size;
+        let collapsed = first.potential < -sim.params.collapse_drop * energy_scale;
         sim.samples.push(first);
         sim.next_sample = 1;
+        if collapsed {
+            let c = sim.collapse_record();
+            sim.collapse = Some(c);
+            sim.finished = true;
+            return Ok(sim);
+        }
         // A seated structure that cannot hold at t = 0 uplifts at once.
         sim.release_if_opening()?;
         Ok(sim)
