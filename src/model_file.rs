@@ -117,10 +117,12 @@ pub fn parse_model_file(path: &Path, text: &str) -> Result<ModelFile, InputError
 /// Reads, parses and validates a model file (the structure; the other tables are checked where
 /// they are used).
 pub fn load_model(path: &Path) -> Result<(ModelFile, Model), InputError> {
-    let text = std::fs::read_to_string(path).map_err(|source| InputError::Io {
-        file: path.to_path_buf(),
-        source,
-    })?;
+    let limit = crr_dynamics::input::MODEL_FILE_LIMIT;
+    let text =
+        crr_dynamics::input::read_regular_text(path, limit).map_err(|source| InputError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
     let file = parse_model_file(path, &text)?;
     let model = Model::from_spec(&file.structure()).map_err(|source| InputError::Model {
         file: path.to_path_buf(),

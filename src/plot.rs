@@ -123,10 +123,12 @@ pub struct Results {
 }
 
 fn read_text(file: &Path) -> Result<String, PlotError> {
-    std::fs::read_to_string(file).map_err(|e| PlotError::Read {
-        file: file.to_path_buf(),
-        message: format!("cannot read the file: {e}"),
-    })
+    crr_dynamics::input::read_regular_text(file, crr_dynamics::input::DATA_FILE_LIMIT).map_err(
+        |e| PlotError::Read {
+            file: file.to_path_buf(),
+            message: format!("cannot read the file: {e}"),
+        },
+    )
 }
 
 /// p and α of a one-coordinate model (a single block on a hinge with two pivot lines) rebuilt
@@ -233,15 +235,20 @@ pub fn read_results(dir: &Path) -> Result<Results, PlotError> {
             fields
                 .get(c)
                 .and_then(|f| f.trim().parse::<f64>().ok())
+                .filter(|v| v.is_finite())
                 .ok_or_else(|| {
                     bad(format!(
-                        "line {}: column `{}` is not a number",
+                        "line {}: column `{}` is not a finite number",
                         row + 2,
                         header[c]
                     ))
                 })
         };
-        r.t.push(value(t_col)?);
+        let t = value(t_col)?;
+        if r.t.last().is_some_and(|&last| t < last) {
+            return Err(bad(format!("line {}: time {t} goes backwards", row + 2)));
+        }
+        r.t.push(t);
         for k in 0..n {
             r.q[k].push(value(q_cols[k])?);
             r.qdot[k].push(value(rate_cols[k])?);
@@ -250,6 +257,10 @@ pub fn read_results(dir: &Path) -> Result<Results, PlotError> {
         r.potential.push(value(energy_cols[1])?);
         r.work_in.push(value(energy_cols[2])?);
         r.dissipated.push(value(energy_cols[3])?);
+    }
+
+    if r.t.is_empty() {
+        return Err(bad("no data rows after the header".into()));
     }
 
     let impacts_file = dir.join("impacts.csv");

@@ -12,6 +12,7 @@ pub mod closed_chain;
 pub mod energy;
 pub mod eom;
 pub mod ground_motion;
+pub mod input;
 pub mod integrator;
 pub mod linalg;
 pub mod mechanism;

@@ -287,7 +287,7 @@ impl TableOptions {
 }
 
 fn read_text(path: &Path) -> Result<String, GroundMotionError> {
-    match std::fs::read(path) {
+    match crate::input::read_regular_file(path, crate::input::DATA_FILE_LIMIT) {
         Ok(bytes) => Ok(String::from_utf8_lossy(&bytes).into_owned()),
         Err(error) => Err(GroundMotionError::Io {
             path: path.display().to_string(),
@@ -463,7 +463,9 @@ fn at2_header(lines: &[&str], source: &str) -> Result<(usize, usize, f64), Groun
 pub fn parse_at2(text: &str, source: &str) -> Result<Record, GroundMotionError> {
     let lines: Vec<&str> = text.lines().collect();
     let (header, npts, dt) = at2_header(&lines, source)?;
-    let mut values = Vec::with_capacity(npts);
+    // Each value takes at least two characters (a digit and a separator): a header's NPTS larger
+    // than the text can hold is caught below without allocating for it.
+    let mut values = Vec::with_capacity(npts.min(text.len() / 2 + 1));
     let mut extra = 0usize;
     let mut extra_line = 0usize;
     for (idx, line) in lines.iter().enumerate().skip(header + 1) {
