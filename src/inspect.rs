@@ -109,6 +109,7 @@ fn mat3(m: &nalgebra::Matrix3<f64>) -> [[f64; 3]; 3] {
 /// Parses `NAME=VALUE` settings of coordinates (rad) into q; other coordinates are 0.
 pub fn configuration(model: &Model, settings: &[String]) -> Result<DVector<f64>, InputError> {
     let mut q = DVector::zeros(model.dof());
+    let mut given = vec![false; model.dof()];
     for s in settings {
         let (name, value) = s.split_once('=').ok_or_else(|| {
             InputError::Argument(format!("--q {s}: expected NAME=VALUE (radians)"))
@@ -132,6 +133,12 @@ pub fn configuration(model: &Model, settings: &[String]) -> Result<DVector<f64>,
                     value.trim()
                 ))
             })?;
+        if std::mem::replace(&mut given[k], true) {
+            return Err(InputError::Argument(format!(
+                "--q {s}: the coordinate \"{}\" is given twice",
+                name.trim()
+            )));
+        }
         q[k] = v;
     }
     Ok(q)

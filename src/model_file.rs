@@ -108,10 +108,86 @@ pub fn parse_model_file(path: &Path, text: &str) -> Result<ModelFile, InputError
     } else {
         toml::from_str(text).map_err(|e| e.to_string().trim_end().to_string())
     };
-    parsed.map_err(|message| InputError::Parse {
+    let file: ModelFile = parsed.map_err(|message| InputError::Parse {
         file: path.to_path_buf(),
         message,
-    })
+    })?;
+    // The typed reading takes the first N values of a longer array and drops the rest: check
+    // the lengths on the generic tree.
+    let tree: Result<serde_json::Value, String> = if is_json {
+        serde_json::from_str(text).map_err(|e| e.to_string())
+    } else {
+        toml::from_str(text).map_err(|e| e.to_string())
+    };
+    if let Ok(tree) = tree
+        && let Some(message) = array_length_error(&tree, "")
+    {
+        return Err(InputError::Parse {
+            file: path.to_path_buf(),
+            message,
+        });
+    }
+    Ok(file)
+}
+
+/// Keys whose value is a point or vector (3 numbers), or a list of them.
+const VECTOR_KEYS: [&str; 11] = [
+    "center",
+    "size",
+    "rotation",
+    "extrude",
+    "axis",
+    "start",
+    "pivot_positive",
+    "pivot_negative",
+    "corners",
+    "vertices",
+    "polygon",
+];
+
+/// The first array of the wrong length in the model tree: a vector of `VECTOR_KEYS` must have
+/// 3 numbers (a pivot may also be a segment of two points), a symmetry's `coordinates` 2 names.
+/// The message gives the item's path (e.g. `body[0].box.size`).
+fn array_length_error(v: &serde_json::Value, at: &str) -> Option<String> {
+    use serde_json::Value;
+    let is_vector = |x: &Value| x.as_array().is_some_and(|a| a.iter().all(Value::is_number));
+    let bad = |what: &str, n: usize, expected: &str| {
+        Some(format!("{what} has {n} values, {expected} expected"))
+    };
+    match v {
+        Value::Object(map) => map.iter().find_map(|(k, x)| {
+            let here = if at.is_empty() {
+                k.clone()
+            } else {
+                format!("{at}.{k}")
+            };
+            let items = x.as_array();
+            match (k.as_str(), items) {
+                ("coordinates", Some(a)) if at.starts_with("symmetry") && a.len() != 2 => {
+                    bad(&here, a.len(), "2")
+                }
+                (key, Some(a)) if VECTOR_KEYS.contains(&key) => {
+                    if is_vector(x) {
+                        (a.len() != 3).then(|| bad(&here, a.len(), "3")).flatten()
+                    } else {
+                        // A list of points (corners, a pivot segment): each of 3 numbers.
+                        a.iter().enumerate().find_map(|(i, p)| match p.as_array() {
+                            Some(pa) if pa.len() != 3 => {
+                                bad(&format!("{here}[{i}]"), pa.len(), "3")
+                            }
+                            _ => None,
+                        })
+                    }
+                }
+                _ => array_length_error(x, &here),
+            }
+        }),
+        Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(i, x)| array_length_error(x, &format!("{at}[{i}]"))),
+        _ => None,
+    }
 }
 
 /// Reads, parses and validates a model file (the structure; the other tables are checked where

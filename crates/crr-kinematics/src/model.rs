@@ -266,6 +266,19 @@ fn finite3(v: &[f64; 3], item: &str, field: &str) -> Result<Vector3<f64>, ModelE
     }
 }
 
+/// A pivot farther from its child's centre than this many times the child's size (the cube root
+/// of its volume) is refused.
+const PIVOT_REACH: f64 = 100.0;
+
+/// Why a body or interface name cannot be used: it becomes a column of the CSV outputs
+/// (`base`, `base_rate`, `base_state`) and an entry of their `;`-joined lists, so separators,
+/// quotes and control characters would break them.
+fn unusable_name(name: &str) -> Option<&'static str> {
+    name.chars()
+        .any(|c| c.is_control() || matches!(c, ',' | ';' | '"'))
+        .then_some("the name holds a comma, a semicolon, a quote or a control character (a line break, a tab), which the CSV outputs cannot carry")
+}
+
 fn quoted(kind: &str, name: &str) -> String {
     format!("{kind} \"{name}\"")
 }
@@ -531,6 +544,9 @@ impl Model {
                     "has an empty name",
                 ));
             }
+            if let Some(why) = unusable_name(&b.name) {
+                return Err(ModelError::new(quoted("body", &b.name), why));
+            }
             if b.name == "ground" {
                 return Err(ModelError::new(
                     quoted("body", &b.name),
@@ -579,6 +595,9 @@ impl Model {
                     "has an empty name",
                 ));
             }
+            if let Some(why) = unusable_name(&i.name) {
+                return Err(ModelError::new(item, why));
+            }
             if names.insert(i.name.clone(), k).is_some() {
                 return Err(ModelError::new(item, "the name is used by two interfaces"));
             }
@@ -611,6 +630,36 @@ impl Model {
                 ));
             }
             let child_com = bodies[child].com;
+            // A contact lies on the child: a pivot far outside it is a typing or unit mistake
+            // (millimetres for metres). 100 times the child's size leaves room for any real
+            // joint and catches those.
+            let reach = PIVOT_REACH * bodies[child].volume.cbrt();
+            let given: Vec<[f64; 3]> = match (&i.rocking_base, &i.pivot_positive, &i.pivot_negative)
+            {
+                (Some(rb), _, _) => rb.corners.clone(),
+                (None, p, n) => [p, n]
+                    .into_iter()
+                    .flatten()
+                    .flat_map(|x| match x {
+                        PivotSpec::Point(a) => vec![*a],
+                        PivotSpec::Segment(s) => s.to_vec(),
+                    })
+                    .collect(),
+            };
+            if let Some(far) = given
+                .iter()
+                .map(|x| (Vector3::from(*x) - child_com).norm())
+                .find(|d| *d > reach)
+            {
+                return Err(ModelError::new(
+                    item,
+                    format!(
+                        "a pivot lies {far:.4e} m from the centre of body \"{}\", more than {PIVOT_REACH} times its size ({:.4e} m): pivots must lie on the child (check the units: metres)",
+                        i.child,
+                        bodies[child].volume.cbrt()
+                    ),
+                ));
+            }
             let kind = match &i.rocking_base {
                 Some(rb) => {
                     if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some()
