@@ -147,3 +147,16 @@ fn a_coordinate_given_twice_is_refused() {
         "the coordinate \"base\" is given twice",
     );
 }
+
+#[test]
+fn sizes_that_overflow_the_mass_properties_are_named_as_such() {
+    let block = bundled("single_block");
+    let p = write(
+        "huge.toml",
+        &block.replace("size = [0.4, 0.4, 2.0]", "size = [1e200, 1e200, 1e200]"),
+    );
+    refused(
+        &["inspect", p.to_str().unwrap()],
+        "body \"block\": its mass properties are not finite",
+    );
+}

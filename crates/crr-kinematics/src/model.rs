@@ -343,7 +343,7 @@ fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
             ));
         }
     };
-    Ok(Body {
+    let body = Body {
         name: spec.name.clone(),
         mass: density * props.volume,
         density,
@@ -352,7 +352,25 @@ fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
         inertia: props.inertia(density),
         second_moment: props.second_moment * density,
         shape,
-    })
+    };
+    // Sizes or densities far outside engineering ranges overflow (or underflow) the mass
+    // properties; say so here rather than let a later check misread the infinities.
+    let finite = body.mass.is_finite()
+        && body.mass > 0.0
+        && body.com.iter().all(|x| x.is_finite())
+        && body.inertia.iter().all(|x| x.is_finite())
+        && body.second_moment.iter().all(|x| x.is_finite());
+    if !finite {
+        return Err(ModelError::new(
+            item,
+            format!(
+                "its mass properties are not finite numbers (volume {:e} m³, mass {:e} kg): \
+                 the sizes or the density are out of range (check the units: metres, kg/m³)",
+                body.volume, body.mass
+            ),
+        ));
+    }
+    Ok(body)
 }
 
 /// A pivot given as a point or an edge: returns a point on the line, checking an edge is parallel
