@@ -10,7 +10,7 @@ use serde_json::{Value, json};
 use crr_dynamics::ground_motion::{Axis, GroundMotion, RecordFormat, Units, read_record};
 use crr_dynamics::{AnalysisSpec, InitialState, solve_initial};
 use crr_impact::simulation::{
-    ImpactRecord, Parameters, Simulation, SimulationError, StopReason, Trajectory,
+    ImpactRecord, Parameters, Sample, Simulation, SimulationError, StopReason, Trajectory,
     check_initial_state,
 };
 use crr_kinematics::{InterfaceKind, Model};
@@ -190,16 +190,41 @@ pub struct Outcome {
     pub error: Option<SimulationError>,
 }
 
-/// Runs the simulation, printing a percentage on stderr when `progress`.
+/// Runs the simulation, printing a percentage on stderr when `progress`; the samples stay in
+/// the trajectory.
 pub fn run(p: &Prepared, progress: bool) -> Result<Outcome, SimulationError> {
+    run_with_sink(p, progress, |_| Ok(()), false)
+}
+
+/// Runs the simulation, handing the samples to `sink` as they are computed (after every step)
+/// when `stream` is set, so that memory stays flat however long the run; the trajectory then
+/// holds no samples (its peaks and energy balance still cover all of them). A sink error stops
+/// the run; it is returned as the run's error with what was computed until then.
+pub fn run_with_sink(
+    p: &Prepared,
+    progress: bool,
+    mut sink: impl FnMut(&[Sample]) -> std::io::Result<()>,
+    stream: bool,
+) -> Result<Outcome, SimulationError> {
     let mut sim = Simulation::new(&p.model, &p.ground, &p.initial, p.params.clone())?;
     let total = p.params.duration;
     let mut shown = -1i64;
+    let mut flush = |sim: &mut Simulation| -> Result<(), SimulationError> {
+        if stream {
+            sink(&sim.drain_samples()).map_err(|e| {
+                SimulationError::Parameter(format!("cannot write the history: {e}"))
+            })?;
+        }
+        Ok(())
+    };
     let error = loop {
         match sim.step() {
-            Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => break None,
+            Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => break flush(&mut sim).err(),
             Ok(_) => {}
-            Err(e) => break Some(e),
+            Err(e) => break flush(&mut sim).err().or(Some(e)),
+        }
+        if let Err(e) = flush(&mut sim) {
+            break Some(e);
         }
         if progress {
             let pct = (100.0 * sim.time() / total).floor() as i64;
@@ -282,38 +307,75 @@ fn num(x: f64) -> String {
     format!("{x:e}")
 }
 
-/// The text of `history.csv`.
-pub fn history_csv(model: &Model, t: &Trajectory) -> String {
+/// The header line of `history.csv`.
+pub fn history_header(model: &Model) -> String {
     let mut s = String::from("t");
-    for c in &t.coordinates {
+    for c in &model.coords {
         s.push(',');
-        s.push_str(c);
+        s.push_str(&c.name);
     }
-    for c in &t.coordinates {
-        s.push_str(&format!(",{c}_rate"));
+    for c in &model.coords {
+        s.push_str(&format!(",{}_rate", c.name));
     }
     s.push_str(",kinetic,potential,work_in,dissipated");
     for i in &model.interfaces {
         s.push_str(&format!(",{}_state", i.name));
     }
     s.push('\n');
+    s
+}
+
+/// One line of `history.csv`.
+pub fn history_row(model: &Model, x: &Sample) -> String {
+    let mut s = num(x.t);
+    for v in x.q.iter().chain(x.qdot.iter()) {
+        s.push(',');
+        s.push_str(&num(*v));
+    }
+    for v in [x.kinetic, x.potential, x.work_in, x.dissipated] {
+        s.push(',');
+        s.push_str(&num(v));
+    }
+    for st in interface_states(model, &x.states) {
+        s.push(',');
+        s.push_str(&st);
+    }
+    s.push('\n');
+    s
+}
+
+/// The text of `history.csv` for the samples a trajectory holds.
+pub fn history_csv(model: &Model, t: &Trajectory) -> String {
+    let mut s = history_header(model);
     for x in &t.samples {
-        s.push_str(&num(x.t));
-        for v in x.q.iter().chain(x.qdot.iter()) {
-            s.push(',');
-            s.push_str(&num(*v));
-        }
-        for v in [x.kinetic, x.potential, x.work_in, x.dissipated] {
-            s.push(',');
-            s.push_str(&num(v));
-        }
-        for st in interface_states(model, &x.states) {
-            s.push(',');
-            s.push_str(&st);
-        }
-        s.push('\n');
+        s.push_str(&history_row(model, x));
     }
     s
+}
+
+/// What the streamed samples leave for the summary: how many were written, and the run's energy
+/// scale (the largest T, |U|, |W| and D met).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SampleStats {
+    /// Rows of history.csv.
+    pub rows: usize,
+    /// The largest of T, |U|, |W| and D over the samples (J).
+    pub energy_scale: f64,
+}
+
+impl SampleStats {
+    /// Counts `samples` in.
+    pub fn add(&mut self, samples: &[Sample]) {
+        self.rows += samples.len();
+        for s in samples {
+            let e = s
+                .kinetic
+                .max(s.potential.abs())
+                .max(s.work_in.abs())
+                .max(s.dissipated);
+            self.energy_scale = self.energy_scale.max(e);
+        }
+    }
 }
 
 /// The text of `impacts.csv`.
@@ -355,7 +417,12 @@ pub const SIMULTANEITY_WARNING: f64 = 1e-2;
 
 /// What a user must know before trusting the results (`warnings` in summary.json, also printed
 /// on stderr by `crr simulate`).
-fn warnings(p: &Prepared, t: &Trajectory, gains: &[&ImpactRecord]) -> Vec<String> {
+fn warnings(
+    p: &Prepared,
+    t: &Trajectory,
+    stats: &SampleStats,
+    gains: &[&ImpactRecord],
+) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(worst) = gains
         .iter()
@@ -370,16 +437,7 @@ fn warnings(p: &Prepared, t: &Trajectory, gains: &[&ImpactRecord]) -> Vec<String
             worst.interfaces.join(", ")
         ));
     }
-    let scale = t
-        .samples
-        .iter()
-        .map(|s| {
-            s.kinetic
-                .max(s.potential.abs())
-                .max(s.work_in.abs())
-                .max(s.dissipated)
-        })
-        .fold(0.0, f64::max);
+    let scale = stats.energy_scale;
     // Below 1e-9 W L (W the weight, L the model size) an error is round-off of the energies.
     let round_off = 1e-9 * p.model.total_mass() * p.model.gravity * p.model.size;
     if t.energy_balance_error > (ENERGY_BALANCE_WARNING * scale).max(round_off) {
@@ -434,6 +492,7 @@ pub fn summary(
     p: &Prepared,
     opts: &SimulateOptions,
     t: &Trajectory,
+    stats: &SampleStats,
     error: Option<&str>,
 ) -> Value {
     let coordinates: Vec<Value> = t
@@ -501,12 +560,12 @@ pub fn summary(
             "rhs_evaluations": t.solver_stats.rhs_evals,
         },
         "end_time": t.end_time,
-        "samples": t.samples.len(),
+        "samples": stats.rows,
         "coordinates": coordinates,
         "impacts": t.impacts.len(),
         "energy_lost_at_impacts": t.impacts.iter().map(|i| i.energy_lost).sum::<f64>(),
         "impacts_with_energy_gain": gains.len(),
-        "warnings": warnings(p, t, &gains),
+        "warnings": warnings(p, t, stats, &gains),
         "uplift_time": t.uplift_time,
         "collapse": {
             "collapsed": t.collapse.is_some(),
@@ -529,10 +588,23 @@ pub fn summary(
 /// (summary.json last), so an interrupted run never leaves a set of files that looks complete
 /// and never mixes two runs.
 pub fn write_outputs(dir: &Path, files: &[(&str, String)]) -> std::io::Result<()> {
+    write_outputs_with(dir, &[], files)
+}
+
+/// [`write_outputs`] with files already written to their temporary names ([`partial_name`]),
+/// renamed with the others.
+pub fn write_outputs_with(
+    dir: &Path,
+    written: &[&str],
+    files: &[(&str, String)],
+) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
-    let mut temps = Vec::new();
+    let mut temps: Vec<(PathBuf, PathBuf)> = written
+        .iter()
+        .map(|name| (partial_name(dir, name), dir.join(name)))
+        .collect();
     for (name, text) in files {
-        let tmp = dir.join(format!(".{name}.partial"));
+        let tmp = partial_name(dir, name);
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(text.as_bytes())?;
         f.sync_all()?;
@@ -550,6 +622,11 @@ pub fn write_outputs(dir: &Path, files: &[(&str, String)]) -> std::io::Result<()
     Ok(())
 }
 
+/// The hidden temporary name a result file is written to before it is renamed into place.
+pub fn partial_name(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!(".{name}.partial"))
+}
+
 /// What `crr simulate` did.
 pub enum SimulateResult {
     /// The run completed; the output folder.
@@ -563,7 +640,28 @@ pub enum SimulateResult {
 pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, InputError> {
     let p = prepare(path, opts)?;
     let progress = !opts.quiet && std::io::stderr().is_terminal();
-    let (trajectory, error) = match run(&p, progress) {
+    let output_error = |source| InputError::Output {
+        dir: p.out.clone(),
+        source,
+    };
+    // history.csv is streamed to its temporary name while the run goes: memory stays flat in the
+    // duration. It is renamed into place with the other files at the end.
+    std::fs::create_dir_all(&p.out).map_err(output_error)?;
+    let history_tmp = partial_name(&p.out, "history.csv");
+    let mut history =
+        std::io::BufWriter::new(std::fs::File::create(&history_tmp).map_err(output_error)?);
+    history
+        .write_all(history_header(&p.model).as_bytes())
+        .map_err(output_error)?;
+    let mut stats = SampleStats::default();
+    let sink = |samples: &[Sample]| -> std::io::Result<()> {
+        stats.add(samples);
+        for x in samples {
+            history.write_all(history_row(&p.model, x).as_bytes())?;
+        }
+        Ok(())
+    };
+    let (trajectory, error) = match run_with_sink(&p, progress, sink, true) {
         Ok(o) => (o.trajectory, o.error.map(|e| e.to_string())),
         Err(e) => {
             // Nothing was integrated: an empty trajectory at t = 0.
@@ -583,19 +681,19 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
             (t, Some(e.to_string()))
         }
     };
-    let sum = summary(path, &p, opts, &trajectory, error.as_deref());
+    let file = history
+        .into_inner()
+        .map_err(|e| output_error(e.into_error()))?;
+    file.sync_all().map_err(output_error)?;
+    let sum = summary(path, &p, opts, &trajectory, &stats, error.as_deref());
     let files = [
-        ("history.csv", history_csv(&p.model, &trajectory)),
         ("impacts.csv", impacts_csv(&trajectory)),
         (
             "summary.json",
             serde_json::to_string_pretty(&sum).expect("summary serialises") + "\n",
         ),
     ];
-    write_outputs(&p.out, &files).map_err(|source| InputError::Output {
-        dir: p.out.clone(),
-        source,
-    })?;
+    write_outputs_with(&p.out, &["history.csv"], &files).map_err(output_error)?;
     Ok(match error {
         None => SimulateResult::Done(p.out, sum),
         Some(e) => SimulateResult::Failed(p.out, e),
@@ -637,9 +735,10 @@ mod tests {
             end_time: 0.0,
             solver_stats: Default::default(),
         };
-        assert!(warnings(&p, &t, &[]).is_empty());
+        let stats = SampleStats::default();
+        assert!(warnings(&p, &t, &stats, &[]).is_empty());
         let (a, b) = (record(0.5, -2.0), record(1.5, -7.0));
-        let w = warnings(&p, &t, &[&a, &b]);
+        let w = warnings(&p, &t, &stats, &[&a, &b]);
         assert_eq!(w.len(), 1);
         assert!(w[0].starts_with("2 impact(s) raised"), "{}", w[0]);
         assert!(w[0].contains("7.000e0 J at t = 1.5 s, base"), "{}", w[0]);

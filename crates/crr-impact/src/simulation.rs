@@ -302,6 +302,9 @@ pub fn check_initial_state(model: &Model, initial: &InitialState) -> Result<(), 
     Ok(())
 }
 
+/// The most output samples one [`Simulation::step`] produces.
+const MAX_SAMPLES_PER_STEP: usize = 4096;
+
 /// The impact event of a rocking slot is g = sign(side)·φ + this margin (rad), falling through 0.
 /// A slot that starts a segment at φ = 0 exactly (just released, or just impacted) then starts
 /// with g > 0 rather than at its root: the integrator takes the sign of a function that starts at
@@ -626,7 +629,13 @@ pub struct Simulation<'a> {
     energy_start: f64,
     next_sample: usize,
     finished: bool,
-    /// Output samples at the output interval, plus the instants just before and after impacts.
+    /// Running over every sample recorded (also those drained): peak |q| per coordinate, the
+    /// largest |T + U − W + D − E(0)|, the time of the last sample.
+    peak_abs: Vec<f64>,
+    balance_error: f64,
+    last_sample_t: f64,
+    /// Output samples at the output interval, plus the instants just before and after impacts,
+    /// since the last [`Simulation::drain_samples`].
     pub samples: Vec<Sample>,
     /// Every impact, in time order.
     pub impacts: Vec<ImpactRecord>,
@@ -725,6 +734,9 @@ impl<'a> Simulation<'a> {
             energy_start: 0.0,
             next_sample: 0,
             finished: false,
+            peak_abs: vec![0.0; n],
+            balance_error: 0.0,
+            last_sample_t: f64::NEG_INFINITY,
             samples: Vec::new(),
             impacts: Vec::new(),
             peaks: Vec::new(),
@@ -739,7 +751,7 @@ impl<'a> Simulation<'a> {
         // event only sees U falling through the threshold, which such a start never does.
         let energy_scale = model.total_mass() * model.gravity * model.size;
         let collapsed = first.potential < -sim.params.collapse_drop * energy_scale;
-        sim.samples.push(first);
+        sim.record_sample(first);
         sim.next_sample = 1;
         if collapsed {
             let c = sim.collapse_record();
@@ -790,10 +802,25 @@ impl<'a> Simulation<'a> {
 
     /// T + U − W + D − E(0): the energy-balance error (J), zero up to the integration tolerance.
     pub fn energy_balance_error(&self) -> f64 {
-        self.samples
-            .iter()
-            .map(|s| (s.kinetic + s.potential - s.work_in + s.dissipated - self.energy_start).abs())
-            .fold(0.0, f64::max)
+        self.balance_error
+    }
+
+    /// Keeps a sample and updates the running peaks and energy balance.
+    fn record_sample(&mut self, s: Sample) {
+        for (p, q) in self.peak_abs.iter_mut().zip(&s.q) {
+            *p = p.max(q.abs());
+        }
+        let balance =
+            (s.kinetic + s.potential - s.work_in + s.dissipated - self.energy_start).abs();
+        self.balance_error = self.balance_error.max(balance);
+        self.last_sample_t = s.t;
+        self.samples.push(s);
+    }
+
+    /// Takes the samples recorded since the last call, so that a long run can stream them to a
+    /// file and keep its memory flat; the peaks and the energy balance still cover every sample.
+    pub fn drain_samples(&mut self) -> Vec<Sample> {
+        std::mem::take(&mut self.samples)
     }
 
     fn sample_at(&mut self, t: f64, y: &[f64]) -> Sample {
@@ -960,6 +987,12 @@ impl<'a> Simulation<'a> {
         if let Some(c) = lift_off {
             t_stop = t_stop.min(self.t + c);
         }
+        // A step returns after at most this many output samples, so that a caller streaming
+        // them (Simulation::drain_samples) keeps its memory flat through long quiet segments.
+        let segment_end = self.t + MAX_SAMPLES_PER_STEP as f64 * self.params.output_interval;
+        if segment_end > self.t {
+            t_stop = t_stop.min(segment_end);
+        }
         let rocking: Vec<(usize, Side)> = (0..model.slot_count)
             .filter(|&s| !self.seated[s])
             .map(|s| (s, self.dynamics.pivots.sides[s]))
@@ -1076,7 +1109,7 @@ impl<'a> Simulation<'a> {
         self.peaks.extend(peaks);
         for (t, y) in pending {
             let s = self.sample_at(t, &y);
-            self.samples.push(s);
+            self.record_sample(s);
         }
         let stop = stop?;
         self.t = self.solver.t();
@@ -1085,9 +1118,9 @@ impl<'a> Simulation<'a> {
             Stop::Reached => {
                 if self.t >= self.params.duration {
                     self.finished = true;
-                    if self.samples.last().is_none_or(|s| s.t < self.t) {
+                    if self.last_sample_t < self.t {
                         let s = self.sample_at(self.t, &self.y.clone());
-                        self.samples.push(s);
+                        self.record_sample(s);
                     }
                     return Ok(StopReason::End(self.t));
                 }
@@ -1104,7 +1137,7 @@ impl<'a> Simulation<'a> {
                         self.collapse = Some(c.clone());
                         self.finished = true;
                         let s = self.sample_at(self.t, &self.y.clone());
-                        self.samples.push(s);
+                        self.record_sample(s);
                         Ok(StopReason::Collapse(c))
                     } else {
                         self.reset_solver();
@@ -1293,7 +1326,7 @@ impl<'a> Simulation<'a> {
         };
         // Sample just before the impact, then switch.
         let pre = self.sample_at(t, &self.y.clone());
-        self.samples.push(pre);
+        self.record_sample(pre);
         for &s in &impacting {
             self.last_impact[s] = t;
         }
@@ -1314,7 +1347,7 @@ impl<'a> Simulation<'a> {
         self.y[..n].copy_from_slice(q_new.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
         let post = self.sample_at(t, &self.y.clone());
-        self.samples.push(post);
+        self.record_sample(post);
         self.impacts.push(record);
         self.reset_solver();
         self.release_if_opening()?;
@@ -1342,13 +1375,7 @@ impl<'a> Simulation<'a> {
 
     /// The results so far.
     pub fn into_trajectory(self) -> Trajectory {
-        let n = self.model.dof();
-        let mut peak_abs = vec![0.0f64; n];
-        for s in &self.samples {
-            for k in 0..n {
-                peak_abs[k] = peak_abs[k].max(s.q[k].abs());
-            }
-        }
+        let mut peak_abs = self.peak_abs.clone();
         for p in &self.peaks {
             peak_abs[p.coordinate] = peak_abs[p.coordinate].max(p.value.abs());
         }
