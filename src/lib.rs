@@ -13,12 +13,14 @@
 //! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
 //! - [`synthetic`]: the reproducible synthetic accelerogram `examples/records/synthetic.AT2`.
 //! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
+//! - [`fuzzing`]: the entry points of the fuzz targets in `fuzz/` and of their corpus replay.
 
 pub use crr_dynamics as dynamics;
 pub use crr_impact as impact;
 pub use crr_kinematics as kinematics;
 
 pub mod check;
+pub mod fuzzing;
 pub mod inspect;
 pub mod model_file;
 pub mod plot;

@@ -161,9 +161,21 @@ pub fn read_results(dir: &Path) -> Result<Results, PlotError> {
     if !dir.is_dir() {
         return Err(PlotError::MissingDir(dir.to_path_buf()));
     }
+    let [summary, history, impacts] =
+        ["summary.json", "history.csv", "impacts.csv"].map(|f| read_text(&dir.join(f)));
+    parse_results(dir, &summary?, &history?, &impacts?)
+}
+
+/// Parses the texts of the three files of a results folder (`dir` names them in messages).
+pub fn parse_results(
+    dir: &Path,
+    summary_text: &str,
+    history_text: &str,
+    impacts_text: &str,
+) -> Result<Results, PlotError> {
     let summary_file = dir.join("summary.json");
     let summary: Value =
-        serde_json::from_str(&read_text(&summary_file)?).map_err(|e| PlotError::Read {
+        serde_json::from_str(summary_text).map_err(|e| PlotError::Read {
             file: summary_file.clone(),
             message: format!("not valid JSON: {e}"),
         })?;
@@ -182,7 +194,7 @@ pub fn read_results(dir: &Path) -> Result<Results, PlotError> {
         .to_string();
 
     let history_file = dir.join("history.csv");
-    let text = read_text(&history_file)?;
+    let text = history_text;
     let bad = |message: String| PlotError::Read {
         file: history_file.clone(),
         message,
@@ -264,7 +276,7 @@ pub fn read_results(dir: &Path) -> Result<Results, PlotError> {
     }
 
     let impacts_file = dir.join("impacts.csv");
-    let text = read_text(&impacts_file)?;
+    let text = impacts_text;
     for (row, line) in text.lines().enumerate().skip(1) {
         if line.trim().is_empty() {
             continue;
