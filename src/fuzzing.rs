@@ -36,7 +36,11 @@ pub fn records(data: &[u8]) {
     let text = text(data);
     let _ = parse_at2(&text, "fuzz.AT2");
     for format in [RecordFormat::Csv, RecordFormat::Text] {
-        let _ = parse_table(&text, "fuzz", &TableOptions::new(format, Units::MetersPerSecondSquared));
+        let _ = parse_table(
+            &text,
+            "fuzz",
+            &TableOptions::new(format, Units::MetersPerSecondSquared),
+        );
     }
 }
 

@@ -174,11 +174,10 @@ pub fn parse_results(
     impacts_text: &str,
 ) -> Result<Results, PlotError> {
     let summary_file = dir.join("summary.json");
-    let summary: Value =
-        serde_json::from_str(summary_text).map_err(|e| PlotError::Read {
-            file: summary_file.clone(),
-            message: format!("not valid JSON: {e}"),
-        })?;
+    let summary: Value = serde_json::from_str(summary_text).map_err(|e| PlotError::Read {
+        file: summary_file.clone(),
+        message: format!("not valid JSON: {e}"),
+    })?;
     let coordinates: Vec<String> = summary["coordinates"]
         .as_array()
         .ok_or_else(|| PlotError::Read {

@@ -1,0 +1,291 @@
+//! Impacts in the simulation: which law applies, the plastic impulse that keeps seated joints
+//! seated, the regularised Dirac force, and the impact event itself (pivot switch, law, seating of
+//! the joints that come to rest, bookkeeping).
+
+use super::*;
+
+/// Regularised Dirac-delta laws acting as a continuous generalized force.
+pub(super) struct Regularised {
+    pub(super) slots: Vec<(usize, f64, f64, f64)>,
+    pub(super) angles: Vec<f64>,
+}
+
+impl GeneralizedForce for Regularised {
+    fn add(
+        &mut self,
+        model: &Model,
+        kin: &Data,
+        _t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        out: &mut DVector<f64>,
+    ) {
+        let n = model.dof();
+        self.angles[..n].copy_from_slice(q.as_slice());
+        closure_angles(model, kin, &mut self.angles[n..]);
+        let mut f = DVector::zeros(n);
+        dirac_regularised_force(model, kin, qdot, &self.angles, &self.slots, &mut f);
+        *out += f;
+    }
+}
+
+/// The plastic impulse that stops the given slots (and keeps the loops closed):
+/// q̇⁺ = q̇ − M⁻¹Cᵀ(C M⁻¹ Cᵀ)⁺ C q̇ with C the closure rows and the slots' rate rows, i.e. the
+/// impulse along those constraints only, with the smallest kinetic-energy loss. Rank-revealing:
+/// dependent rows (slots locked together in a loop) are harmless. Returns q̇⁺ and T⁺.
+pub(super) fn plastic_projection(
+    model: &Model,
+    template: &Dynamics,
+    ground: &GroundMotion,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    pivots: &ActivePivots,
+    slots: &[usize],
+) -> (DVector<f64>, f64) {
+    let mut d = template.clone();
+    d.pivots = pivots.clone();
+    d.seated.clear();
+    d.evaluate(model, ground, t, q, qdot);
+    let n = model.dof();
+    let m = d.kin.mass_matrix.clone();
+    let kinetic = |v: &DVector<f64>| 0.5 * v.dot(&(&m * v));
+    if slots.is_empty() {
+        return (qdot.clone(), kinetic(qdot));
+    }
+    let phi = d.scaled_jacobian();
+    let rows = phi.nrows() + slots.len();
+    let mut c = nalgebra::DMatrix::zeros(rows, n);
+    c.rows_mut(0, phi.nrows()).copy_from(&phi);
+    let mut row = DVector::zeros(n);
+    for (i, &s) in slots.iter().enumerate() {
+        slot_row(model, &d.kin, s, &mut row);
+        c.row_mut(phi.nrows() + i).copy_from(&row.transpose());
+    }
+    let chol = m.clone().cholesky().expect("M is positive definite");
+    let y = chol.solve(&c.transpose());
+    let a = &c * &y;
+    let (lambda, _) = crr_dynamics::linalg::pinv_solve(&a, &(&c * qdot));
+    let out = qdot - y * lambda;
+    let k = kinetic(&out);
+    (out, k)
+}
+
+/// Applies the impact laws of the impacting slots: the momentum law if any of their interfaces
+/// uses it; otherwise one rate law ([`restitution_law`]) with a factor per slot: r for
+/// restitution, r^C for the exact Dirac law, and 1 for a regularised Dirac law (an elastic pivot
+/// switch: its force does the dissipation on either side of the switch).
+pub(super) fn apply_law(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    before: &ActivePivots,
+    after: &ActivePivots,
+    impacting: &[usize],
+) -> Result<crate::laws::ImpactResult, ImpactError> {
+    let laws: Vec<ImpactLaw> = impacting
+        .iter()
+        .map(|&s| model.interfaces[slot_interface(model, s)].impact)
+        .collect();
+    if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
+        return momentum_law(model, kin, q, qdot, before, after);
+    }
+    if let Some(dirac) = laws
+        .iter()
+        .zip(impacting)
+        .map(|(l, &s)| match *l {
+            ImpactLaw::Dirac { r, c } => Some((s, r, c)),
+            _ => None,
+        })
+        .collect::<Option<Vec<_>>>()
+    {
+        return dirac_law(model, kin, q, qdot, before, after, &dirac);
+    }
+    let factors: Vec<(usize, f64)> = laws
+        .iter()
+        .zip(impacting)
+        .map(|(l, &s)| match *l {
+            ImpactLaw::Restitution(r) => (s, r),
+            ImpactLaw::Dirac { r, c } => (s, r.powf(c)),
+            _ => (s, 1.0),
+        })
+        .collect();
+    restitution_law(model, kin, q, qdot, before, after, &factors)
+}
+
+impl Simulation<'_> {
+    /// Handles an impact fired by `slot` at the current time.
+    pub(super) fn impact(&mut self, slot: usize) -> Result<usize, SimulationError> {
+        if self.impacts.len() >= self.params.max_impacts {
+            return Err(SimulationError::TooManyImpacts(self.params.max_impacts));
+        }
+        let model = self.model;
+        let (t, q, qdot) = (self.t, self.q(), self.qdot());
+        let before = self.dynamics.pivots.clone();
+        let mut kin = Data::new(model);
+        let mut angles = vec![0.0; model.slot_count];
+        slot_angles(model, &mut kin, &q, &before, &mut angles);
+        crr_kinematics::velocities(model, &mut kin, &qdot);
+        let mut rates = vec![0.0; model.slot_count];
+        slot_rates(model, &kin, &qdot, &mut rates);
+        let mut impacting: Vec<usize> = (0..model.slot_count)
+            .filter(|&s| {
+                s == slot
+                    || (!self.seated[s]
+                        && angles[s].abs() <= self.params.simultaneity
+                        && rates[s] * before.sides[s].sign() < 0.0)
+            })
+            .collect();
+        let held: Vec<usize> = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        // A rocking joint at φ ≈ 0 that the impact sends into its closed side impacts too (its
+        // pivot switches): enlarge the impacting set until no joint penetrates.
+        let (after, q_new, result, mut qdot_after, mut kinetic_after) = loop {
+            let mut after = before.clone();
+            for &s in &impacting {
+                after.sides[s] = before.sides[s].flipped();
+            }
+            // The impact happens at φ = 0: the located state is within the event tolerance of it
+            // (and a joint impacting with it within `simultaneity`). The laws act at φ = 0
+            // exactly, where the two chains place every body identically; at the located
+            // angle the pivot switch would move the bodies above by φ·|P⁺ − P⁻|.
+            let mut q_at = q.clone();
+            for &s in &impacting {
+                if s < model.dof() {
+                    q_at[s] = 0.0;
+                }
+            }
+            let q = q_at;
+            let result = apply_law(model, &mut kin, &q, &qdot, &before, &after, &impacting)
+                .map_err(|source| SimulationError::Impact { t, source })?;
+            // Joints that were seated stay seated through the impact: a plastic impulse on them
+            // (booked as dissipation), as "all other hinges persisting".
+            let (qd, k) = plastic_projection(
+                model,
+                &self.dynamics,
+                self.ground,
+                t,
+                &q,
+                &result.qdot,
+                &after,
+                &held,
+            );
+            forward_kinematics(model, &mut kin, &q, &after);
+            crr_kinematics::velocities(model, &mut kin, &qd);
+            slot_rates(model, &kin, &qd, &mut rates);
+            let wrong: Vec<usize> = (0..model.slot_count)
+                .filter(|&s| {
+                    !self.seated[s]
+                        && !impacting.contains(&s)
+                        && angles[s].abs() <= self.params.simultaneity
+                        && after.sides[s].sign() * rates[s] < -1e-12
+                })
+                .collect();
+            if wrong.is_empty() {
+                break (after, q, result, qd, k);
+            }
+            impacting.extend(wrong);
+        };
+        let rates_after: Vec<f64> = impacting.iter().map(|&s| rates[s]).collect();
+        // Seating of the impacting interfaces that come to rest. Seating one joint of a loop can
+        // lock the others: seat, recompute the rates, and seat every impacting slot brought below
+        // the threshold, until nothing changes.
+        // Candidates: the impacting slots, and rocking slots resting at φ ≈ 0 with a negligible rate.
+        let candidates: Vec<usize> = (0..model.slot_count)
+            .filter(|&s| {
+                impacting.contains(&s)
+                    || (!self.seated[s] && angles[s].abs() <= self.params.simultaneity)
+            })
+            .collect();
+        let mut to_seat: Vec<usize> = candidates
+            .iter()
+            .copied()
+            .filter(|&s| {
+                rates[s].abs() < self.params.seat_rate
+                    || (impacting.contains(&s) && t - self.last_impact[s] < self.params.min_impact_interval)
+                    // A joint the law sends back into its closed side cannot open: it stays closed.
+                    || after.sides[s].sign() * rates[s] < 0.0
+            })
+            .collect();
+        let mut pending = to_seat.clone();
+        while !pending.is_empty() {
+            let all: Vec<usize> = held.iter().chain(&to_seat).copied().collect();
+            (qdot_after, kinetic_after) = plastic_projection(
+                model,
+                &self.dynamics,
+                self.ground,
+                t,
+                &q_new,
+                &qdot_after,
+                &after,
+                &all,
+            );
+            forward_kinematics(model, &mut kin, &q_new, &after);
+            crr_kinematics::velocities(model, &mut kin, &qdot_after);
+            slot_rates(model, &kin, &qdot_after, &mut rates);
+            pending = candidates
+                .iter()
+                .copied()
+                .filter(|&s| {
+                    !to_seat.contains(&s)
+                        && (rates[s].abs() < self.params.seat_rate
+                            || after.sides[s].sign() * rates[s] < 0.0)
+                })
+                .collect();
+            to_seat.extend(pending.iter().copied());
+        }
+        let before_rates: Vec<f64> = {
+            forward_kinematics(model, &mut kin, &q, &before);
+            crr_kinematics::velocities(model, &mut kin, &qdot);
+            let mut r = vec![0.0; model.slot_count];
+            slot_rates(model, &kin, &qdot, &mut r);
+            impacting.iter().map(|&s| r[s]).collect()
+        };
+        let lost = result.kinetic_before - kinetic_after;
+        let record = ImpactRecord {
+            t,
+            interfaces: {
+                let mut names: Vec<String> = impacting
+                    .iter()
+                    .map(|&s| model.interfaces[slot_interface(model, s)].name.clone())
+                    .collect();
+                names.dedup();
+                names
+            },
+            slots: impacting.clone(),
+            rates_before: before_rates,
+            rates_after,
+            energy_lost: lost,
+            energy_gain: result.kinetic_after > result.kinetic_before * (1.0 + 1e-9) + 1e-12,
+            seated: to_seat.clone(),
+        };
+        // Sample just before the impact, then switch.
+        let pre = self.sample_at(t, &self.y.clone());
+        self.record_sample(pre);
+        for &s in &impacting {
+            self.last_impact[s] = t;
+        }
+        for &s in &to_seat {
+            self.seated[s] = true;
+        }
+        self.dynamics.pivots = after;
+        self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        // The snap of the impacting angles to exactly 0 changes U by round-off: booked too.
+        let u_snap = {
+            forward_kinematics(model, &mut kin, &q, &before);
+            let u0 = potential_energy(model, &kin);
+            forward_kinematics(model, &mut kin, &q_new, &self.dynamics.pivots);
+            u0 - potential_energy(model, &kin)
+        };
+        self.dissipated_at_impacts += lost + u_snap;
+        let n = model.dof();
+        self.y[..n].copy_from_slice(q_new.as_slice());
+        self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
+        let post = self.sample_at(t, &self.y.clone());
+        self.record_sample(post);
+        self.impacts.push(record);
+        self.reset_solver();
+        self.release_if_opening()?;
+        Ok(self.impacts.len() - 1)
+    }
+}
