@@ -1,15 +1,10 @@
 //! Inputs that used to be accepted silently get a clear error naming the item (exit 2).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn crr(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_crr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("crr runs")
-}
+use std::path::{Path, PathBuf};
+
+use common::{bundled_text as bundled, crr, refused};
 
 fn write(name: &str, text: &str) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks");
@@ -17,24 +12,6 @@ fn write(name: &str, text: &str) -> PathBuf {
     let p = d.join(name);
     std::fs::write(&p, text).unwrap();
     p
-}
-
-fn refused(args: &[&str], needle: &str) {
-    let o = crr(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert!(
-        err.starts_with("crr: error: ") && err.contains(needle),
-        "{args:?}: {err}"
-    );
-}
-
-fn bundled(name: &str) -> String {
-    std::fs::read_to_string(format!(
-        "{}/examples/models/{name}.toml",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap()
 }
 
 #[test]

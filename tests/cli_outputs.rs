@@ -2,29 +2,15 @@
 //! never lead outside `results/`), an earlier run is never overwritten without `--force`, and a
 //! forced run replaces the earlier set whole (no stale plots beside new data).
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn crr_in(cwd: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_crr"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("crr runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("outputs_{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use common::{crr_in, scratch};
 
 /// The bundled single block renamed, written into `dir`, run for 1 s.
 fn model_named(dir: &Path, name: &str) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("examples/models/single_block.toml")).unwrap();
-    let text = text.replacen(
+    let text = common::bundled_text("single_block").replacen(
         "name = \"single_block\"",
         &format!("name = {}", toml_string(name)),
         1,
@@ -72,7 +58,7 @@ fn model_names_never_lead_outside_results() {
         ("", "model"),
         ("temple front-1.2", "temple_front-1.2"),
     ] {
-        let work = scratch(&format!("names_{}", folder.replace('.', "d")));
+        let work = scratch(&format!("outputs_names_{}", folder.replace('.', "d")));
         let cwd = work.join("cwd");
         std::fs::create_dir_all(&cwd).unwrap();
         let model = model_named(&work, name);
@@ -106,7 +92,7 @@ fn model_names_never_lead_outside_results() {
 
 #[test]
 fn an_earlier_run_is_replaced_only_with_force_and_whole() {
-    let work = scratch("force");
+    let work = scratch("outputs_force");
     let model = model_named(&work, "single_block");
     let out = work.join("out");
     let run = |extra: &[&str]| {

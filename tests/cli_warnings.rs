@@ -1,22 +1,14 @@
 //! Runs whose results cannot be fully trusted say so: `warnings` in summary.json, each printed on
 //! stderr, and a last line counting them. The bundled models run clean.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn crr(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_crr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("crr runs")
-}
+use std::path::{Path, PathBuf};
+
+use common::{bundled_text, crr};
 
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("warnings_{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch(&format!("warnings_{name}"))
 }
 
 /// Runs `model_text` (written into a scratch folder) and returns (summary, stderr).
@@ -40,10 +32,7 @@ fn run(tag: &str, model_text: &str, extra: &[&str]) -> (serde_json::Value, Strin
 }
 
 fn single_block_with(analysis: &str) -> String {
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml"),
-    )
-    .unwrap();
+    let text = bundled_text("single_block");
     let cut = text.find("[analysis]").unwrap_or(text.len());
     format!("{}[analysis]\n{analysis}\n", &text[..cut])
 }

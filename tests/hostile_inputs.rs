@@ -1,46 +1,15 @@
 //! Damaged or hostile inputs get a clear error (exit 2, the file named), never a panic, a hang or
 //! an allocation the input does not justify.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::time::Duration;
+mod common;
 
-fn crr(args: &[&str]) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_crr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("crr runs");
-    // A hang is a failure: kill it after 60 s (the cases here answer in milliseconds).
-    for _ in 0..600 {
-        if child.try_wait().unwrap().is_some() {
-            return child.wait_with_output().unwrap();
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    }
-    child.kill().unwrap();
-    panic!("crr {args:?} did not answer within 60 s");
-}
+use std::path::PathBuf;
+use std::process::Command;
+
+use common::{crr, refused};
 
 fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("hostile_{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Exit 2, one `crr: error:` line naming `needle`, no panic.
-fn refused(args: &[&str], needle: &str) {
-    let o = crr(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert!(
-        err.starts_with("crr: error: ") && err.contains(needle),
-        "{args:?}: {err}"
-    );
-    assert!(!err.contains("panicked"), "{err}");
+    common::scratch(&format!("hostile_{name}"))
 }
 
 #[test]

@@ -1,0 +1,58 @@
+//! Helpers shared by the command-line tests: run `crr` (killed if it hangs), scratch folders,
+//! the bundled models' text, and the check that an input is refused cleanly.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::Duration;
+
+/// Runs `crr` with `args` in `cwd`; a run that has not answered within 120 s is a failure (the
+/// cases of these tests answer in seconds).
+pub fn crr_in(cwd: &Path, args: &[&str]) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args(args)
+        .current_dir(cwd)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("crr runs");
+    for _ in 0..1200 {
+        if child.try_wait().unwrap().is_some() {
+            return child.wait_with_output().unwrap();
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    child.kill().unwrap();
+    panic!("crr {args:?} did not answer within 120 s");
+}
+
+/// Runs `crr` with `args` in the package's folder (bundled paths are relative to it).
+pub fn crr(args: &[&str]) -> Output {
+    crr_in(Path::new(env!("CARGO_MANIFEST_DIR")), args)
+}
+
+/// A fresh empty folder under the target's temporary folder.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The text of the bundled model `examples/models/<name>.toml`.
+pub fn bundled_text(name: &str) -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(root.join(format!("examples/models/{name}.toml"))).unwrap()
+}
+
+/// `crr args` exits with status 2 and one `crr: error:` message containing `needle`, no panic.
+pub fn refused(args: &[&str], needle: &str) {
+    let o = crr(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert!(
+        err.starts_with("crr: error: ") && err.contains(needle),
+        "{args:?}: {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}
