@@ -32,6 +32,16 @@
 //! is `(t*, y(t*))` and the dense output of that *partial* step (not of the
 //! full trial step) is the one passed to `on_step`.
 //!
+//! **The landing step validates the located root** (adaptive methods): it
+//! must pass the error control and agree with the interpolant at `t*` to
+//! within [`DENSE_TRUST`] tolerances. Otherwise the accepted step had stepped
+//! over a narrow feature its stages did not see (e.g. a force confined to a
+//! thin band of the state), so its interpolant and the signs of the event
+//! functions at its end say nothing about where the roots are: the step is
+//! rejected and redone from `t0` with the landing step's (or a smaller) size,
+//! and the events are detected again on that step. The state never moves
+//! past a root without a step whose ends show the sign change.
+//!
 //! **No re-firing on restart**: at the start of every [`Solver::advance`]
 //! the event functions are evaluated at the current state. A function that
 //! is zero there (`|g_i| ≤` [`EVENT_ZERO_TOL`]), or the function that fired
@@ -436,6 +446,12 @@ fn crosses(ga: f64, gb: f64, dir: Direction) -> bool {
 /// starts at zero is sampled.
 const ZERO_START_PROBE: f64 = 1e-3;
 
+/// Largest distance (RMS, in tolerances `atol + rtol·|y|`) between the dense output of a step at
+/// a located event time and the genuine step that lands there, for the step to be trusted (see
+/// [`Solver::advance`]). The interpolant of an accepted step is accurate to a few tolerances; a
+/// step whose stages missed a narrow feature is off by orders of magnitude more.
+pub const DENSE_TRUST: f64 = 1e3;
+
 /// An ODE solver holding the current state `(t, y)`.
 ///
 /// All work buffers are allocated in [`Solver::new`]; stepping does not
@@ -453,6 +469,8 @@ pub struct Solver {
     f_valid: bool,
     y_new: Vec<f64>,
     y_tmp: Vec<f64>,
+    /// The interpolant at a located event time, checked against the landing step.
+    y_event: Vec<f64>,
     /// Stage derivatives, `stages × dim`.
     k: Vec<f64>,
     /// Dense-output coefficients of the last computed step, `ncoef × dim`.
@@ -498,6 +516,7 @@ impl Solver {
             f_valid: false,
             y_new: vec![0.0; dim],
             y_tmp: vec![0.0; dim],
+            y_event: vec![0.0; dim],
             k: vec![0.0; stages * dim],
             dense: vec![0.0; ncoef * dim],
             h_next: 0.0,
@@ -595,8 +614,9 @@ impl Solver {
     /// for every accepted step with its dense output (for an event, the
     /// partial step ending at the event). See the module documentation for
     /// the event semantics. The step repeated to land on an event time is
-    /// error-checked; if it fails, the event time is reached by adaptive
-    /// sub-steps that land on it exactly. Interior double crossings of an event
+    /// error-checked and compared with the interpolant; if either test fails,
+    /// the step is redone from its start with a smaller size and the events
+    /// are detected on that step. Interior double crossings of an event
     /// function within one step (no sign change at the step ends) are not
     /// detected; limit `h_max` if that matters.
     ///
@@ -746,47 +766,41 @@ impl Solver {
 
             if let Some((index, t_star)) = found {
                 if t_star != t1 {
-                    // Integrate exactly to the event time from the step start, with error control:
-                    // the landing step is checked, and if it fails (a narrow feature inside the
-                    // step) t* is reached by adaptive sub-steps that land on it exactly.
-                    let mut h_sub = t_star - self.t;
-                    loop {
-                        let last_sub = self.t + h_sub >= t_star;
-                        let t_sub = if last_sub { t_star } else { self.t + h_sub };
-                        let h_try = t_sub - self.t;
-                        if !self.f_valid {
-                            call_rhs(sys, &mut self.stats, self.t, &self.y, &mut self.f)?;
-                            self.f_valid = true;
-                        }
-                        let err = self.rk_step(sys, h_try, t_sub)?;
-                        self.stats.steps += 1;
-                        if !err.is_finite() || self.y_new.iter().any(|v| !v.is_finite()) {
-                            return Err(SolveError::NonFinite {
-                                t: self.t,
-                                h: h_try,
-                            });
-                        }
-                        if adaptive && err > 1.0 {
+                    // Land on t* with a genuine step from the step start. The root was located on
+                    // the interpolant of a step whose stages may have missed a narrow feature
+                    // (a regularised δ zone inside the step): then the landing step fails the
+                    // error control or disagrees with the interpolant, and its state may lie past
+                    // other roots that would never fire (formerly sub-steps carried the state on to
+                    // t* without event detection). Reject the long step and redo it with the
+                    // landing step's size, so events are located only on steps that resolve them.
+                    let h_land = t_star - self.t;
+                    if adaptive {
+                        dense_eval(&self.dense, self.dim, self.t, h, t_star, &mut self.y_event);
+                    }
+                    let err = self.rk_step(sys, h_land, t_star)?;
+                    self.stats.steps += 1;
+                    if !err.is_finite() || self.y_new.iter().any(|v| !v.is_finite()) {
+                        return Err(SolveError::NonFinite {
+                            t: self.t,
+                            h: h_land,
+                        });
+                    }
+                    if adaptive {
+                        let mismatch = self.scaled_distance(&self.y_new, &self.y_event);
+                        if err > 1.0 || mismatch > DENSE_TRUST {
+                            self.stats.accepted -= 1;
                             self.stats.rejected += 1;
-                            h_sub = h_try * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9);
-                            if h_sub <= 10.0 * f64::EPSILON * self.t.abs().max(1.0) {
-                                return Err(SolveError::StepSizeUnderflow {
-                                    t: self.t,
-                                    h: h_sub,
-                                });
-                            }
+                            self.last_rejected = true;
+                            h = if err > 1.0 {
+                                h_land * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9)
+                            } else {
+                                h_land
+                            };
                             continue;
                         }
-                        self.finish_step(sys, h_try, t_sub)?;
-                        self.emit(on_step, h_try, t_sub);
-                        if last_sub {
-                            break;
-                        }
-                        self.commit(t_sub);
-                        self.project(sys)?;
-                        h_sub = (h_try * (0.9 * err.max(1e-10).powf(-0.2)).clamp(0.2, 5.0))
-                            .min(t_star - self.t);
                     }
+                    self.finish_step(sys, h_land, t_star)?;
+                    self.emit(on_step, h_land, t_star);
                 } else {
                     self.emit(on_step, h, t1);
                 }
@@ -863,6 +877,21 @@ impl Solver {
         std::mem::swap(&mut self.y, &mut self.y_new);
         self.t = t1;
         self.f_valid = true;
+    }
+
+    /// RMS of `a − b` in units of the tolerance `atol + rtol·max(|a|, |b|)`, the norm of the
+    /// error control.
+    fn scaled_distance(&self, a: &[f64], b: &[f64]) -> f64 {
+        if a.is_empty() {
+            return 0.0;
+        }
+        let (rtol, atol) = (self.opts.rtol, self.opts.atol);
+        let sum: f64 = a
+            .iter()
+            .zip(b)
+            .map(|(&x, &y)| ((x - y) / (atol + rtol * x.abs().max(y.abs()))).powi(2))
+            .sum();
+        (sum / a.len() as f64).sqrt()
     }
 
     /// Locates the root of `g_i` on `[ta, tb_max]` (within the current

@@ -723,3 +723,90 @@ fn options_deserialize_with_defaults_and_deny_unknown() {
     let m = MapDeserializer::<_, Error>::new([("rtoll", 1e-6)].into_iter());
     assert!(Options::deserialize(m).is_err());
 }
+
+// ------------------------------------------------------------------ narrow features
+
+/// x' = v, v' = -v·|v|·ln 2·δ_w(x - 1): a unit-area raised cosine of width w halves v while x
+/// crosses the band |x - 1| < w/2 and does nothing elsewhere, so smooth steps grow large and
+/// can step over the band without a stage inside it.
+struct Band {
+    w: f64,
+}
+impl OdeSystem for Band {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        let u = y[0] - 1.0;
+        let delta = if u.abs() < 0.5 * self.w {
+            (1.0 + (2.0 * PI * u / self.w).cos()) / self.w
+        } else {
+            0.0
+        };
+        dydt[0] = y[1];
+        dydt[1] = -std::f64::consts::LN_2 * y[1] * y[1].abs() * delta;
+        Ok(())
+    }
+}
+
+/// The band's edges and centre: g_k = x - 1 - (k - 1)·w/2.
+struct BandEdges {
+    w: f64,
+}
+impl EventFunctions for BandEdges {
+    fn count(&self) -> usize {
+        3
+    }
+    fn eval(&mut self, _t: f64, y: &[f64], g: &mut [f64]) {
+        for (k, gk) in g.iter_mut().enumerate() {
+            *gk = y[0] - 1.0 - (k as f64 - 1.0) * 0.5 * self.w;
+        }
+    }
+    fn direction(&self, _i: usize) -> Direction {
+        Direction::Rising
+    }
+}
+
+#[test]
+fn a_step_over_a_narrow_band_does_not_skip_its_events() {
+    // Whatever the band width, the three roots fire in order, each at its own root, with the
+    // state never past a later one: a long step whose stages missed the band has a meaningless
+    // interpolant, and the landing step must expose it (error control, distance to the
+    // interpolant) so that the step is redone rather than carried on past the other roots.
+    let widths: Vec<f64> = (0..25)
+        .map(|k| 1e-4 * 100f64.powf(k as f64 / 24.0))
+        .collect();
+    for method in [Method::Dop853, Method::Dopri5] {
+        for &w in &widths {
+            let mut s = Solver::new(method, Options::default(), 2).unwrap();
+            s.reset(0.0, &[0.0, 1.0]);
+            let (mut sys, mut ev) = (Band { w }, BandEdges { w });
+            for k in 0..3 {
+                let stop = s.advance(&mut sys, 10.0, &mut ev, &mut ignore).unwrap();
+                assert!(
+                    matches!(stop, Stop::Event { index, .. } if index == k),
+                    "{method:?}, w = {w:e}: expected event {k}, got {stop:?} at x = {}",
+                    s.y()[0]
+                );
+                let mut g = [0.0; 3];
+                ev.eval(s.t(), s.y(), &mut g);
+                assert!(
+                    g[k].abs() < 1e-9,
+                    "{method:?}, w = {w:e}: g{k} = {:e}",
+                    g[k]
+                );
+                assert!(g[k + 1..].iter().all(|&x| x < 0.0), "{method:?}, w = {w:e}");
+            }
+            // The band halved the rate (to the integration tolerance).
+            assert_eq!(
+                s.advance(&mut sys, 10.0, &mut ev, &mut ignore).unwrap(),
+                Stop::Reached
+            );
+            assert!(
+                (s.y()[1] - 0.5).abs() < 1e-6,
+                "{method:?}, w = {w:e}: {}",
+                s.y()[1]
+            );
+        }
+    }
+}
