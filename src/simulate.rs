@@ -665,19 +665,7 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
         Ok(o) => (o.trajectory, o.error.map(|e| e.to_string())),
         Err(e) => {
             // Nothing was integrated: an empty trajectory at t = 0.
-            let t = Trajectory {
-                coordinates: p.model.coords.iter().map(|c| c.name.clone()).collect(),
-                samples: Vec::new(),
-                impacts: Vec::new(),
-                peaks: Vec::new(),
-                peak_abs: vec![0.0; p.model.dof()],
-                uplift_time: None,
-                collapse: None,
-                violation: None,
-                energy_balance_error: 0.0,
-                end_time: 0.0,
-                solver_stats: Default::default(),
-            };
+            let t = Trajectory::empty(&p.model);
             (t, Some(e.to_string()))
         }
     };
@@ -722,19 +710,7 @@ mod tests {
         // No law of crr raises T for r ≤ 1, so the case is built by hand.
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
         let p = prepare(&path, &SimulateOptions::default()).unwrap();
-        let t = Trajectory {
-            coordinates: vec!["base".into()],
-            samples: Vec::new(),
-            impacts: Vec::new(),
-            peaks: Vec::new(),
-            peak_abs: vec![0.0],
-            uplift_time: None,
-            collapse: None,
-            violation: None,
-            energy_balance_error: 0.0,
-            end_time: 0.0,
-            solver_stats: Default::default(),
-        };
+        let t = Trajectory::empty(&p.model);
         let stats = SampleStats::default();
         assert!(warnings(&p, &t, &stats, &[]).is_empty());
         let (a, b) = (record(0.5, -2.0), record(1.5, -7.0));

@@ -12,7 +12,7 @@
 //! Body velocities come from the body Jacobians (J_c, J_ω), the energies from ½Σ(m|v|² + ωᵀIω),
 //! and κ from Σ Jᵀ𝕄J; the laws use M assembled from the composite inertias.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crr::impact::laws::{dirac_law, momentum_law, restitution_law};
 use crr::impact::simulation::{ImpactRecord, Sample};
@@ -20,6 +20,8 @@ use crr::impact::{SlotState, Trajectory};
 use crr::kinematics::mass_matrix::world_inertia;
 use crr::kinematics::{ActivePivots, Data, Model, Side, forward_kinematics, jacobians};
 use crr::load_model;
+
+mod common;
 use crr::simulate::{SimulateOptions, prepare, run};
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -114,6 +116,26 @@ fn jacobian_mass_matrix(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) 
     m
 }
 
+/// The pivots before and after coordinate k (at 0) crosses with rate q̇ₖ: the others follow
+/// their signs, k rocks on the side it is closing on and switches to the other.
+fn crossing(
+    model: &Model,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    k: usize,
+) -> (ActivePivots, ActivePivots) {
+    let mut before = ActivePivots::uniform(model, Side::Positive);
+    before.follow_coordinates(q);
+    before.sides[k] = if qd[k] < 0.0 {
+        Side::Positive
+    } else {
+        Side::Negative
+    };
+    let mut after = before.clone();
+    after.sides[k] = before.sides[k].flipped();
+    (before, after)
+}
+
 /// A deterministic spread of numbers in [−1, 1].
 fn spread(i: usize) -> f64 {
     ((i as f64 + 1.0) * 2.399_963).sin()
@@ -165,15 +187,7 @@ fn check_open_chain_maps(model: &Model) -> usize {
                 }
             });
             let qd = DVector::from_fn(n, |i, _| spread(11 * case + 5 * i + 1));
-            let mut before = ActivePivots::uniform(model, Side::Positive);
-            before.follow_coordinates(&q);
-            before.sides[k] = if qd[k] < 0.0 {
-                Side::Positive
-            } else {
-                Side::Negative
-            };
-            let mut after = before.clone();
-            after.sides[k] = before.sides[k].flipped();
+            let (before, after) = crossing(model, &q, &qd, k);
             let m_minus = motion(model, &q, &qd, &before);
             let (t_minus, h_minus) = (kinetic(model, &m_minus), hinge_momenta(model, &m_minus));
             let h_scale = h_minus.iter().fold(0.0f64, |a, h| a.max(h.abs()));
@@ -247,15 +261,7 @@ fn the_momentum_law_also_keeps_the_impacting_subtree_momentum_about_its_new_pivo
     for k in [0, 3, n - 1] {
         let q = DVector::from_fn(n, |i, _| if i == k { 0.0 } else { 0.05 * spread(i) });
         let qd = DVector::from_fn(n, |i, _| spread(3 * i + 2));
-        let mut before = ActivePivots::uniform(&model, Side::Positive);
-        before.follow_coordinates(&q);
-        before.sides[k] = if qd[k] < 0.0 {
-            Side::Positive
-        } else {
-            Side::Negative
-        };
-        let mut after = before.clone();
-        after.sides[k] = before.sides[k].flipped();
+        let (before, after) = crossing(&model, &q, &qd, k);
         let res = momentum_law(&model, &mut kin, &q, &qd, &before, &after).unwrap();
         // The pre-impact motion's momentum about the new pivots: the body velocities of the old
         // chain with the pivots of the new one.
@@ -271,19 +277,6 @@ fn the_momentum_law_also_keeps_the_impacting_subtree_momentum_about_its_new_pivo
             );
         }
     }
-}
-
-/// Writes `text` as a model file in a fresh folder and runs it.
-fn simulate_text(tag: &str, text: &str) -> (Model, Trajectory) {
-    let dir = std::env::temp_dir().join(format!("crr-chain-impacts-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path: PathBuf = dir.join("model.toml");
-    std::fs::write(&path, text).unwrap();
-    let prepared = prepare(&path, &SimulateOptions::default()).unwrap();
-    let outcome = run(&prepared, false).unwrap();
-    assert!(outcome.error.is_none(), "{tag}: {:?}", outcome.error);
-    std::fs::remove_dir_all(&dir).ok();
-    (prepared.model, outcome.trajectory)
 }
 
 /// The bundled model's text with `impact = { law }` on every interface, the ground motion and the
@@ -393,9 +386,10 @@ fn stacks_released_from_a_grid_of_angles_keep_momenta_and_never_gain_energy() {
                      [analysis]\nduration = 3.0\n"
                 );
                 let tag = format!("stack {law} base {base} joint {joint}");
-                let (model, traj) = simulate_text(
+                let (model, traj) = common::run_model_text(
                     &format!("{}", impacts),
                     &with_law("two_block_stack", law, &tail),
+                    None,
                 );
                 worst = worst.max(check_run(&model, &traj, &tag));
                 impacts += traj.impacts.len();
@@ -412,9 +406,10 @@ fn the_drum_column_under_its_pulse_keeps_momenta_and_never_gains_energy() {
     let pulse = "[ground_motion]\nx = { one_sine_pulse = { amplitude = 2.5, period = 0.5 } }\n\
                  [analysis]\nduration = 4.0\n";
     for law in ["restitution = 0.9", "dirac = { r = 0.9, c = 1.0 }"] {
-        let (model, traj) = simulate_text(
+        let (model, traj) = common::run_model_text(
             &law.replace(|c: char| !c.is_ascii_alphanumeric(), ""),
             &with_law("drum_column", law, pulse),
+            None,
         );
         let worst = check_run(&model, &traj, &format!("drum column, {law}"));
         eprintln!(
@@ -460,9 +455,10 @@ fn the_symmetric_trilithon_keeps_r_squared_of_its_energy_at_every_impact() {
         ("restitution = 1.0", 1.0),
     ] {
         let tail = "[initial]\nangles = { base_left = 0.06 }\n[analysis]\nduration = 6.0\n";
-        let (model, traj) = simulate_text(
+        let (model, traj) = common::run_model_text(
             &law.replace(|c: char| !c.is_ascii_alphanumeric(), ""),
             &with_law("trilithon", law, tail),
+            None,
         );
         assert!(traj.impacts.iter().all(|imp| imp.interfaces.len() == 4));
         let ratios = energy_ratios(&model, &traj);
@@ -528,12 +524,13 @@ fn impact_times(name: &str, law: &str, count: usize) -> Vec<f64> {
         "trilithon" => "[initial]\nangles = { base_left = 0.06 }\n[analysis]\nduration = 3.0\n",
         _ => "[initial]\nangles = { springing_right = 0.03 }\n[analysis]\nduration = 1.0\n",
     };
-    let (_, traj) = simulate_text(
+    let (_, traj) = common::run_model_text(
         &format!(
             "{name}{}",
             law.replace(|c: char| !c.is_ascii_alphanumeric(), "")
         ),
         &with_law(name, law, tail),
+        None,
     );
     assert!(
         traj.impacts.len() >= count,
@@ -611,15 +608,12 @@ fn every_bundled_model_with_every_law_loses_energy_at_every_impact() {
                 "{name}-{}",
                 law.replace(|c: char| !c.is_ascii_alphanumeric(), "")
             );
-            let path = std::env::temp_dir()
-                .join(format!("crr-every-law-{}-{tag}.toml", std::process::id()));
-            std::fs::write(&path, &model_text).unwrap();
+            let path = common::write_model(&format!("every_law_{tag}"), &model_text);
             let opts = SimulateOptions {
                 duration: Some(2.0),
                 ..Default::default()
             };
             let prepared = prepare(&path, &opts).unwrap();
-            std::fs::remove_file(&path).ok();
             let outcome = run(&prepared, false).unwrap();
             assert!(outcome.error.is_none(), "{tag}: {:?}", outcome.error);
             let traj = outcome.trajectory;

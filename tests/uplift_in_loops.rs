@@ -6,33 +6,21 @@
 //! under x alone never moved, a false "safe".
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 
 use crr::impact::{SlotState, Trajectory};
 use crr::kinematics::Model;
-use crr::simulate::{SimulateOptions, prepare, run};
 
 const G: f64 = 9.81;
 
 /// The bundled baldachin with `motion` as its `[ground_motion]` table, run for `duration`.
 fn baldachin(tag: &str, motion: &str, duration: f64) -> (Model, Trajectory) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("examples/models/baldachin.toml")).unwrap();
+    let text = common::bundled_text("baldachin");
     let cut = text.find("[ground_motion]").unwrap();
     let text = format!("{}[ground_motion]\n{motion}\n", &text[..cut]);
-    let dir = std::env::temp_dir().join(format!("crr-uplift-loops-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path: PathBuf = dir.join("baldachin.toml");
-    std::fs::write(&path, text).unwrap();
-    let opts = SimulateOptions {
-        duration: Some(duration),
-        ..Default::default()
-    };
-    let prepared = prepare(&path, &opts).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
-    let outcome = run(&prepared, false).unwrap();
-    assert!(outcome.error.is_none(), "{tag}: {:?}", outcome.error);
-    (prepared.model, outcome.trajectory)
+    common::run_model_text(&format!("baldachin_{tag}"), &text, Some(duration))
 }
 
 /// Indices of the base tilts about x (`.1`, driven by a_y) and about y (`.2`, driven by a_x).

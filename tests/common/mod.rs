@@ -56,3 +56,31 @@ pub fn refused(args: &[&str], needle: &str) {
     );
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// Writes `text` as `<tag>.toml` in a scratch folder, prepares it as `crr simulate` does
+/// (`duration` overriding `[analysis]`) and runs it in memory; the run must complete. The model
+/// file stays in the folder (the record paths of a test may be relative to it).
+pub fn run_model_text(
+    tag: &str,
+    text: &str,
+    duration: Option<f64>,
+) -> (crr::kinematics::Model, crr::impact::Trajectory) {
+    let path = write_model(tag, text);
+    let opts = crr::simulate::SimulateOptions {
+        duration,
+        ..Default::default()
+    };
+    let p = crr::simulate::prepare(&path, &opts).unwrap_or_else(|e| panic!("{tag}: {e}"));
+    let o = crr::simulate::run(&p, false).unwrap();
+    assert!(o.error.is_none(), "{tag}: {:?}", o.error);
+    (p.model, o.trajectory)
+}
+
+/// Writes `text` as `<tag>.toml` in the scratch folder `models` and returns its path.
+pub fn write_model(tag: &str, text: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("models");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{tag}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}

@@ -785,3 +785,22 @@ pub struct Trajectory {
     /// Integrator work over the whole run: steps, rejections, right-hand side evaluations.
     pub solver_stats: crr_dynamics::integrator::Stats,
 }
+
+impl Trajectory {
+    /// The results of a run that integrated nothing: no samples, impacts or peaks, at t = 0.
+    pub fn empty(model: &Model) -> Self {
+        Trajectory {
+            coordinates: model.coords.iter().map(|c| c.name.clone()).collect(),
+            samples: Vec::new(),
+            impacts: Vec::new(),
+            peaks: Vec::new(),
+            peak_abs: vec![0.0; model.dof()],
+            uplift_time: None,
+            collapse: None,
+            violation: None,
+            energy_balance_error: 0.0,
+            end_time: 0.0,
+            solver_stats: Default::default(),
+        }
+    }
+}
