@@ -11,7 +11,7 @@ use crr_kinematics::{
 };
 
 use crate::eom::{DynamicsError, constraint_row_scale};
-use crate::linalg::{JacobiSvd, pinv_solve, pivot_columns, rank};
+use crate::linalg::{JacobiSvd, pinv_solve_in, pivot_columns, rank};
 
 /// Convergence threshold of the Newton projections, relative to the model size for point rows.
 pub const CLOSURE_TOLERANCE: f64 = 1e-13;
@@ -203,7 +203,8 @@ pub fn project_positions(
 
 /// One Newton step on Φ(q) = 0 changing only the coordinates `cols`: q_cols −= (Φ_q,cols)⁺ Φ.
 fn min_norm_step(jac: &DMatrix<f64>, phi: &DVector<f64>, cols: &[usize], q: &mut DVector<f64>) {
-    let (dx, _) = pinv_solve(&jac.select_columns(cols.iter()), phi);
+    // The rank threshold is that of the whole Jacobian (see `pinv_solve_in`).
+    let (dx, _) = pinv_solve_in(&jac.select_columns(cols.iter()), phi, jac.norm());
     for (j, &c) in cols.iter().enumerate() {
         q[c] -= dx[j];
     }
@@ -223,7 +224,7 @@ pub fn project_velocities(
     let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
     let res = &jac * &*qdot;
     let sub = DMatrix::from_fn(jac.nrows(), cols.len(), |i, j| jac[(i, cols[j])]);
-    let (dx, _) = pinv_solve(&sub, &res);
+    let (dx, _) = pinv_solve_in(&sub, &res, jac.norm());
     for (j, &c) in cols.iter().enumerate() {
         qdot[c] -= dx[j];
     }

@@ -281,6 +281,21 @@ pub fn pinv_solve(a: &DMatrix<f64>, b: &DVector<f64>) -> (DVector<f64>, usize) {
     (svd.solve(b), svd.rank())
 }
 
+/// [`pinv_solve`] for a block of columns of a larger matrix whose norm is `reference`: singular
+/// values at or below `RANK_TOLERANCE · max(σ_max(A), reference)` are dropped. A block's own σ_max
+/// is the wrong scale: a coordinate that does not enter the constraints at this configuration has
+/// a column of round-off (1e-17), which a block of that column alone would invert, wiping the
+/// coordinate's velocity in a projection.
+pub fn pinv_solve_in(a: &DMatrix<f64>, b: &DVector<f64>, reference: f64) -> (DVector<f64>, usize) {
+    if a.nrows() == 0 || a.ncols() == 0 {
+        return (DVector::zeros(a.ncols()), 0);
+    }
+    let svd = JacobiSvd::thin(a);
+    let tol = svd.tolerance().max(RANK_TOLERANCE * reference);
+    let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
+    (svd.solve_with(b, tol), rank)
+}
+
 /// A⁺, the pseudo-inverse with singular values below `RANK_TOLERANCE · σ_max` dropped.
 pub fn pseudo_inverse(a: &DMatrix<f64>) -> DMatrix<f64> {
     if a.nrows() == 0 || a.ncols() == 0 {

@@ -12,7 +12,7 @@ use crr_kinematics::{
 
 use crate::closed_chain::project_positions;
 use crate::eom::{DynamicsError, constraint_row_scale};
-use crate::linalg::pinv_solve;
+use crate::linalg::pinv_solve_in;
 
 /// The reduced one-coordinate quantities at a closed configuration.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,7 +53,9 @@ pub fn reduce_at(
         let rhs = DVector::from_fn(model.constraint_rows, |i, _| {
             -s[i] * kin.phi_q[(i, coordinate)]
         });
-        let (x, rank) = pinv_solve(&jo, &rhs);
+        // Ranked against the whole scaled Jacobian, whose norm is |jo| and |rhs| together.
+        let whole = (jo.norm_squared() + rhs.norm_squared()).sqrt();
+        let (x, rank) = pinv_solve_in(&jo, &rhs, whole);
         if rank != others.len() || (&jo * &x - &rhs).amax() > 1e-9 {
             return Err(DynamicsError::Closure(format!(
                 "coordinate \"{}\" does not drive a one-DOF mechanism here (DOF(2) ≠ 1 or it is locked)",

@@ -50,16 +50,13 @@ proptest! {
         };
         let scale = model.total_mass() * model.gravity * model.size;
         prop_assert!(traj.samples.iter().all(|s| s.q.iter().chain(&s.qdot).all(|x| x.is_finite())));
-        // The energy balance closes to the integration tolerance: 1e-6 of m g L. Only on open
-        // chains: random loops can lose energy outside the impacts (found by this test:
-        // random_chain(5666421547292326072, 3, 1) under 1 m/s², 24.6 J of 26.8; open, see the
-        // issue notes), which `crr simulate` reports as a warning.
-        if closures == 0 {
-          prop_assert!(
+        // The energy balance closes to the integration tolerance: 1e-6 of m g L, on open chains
+        // and loops alike (loops lost energy outside the impacts before the projection's rank
+        // threshold was fixed: tests/projection_round_off.rs).
+        prop_assert!(
             traj.energy_balance_error <= 1e-6 * scale,
             "energy balance {} of {scale}",
             traj.energy_balance_error
-          );
-        }
+        );
     }
 }

@@ -234,7 +234,13 @@ fn random_interface(
         )
     } else {
         let u = rng.unit();
-        let d = crate::closure::perpendicular(&u) * rng.uniform(0.1, 0.5);
+        let mut d = crate::closure::perpendicular(&u) * rng.uniform(0.1, 0.5);
+        // The child's centre must lie clearly off the joint face through the two pivot lines
+        // (the model refuses a face through it): if it lies near, turn the face about u by 90°.
+        let off = |d: &Vector3<f64>| u.cross(d).normalize().dot(&(child_com - joint)).abs();
+        if off(&d) < 1e-3 * (child_com - joint).norm() {
+            d = u.cross(&d);
+        }
         let (mut pos, mut neg) = (joint - d * 0.5, joint + d * 0.5);
         if u.cross(&(neg - pos)).dot(&(child_com - pos)) < 0.0 {
             std::mem::swap(&mut pos, &mut neg);
