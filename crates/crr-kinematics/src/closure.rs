@@ -117,9 +117,7 @@ pub fn constraint_jacobian(model: &Model, data: &mut Data, pivots: &ActivePivots
 }
 
 /// The relative angles of every closure slot (in slot order, `slot_count − DOF(1)` values) from
-/// the relative rotation Γ_Aᵀ Γ_B: for a hinge the twist angle about u (swing–twist decomposition); for a rocking base the tilts θ₁
-/// about e₁ and θ₂ about e₂ with Γ_AᵀΓ_B = R(e₁, θ₁)R(e₂, θ₂). Requires
-/// [`crate::forward_kinematics`].
+/// the relative rotation Γ_Aᵀ Γ_B ([`relative_angles`]). Requires [`crate::forward_kinematics`].
 pub fn closure_angles(model: &Model, data: &Data, out: &mut [f64]) {
     let base = model.dof();
     for cl in &model.closures {
@@ -127,25 +125,47 @@ pub fn closure_angles(model: &Model, data: &Data, out: &mut [f64]) {
         let (a, b) = closure_frames(model, cl.interface);
         let rel = frame_rot(data, a).transpose() * frame_rot(data, b);
         let s0 = iface.slots.start - base;
-        match &iface.kind {
-            InterfaceKind::Hinge { axis, .. } => {
-                // Twist of the swing–twist decomposition: 2 atan2(v·u, w) of the quaternion
-                // (w, v) of Γ_AᵀΓ_B, independent of any reference direction.
-                let quat = UnitQuaternion::from_matrix(&rel);
-                let mut t = 2.0 * quat.imag().dot(axis).atan2(quat.w);
-                if t > std::f64::consts::PI {
-                    t -= 2.0 * std::f64::consts::PI;
-                } else if t <= -std::f64::consts::PI {
-                    t += 2.0 * std::f64::consts::PI;
-                }
-                out[s0] = t;
+        relative_angles(&iface.kind, &rel, &mut out[s0..s0 + iface.slots.len()]);
+    }
+}
+
+/// The angles of an interface from the relative rotation Γ_Aᵀ Γ_B of its child to its parent:
+/// for a hinge the twist angle about u (swing–twist decomposition); for a rocking base the tilts
+/// θ₁ about e₁ and θ₂ about e₂ with Γ_AᵀΓ_B = R(e₁, θ₁)R(e₂, θ₂). For a tree interface these are
+/// its coordinates; for a closure, its closure angles.
+pub fn relative_angles(kind: &InterfaceKind, rel: &Matrix3<f64>, out: &mut [f64]) {
+    match kind {
+        InterfaceKind::Hinge { axis, .. } => {
+            // Twist of the swing–twist decomposition: 2 atan2(v·u, w) of the quaternion
+            // (w, v) of Γ_AᵀΓ_B, independent of any reference direction.
+            let quat = UnitQuaternion::from_matrix(rel);
+            let mut t = 2.0 * quat.imag().dot(axis).atan2(quat.w);
+            if t > std::f64::consts::PI {
+                t -= 2.0 * std::f64::consts::PI;
+            } else if t <= -std::f64::consts::PI {
+                t += 2.0 * std::f64::consts::PI;
             }
-            InterfaceKind::RockingBase { normal, e1, e2, .. } => {
-                let r2 = rel * e2;
-                out[s0] = normal.dot(&r2).atan2(e2.dot(&r2));
-                let r1 = rel.transpose() * e1;
-                out[s0 + 1] = normal.dot(&r1).atan2(e1.dot(&r1));
-            }
+            out[0] = t;
         }
+        InterfaceKind::RockingBase { normal, e1, e2, .. } => {
+            let r2 = rel * e2;
+            out[0] = normal.dot(&r2).atan2(e2.dot(&r2));
+            let r1 = rel.transpose() * e1;
+            out[1] = normal.dot(&r1).atan2(e1.dot(&r1));
+        }
+    }
+}
+
+/// Every slot's angle (`slot_count` values: the coordinates q, then the closure angles) measured
+/// from the bodies' rotations alone, `rotations[b]` the rotation of body b from rest, e.g. poses
+/// from another engine.
+pub fn interface_angles(model: &Model, rotations: &[Matrix3<f64>], out: &mut [f64]) {
+    for iface in &model.interfaces {
+        let ra = match iface.parent {
+            crate::model::Parent::Ground => Matrix3::identity(),
+            crate::model::Parent::Body(p) => rotations[p],
+        };
+        let rel = ra.transpose() * rotations[iface.child];
+        relative_angles(&iface.kind, &rel, &mut out[iface.slots.clone()]);
     }
 }

@@ -46,7 +46,9 @@ pub mod shapes;
 pub mod spec;
 pub mod velocity;
 
-pub use closure::{closure_angles, constraint_jacobian, constraint_residual};
+pub use closure::{
+    closure_angles, constraint_jacobian, constraint_residual, interface_angles, relative_angles,
+};
 pub use data::Data;
 pub use error::ModelError;
 pub use gamma::mass_matrix_gamma;

@@ -1,0 +1,108 @@
+//! `crr-validation`: crr models run in rapier, and the validation report.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use crr::simulate::{SimulateOptions, prepare};
+use crr_validation::run::{run, write_history};
+use crr_validation::scene::Settings;
+
+/// crr-validation: cross-check crr models in rapier.
+#[derive(Parser)]
+#[command(name = "crr-validation", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a crr model file in rapier and write history.csv with crr's coordinate columns.
+    Rapier {
+        /// Model file (the one `crr simulate` reads).
+        model: PathBuf,
+        /// Output folder (default results/<model name>-rapier).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Rapier time step (s).
+        #[arg(long, default_value_t = Settings::default().dt)]
+        dt: f64,
+        /// Solver substeps per step.
+        #[arg(long, default_value_t = Settings::default().substeps)]
+        substeps: usize,
+        /// Friction coefficient.
+        #[arg(long, default_value_t = Settings::default().friction)]
+        friction: f64,
+        /// Duration (s), overriding the model's.
+        #[arg(long)]
+        duration: Option<f64>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Rapier {
+            model,
+            out,
+            dt,
+            substeps,
+            friction,
+            duration,
+        } => {
+            if !(dt.is_finite() && dt > 0.0 && friction.is_finite() && friction >= 0.0) {
+                eprintln!("crr-validation: --dt must be positive and --friction non-negative");
+                return ExitCode::from(2);
+            }
+            let opts = SimulateOptions {
+                out: None,
+                duration,
+                record: None,
+                quiet: true,
+                force: true,
+            };
+            let p = match prepare(&model, &opts) {
+                Ok(p) => p,
+                Err(e) => {
+                    eprintln!("crr-validation: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let settings = Settings {
+                dt,
+                substeps,
+                friction,
+                ..Settings::default()
+            };
+            let out = out.unwrap_or_else(|| {
+                let mut d = crr::simulate::default_out_dir(&p.file.name).into_os_string();
+                d.push("-rapier");
+                PathBuf::from(d)
+            });
+            let r = match run(&p, &settings) {
+                Ok(r) => r,
+                Err(e) => {
+                    eprintln!("crr-validation: {}: {e}", model.display());
+                    return ExitCode::from(2);
+                }
+            };
+            if let Err(e) = std::fs::create_dir_all(&out)
+                .and_then(|_| write_history(&r, &out.join("history.csv")))
+            {
+                eprintln!("crr-validation: {}: {e}", out.display());
+                return ExitCode::from(1);
+            }
+            println!(
+                "{}: rapier, {} steps of {dt} s, collapse: {}, largest slip {:.3e} m; results in {}",
+                model.display(),
+                r.steps,
+                r.collapse
+                    .map_or("no".to_string(), |t| format!("yes at t = {t} s")),
+                r.max_slip,
+                out.display()
+            );
+            ExitCode::SUCCESS
+        }
+    }
+}
