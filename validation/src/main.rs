@@ -34,6 +34,9 @@ enum Command {
         /// Friction coefficient.
         #[arg(long, default_value_t = Settings::default().friction)]
         friction: f64,
+        /// Rapier's length unit as a fraction of the model size.
+        #[arg(long, default_value_t = Settings::default().length_unit)]
+        length_unit: f64,
         /// Duration (s), overriding the model's.
         #[arg(long)]
         duration: Option<f64>,
@@ -49,10 +52,20 @@ fn main() -> ExitCode {
             dt,
             substeps,
             friction,
+            length_unit,
             duration,
         } => {
-            if !(dt.is_finite() && dt > 0.0 && friction.is_finite() && friction >= 0.0) {
-                eprintln!("crr-validation: --dt must be positive and --friction non-negative");
+            if !(dt.is_finite()
+                && dt > 0.0
+                && friction.is_finite()
+                && friction >= 0.0
+                && length_unit.is_finite()
+                && length_unit > 0.0)
+            {
+                eprintln!(
+                    "crr-validation: --dt and --length-unit must be positive, --friction \
+                     non-negative"
+                );
                 return ExitCode::from(2);
             }
             let opts = SimulateOptions {
@@ -73,6 +86,7 @@ fn main() -> ExitCode {
                 dt,
                 substeps,
                 friction,
+                length_unit,
                 ..Settings::default()
             };
             let out = out.unwrap_or_else(|| {

@@ -4,11 +4,10 @@
 //! (the angle measured from the pose is crr's initial angle, the pivot corner sits on the
 //! support). Then the first zero crossing of the block released at θ₀ = 0.1 rad: the exact time
 //! is the energy quadrature t = ∫₀^θ₀ dθ / √(2p²(cos(α − θ₀) − cos(α − θ))). crr's impact time
-//! agrees with it to 1e-6 relative. Rapier, converged in its step (2e-5 … 1e-3 s give 0.5128 …
-//! 0.5132 s) and insensitive to its contact stiffness, crosses 3.3 % late: T + U from its own
-//! velocities falls by 5 % over the quarter cycle (dissipation at the rotating edge contact).
-//! That is rapier's measured error on rocking (validation/README.md); the test bounds it at 4 %
-//! so that a regression in either engine shows.
+//! agrees with it to 1e-6 relative. Rapier, with its contact tolerances at 0.005 of the model
+//! size (at the model size it crossed 3.3 % late: a rocking edge sank and slid), crosses within
+//! 0.1 % of crr on its first two crossings (0.4968 s and 1.3575 s against 0.49656 s and
+//! 1.35850 s): the bound, 0.5 %, is asserted.
 
 use std::path::Path;
 
@@ -20,7 +19,7 @@ fn block() -> crr::simulate::Prepared {
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/models/single_block.toml");
     let opts = SimulateOptions {
         out: None,
-        duration: Some(0.7),
+        duration: Some(1.5),
         record: None,
         quiet: true,
         force: true,
@@ -79,17 +78,22 @@ fn first_crossing_of_the_free_block_in_crr_and_rapier() {
         "crr {crr_first} vs exact {exact}"
     );
     let rapier = run(&p, &Settings::default()).unwrap();
-    let first = rapier
+    let crossings: Vec<f64> = rapier
         .t
         .windows(2)
         .zip(rapier.q.windows(2))
-        .find(|(_, q)| q[0][0] > 0.0 && q[1][0] <= 0.0)
+        .filter(|(_, q)| q[0][0] != 0.0 && q[0][0] * q[1][0] < 0.0)
         .map(|(t, q)| t[0] + (t[1] - t[0]) * q[0][0] / (q[0][0] - q[1][0]))
-        .expect("rapier's block crosses 0");
-    let late = (first - exact) / exact;
-    assert!(
-        late > 0.0 && late < 0.04,
-        "rapier {first} vs exact {exact}: {late:+.4}"
-    );
-    assert!(rapier.max_slip < 1e-3, "slip {}", rapier.max_slip);
+        .collect();
+    for k in 0..2 {
+        let crr_t = crr_run.trajectory.impacts[k].t;
+        let off = (crossings[k] - crr_t) / crr_t;
+        assert!(
+            off.abs() < 5e-3,
+            "crossing {k}: rapier {} vs crr {crr_t}: {off:+.4}",
+            crossings[k]
+        );
+    }
+    // Nothing slides: the pivot corners stay within 0.1 mm of their seats.
+    assert!(rapier.max_slip < 1e-4, "slip {}", rapier.max_slip);
 }
