@@ -25,7 +25,7 @@ use crate::model_file::ModelFile;
 pub const SIZE: (u32, u32) = (1000, 700);
 
 /// The font family every text of the plots uses.
-const FONT: &str = "sans-serif";
+pub const FONT: &str = "sans-serif";
 
 /// A failure to read the results or to draw a plot.
 #[derive(Debug, thiserror::Error)]

@@ -111,6 +111,7 @@ fn check_out_dir(out: &Path, force: bool) -> Result<(), InputError> {
 }
 
 /// Everything a run needs, read and checked from the inputs.
+#[derive(Clone, Debug)]
 pub struct Prepared {
     /// The model file as read.
     pub file: ModelFile,
@@ -480,6 +481,24 @@ fn warnings(
              joints far from their seats are taken to impact together",
             num(p.params.simultaneity),
             alpha_min
+        ));
+    }
+    if let Some(v) = &t.violation {
+        let what = if v.kind == "tension" {
+            format!(
+                "would need tension (N = {:.4e} N): the bodies separate (flight)",
+                v.normal
+            )
+        } else {
+            format!(
+                "needs friction |F_t|/N = {:.4} above μ: it slides",
+                v.friction_demand
+            )
+        };
+        out.push(format!(
+            "the rigid-contact hypotheses fail at t = {} s: interface \"{}\" {what}; the results \
+             after that time are outside crr's model",
+            v.t, v.interface
         ));
     }
     out.extend(p.ground.record_warnings());

@@ -127,8 +127,33 @@ fn extra_values_in_a_record_are_a_warning() {
     );
 }
 
+/// The four-hinge arch under a one-sine pulse of 24 m/s² (2.4 g) × 0.5 s: its joint at 60°
+/// would have to pull at 0.23 s (the hypotheses monitor's normal force turns negative). Rapier,
+/// which lets the voussoirs separate, shows them flying apart and sliding 0.19 m
+/// (validation/REPORT.md): a run past that point is outside crr's model and must say so.
 #[test]
-fn the_bundled_models_run_without_warnings() {
+fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
+    let text = bundled_text("arch");
+    let cut = text.find("[initial]").unwrap();
+    let model = format!(
+        "{}[analysis]\nduration = 2.0\n\n[ground_motion]\nx = {{ one_sine_pulse = {{ amplitude = 24.0, period = 0.5 }} }}\n",
+        &text[..cut]
+    );
+    let (s, err) = run("flight", &model, &[]);
+    assert_reported("flight", &s, &err);
+    let w = warnings(&s);
+    assert!(
+        w.iter()
+            .any(|x| x.contains("\"joint_60\" would need tension")),
+        "{w:?}"
+    );
+    let v = &s["hypothesis_violation"];
+    assert_eq!(v["kind"], "tension");
+    assert!(v["normal_force"].as_f64().unwrap() < 0.0);
+}
+
+#[test]
+fn the_bundled_models_run_without_warnings_but_the_drum_columns_flight() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
     let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -152,6 +177,14 @@ fn the_bundled_models_run_without_warnings() {
         let s: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
+        // The drum column's impact at 0.422 s needs tension under the third drum (the drums
+        // above would jump): the one bundled run outside crr's model, and it says so.
+        if stem == "drum_column" {
+            let w = warnings(&s);
+            assert_eq!(w.len(), 1, "{w:?}");
+            assert!(w[0].contains("\"bed_3\" would need tension"), "{w:?}");
+            continue;
+        }
         assert!(warnings(&s).is_empty(), "{stem}: {s}");
         assert!(!err.contains("warning"), "{stem}: {err}");
     }

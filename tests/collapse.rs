@@ -75,8 +75,7 @@ fn impossible_initial_states_are_refused_naming_the_joint() {
             &block.replace("base = 0.1", &format!("base = {angle}")),
         );
         let e = prepare(&path, &SimulateOptions::default())
-            .err()
-            .expect("refused")
+            .expect_err("refused")
             .to_string();
         assert!(
             e.contains("initial angle of base") && e.contains("±π/2"),
@@ -89,8 +88,7 @@ fn impossible_initial_states_are_refused_naming_the_joint() {
         &trilithon.replace("base_left = 0.06", "base_left = 2.0"),
     );
     let e = prepare(&path, &SimulateOptions::default())
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(e.contains("±π/2"), "{e}");
 }

@@ -41,11 +41,39 @@ enum Command {
         #[arg(long)]
         duration: Option<f64>,
     },
+    /// Run the validation cases in crr and rapier and write validation/REPORT.md with its
+    /// figures in validation/report/.
+    Report {
+        /// Folder of REPORT.md (default: this package's folder, validation/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Size n of the n × n overturning map.
+        #[arg(long, default_value_t = 20)]
+        grid: usize,
+    },
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Report { out, grid } => {
+            let dir = out.unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")));
+            let start = std::time::Instant::now();
+            match crr_validation::report::write_report(&dir, grid.max(2), &Settings::default()) {
+                Ok(path) => {
+                    println!(
+                        "wrote {} in {:.0} s",
+                        path.display(),
+                        start.elapsed().as_secs_f64()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("crr-validation: report: {e}");
+                    ExitCode::from(1)
+                }
+            }
+        }
         Command::Rapier {
             model,
             out,

@@ -484,7 +484,9 @@ impl<'a> Simulation<'a> {
             if let Ok(forces) =
                 crate::monitor::contact_forces(self.model, &mut d, self.ground, t, &q, &qdot)
             {
-                let tol = 1e-9 * self.model.total_mass() * self.model.gravity;
+                let tol = crate::monitor::TENSION_TOLERANCE
+                    * self.model.total_mass()
+                    * self.model.gravity;
                 self.violation =
                     crate::monitor::check(self.model, &forces, t, self.params.friction, tol);
             }
