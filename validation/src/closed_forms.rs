@@ -22,6 +22,22 @@ impl Block {
         }
     }
 
+    /// A frame of identical columns (this block) under a cap beam of mass γ times the columns'
+    /// (Makris & Vassiliou 2013): the single-block equation with p̂² = p²(1 + 2γ)/(1 + 3γ).
+    pub fn with_cap_beam(&self, gamma: f64) -> Self {
+        Self {
+            alpha: self.alpha,
+            p: self.p * ((1.0 + 2.0 * gamma) / (1.0 + 3.0 * gamma)).sqrt(),
+        }
+    }
+
+    /// The frame's rate ratio of an impact (Makris & Vassiliou 2013), α of the columns:
+    /// r = (1 − 1.5 sin²α + 3γ cos 2α)/(1 + 3γ).
+    pub fn cap_beam_r(&self, gamma: f64) -> f64 {
+        let a = self.alpha;
+        (1.0 - 1.5 * a.sin().powi(2) + 3.0 * gamma * (2.0 * a).cos()) / (1.0 + 3.0 * gamma)
+    }
+
     /// Housner's rate ratio of an impact, r = 1 − 1.5 sin²α (angular momentum about the new
     /// corner).
     pub fn housner_r(&self) -> f64 {

@@ -458,16 +458,13 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
         "## 3–7. Structures\n\n\
          | case | coordinate | first impact crr (s) | rapier (s) | peak crr (rad) | peak rapier (rad) | difference | largest |Δq| (rad) | rapier slip (m) | expected |\n|---|---|---|---|---|---|---|---|---|---|"
     );
+    let mut losses = Vec::new();
     // Trilithon, free: Makris & Vassiliou's frame.
     let tri = bundled("trilithon", None)?;
     let gamma = tri.model.bodies[2].mass / (tri.model.bodies[0].mass + tri.model.bodies[1].mass);
     let col = Block::new(0.25, 2.0, tri.model.gravity);
-    let frame = Block {
-        alpha: col.alpha,
-        p: col.p * ((1.0 + 2.0 * gamma) / (1.0 + 3.0 * gamma)).sqrt(),
-    };
-    let r_mv = (1.0 - 1.5 * col.alpha.sin().powi(2) + 3.0 * gamma * (2.0 * col.alpha).cos())
-        / (1.0 + 3.0 * gamma);
+    let frame = col.with_cap_beam(gamma);
+    let r_mv = col.cap_beam_r(gamma);
     let mut tri_free = tri.clone();
     tri_free.params.duration = 4.0;
     let tr = crr(&tri_free)?;
@@ -489,7 +486,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
             ))
         );
     }
-    structure(
+    losses.push(structure(
         w,
         &figures,
         s,
@@ -497,8 +494,8 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
         tri_free,
         "as the block: the frame is one DOF",
         "trilithon_free.png",
-    )?;
-    structure(
+    )?);
+    losses.push(structure(
         w,
         &figures,
         s,
@@ -510,10 +507,10 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
         },
         "as the block",
         "trilithon_pulse.png",
-    )?;
+    )?);
     let mut stack = bundled("two_block_stack", None)?;
     stack.params.duration = 4.0;
-    structure(
+    losses.push(structure(
         w,
         &figures,
         s,
@@ -521,7 +518,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
         stack,
         "first peaks within rapier's error (3 %); after the first impact, the impact model",
         "stack.png",
-    )?;
+    )?);
     let record = RecordArg {
         file: Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/records/synthetic.AT2"),
         format: crr::dynamics::ground_motion::RecordFormat::PeerAt2,
@@ -531,7 +528,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
     };
     let mut drums = bundled("drum_column", Some(record))?;
     drums.params.duration = 10.0;
-    structure(
+    losses.push(structure(
         w,
         &figures,
         s,
@@ -539,10 +536,10 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
         drums,
         "the onset (first impact); afterwards many impacts under the record, each one a simultaneous-impact model (see below)",
         "drum_column.png",
-    )?;
+    )?);
     let mut bald = bundled("baldachin", None)?;
     bald.params.duration = 3.0;
-    structure(
+    losses.push(structure(
         w,
         &figures,
         s,
@@ -550,7 +547,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
         bald,
         "first tilts as the block; crr's rocking bases do not twist, rapier's columns can",
         "baldachin.png",
-    )?;
+    )?);
     let arch = bundled("arch", None)?;
     for (amp, label, fig) in [
         (6.0, "arch, pulse 6 m/s² × 0.5 s", "arch_open.png"),
@@ -568,7 +565,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
             collapse_crr.map_or("no".into(), |t| format!("at {t:.3} s")),
             collapse_rapier.map_or("no".into(), |t| format!("at {t:.3} s")),
         );
-        structure(
+        losses.push(structure(
             w,
             &figures,
             s,
@@ -576,7 +573,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
             p,
             "through the pulse as the block; after the first impact, the impact model",
             fig,
-        )?;
+        )?);
     }
     let _ = writeln!(
         w,
@@ -608,11 +605,9 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
          the two models of a simultaneous impact part.\n\n\
          | case | crr impact time | kinetic energy lost, crr | rapier |\n|---|---|---|---|"
     );
-    IMPACT_LOSSES.with(|l| {
-        for row in l.borrow_mut().drain(..) {
-            let _ = writeln!(w, "{row}");
-        }
-    });
+    for row in losses.iter().flatten() {
+        let _ = writeln!(w, "{row}");
+    }
     let _ = writeln!(
         w,
         "\n## Findings\n\n\
@@ -653,7 +648,8 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
     Ok(path)
 }
 
-/// Runs `p` in both engines and writes one table row per coordinate (up to 4) and an overlay.
+/// Runs `p` in both engines and writes one table row per coordinate (up to 4) and an overlay;
+/// returns the row of the impact-loss table, when the run has an impact after the ground motion.
 fn structure(
     w: &mut String,
     figures: &Path,
@@ -662,7 +658,7 @@ fn structure(
     p: Prepared,
     expected: &str,
     fig: &str,
-) -> Result<(), String> {
+) -> Result<Option<String>, String> {
     // Fine samples: rapier's impacts last a few ms, and its energy is read 5 ms on each side.
     let mut p = p;
     p.params.output_interval = p.params.output_interval.min(1e-3);
@@ -696,21 +692,16 @@ fn structure(
             v.t, v.interface, v.kind, v.normal
         );
     }
-    if let Some((crr_loss, rapier_loss, t)) = first_free_impact_loss(&p, &tr, &ra) {
-        IMPACT_LOSSES.with(|l| {
-            l.borrow_mut().push(format!(
+    overlay_png(&figures.join(fig), label, &series)?;
+    Ok(
+        first_free_impact_loss(&p, &tr, &ra).map(|(crr_loss, rapier_loss, t)| {
+            format!(
                 "| {label} | {t:.3} s | {:.1} % | {:.1} % |",
                 100.0 * crr_loss,
                 100.0 * rapier_loss
-            ))
-        });
-    }
-    overlay_png(&figures.join(fig), label, &series)
-}
-
-thread_local! {
-    /// Rows of the impact-loss table, gathered by [`structure`].
-    static IMPACT_LOSSES: std::cell::RefCell<Vec<String>> = const { std::cell::RefCell::new(Vec::new()) };
+            )
+        }),
+    )
 }
 
 /// The share of the kinetic energy lost at the first impact after the ground motion has ended,

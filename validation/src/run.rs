@@ -52,7 +52,8 @@ pub fn run(p: &Prepared, s: &Settings) -> Result<RapierRun, String> {
         .sum();
     let mut angles = vec![0.0; model.slot_count];
     let mut previous = vec![0.0; model.slot_count];
-    measure(model, &world, &bodies, &mut previous);
+    let mut rotations = vec![Matrix3::identity(); bodies.len()];
+    measure(model, &world, &bodies, &mut rotations, &mut previous);
     let steps = (p.params.duration / s.dt).round() as usize;
     let every = ((p.params.output_interval / s.dt).round() as usize).max(1);
     let mut record = |world: &PhysicsWorld, step: usize, angles: &[f64], previous: &[f64]| {
@@ -77,7 +78,7 @@ pub fn run(p: &Prepared, s: &Settings) -> Result<RapierRun, String> {
         let a = p.ground.acceleration(t_mid);
         world.gravity = Vector::new(-a.x, -a.y, -model.gravity - a.z);
         world.step();
-        measure(model, &world, &bodies, &mut angles);
+        measure(model, &world, &bodies, &mut rotations, &mut angles);
         if !angles.iter().all(|x| x.is_finite()) {
             return Err(format!(
                 "rapier produced a non-finite pose at t = {}",
@@ -98,13 +99,18 @@ pub fn run(p: &Prepared, s: &Settings) -> Result<RapierRun, String> {
     Ok(out)
 }
 
-/// Every slot's angle from the bodies' poses.
-fn measure(model: &Model, world: &PhysicsWorld, bodies: &[RigidBodyHandle], out: &mut [f64]) {
-    let rotations: Vec<Matrix3<f64>> = bodies
-        .iter()
-        .map(|h| rotation_matrix(&world.bodies[*h]))
-        .collect();
-    interface_angles(model, &rotations, out);
+/// Every slot's angle from the bodies' poses (`rotations` is workspace, one per body).
+fn measure(
+    model: &Model,
+    world: &PhysicsWorld,
+    bodies: &[RigidBodyHandle],
+    rotations: &mut [Matrix3<f64>],
+    out: &mut [f64],
+) {
+    for (r, h) in rotations.iter_mut().zip(bodies) {
+        *r = rotation_matrix(&world.bodies[*h]);
+    }
+    interface_angles(model, rotations, out);
 }
 
 /// Kinetic energy from rapier's velocities and the bodies' exact inertia; potential energy from

@@ -12,6 +12,7 @@
 use std::path::Path;
 
 use crr::simulate::{SimulateOptions, prepare, run as run_crr};
+use crr_validation::closed_forms::Block;
 use crr_validation::run::run;
 use crr_validation::scene::{Settings, build, rotation_matrix};
 
@@ -25,27 +26,6 @@ fn block() -> crr::simulate::Prepared {
         force: true,
     };
     prepare(&model, &opts).unwrap()
-}
-
-/// The exact quarter period from θ₀ to 0 (energy quadrature, θ = θ₀ − s² removes the
-/// endpoint singularity; 20 000 Simpson panels are exact to ~1e-12).
-fn exact_quarter(alpha: f64, p: f64, theta0: f64) -> f64 {
-    let smax = theta0.sqrt();
-    let f = |s: f64| {
-        if s == 0.0 {
-            // θ̇² ≈ 2p² sin(α − θ₀) s² near θ₀: 2s/θ̇ → 2/(p √(2 sin(α − θ₀))).
-            return 2.0 / (p * (2.0 * (alpha - theta0).sin()).sqrt());
-        }
-        let th = theta0 - s * s;
-        2.0 * s / (2.0 * p * p * ((alpha - theta0).cos() - (alpha - th).cos())).sqrt()
-    };
-    let n = 20_000;
-    let h = smax / n as f64;
-    let mut sum = f(0.0) + f(smax);
-    for i in 1..n {
-        sum += f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
-    }
-    sum * h / 3.0
 }
 
 #[test]
@@ -67,10 +47,8 @@ fn the_scene_starts_at_crrs_initial_state() {
 #[test]
 fn first_crossing_of_the_free_block_in_crr_and_rapier() {
     let p = block();
-    let (b, h) = (0.2f64, 1.0f64);
-    let (alpha, r) = ((b / h).atan(), (b * b + h * h).sqrt());
-    let pp = (3.0 * 9.81 / (4.0 * r)).sqrt();
-    let exact = exact_quarter(alpha, pp, 0.1);
+    // The exact quadrature (src/closed_forms.rs, checked against Housner's linearised period).
+    let exact = Block::new(0.2, 1.0, p.model.gravity).quarter_period(0.1);
     let crr_run = run_crr(&p, false).unwrap();
     let crr_first = crr_run.trajectory.impacts[0].t;
     assert!(

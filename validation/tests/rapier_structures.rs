@@ -22,10 +22,7 @@ fn trilithon_free_rocking_follows_makris_and_vassiliou_in_both_engines() {
     // γ = cap beam mass / column mass; the frame rocks as one column with p̂² = p²(1+2γ)/(1+3γ).
     let gamma = m.bodies[2].mass / (m.bodies[0].mass + m.bodies[1].mass);
     let column = Block::new(0.25, 2.0, m.gravity);
-    let frame = Block {
-        alpha: column.alpha,
-        p: column.p * ((1.0 + 2.0 * gamma) / (1.0 + 3.0 * gamma)).sqrt(),
-    };
+    let frame = column.with_cap_beam(gamma);
     let exact = frame.quarter_period(0.06);
     let tr = crr(&p).unwrap();
     let t_crr = tr.impacts[0].t;

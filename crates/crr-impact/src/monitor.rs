@@ -185,8 +185,8 @@ pub fn contact_forces(
 /// A pivot's normal force counts as tension (flight) below −TENSION_TOLERANCE W, W the
 /// structure's weight: a tension of a thousandth of the weight is within what the rigid-contact
 /// idealisation resolves (the drum column's pivots dip to −2e-4 W at impact instants), and the
-/// onset of a real flight grows past it within a sample or two (the arch under a 2.4 g pulse:
-/// −5e-3 W at its first sample beyond).
+/// onset of a real flight grows past it within a sample (the arch under a 2.4 g pulse: −2e-3 W
+/// at its first sample beyond with 1 ms samples, −5e-3 W with 10 ms).
 pub const TENSION_TOLERANCE: f64 = 1e-3;
 
 /// The first violation among the given contact forces at time t (tension first, then sliding
