@@ -18,8 +18,7 @@ use crr_kinematics::{
 
 use crate::ground_motion::GroundMotion;
 use crate::linalg::{
-    JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, cholesky_solve,
-    forward_substitute,
+    JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, forward_substitute,
 };
 
 /// A failure of the equations of motion at some state.
@@ -90,8 +89,17 @@ pub struct Dynamics {
     pub seat_reactions: DVector<f64>,
     /// Extra generalized force added to Q at the last evaluation (e.g. a regularised impact law).
     pub extra_force: DVector<f64>,
+    /// Cholesky factor L of M_ff, the block of M over the free (not seated) coordinates.
     factor: DMatrix<f64>,
     row_scale: DVector<f64>,
+    /// Seated tree coordinates (q̈ₖ = 0), by coordinate.
+    locked: Vec<bool>,
+    /// The coordinates not seated, in order: the columns of `factor`.
+    free: Vec<usize>,
+    /// r = Q + F_extra − h at the last evaluation (N m).
+    residual: DVector<f64>,
+    /// Working vector over the free coordinates: z_free, then q̈_f.
+    z: DVector<f64>,
 }
 
 /// A generalized force added to the equations of motion (e.g. the regularised Dirac-delta law).
@@ -176,6 +184,10 @@ impl Dynamics {
             seated: Vec::new(),
             seat_reactions: DVector::zeros(0),
             extra_force: DVector::zeros(n),
+            locked: vec![false; n],
+            free: (0..n).collect(),
+            residual: DVector::zeros(n),
+            z: DVector::zeros(n),
         }
     }
 
@@ -193,13 +205,10 @@ impl Dynamics {
         mass_matrix(model, &mut self.kin);
         velocities(model, &mut self.kin, qdot);
         velocity_product(model, &mut self.kin);
+        // One look-up of a_g(t) (a record's is a binary search) for both loads.
         let a = ground.acceleration(t);
-        generalized_gravity(
-            model,
-            &mut self.kin,
-            &effective_gravity(model, ground, t),
-            &mut self.load,
-        );
+        let g_eff = Vector3::new(-a.x, -a.y, -model.gravity - a.z);
+        generalized_gravity(model, &mut self.kin, &g_eff, &mut self.load);
         generalized_gravity(model, &mut self.kin, &(-a), &mut self.ground_force);
         if model.constraint_rows > 0 {
             constraint_jacobian(model, &mut self.kin, &self.pivots);
@@ -207,21 +216,40 @@ impl Dynamics {
         }
     }
 
-    /// Factorises M (after [`Self::evaluate`]).
+    /// Collects the free coordinates (those not seated) and factorises their block of M,
+    /// M_ff = L Lᵀ (after [`Self::evaluate`]).
     fn factorise(&mut self, model: &Model) -> Result<(), DynamicsError> {
-        self.factor.copy_from(&self.kin.mass_matrix);
+        let n = model.dof();
+        self.locked.clear();
+        self.locked.resize(n, false);
+        // On closed chains seated coordinates stay constraint rows: with the loops their
+        // reactions are statically indeterminate, and the minimum-norm multipliers over all rows
+        // together are the ones the contact forces report.
+        if model.constraint_rows == 0 {
+            for &s in &self.seated {
+                if s < n {
+                    self.locked[s] = true;
+                }
+            }
+        }
+        self.free.clear();
+        self.free.extend((0..n).filter(|&k| !self.locked[k]));
+        let nf = self.free.len();
+        if self.factor.nrows() != nf {
+            self.factor = DMatrix::zeros(nf, nf);
+        }
+        for (i, &fi) in self.free.iter().enumerate() {
+            for (j, &fj) in self.free.iter().enumerate().take(i + 1) {
+                self.factor[(i, j)] = self.kin.mass_matrix[(fi, fj)];
+            }
+        }
         cholesky_in_place(&mut self.factor).map_err(|k| DynamicsError::SingularMassMatrix {
-            coordinate: model.coords[k].name.clone(),
+            coordinate: model.coords[self.free[k]].name.clone(),
         })
     }
 
-    /// Solves M x = b with the current factor.
-    pub fn solve_mass(&self, b: &mut DVector<f64>) {
-        cholesky_solve(&self.factor, b.as_mut_slice());
-    }
-
-    /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains with nothing seated do not
-    /// allocate.
+    /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains with no seated closure
+    /// angle do not allocate.
     pub fn accelerations(
         &mut self,
         model: &Model,
@@ -234,6 +262,13 @@ impl Dynamics {
     }
 
     /// [`Self::accelerations`] with an extra generalized force.
+    ///
+    /// On open chains seated coordinates are held by eliminating them: q̈ₖ = 0 and the free
+    /// coordinates solve M_ff q̈_f = (Q − h)_f, the reaction of a seated coordinate being the
+    /// residual of its own row, M_k· q̈ + h_k − Q_k. This is Gauss' principle with the rows
+    /// eₖᵀq̈ = 0 solved exactly instead of by a rank-revealing decomposition. On closed chains
+    /// they stay rows of B (their reactions and the loops' are indeterminate together; the
+    /// minimum-norm set over all rows is the reported one).
     pub fn accelerations_with(
         &mut self,
         model: &Model,
@@ -244,39 +279,72 @@ impl Dynamics {
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
         self.evaluate(model, ground, t, q, qdot);
+        self.solve_evaluated(model, t, q, qdot, extra)
+    }
+
+    /// The solve of [`Self::accelerations_with`] on the state last given to [`Self::evaluate`]:
+    /// q̈, λ and the seat reactions for the current seated slots. The kinematics, M, h and Q do
+    /// not depend on which slots are seated, so that trying several seated sets at one state
+    /// (the uplift test) evaluates them once.
+    pub fn solve_evaluated(
+        &mut self,
+        model: &Model,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) -> Result<(), DynamicsError> {
         self.factorise(model)?;
         self.extra_force.fill(0.0);
         if let Some(f) = extra {
             f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
         }
-        // Gauss' principle in the coordinates z = Lᵀq̈ (M = L Lᵀ): z is the point of the affine set
-        // B z = −c nearest to z_free = L⁻¹(Q − h), with B = Φ' L⁻ᵀ the row-scaled closures and
-        // seated slot rows. Decomposing B (rows × DOF(1)) rather than B Bᵀ keeps the conditioning
-        // unsquared and the matrix small when many rows are redundant.
-        self.qddot.copy_from(&self.load);
-        self.qddot += &self.extra_force;
-        self.qddot -= &self.kin.velocity_product;
-        forward_substitute(&self.factor, self.qddot.as_mut_slice());
-        let rows = model.constraint_rows + self.seated.len();
-        if rows == 0 {
-            back_substitute_transposed(&self.factor, self.qddot.as_mut_slice());
-            return Ok(());
-        }
         let n = model.dof();
-        // Bᵀ = L⁻¹ (row-scaled Φ_q, seated rows)ᵀ, filled column by column.
-        let mut bt = DMatrix::zeros(n, rows);
+        let nf = self.free.len();
+        // r = Q + F_extra − h: the generalized force left for inertia and constraints.
+        self.residual.copy_from(&self.load);
+        self.residual += &self.extra_force;
+        self.residual -= &self.kin.velocity_product;
+        // Gauss' principle in the coordinates z = Lᵀq̈_f (M_ff = L Lᵀ): z is the point of the
+        // affine set B z = −c nearest to z_free = L⁻¹ r_f, with B = Φ'_f L⁻ᵀ the row-scaled closures
+        // and the seated rows not eliminated, over the free columns. Decomposing B (rows × free) rather
+        // than B Bᵀ keeps the conditioning unsquared and the matrix small when many rows are
+        // redundant.
+        self.z.resize_vertically_mut(nf, 0.0);
+        for (i, &k) in self.free.iter().enumerate() {
+            self.z[i] = self.residual[k];
+        }
+        forward_substitute(&self.factor, self.z.as_mut_slice());
+        let seated_rows = self.seated.iter().filter(|&&s| self.is_row(s)).count();
+        let rows = model.constraint_rows + seated_rows;
+        if rows == 0 {
+            back_substitute_transposed(&self.factor, self.z.as_mut_slice());
+            self.scatter_accelerations();
+            self.lambda.fill(0.0);
+            self.seat_reactions
+                .resize_vertically_mut(self.seated.len(), 0.0);
+            self.tree_reactions(None);
+            return self.check_finite(t);
+        }
+        // Bᵀ = L⁻¹ (row-scaled Φ_q, seated rows)ᵀ over the free columns, column by column.
+        let mut bt = DMatrix::zeros(nf, rows);
         for i in 0..model.constraint_rows {
-            for j in 0..n {
-                bt[(j, i)] = self.row_scale[i] * self.kin.phi_q[(i, j)];
+            for (j, &k) in self.free.iter().enumerate() {
+                bt[(j, i)] = self.row_scale[i] * self.kin.phi_q[(i, k)];
             }
         }
         let mut bias = DVector::zeros(rows);
         bias.rows_mut(0, model.constraint_rows)
             .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
+        let mut seated_row_matrix = DMatrix::zeros(n, seated_rows);
         let mut row = DVector::zeros(n);
-        for (k, &slot) in self.seated.iter().enumerate() {
+        let row_slots = self.seated.iter().copied().filter(|&s| self.is_row(s));
+        for (k, slot) in row_slots.enumerate() {
             bias[model.constraint_rows + k] = slot_row(model, &self.kin, slot, &mut row);
-            bt.column_mut(model.constraint_rows + k).copy_from(&row);
+            seated_row_matrix.column_mut(k).copy_from(&row);
+            for (j, &c) in self.free.iter().enumerate() {
+                bt[(j, model.constraint_rows + k)] = row[c];
+            }
         }
         for mut col in bt.column_iter_mut() {
             forward_substitute(&self.factor, col.as_mut_slice());
@@ -285,18 +353,69 @@ impl Dynamics {
         let svd = JacobiSvd::thin(&b);
         // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
         let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt());
-        let residual = &b * &self.qddot + &bias;
+        let residual = &b * &self.z + &bias;
         let dz = -svd.solve_with(&residual, tol);
         // z − z_free = Bᵀ λ': the minimum-norm multipliers.
         let lambda_scaled = svd.solve_transposed_with(&dz, tol);
-        self.qddot += &dz;
-        back_substitute_transposed(&self.factor, self.qddot.as_mut_slice());
+        self.z += &dz;
+        back_substitute_transposed(&self.factor, self.z.as_mut_slice());
+        self.scatter_accelerations();
         self.lambda = lambda_scaled
             .rows(0, model.constraint_rows)
             .component_mul(&self.row_scale);
-        self.seat_reactions = lambda_scaled
-            .rows(model.constraint_rows, self.seated.len())
-            .into_owned();
+        let row_reactions = lambda_scaled.rows(model.constraint_rows, seated_rows);
+        // Seat reactions in the order of `seated`: tree coordinates from their rows' residuals
+        // (below), closure angles from the decomposition.
+        self.seat_reactions
+            .resize_vertically_mut(self.seated.len(), 0.0);
+        let mut a = 0;
+        for (i, &s) in self.seated.iter().enumerate() {
+            if self.is_row(s) {
+                self.seat_reactions[i] = row_reactions[a];
+                a += 1;
+            }
+        }
+        let row_force = &seated_row_matrix * row_reactions;
+        self.tree_reactions(Some(&row_force));
+        self.check_finite(t)
+    }
+
+    /// True if seated slot `s` is held by a constraint row (a closure angle, or any slot of a
+    /// closed chain), false if eliminated (a tree coordinate of an open chain).
+    fn is_row(&self, s: usize) -> bool {
+        s >= self.locked.len() || !self.locked[s]
+    }
+
+    /// Writes q̈ from the free accelerations in `z` (seated tree coordinates: 0).
+    fn scatter_accelerations(&mut self) {
+        self.qddot.fill(0.0);
+        for (i, &k) in self.free.iter().enumerate() {
+            self.qddot[k] = self.z[i];
+        }
+    }
+
+    /// Reactions of the seated tree coordinates: the residual of their rows of the equations of
+    /// motion, M_k· q̈ − r_k − (Φ_qᵀλ)_k − (angle rows' force)_k, written in the order of `seated`
+    /// (`seat_reactions` is sized to `seated` unless only tree coordinates are seated, when the
+    /// two coincide).
+    fn tree_reactions(&mut self, row_force: Option<&DVector<f64>>) {
+        for (i, &s) in self.seated.iter().enumerate() {
+            if self.is_row(s) {
+                continue;
+            }
+            let mut reaction =
+                self.kin.mass_matrix.row(s).dot(&self.qddot.transpose()) - self.residual[s];
+            for r in 0..self.lambda.len() {
+                reaction -= self.kin.phi_q[(r, s)] * self.lambda[r];
+            }
+            if let Some(f) = row_force {
+                reaction -= f[s];
+            }
+            self.seat_reactions[i] = reaction;
+        }
+    }
+
+    fn check_finite(&self, t: f64) -> Result<(), DynamicsError> {
         if self.qddot.iter().any(|x| !x.is_finite()) {
             return Err(DynamicsError::NonFinite {
                 what: "acceleration",

@@ -100,6 +100,13 @@ pub trait EventFunctions {
     fn count(&self) -> usize;
     /// Evaluates all event functions at `(t, y)` into `g` (length `count()`).
     fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]);
+    /// Evaluates function `i` alone at `(t, y)`; root location calls only this. `g` is scratch
+    /// of length `count()`. The default evaluates them all; an implementation whose functions
+    /// differ much in cost (one needing a solve of the dynamics) overrides it.
+    fn eval_one(&mut self, i: usize, t: f64, y: &[f64], g: &mut [f64]) -> f64 {
+        self.eval(t, y, g);
+        g[i]
+    }
     /// Allowed crossing direction of function `i`.
     fn direction(&self, i: usize) -> Direction;
 }
@@ -921,8 +928,7 @@ impl Solver {
         let (t0, dim) = (*t, *dim);
         let mut g = |tt: f64| {
             dense_eval(dense, dim, t0, h, tt, y_tmp);
-            events.eval(tt, y_tmp, g_tmp);
-            g_tmp[i]
+            events.eval_one(i, tt, y_tmp, g_tmp)
         };
         let (tb, gb) = if tb_max < t1 {
             let gm = g(tb_max);

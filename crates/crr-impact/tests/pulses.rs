@@ -214,3 +214,48 @@ fn trilithon_activates_at_its_multiplier() {
         }
     }
 }
+
+/// Under a record (linear between samples) a block at rest uplifts where the interpolated
+/// acceleration first reaches g tan α: a single triangular spike rising from 0.6 g tan α to
+/// 1.5 g tan α between two samples 0.01 s apart crosses the threshold at
+/// t* = t₀ + dt (1 − 0.6)/(1.5 − 0.6). The seated state is not integrated (nothing moves): until
+/// t* every sample is exactly at rest with no work done.
+#[test]
+fn uplift_under_a_record_is_located_between_its_samples() {
+    use crr_dynamics::ground_motion::Record;
+    let (b, h): (f64, f64) = (0.2, 1.0);
+    let threshold = G * (b / h);
+    let dt = 0.01;
+    // Quiet below the threshold for 0.3 s, then the spike's rising side between samples 30 and 31.
+    let mut accel: Vec<f64> = (0..=30)
+        .map(|i| 0.6 * threshold * (i as f64 / 30.0))
+        .collect();
+    accel.extend([1.5 * threshold, 0.0, 0.0]);
+    let ground =
+        GroundMotion::from_record(Axis::X, Record::uniform(dt, accel).unwrap(), 1.0).unwrap();
+    let expected = 30.0 * dt + dt * (1.0 - 0.6) / (1.5 - 0.6);
+    let traj = run_from_rest(&single_block(b, h, 2500.0), &ground, 0.4);
+    let t_up = traj.uplift_time.expect("the block uplifts");
+    // Bisection to 1e-13·max(1, t) on the release test; its threshold (an opening acceleration
+    // of 1e-9 g/L) is passed tol/(dφ̈/dt) ≈ 8e-11 s after the acceleration crosses g tan α.
+    assert!(
+        (t_up - expected).abs() < 1e-9,
+        "uplift at {t_up}, expected {expected}"
+    );
+    for s in traj.samples.iter().filter(|s| s.t < t_up) {
+        assert_eq!(
+            (s.q[0], s.qdot[0], s.kinetic, s.work_in),
+            (0.0, 0.0, 0.0, 0.0)
+        );
+        assert_eq!(s.states[0], SlotState::Seated);
+    }
+    // Output samples every 0.01 s through the rest, none missing.
+    let before = traj.samples.iter().filter(|s| s.t < t_up).count();
+    assert_eq!(before, 31, "samples at 0, 0.01, …, 0.30 s");
+    let after = traj.samples.iter().find(|s| s.t > t_up).unwrap();
+    assert!(
+        after.q[0] < 0.0 && after.qdot[0] < 0.0,
+        "rocks on the −x edge"
+    );
+    assert_eq!(after.states[0], SlotState::Negative);
+}

@@ -70,6 +70,19 @@ impl Signal {
         }
     }
 
+    /// True if the signal is affine in t on [t0, t1], an interval with no breakpoint inside:
+    /// records (linear interpolation between samples), rectangular pulses and constants always;
+    /// sines, cosine pulses and Ricker wavelets only outside their windows.
+    pub(super) fn is_affine_on(&self, t0: f64, t1: f64) -> bool {
+        match self {
+            Signal::Record(_) | Signal::Rectangular { .. } | Signal::Constant { .. } => true,
+            Signal::Sine { start, .. } | Signal::CosinePulse { start, .. } => {
+                t1 <= *start || t0 >= self.window_end()
+            }
+            Signal::Ricker { .. } => t0 >= self.end_time(),
+        }
+    }
+
     /// Value at `t` (closed windows) or a one-sided limit.
     pub(super) fn value(&self, t: f64, side: Option<Side>) -> f64 {
         if t.is_nan() {

@@ -392,6 +392,17 @@ impl GroundMotion {
             .reduce(f64::min)
     }
 
+    /// True if every component is affine in t on [t0, t1] (an interval inside which
+    /// [`Self::next_breakpoint`] finds no breakpoint): then a quantity linear in the ground
+    /// acceleration that is positive at t1 and crossed 0 inside the interval stays positive up to
+    /// t1, so testing the interval's end detects it.
+    pub fn is_affine_on(&self, t0: f64, t1: f64) -> bool {
+        self.components
+            .iter()
+            .flatten()
+            .all(|c| c.signal.is_affine_on(t0, t1))
+    }
+
     /// Time (≥ 0) after which every component is 0 forever: the end of the last record or
     /// pulse; `f64::INFINITY` for an endless sine or a constant. A Ricker wavelet counts
     /// as over at `center + 3/frequency` (beyond it `|a| < 1e-35·|A|`). 0 for no motion.

@@ -23,6 +23,11 @@ pub(super) struct SegmentEvents<'b> {
     pub(super) angles: Vec<f64>,
     /// Present when some slot is seated: the dynamics to test releases with.
     pub(super) uplift: Option<Dynamics>,
+    /// Workspace of the uplift test (a copy of the dynamics, reused at every evaluation).
+    pub(super) trial: Dynamics,
+    /// q and q̇ of the state evaluated.
+    pub(super) q: DVector<f64>,
+    pub(super) qdot: DVector<f64>,
     pub(super) u_rest: f64,
     pub(super) energy_scale: f64,
     pub(super) collapse_drop: f64,
@@ -43,40 +48,93 @@ impl SegmentEvents<'_> {
     }
 }
 
+impl SegmentEvents<'_> {
+    /// Loads q (and q̇) from y and the slot angles of q.
+    fn load_state(&mut self, y: &[f64]) {
+        let n = self.model.dof();
+        self.q.as_mut_slice().copy_from_slice(&y[..n]);
+        self.qdot.as_mut_slice().copy_from_slice(&y[n..2 * n]);
+        slot_angles(
+            self.model,
+            &mut self.kin,
+            &self.q,
+            &self.pivots,
+            &mut self.angles,
+        );
+    }
+
+    /// The collapse function: U above its threshold, positive while standing (needs
+    /// [`Self::load_state`]).
+    fn collapse_value(&self) -> f64 {
+        if self.rocking.is_empty() {
+            1.0
+        } else {
+            (potential_energy(self.model, &self.kin) - self.u_rest) / self.energy_scale
+                + self.collapse_drop
+        }
+    }
+
+    /// The uplift function: +1 when the seated state cannot hold at t, −1 while it holds.
+    fn uplift_value(&mut self, t: f64) -> f64 {
+        let Some(template) = &self.uplift else {
+            return -1.0;
+        };
+        let opens = opening_mode_in(
+            self.model,
+            self.ground,
+            template,
+            &mut self.trial,
+            t,
+            &self.q,
+            &self.qdot,
+        )
+        .is_some();
+        if opens { 1.0 } else { -1.0 }
+    }
+
+    /// Zone edge function `j` (0-based over the zones' two edges).
+    fn zone_value(&self, j: usize) -> f64 {
+        let (slot, half) = self.zones[j / 2];
+        if j.is_multiple_of(2) {
+            self.angles[slot] - half
+        } else {
+            self.angles[slot] + half
+        }
+    }
+}
+
 impl EventFunctions for SegmentEvents<'_> {
     fn count(&self) -> usize {
         self.first_zone_index() + 2 * self.zones.len()
     }
 
     fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
-        let n = self.model.dof();
-        let q = DVector::from_column_slice(&y[..n]);
-        slot_angles(
-            self.model,
-            &mut self.kin,
-            &q,
-            &self.pivots,
-            &mut self.angles,
-        );
+        self.load_state(y);
         for (i, &(s, side)) in self.rocking.iter().enumerate() {
             g[i] = side.sign() * self.angles[s] + ROCKING_EVENT_MARGIN;
         }
-        let ci = self.collapse_index();
-        g[ci] = if self.rocking.is_empty() {
-            1.0
-        } else {
-            (potential_energy(self.model, &self.kin) - self.u_rest) / self.energy_scale
-                + self.collapse_drop
-        };
-        if let Some(template) = &self.uplift {
-            let qdot = DVector::from_column_slice(&y[n..2 * n]);
-            let opens = opening_mode(self.model, self.ground, template, t, &q, &qdot).is_some();
-            g[self.uplift_index()] = if opens { 1.0 } else { -1.0 };
+        g[self.collapse_index()] = self.collapse_value();
+        if self.uplift.is_some() {
+            g[self.uplift_index()] = self.uplift_value(t);
         }
         let z0 = self.first_zone_index();
-        for (i, &(slot, half)) in self.zones.iter().enumerate() {
-            g[z0 + 2 * i] = self.angles[slot] - half;
-            g[z0 + 2 * i + 1] = self.angles[slot] + half;
+        for j in 0..2 * self.zones.len() {
+            g[z0 + j] = self.zone_value(j);
+        }
+    }
+
+    /// One function alone: root location on an impact does not solve the uplift problem.
+    fn eval_one(&mut self, i: usize, t: f64, y: &[f64], _g: &mut [f64]) -> f64 {
+        self.load_state(y);
+        if i < self.rocking.len() {
+            let (s, side) = self.rocking[i];
+            side.sign() * self.angles[s] + ROCKING_EVENT_MARGIN
+        } else if i == self.collapse_index() {
+            self.collapse_value()
+        } else if self.uplift.is_some() && i == self.uplift_index() {
+            self.uplift_value(t)
+        } else {
+            self.zone_value(i - self.first_zone_index())
         }
     }
 

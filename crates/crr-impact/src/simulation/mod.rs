@@ -44,6 +44,7 @@ mod slots;
 use events::*;
 use impacts::*;
 pub use seating::opening_mode;
+use seating::opening_mode_in;
 pub use slots::check_initial_state;
 use slots::*;
 
@@ -272,6 +273,9 @@ pub struct Simulation<'a> {
     solver: Solver,
     regularised: Option<Regularised>,
     out_kin: Data,
+    /// Workspaces reused by every segment and sample: the events' kinematics, the uplift test's
+    /// dynamics and the monitor's dynamics (the run allocates them once, not per step).
+    spare: Workspaces,
     /// State [q, q̇, W, D] at the current time.
     y: Vec<f64>,
     t: f64,
@@ -301,6 +305,15 @@ pub struct Simulation<'a> {
     /// First failure of the no-flight (compressive contact) or no-slip hypothesis, checked at
     /// every output sample and impact instant.
     pub violation: Option<crate::monitor::Violation>,
+}
+
+/// Workspaces of a simulation reused from segment to segment (taken by a segment's events and
+/// given back after it).
+#[derive(Clone, Debug)]
+struct Workspaces {
+    events_kin: Option<Data>,
+    trial: Option<Dynamics>,
+    monitor: Dynamics,
 }
 
 impl<'a> Simulation<'a> {
@@ -370,6 +383,11 @@ impl<'a> Simulation<'a> {
             solver,
             regularised,
             out_kin: Data::new(model),
+            spare: Workspaces {
+                events_kin: Some(Data::new(model)),
+                trial: Some(Dynamics::new(model, initial.pivots.clone())),
+                monitor: Dynamics::new(model, initial.pivots.clone()),
+            },
             y,
             t: 0.0,
             seated,
@@ -480,9 +498,11 @@ impl<'a> Simulation<'a> {
             }
         }
         if self.violation.is_none() {
-            let mut d = self.dynamics.clone();
+            let d = &mut self.spare.monitor;
+            d.pivots.clone_from(&self.dynamics.pivots);
+            d.seated.clone_from(&self.dynamics.seated);
             if let Ok(forces) =
-                crate::monitor::contact_forces(self.model, &mut d, self.ground, t, &q, &qdot)
+                crate::monitor::contact_forces(self.model, d, self.ground, t, &q, &qdot)
             {
                 let tol = crate::monitor::TENSION_TOLERANCE
                     * self.model.total_mass()
@@ -532,6 +552,11 @@ impl<'a> Simulation<'a> {
         if segment_end > self.t {
             t_stop = t_stop.min(segment_end);
         }
+        if lift_off.is_none()
+            && let Some(stop) = self.rest_until_uplift(t_stop)?
+        {
+            return Ok(stop);
+        }
         let rocking: Vec<(usize, Side)> = (0..model.slot_count)
             .filter(|&s| !self.seated[s])
             .map(|s| (s, self.dynamics.pivots.sides[s]))
@@ -540,10 +565,21 @@ impl<'a> Simulation<'a> {
             model,
             ground: self.ground,
             rocking,
-            kin: Data::new(model),
+            kin: self
+                .spare
+                .events_kin
+                .take()
+                .unwrap_or_else(|| Data::new(model)),
             pivots: self.dynamics.pivots.clone(),
             angles: vec![0.0; model.slot_count],
             uplift: (!self.dynamics.seated.is_empty()).then(|| self.dynamics.clone()),
+            trial: self
+                .spare
+                .trial
+                .take()
+                .unwrap_or_else(|| self.dynamics.clone()),
+            q: DVector::zeros(n),
+            qdot: DVector::zeros(n),
             u_rest: self.u_rest,
             energy_scale: model.total_mass() * model.gravity * model.size,
             collapse_drop: self.params.collapse_drop,
@@ -644,6 +680,16 @@ impl<'a> Simulation<'a> {
             .solver
             .advance(&mut sys, t_stop, &mut events, &mut on_step);
         drop(sys);
+        let (collapse_index, first_zone_index) =
+            (events.collapse_index(), events.first_zone_index());
+        let SegmentEvents {
+            kin: events_kin,
+            trial,
+            rocking,
+            ..
+        } = events;
+        self.spare.events_kin = Some(events_kin);
+        self.spare.trial = Some(trial);
         self.next_sample = next_sample;
         self.peaks.extend(peaks);
         for (t, y) in pending {
@@ -666,10 +712,10 @@ impl<'a> Simulation<'a> {
                 Ok(StopReason::Breakpoint(self.t))
             }
             Stop::Event { index, .. } => {
-                if index < events.rocking.len() {
-                    let slot = events.rocking[index].0;
+                if index < rocking.len() {
+                    let slot = rocking[index].0;
                     self.impact(slot).map(StopReason::Impact)
-                } else if index == events.collapse_index() {
+                } else if index == collapse_index {
                     let (q, qdot) = (self.q(), self.qdot());
                     if q.dot(&qdot) > 0.0 {
                         let c = self.collapse_record();
@@ -682,7 +728,7 @@ impl<'a> Simulation<'a> {
                         self.reset_solver();
                         Ok(StopReason::Breakpoint(self.t))
                     }
-                } else if index >= events.first_zone_index() {
+                } else if index >= first_zone_index {
                     // Entering or leaving a regularised δ zone: restart with a fresh step size.
                     self.reset_solver();
                     Ok(StopReason::Breakpoint(self.t))

@@ -17,29 +17,64 @@ pub fn opening_mode(
     q: &DVector<f64>,
     qdot: &DVector<f64>,
 ) -> Option<Vec<(usize, Side)>> {
+    let mut trial = template.clone();
+    opening_mode_in(model, ground, template, &mut trial, t, q, qdot)
+}
+
+/// [`opening_mode`] with a workspace: `trial` is any [`Dynamics`] of the same model (its pivots
+/// and seated slots are overwritten), so that the uplift test at every step allocates no
+/// workspace of the dynamics.
+pub(super) fn opening_mode_in(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<Vec<(usize, Side)>> {
     let seated = template.seated.clone();
     if seated.is_empty() {
         return None;
     }
     let tol = 1e-9 * model.gravity / model.size;
     let mut row = DVector::zeros(model.dof());
-    let mut trial = template.clone();
-    let mut accel = |trial: &mut Dynamics, slot: usize| -> Option<f64> {
-        trial.accelerations(model, ground, t, q, qdot).ok()?;
+    let mut accel = |trial: &mut Dynamics, slot: usize, evaluated: bool| -> Option<f64> {
+        if evaluated {
+            trial.solve_evaluated(model, t, q, qdot, None).ok()?;
+        } else {
+            trial.accelerations(model, ground, t, q, qdot).ok()?;
+        }
         let bias = slot_row(model, &trial.kin, slot, &mut row);
         Some(row.dot(&trial.qddot) + bias)
     };
+    // Opening acceleration of each single release (slot, side), indexed 2i (positive side) and
+    // 2i + 1 (negative). The releases on the slots' current sides share the template's chain,
+    // evaluated once; a release on the other side changes the chain and is evaluated anew.
+    let mut opening: Vec<Option<f64>> = vec![None; 2 * seated.len()];
+    let side_index = |side: Side| usize::from(side == Side::Negative);
+    trial.pivots.clone_from(&template.pivots);
+    trial.evaluate(model, ground, t, q, qdot);
+    for (i, &k) in seated.iter().enumerate() {
+        let side = template.pivots.sides[k];
+        trial.seated = seated.iter().copied().filter(|&s| s != k).collect();
+        opening[2 * i + side_index(side)] = accel(trial, k, true).map(|a| side.sign() * a);
+    }
+    for (i, &k) in seated.iter().enumerate() {
+        let side = template.pivots.sides[k].flipped();
+        trial.seated = seated.iter().copied().filter(|&s| s != k).collect();
+        trial.pivots.clone_from(&template.pivots);
+        trial.pivots.sides[k] = side;
+        opening[2 * i + side_index(side)] = accel(trial, k, false).map(|a| side.sign() * a);
+    }
     let mut best: Option<(usize, Side, f64)> = None;
-    for &k in &seated {
+    for (i, &k) in seated.iter().enumerate() {
         for side in [Side::Positive, Side::Negative] {
-            trial.seated = seated.iter().copied().filter(|&s| s != k).collect();
-            trial.pivots = template.pivots.clone();
-            trial.pivots.sides[k] = side;
-            if let Some(a) = accel(&mut trial, k) {
-                let opening = side.sign() * a;
-                if opening > tol && best.is_none_or(|b| opening > b.2) {
-                    best = Some((k, side, opening));
-                }
+            if let Some(o) = opening[2 * i + side_index(side)]
+                && o > tol
+                && best.is_none_or(|b| o > b.2)
+            {
+                best = Some((k, side, o));
             }
         }
     }
@@ -66,7 +101,7 @@ pub fn opening_mode(
             .copied()
             .filter(|s| !released.iter().any(|r| r.0 == *s))
             .collect();
-        trial.pivots = template.pivots.clone();
+        trial.pivots.clone_from(&template.pivots);
         for &(s, side, _) in &released {
             trial.pivots.sides[s] = side;
         }
@@ -122,6 +157,93 @@ impl Simulation<'_> {
             self.reset_solver();
         }
         Ok(mode)
+    }
+
+    /// At rest with every tree coordinate seated nothing moves (q = 0 on the seated angles,
+    /// q̇ = 0, hence Ẇ = 0) until the seated state cannot hold: instead of integrating a
+    /// constant state, the uplift test is evaluated on a time grid up to `t_stop` and its first
+    /// failure located by bisection to 1e-13·max(1, t), the precision of the integrator's event
+    /// location. The grid is the integrator's step cap while seated ([`SEATED_MAX_STEP`]), or
+    /// the whole interval when the test cannot change inside it: after the ground motion ends,
+    /// and on open chains while the ground motion is affine in t (records between samples),
+    /// since at rest each single release's opening acceleration is linear in g_eff(t) and, once
+    /// past its threshold inside the interval, stays past it to the end. Output samples of the
+    /// interval are recorded. Returns None (nothing done) unless every tree coordinate is seated.
+    pub(super) fn rest_until_uplift(
+        &mut self,
+        t_stop: f64,
+    ) -> Result<Option<StopReason>, SimulationError> {
+        let model = self.model;
+        let n = model.dof();
+        if !self.seated[..n].iter().all(|&s| s) || self.t >= t_stop {
+            return Ok(None);
+        }
+        // Seated coordinates are held at exactly 0 with rate 0 (projection after every step).
+        for k in 0..n {
+            self.y[k] = 0.0;
+            self.y[n + k] = 0.0;
+        }
+        let (q, qdot) = (self.q(), self.qdot());
+        let mut trial = self
+            .spare
+            .trial
+            .take()
+            .unwrap_or_else(|| self.dynamics.clone());
+        let (ground, template) = (self.ground, &self.dynamics);
+        let mut opens =
+            |t: f64| opening_mode_in(model, ground, template, &mut trial, t, &q, &qdot).is_some();
+        let mut found = None;
+        let mut t0 = self.t;
+        while t0 < t_stop {
+            let whole = ground.duration() <= t0
+                || (model.constraint_rows == 0 && ground.is_affine_on(t0, t_stop));
+            let t1 = if whole {
+                t_stop
+            } else {
+                (t0 + SEATED_MAX_STEP).min(t_stop)
+            };
+            if opens(t1) {
+                let (mut lo, mut hi) = (t0, t1);
+                while hi - lo > 1e-13 * hi.abs().max(1.0) {
+                    let mid = 0.5 * (lo + hi);
+                    if opens(mid) {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                found = Some(hi);
+                break;
+            }
+            t0 = t1;
+        }
+        self.spare.trial = Some(trial);
+        let t_end = found.unwrap_or(t_stop);
+        let dt = self.params.output_interval;
+        let y = self.y.clone();
+        while (self.next_sample as f64) * dt <= t_end + 1e-12 * dt
+            && (self.next_sample as f64) * dt <= self.params.duration + 1e-12 * dt
+        {
+            let s = self.sample_at(self.next_sample as f64 * dt, &y);
+            self.record_sample(s);
+            self.next_sample += 1;
+        }
+        self.t = t_end;
+        self.reset_solver();
+        if found.is_some()
+            && let Some(mode) = self.release_if_opening()?
+        {
+            return Ok(Some(StopReason::Uplift(self.t, mode)));
+        }
+        if self.t >= self.params.duration {
+            self.finished = true;
+            if self.last_sample_t < self.t {
+                let s = self.sample_at(self.t, &y);
+                self.record_sample(s);
+            }
+            return Ok(Some(StopReason::End(self.t)));
+        }
+        Ok(Some(StopReason::Breakpoint(self.t)))
     }
 
     /// Seats rocking joints that sit at φ ≈ 0 with a negligible rate while their acceleration

@@ -1,0 +1,135 @@
+//! Seated coordinates held by elimination (q̈ₖ = 0, the free block of M solved alone), checked
+//! against Newton–Euler on the bodies: the accelerations of the bodies come from central
+//! differences of the forward kinematics along q(t) = q + q̇t + ½q̈t², never from M, h or Q.
+
+use nalgebra::{DVector, Vector3};
+
+use crr_dynamics::Dynamics;
+use crr_dynamics::ground_motion::GroundMotion;
+use crr_kinematics::fixtures::serial_chain;
+use crr_kinematics::mass_matrix::world_inertia;
+use crr_kinematics::{ActivePivots, Data, Model, Side, forward_kinematics};
+
+/// Centres and angular momenta about the centres of the bodies at q(t), q̇(t).
+fn bodies_at(
+    model: &Model,
+    data: &mut Data,
+    pivots: &ActivePivots,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    forward_kinematics(model, data, q, pivots);
+    model
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(b, body)| {
+            let k = model.body_coord[b];
+            // ω = Σ over the path of the axes times their rates.
+            let mut omega = Vector3::zeros();
+            let mut j = Some(k);
+            while let Some(jj) = j {
+                omega += data.axis[jj] * qdot[jj];
+                j = model.coords[jj].parent;
+            }
+            let inertia = world_inertia(body, &data.rot_ops[k]);
+            (data.com[b], inertia * omega)
+        })
+        .collect()
+}
+
+/// For each coordinate k, w_k · Σ over its subtree of [(c − p_k) × m(c̈ − g) + Ḣ]: the moment
+/// the joint must carry about its axis (0 at a free joint, the reaction at a seated one).
+fn joint_moments(
+    model: &Model,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    qddot: &DVector<f64>,
+) -> Vec<f64> {
+    let pivots = ActivePivots::uniform(model, Side::Positive);
+    let mut data = Data::new(model);
+    let h = 1e-4;
+    let mut at = |t: f64| {
+        let qt = q + qdot * t + qddot * (0.5 * t * t);
+        let qdt = qdot + qddot * t;
+        bodies_at(model, &mut data, &pivots, &qt, &qdt)
+    };
+    let (minus, zero, plus) = (at(-h), at(0.0), at(h));
+    forward_kinematics(model, &mut data, q, &pivots);
+    let g = Vector3::new(0.0, 0.0, -model.gravity);
+    (0..model.dof())
+        .map(|k| {
+            let mut moment = Vector3::zeros();
+            for (b, body) in model.bodies.iter().enumerate() {
+                // Body b is in the subtree of k when k is on its coordinate's path.
+                let mut j = Some(model.body_coord[b]);
+                let mut inside = false;
+                while let Some(jj) = j {
+                    inside |= jj == k;
+                    j = model.coords[jj].parent;
+                }
+                if !inside {
+                    continue;
+                }
+                let c = zero[b].0;
+                let c_ddot = (plus[b].0 - 2.0 * c + minus[b].0) / (h * h);
+                let h_dot = (plus[b].1 - minus[b].1) / (2.0 * h);
+                moment += (c - data.pivot[k]).cross(&(body.mass * (c_ddot - g))) + h_dot;
+            }
+            data.axis[k].dot(&moment)
+        })
+        .collect()
+}
+
+#[test]
+fn seated_coordinates_carry_the_newton_euler_moments() {
+    let model = Model::from_spec(&serial_chain(4)).unwrap();
+    let ground = GroundMotion::none();
+    // Scale of the joint moments: m g L of the whole chain.
+    let scale = model.total_mass() * model.gravity * model.size;
+    for seated in [vec![1], vec![0, 2], vec![3], vec![0, 1, 2, 3]] {
+        let q = DVector::from_fn(4, |k, _| {
+            if seated.contains(&k) {
+                0.0
+            } else {
+                0.4 * ((k + 1) as f64).sin()
+            }
+        });
+        let qdot = DVector::from_fn(4, |k, _| {
+            if seated.contains(&k) {
+                0.0
+            } else {
+                0.7 * ((2 * k + 1) as f64).cos()
+            }
+        });
+        let mut dynamics = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+        dynamics.seated = seated.clone();
+        dynamics
+            .accelerations(&model, &ground, 0.0, &q, &qdot)
+            .unwrap();
+        let moments = joint_moments(&model, &q, &qdot, &dynamics.qddot);
+        for k in 0..4 {
+            match seated.iter().position(|&s| s == k) {
+                Some(i) => {
+                    assert_eq!(dynamics.qddot[k], 0.0, "seated {seated:?}: q̈{k}");
+                    // Central differences with h = 1e-4: truncation ~h²·|d⁴x/dt⁴|, round-off
+                    // ~ε/h² of the positions: both below 1e-6 of m g L here.
+                    let err = (dynamics.seat_reactions[i] - moments[k]).abs() / scale;
+                    assert!(
+                        err < 1e-6,
+                        "seated {seated:?}: reaction {k} = {} vs Newton–Euler {} ({err:e})",
+                        dynamics.seat_reactions[i],
+                        moments[k]
+                    );
+                }
+                None => {
+                    let err = moments[k].abs() / scale;
+                    assert!(
+                        err < 1e-6,
+                        "seated {seated:?}: free joint {k} carries {err:e} m g L"
+                    );
+                }
+            }
+        }
+    }
+}
