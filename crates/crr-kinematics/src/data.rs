@@ -26,7 +26,8 @@ pub struct Data {
     pub com: Vec<Vector3<f64>>,
 
     // --- filled by `jacobians` ---
-    /// J_c: centre-of-mass Jacobians, rows 3n..3n+3 for body n (m/rad), DOF(1) columns.
+    /// J_c: centre-of-mass Jacobians, rows 3n..3n+3 for body n (m/rad), DOF(1) columns (0 × 0
+    /// until the first `jacobians` call).
     pub com_jacobian: DMatrix<f64>,
     /// J_ω: angular-velocity Jacobians, rows 3n..3n+3 for body n (1/rad → rad/s per rad/s).
     pub angular_jacobian: DMatrix<f64>,
@@ -71,7 +72,6 @@ impl Data {
     /// Allocates the workspace for `model`.
     pub fn new(model: &Model) -> Self {
         let n = model.dof();
-        let nb = model.bodies.len();
         Self {
             rot_ops: vec![Matrix3::identity(); n],
             frame_translation: vec![Vector3::zeros(); n],
@@ -79,8 +79,9 @@ impl Data {
             pivot_rest: vec![Vector3::zeros(); n],
             pivot: vec![Vector3::zeros(); n],
             com: model.bodies.iter().map(|b| b.com).collect(),
-            com_jacobian: DMatrix::zeros(3 * nb, n),
-            angular_jacobian: DMatrix::zeros(3 * nb, n),
+            // Allocated by the first `jacobians` call: the hot path never reads them.
+            com_jacobian: DMatrix::zeros(0, 0),
+            angular_jacobian: DMatrix::zeros(0, 0),
             composite_inertia: vec![Matrix6::zeros(); n],
             mass_matrix: DMatrix::zeros(n, n),
             subtree_mass: vec![0.0; n],

@@ -1,6 +1,6 @@
 //! Forward kinematics along the dynamic chain (eq 1) and the body Jacobians.
 
-use nalgebra::{DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use crate::data::Data;
 use crate::model::{Model, Parent};
@@ -63,6 +63,11 @@ pub fn frame_point(data: &Data, k: Option<usize>, x_rest: &Vector3<f64>) -> Vect
 /// Fills the centre-of-mass and angular-velocity Jacobians J_c and J_ω of every body (ċ = J_c q̇,
 /// ω = J_ω q̇), after [`forward_kinematics`].
 pub fn jacobians(model: &Model, data: &mut Data) {
+    let shape = (3 * model.bodies.len(), model.dof());
+    if data.com_jacobian.shape() != shape {
+        data.com_jacobian = DMatrix::zeros(shape.0, shape.1);
+        data.angular_jacobian = DMatrix::zeros(shape.0, shape.1);
+    }
     data.com_jacobian.fill(0.0);
     data.angular_jacobian.fill(0.0);
     for b in 0..model.bodies.len() {

@@ -54,7 +54,9 @@ pub use error::ModelError;
 pub use gamma::mass_matrix_gamma;
 pub use kinematics::{body_point, body_rotation, forward_kinematics, jacobians};
 pub use mass_matrix::{kinetic_energy, mass_matrix, mass_matrix_from_jacobians};
-pub use model::{Body, Closure, Coordinate, Interface, InterfaceKind, Model, Parent, Role, Side};
+pub use model::{
+    Body, Closure, Coordinate, Interface, InterfaceKind, MAX_COORDINATES, Model, Parent, Role, Side,
+};
 pub use pivots::ActivePivots;
 pub use potential::{generalized_gravity, potential_energy};
 pub use spec::{

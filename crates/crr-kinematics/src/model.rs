@@ -536,6 +536,26 @@ fn rocking_base_kind(
     })
 }
 
+/// The largest DOF(1) a model may have: the equations of motion, the impact laws and the
+/// workspaces are dense (n × n matrices, Cholesky and rank-revealing factorisations), so a larger
+/// model would allocate gigabytes (20 000 coordinates: 3.2 GB per matrix) and take minutes per
+/// evaluation. Refused by [`Model::from_spec`] before anything of that size is allocated.
+pub const MAX_COORDINATES: usize = 2048;
+
+/// The error of a model over [`MAX_COORDINATES`] (`n` coordinates, or `at_least` n).
+fn too_many_coordinates(name: &str, n: usize, at_least: &str) -> ModelError {
+    let gb = (n * n * 8) as f64 / 1e9;
+    ModelError::new(
+        quoted("model", name),
+        format!(
+            "has DOF(1) = {at_least}{n} coordinates, more than the {MAX_COORDINATES} that crr's \
+             dense equations of motion handle (one n × n mass matrix alone would take {gb:.1} GB, \
+             and its factorisation O(n³) work at every evaluation); simulate the structure's \
+             independent parts as separate models"
+        ),
+    )
+}
+
 impl Model {
     /// Validates a description and builds the model: mass properties, interface geometry, the
     /// spanning tree from the ground (coordinates in breadth-first order, interfaces in file order)
@@ -551,6 +571,15 @@ impl Model {
             return Err(ModelError::new(
                 quoted("model", &spec.name),
                 "has no bodies",
+            ));
+        }
+        // Every body moves with at least one coordinate of its own: more bodies than
+        // MAX_COORDINATES are refused before any per-body work.
+        if spec.body.len() > MAX_COORDINATES {
+            return Err(too_many_coordinates(
+                &spec.name,
+                spec.body.len(),
+                "at least ",
             ));
         }
         let mut body_index = HashMap::new();
@@ -811,6 +840,9 @@ impl Model {
         }
         let closure_rows = row;
         let row = row + symmetries.len();
+        if coords.len() > MAX_COORDINATES {
+            return Err(too_many_coordinates(&spec.name, coords.len(), ""));
+        }
         let interfaces = ends
             .into_iter()
             .enumerate()

@@ -328,3 +328,60 @@ fn unknown_fields_are_rejected_by_the_parser() {
         .unwrap_err();
     assert!(e.to_string().contains("densty"), "{e}");
 }
+
+/// Models beyond `MAX_COORDINATES` are refused naming the model and the count: by their number
+/// of bodies before any per-body work (10 000 blocks), and by their coordinates once counted
+/// (1 025 blocks on rocking bases have two tilts each: 2 050 coordinates). One under the limit
+/// (1 024 blocks, 2 048 coordinates) builds.
+#[test]
+fn models_beyond_the_dense_size_are_refused() {
+    use crr_kinematics::MAX_COORDINATES;
+    use crr_kinematics::fixtures::{box_body, rocking_base};
+    let blocks = |n: usize| StructureSpec {
+        name: format!("field_{n}"),
+        gravity: 9.81,
+        body: (0..n)
+            .map(|i| {
+                box_body(
+                    &format!("b{i}"),
+                    2500.0,
+                    [3.0 * i as f64, 0.0, 1.0],
+                    [0.4, 0.4, 2.0],
+                )
+            })
+            .collect(),
+        interface: (0..n)
+            .map(|i| {
+                let x = 3.0 * i as f64;
+                rocking_base(
+                    &format!("base{i}"),
+                    "ground",
+                    &format!("b{i}"),
+                    [
+                        [x - 0.2, -0.2, 0.0],
+                        [x + 0.2, -0.2, 0.0],
+                        [x + 0.2, 0.2, 0.0],
+                        [x - 0.2, 0.2, 0.0],
+                    ],
+                )
+            })
+            .collect(),
+        symmetry: Vec::new(),
+    };
+    let e = Model::from_spec(&blocks(10_000)).expect_err("10 000 bodies");
+    assert_eq!(e.item, "model \"field_10000\"");
+    assert!(
+        e.problem.contains("at least 10000 coordinates"),
+        "{}",
+        e.problem
+    );
+    let e = Model::from_spec(&blocks(1025)).expect_err("2 050 coordinates");
+    assert!(
+        e.problem.contains("DOF(1) = 2050 coordinates"),
+        "{}",
+        e.problem
+    );
+    assert!(e.problem.contains(&MAX_COORDINATES.to_string()));
+    let model = Model::from_spec(&blocks(1024)).expect("2 048 coordinates build");
+    assert_eq!(model.dof(), MAX_COORDINATES);
+}
