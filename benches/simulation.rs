@@ -3,7 +3,11 @@
 //! - `pulse`: a trilithon and a two-sided four-hinge arch from rest under a one-sine pulse in x
 //!   that rocks them without collapse, 5 s;
 //! - `drum_column`: a column of 8 drums and a capital (9 two-sided hinges about y) under a 20 s
-//!   synthetic accelerogram (smoothed, enveloped white noise from a fixed seed, PGA 0.3 g).
+//!   synthetic accelerogram (smoothed, enveloped white noise from a fixed seed, PGA 0.3 g);
+//! - `bundled_models`: the files of `examples/models` as `crr simulate` runs them (model,
+//!   ground motion, initial state and `[analysis]` from the file; no output written);
+//! - `many_bodies`: how a run grows with the number of bodies: a stack of n drums standing
+//!   seated for 0.5 s, and n free-standing blocks of distinct sizes under one sine pulse for 1 s.
 //!
 //! Models, ground motions and initial states are built outside the timing; each run is checked
 //! once before it is timed (it rocks, it does not collapse where it must not, no impact gains
@@ -24,7 +28,7 @@ use crr_dynamics::integrator::Options;
 use crr_dynamics::{InitialSpec, InitialState, equivalent_block, solve_initial};
 use crr_impact::{Parameters, Simulation, Trajectory};
 use crr_kinematics::fixtures::{
-    SplitMix, box_body, colonnade, four_hinge_arch, oriented_hinge, single_block, trilithon,
+    SplitMix, box_body, colonnade, four_hinge_arch, hinge, oriented_hinge, single_block, trilithon,
 };
 use crr_kinematics::spec::DEFAULT_GRAVITY;
 use crr_kinematics::{Model, StructureSpec};
@@ -293,5 +297,187 @@ fn drum_column_record(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, free_rocking, pulse, drum_column_record);
+fn bundled_models(c: &mut Criterion) {
+    let mut group = c.benchmark_group("bundled_models");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["block_record", "drum_column", "baldachin"] {
+        let path = root.join("examples/models").join(format!("{name}.toml"));
+        let opts = crr::simulate::SimulateOptions {
+            // Nothing is written: only the output folder's check reads this path.
+            out: Some(std::env::temp_dir().join("crr-bench-unused")),
+            force: true,
+            quiet: true,
+            ..Default::default()
+        };
+        let prepared = crr::simulate::prepare(&path, &opts).expect("bundled model");
+        let outcome = crr::simulate::run(&prepared, false).expect("runs");
+        assert!(outcome.error.is_none(), "{name}: {:?}", outcome.error);
+        check(&format!("bundled_models/{name}"), &outcome.trajectory, None);
+        group.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter(|| black_box(crr::simulate::run(black_box(&prepared), false).expect("runs")));
+        });
+    }
+    group.finish();
+}
+
+/// A stack of `n` drums 0.6 × 0.6 × 0.5 m on two-sided hinges about y.
+fn drum_stack(n: usize) -> StructureSpec {
+    let body = (0..n)
+        .map(|i| {
+            box_body(
+                &format!("drum_{i}"),
+                2500.0,
+                [0.0, 0.0, 0.25 + 0.5 * i as f64],
+                [0.6, 0.6, 0.5],
+            )
+        })
+        .collect();
+    let interface = (0..n)
+        .map(|i| {
+            let z = 0.5 * i as f64;
+            let parent = if i == 0 {
+                "ground".to_string()
+            } else {
+                format!("drum_{}", i - 1)
+            };
+            two_sided_hinge(
+                &format!("bed_{i}"),
+                &parent,
+                &format!("drum_{i}"),
+                0.0,
+                0.3,
+                z,
+            )
+        })
+        .collect();
+    StructureSpec {
+        name: format!("stack_{n}"),
+        gravity: G,
+        body,
+        interface,
+        symmetry: Vec::new(),
+    }
+}
+
+/// `n` free-standing blocks 3 m apart, half-widths 0.2 + 0.002 i and half-heights 1 + 0.01 i
+/// (distinct slendernesses, so that their impacts do not coincide).
+fn block_field(n: usize) -> StructureSpec {
+    let dims: Vec<(f64, f64, f64)> = (0..n)
+        .map(|i| {
+            (
+                3.0 * i as f64,
+                0.2 + 0.002 * i as f64,
+                1.0 + 0.01 * i as f64,
+            )
+        })
+        .collect();
+    StructureSpec {
+        name: format!("blocks_{n}"),
+        gravity: G,
+        body: dims
+            .iter()
+            .enumerate()
+            .map(|(i, &(x, b, h))| {
+                box_body(
+                    &format!("block_{i}"),
+                    2500.0,
+                    [x, 0.0, h],
+                    [2.0 * b, 0.4, 2.0 * h],
+                )
+            })
+            .collect(),
+        interface: dims
+            .iter()
+            .enumerate()
+            .map(|(i, &(x, b, _))| {
+                two_sided_hinge(
+                    &format!("base_{i}"),
+                    "ground",
+                    &format!("block_{i}"),
+                    x,
+                    b,
+                    0.0,
+                )
+            })
+            .collect(),
+        symmetry: Vec::new(),
+    }
+}
+
+/// A hinge about y with pivot lines at x = x₀ ± b (P⁺ on +x), height z.
+fn two_sided_hinge(
+    name: &str,
+    parent: &str,
+    child: &str,
+    x0: f64,
+    b: f64,
+    z: f64,
+) -> crr_kinematics::InterfaceSpec {
+    hinge(
+        name,
+        parent,
+        child,
+        [0.0, 1.0, 0.0],
+        [x0 + b, 0.0, z],
+        [x0 - b, 0.0, z],
+    )
+}
+
+fn many_bodies(c: &mut Criterion) {
+    let mut group = c.benchmark_group("many_bodies");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(200))
+        .measurement_time(Duration::from_secs(3));
+    for n in [10, 30, 100] {
+        let model = Model::from_spec(&drum_stack(n)).expect("valid stack");
+        let params = Parameters {
+            duration: 0.5,
+            ..Parameters::default()
+        };
+        let ground = GroundMotion::none();
+        let init = at_rest(&model);
+        check(
+            &format!("many_bodies/stack_at_rest/{n}"),
+            &run(&model, &ground, &init, params.clone()),
+            Some(false),
+        );
+        group.bench_function(BenchmarkId::new("stack_at_rest", n), |b| {
+            b.iter(|| black_box(run(&model, &ground, black_box(&init), params.clone())));
+        });
+    }
+    for n in [5, 10, 20] {
+        let model = Model::from_spec(&block_field(n)).expect("valid blocks");
+        let params = Parameters {
+            duration: 1.0,
+            ..Parameters::default()
+        };
+        let ground = sine_pulse_x(3.0, 0.5);
+        let init = at_rest(&model);
+        let traj = run(&model, &ground, &init, params.clone());
+        assert!(traj.uplift_time.is_some(), "blocks_{n}: no uplift");
+        check(
+            &format!("many_bodies/blocks_under_pulse/{n}"),
+            &traj,
+            Some(false),
+        );
+        group.bench_function(BenchmarkId::new("blocks_under_pulse", n), |b| {
+            b.iter(|| black_box(run(&model, &ground, black_box(&init), params.clone())));
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    free_rocking,
+    pulse,
+    drum_column_record,
+    bundled_models,
+    many_bodies
+);
 criterion_main!(benches);

@@ -89,6 +89,12 @@ pub struct Dynamics {
     pub seat_reactions: DVector<f64>,
     /// Extra generalized force added to Q at the last evaluation (e.g. a regularised impact law).
     pub extra_force: DVector<f64>,
+    /// On closed chains, solve the seated coordinates as constraint rows with the loops, so that
+    /// λ and the seat reactions are the minimum-norm set over all rows (what the contact forces
+    /// report; the default). When false they are eliminated like on open chains: the same q̈,
+    /// at a fraction of the cost, but an indeterminate split of the reactions between the loops
+    /// and the seats (the integration and the uplift test need q̈ only).
+    pub min_norm_multipliers: bool,
     /// Cholesky factor L of M_ff, the block of M over the free (not seated) coordinates.
     factor: DMatrix<f64>,
     row_scale: DVector<f64>,
@@ -184,6 +190,7 @@ impl Dynamics {
             seated: Vec::new(),
             seat_reactions: DVector::zeros(0),
             extra_force: DVector::zeros(n),
+            min_norm_multipliers: true,
             locked: vec![false; n],
             free: (0..n).collect(),
             residual: DVector::zeros(n),
@@ -222,10 +229,11 @@ impl Dynamics {
         let n = model.dof();
         self.locked.clear();
         self.locked.resize(n, false);
-        // On closed chains seated coordinates stay constraint rows: with the loops their
-        // reactions are statically indeterminate, and the minimum-norm multipliers over all rows
-        // together are the ones the contact forces report.
-        if model.constraint_rows == 0 {
+        // On closed chains seated coordinates stay constraint rows when the multipliers are
+        // wanted: with the loops their reactions are statically indeterminate, and the
+        // minimum-norm set over all rows together is the one the contact forces report. q̈ is the
+        // same either way.
+        if model.constraint_rows == 0 || !self.min_norm_multipliers {
             for &s in &self.seated {
                 if s < n {
                     self.locked[s] = true;
@@ -352,7 +360,25 @@ impl Dynamics {
         let b = bt.transpose();
         let svd = JacobiSvd::thin(&b);
         // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
-        let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt());
+        let mut tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt());
+        if nf < n {
+            // With seated coordinates eliminated, B's own σ_max can be round-off (a loop whose
+            // free coordinates do not enter its closure here): the threshold is then taken
+            // against the whole row-scaled Jacobian with every column, Jacobi-scaled by M's
+            // diagonal (‖Φ'_j‖/√M_jj, the size of B's column j), so that noise is never inverted.
+            let mut whole = 0.0;
+            for j in 0..n {
+                let mut col = 0.0;
+                for i in 0..model.constraint_rows {
+                    col += (self.row_scale[i] * self.kin.phi_q[(i, j)]).powi(2);
+                }
+                for k in 0..seated_rows {
+                    col += seated_row_matrix[(j, k)].powi(2);
+                }
+                whole += col / self.kin.mass_matrix[(j, j)];
+            }
+            tol = tol.max(RANK_TOLERANCE.sqrt() * whole.sqrt());
+        }
         let residual = &b * &self.z + &bias;
         let dz = -svd.solve_with(&residual, tol);
         // z − z_free = Bᵀ λ': the minimum-norm multipliers.

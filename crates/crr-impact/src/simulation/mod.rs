@@ -358,6 +358,9 @@ impl<'a> Simulation<'a> {
             }
         }
         let mut dynamics = Dynamics::new(model, pivots);
+        // The integration and the uplift test need q̈ only; the monitor has its own workspace
+        // with the minimum-norm multipliers.
+        dynamics.min_norm_multipliers = false;
         dynamics.seated = (0..model.slot_count).filter(|&s| seated[s]).collect();
         let regularised_slots: Vec<(usize, f64, f64, f64)> = (0..model.slot_count)
             .filter_map(
@@ -375,6 +378,7 @@ impl<'a> Simulation<'a> {
         let y = ConstrainedSystem::pack(&initial.q, &initial.qdot, 0.0, 0.0);
         solver.reset(0.0, &y);
         let u_rest = crr_dynamics::energy::rest_potential(model);
+        let trial = dynamics.clone();
         let mut sim = Self {
             model,
             ground,
@@ -385,7 +389,7 @@ impl<'a> Simulation<'a> {
             out_kin: Data::new(model),
             spare: Workspaces {
                 events_kin: Some(Data::new(model)),
-                trial: Some(Dynamics::new(model, initial.pivots.clone())),
+                trial: Some(trial),
                 monitor: Dynamics::new(model, initial.pivots.clone()),
             },
             y,
