@@ -35,7 +35,7 @@ const CHOLESKY_STACK_BYTES: usize = 4096;
 /// (a = L Lᵀ; only the lower triangle is read, and the strict upper one holds scratch afterwards:
 /// faer's blocked factorisation writes there). Returns the failing pivot on a non-positive (or
 /// non-finite) one. Plain loops below [`FAER_CHOLESKY_MIN`], faer's blocked
-/// factorisation from there on; neither allocates below 480 coordinates.
+/// factorisation from there on, with its workspace on the stack below about 480 coordinates.
 pub fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), usize> {
     let n = a.nrows();
     if n < FAER_CHOLESKY_MIN {
@@ -44,7 +44,7 @@ pub fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), usize> {
     let req = cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default());
     let mut on_stack = [MaybeUninit::<u8>::uninit(); CHOLESKY_STACK_BYTES];
     let mut on_heap;
-    let stack = if req.size_bytes() <= CHOLESKY_STACK_BYTES {
+    let stack = if req.unaligned_bytes_required() <= CHOLESKY_STACK_BYTES {
         MemStack::new(&mut on_stack)
     } else {
         on_heap = MemBuffer::new(req);
