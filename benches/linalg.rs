@@ -1,6 +1,9 @@
 //! The dense factorisations of the engine on its own matrices, by three libraries: the one-sided
 //! Jacobi SVD written in `crr_dynamics::linalg`, nalgebra's bidiagonal SVD, faer's thin (and full)
-//! SVD and faer's column-pivoted QR; and Cholesky of M (the crate's, faer's `llt`, nalgebra's).
+//! SVD and faer's column-pivoted QR; and Cholesky of M with one solve (the crate's plain loops,
+//! what the engine runs — those loops below `FAER_CHOLESKY_MIN`, faer's from there on —, faer's
+//! `llt` allocating and in place, nalgebra's). The table and the decision are in ARCHITECTURE.md
+//! ("Dense factorisations").
 //!
 //! Matrices (built outside the timing, at consistent states):
 //! - `B`: the equations of motion's B = Φ' L⁻ᵀ (row-scaled Φ_q, M = L Lᵀ), rows × DOF(1), solved

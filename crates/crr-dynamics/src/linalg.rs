@@ -4,8 +4,9 @@
 //!
 //! Which code serves which size was decided by `cargo bench --bench linalg` (ARCHITECTURE.md,
 //! "Dense factorisations: faer, nalgebra and the crate's own"): faer's Cholesky is slower than the
-//! loops below up to 16 coordinates and faster from 32 (7–10 times at 128); its SVD is slower than
-//! the Jacobi SVD on every matrix the engine decomposes (5 × 3 to 12 × 10), so the latter stays.
+//! loops below up to 16 coordinates and faster from 32 (7–10 times at 128); its SVD is 3–5 times
+//! slower than the Jacobi SVD on the 5 × 3 matrices of the engine and on par at 12 × 10, so the
+//! Jacobi SVD stays.
 
 use std::mem::MaybeUninit;
 
@@ -60,8 +61,8 @@ pub fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), usize> {
     );
     match result {
         Ok(_) => {
-            // faer stops on a non-positive pivot but, as its comparison is `> 0`, passes a NaN
-            // one: report it like the loops do.
+            // faer's kernel already rejects NaN and infinite pivots (`!(d > 0)`, then a finiteness
+            // test); this O(n) check keeps the loops' contract whichever of its paths ran.
             match (0..n).find(|&j| !(a[(j, j)] > 0.0 && a[(j, j)].is_finite())) {
                 Some(j) => Err(j),
                 None => Ok(()),
