@@ -1,15 +1,80 @@
-//! Small dense linear algebra used by the equations of motion: in-place Cholesky (no allocation)
-//! and rank-revealing least squares by the singular value decomposition.
+//! Small dense linear algebra used by the equations of motion: in-place Cholesky (no allocation
+//! below [`FAER_CHOLESKY_MIN`] = 32 coordinates; faer's blocked factorisation from there on) and
+//! rank-revealing least squares by a one-sided Jacobi singular value decomposition.
+//!
+//! Which code serves which size was decided by `cargo bench --bench linalg` (ARCHITECTURE.md,
+//! "Dense factorisations: faer, nalgebra and the crate's own"): faer's Cholesky is slower than the
+//! loops below up to 16 coordinates and faster from 32 (7–10 times at 128); its SVD is 3–5 times
+//! slower than the Jacobi SVD on the 5 × 3 matrices of the engine and on par at 12 × 10, so the
+//! Jacobi SVD stays.
 
+use std::mem::MaybeUninit;
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{
+    LltError, cholesky_in_place as faer_cholesky_in_place, cholesky_in_place_scratch,
+};
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{MatMut, MatRef, Par};
 use nalgebra::{DMatrix, DVector};
 
 /// Relative threshold on singular values below which a direction counts as dependent.
 pub const RANK_TOLERANCE: f64 = 1e-9;
 
+/// Order from which [`cholesky_in_place`] and the triangular solves use faer (blocked, SIMD)
+/// rather than the plain loops of [`cholesky_in_place_unblocked`]: the crossover measured by
+/// `cargo bench --bench linalg` (faer's call overhead dominates below 16, its blocking wins from 32).
+pub const FAER_CHOLESKY_MIN: usize = 32;
+
+/// Bytes of faer's Cholesky workspace kept on the stack (one column of n values, aligned): enough
+/// up to n ≈ 480; larger orders allocate it.
+const CHOLESKY_STACK_BYTES: usize = 4096;
+
 /// Factorises the symmetric positive definite `a` in place into its lower Cholesky factor L
-/// (a = L Lᵀ; the strict upper triangle is left untouched). Returns the failing pivot on a
-/// non-positive one.
+/// (a = L Lᵀ; only the lower triangle is read, and the strict upper one holds scratch afterwards:
+/// faer's blocked factorisation writes there). Returns the failing pivot on a non-positive (or
+/// non-finite) one. Plain loops below [`FAER_CHOLESKY_MIN`], faer's blocked
+/// factorisation from there on, with its workspace on the stack below about 480 coordinates.
 pub fn cholesky_in_place(a: &mut DMatrix<f64>) -> Result<(), usize> {
+    let n = a.nrows();
+    if n < FAER_CHOLESKY_MIN {
+        return cholesky_in_place_unblocked(a);
+    }
+    let req = cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default());
+    let mut on_stack = [MaybeUninit::<u8>::uninit(); CHOLESKY_STACK_BYTES];
+    let mut on_heap;
+    let stack = if req.unaligned_bytes_required() <= CHOLESKY_STACK_BYTES {
+        MemStack::new(&mut on_stack)
+    } else {
+        on_heap = MemBuffer::new(req);
+        MemStack::new(&mut on_heap)
+    };
+    let view = MatMut::from_column_major_slice_mut(a.as_mut_slice(), n, n);
+    let result = faer_cholesky_in_place(
+        view,
+        Default::default(),
+        Par::Seq,
+        stack,
+        Default::default(),
+    );
+    match result {
+        Ok(_) => {
+            // faer's kernel already rejects NaN and infinite pivots (`!(d > 0)`, then a finiteness
+            // test); this O(n) check keeps the loops' contract whichever of its paths ran.
+            match (0..n).find(|&j| !(a[(j, j)] > 0.0 && a[(j, j)].is_finite())) {
+                Some(j) => Err(j),
+                None => Ok(()),
+            }
+        }
+        Err(LltError::NonPositivePivot { index }) => Err(index),
+    }
+}
+
+/// [`cholesky_in_place`] by plain loops (used below [`FAER_CHOLESKY_MIN`]; public so that the
+/// benchmark can time it on every order).
+pub fn cholesky_in_place_unblocked(a: &mut DMatrix<f64>) -> Result<(), usize> {
     let n = a.nrows();
     for j in 0..n {
         let mut d = a[(j, j)];
@@ -38,8 +103,22 @@ pub fn cholesky_solve(l: &DMatrix<f64>, b: &mut [f64]) {
     back_substitute_transposed(l, b);
 }
 
+/// L (lower triangle of `l`, n × n) as a faer view, and `b` as an n × 1 one.
+fn faer_views<'a>(l: &'a DMatrix<f64>, b: &'a mut [f64]) -> (MatRef<'a, f64>, MatMut<'a, f64>) {
+    let n = l.nrows();
+    (
+        MatRef::from_column_major_slice(l.as_slice(), n, n),
+        MatMut::from_column_major_slice_mut(b, n, 1),
+    )
+}
+
 /// Solves L y = b in place (L lower triangular, from [`cholesky_in_place`]).
 pub fn forward_substitute(l: &DMatrix<f64>, b: &mut [f64]) {
+    if l.nrows() >= FAER_CHOLESKY_MIN {
+        let (l, b) = faer_views(l, b);
+        solve_lower_triangular_in_place(l, b, Par::Seq);
+        return;
+    }
     for i in 0..l.nrows() {
         let mut s = b[i];
         for k in 0..i {
@@ -52,6 +131,11 @@ pub fn forward_substitute(l: &DMatrix<f64>, b: &mut [f64]) {
 /// Solves Lᵀ x = y in place (L lower triangular, from [`cholesky_in_place`]).
 pub fn back_substitute_transposed(l: &DMatrix<f64>, b: &mut [f64]) {
     let n = l.nrows();
+    if n >= FAER_CHOLESKY_MIN {
+        let (l, b) = faer_views(l, b);
+        solve_upper_triangular_in_place(l.transpose(), b, Par::Seq);
+        return;
+    }
     for i in (0..n).rev() {
         let mut s = b[i];
         for k in i + 1..n {
@@ -361,6 +445,42 @@ mod tests {
         // A singular matrix is reported at its failing pivot, never a NaN.
         let mut s = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]);
         assert_eq!(cholesky_in_place(&mut s), Err(1));
+    }
+
+    #[test]
+    fn cholesky_on_both_sides_of_the_faer_crossover_factorises_solves_and_reports_pivots() {
+        for n in [FAER_CHOLESKY_MIN - 1, FAER_CHOLESKY_MIN, 70] {
+            // A = B Bᵀ + n I with |Bᵢⱼ| ≤ 1: eigenvalues in [n, n + ‖B‖²] ⊂ [n, n + n²], so
+            // κ(A) ≤ 1 + n. Cholesky is backward stable, |L Lᵀ − A| ≤ c n ε |L||Lᵀ| (Higham,
+            // thm. 10.3), and the solve's forward error is within c n ε κ |x|; c = 10 below.
+            let b = DMatrix::from_fn(n, n, |i, j| (((i * 7 + j * 3) % 11) as f64 - 5.0) / 5.0);
+            let a = &b * b.transpose() + DMatrix::identity(n, n) * n as f64;
+            let mut l = a.clone();
+            cholesky_in_place(&mut l).unwrap();
+            let lower = l.lower_triangle();
+            let tol = 10.0 * n as f64 * f64::EPSILON;
+            assert!(
+                (&lower * lower.transpose() - &a).norm() <= tol * a.norm(),
+                "n = {n}"
+            );
+            let x_true = DVector::from_fn(n, |i, _| (i % 5) as f64 - 2.0);
+            let mut rhs: Vec<f64> = (&a * &x_true).iter().copied().collect();
+            cholesky_solve(&l, &mut rhs);
+            let err = (DVector::from_vec(rhs) - &x_true).norm();
+            assert!(
+                err <= tol * (1.0 + n as f64) * x_true.norm(),
+                "n = {n}: {err:e}"
+            );
+            // A zero pivot (row and column k of A zero) and a NaN one are reported at k.
+            let k = n - 5;
+            let mut singular = a.clone();
+            singular.row_mut(k).fill(0.0);
+            singular.column_mut(k).fill(0.0);
+            assert_eq!(cholesky_in_place(&mut singular), Err(k), "n = {n}");
+            let mut nan = a.clone();
+            nan[(k, k)] = f64::NAN;
+            assert_eq!(cholesky_in_place(&mut nan), Err(k), "n = {n}");
+        }
     }
 
     /// Checks A = W Vᵀ, VᵀV = I and the orthogonality of W's columns, to `tol` relative to |A|.

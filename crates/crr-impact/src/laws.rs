@@ -405,7 +405,7 @@ impl Metric {
             needed: d,
             hint: "the mass matrix is not positive definite on the mechanism's velocities",
         })?;
-        // cholesky_in_place leaves the strict upper triangle as it was: clear it, Lᵀ is used.
+        // cholesky_in_place leaves scratch in the strict upper triangle: clear it, Lᵀ is used.
         chol.fill_upper_triangle(0.0, 1);
         Ok(Self {
             null: chain.null.clone(),
