@@ -8,6 +8,11 @@
 //! Φ_qᵀλ = L(z − z_free). Redundant closures (a colonnade under a rigid slab) make B rank-deficient:
 //! its pseudo-inverse (one-sided Jacobi SVD, singular values below √[`RANK_TOLERANCE`]·σ_max
 //! dropped) gives the minimum-norm λ, and q̈ is unique.
+//!
+//! Open chains whose seated slots are all tree coordinates (no closure rows) are solved, from
+//! [`ARTICULATED_BODY_MIN_DOF`] coordinates on, by the articulated-body algorithm
+//! ([`crate::articulated_body`]) in O(DOF(1)) without forming M; M and its factor are then
+//! computed only on request ([`Dynamics::ensure_mass_matrix`], [`Dynamics::ensure_factor`]).
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -16,6 +21,7 @@ use crr_kinematics::{
     generalized_gravity, mass_matrix, velocities, velocity_product,
 };
 
+use crate::articulated_body::ArticulatedBody;
 use crate::ground_motion::GroundMotion;
 use crate::linalg::{
     JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, cholesky_solve,
@@ -70,7 +76,10 @@ pub fn constraint_row_scale(model: &Model) -> DVector<f64> {
 /// Workspace and results of one evaluation of the equations of motion (allocated once).
 #[derive(Clone, Debug)]
 pub struct Dynamics {
-    /// The kinematics workspace (Γ, M, h, Φ_q …).
+    /// The kinematics workspace (Γ, M, h, Φ_q …). After [`Self::accelerations`] on the
+    /// articulated-body path it holds the frames, V and A (and Q's subtree sums) but neither M nor
+    /// h: call [`Self::ensure_mass_matrix`] before reading `kin.mass_matrix` (or
+    /// [`Self::evaluate`] for everything).
     pub kin: Data,
     /// The dynamic chain: the active pivots, held fixed between impacts.
     pub pivots: ActivePivots,
@@ -90,8 +99,37 @@ pub struct Dynamics {
     pub seat_reactions: DVector<f64>,
     /// Extra generalized force added to Q at the last evaluation (e.g. a regularised impact law).
     pub extra_force: DVector<f64>,
+    /// The algorithm [`Self::accelerations_with`] uses ([`ForwardSolver::Auto`] by default).
+    pub solver: ForwardSolver,
     factor: DMatrix<f64>,
     row_scale: DVector<f64>,
+    articulated: ArticulatedBody,
+    /// `kin.mass_matrix` holds M of the current kinematics.
+    mass_current: bool,
+    /// `factor` holds the Cholesky factor of the current M.
+    factor_current: bool,
+    /// The last [`Self::accelerations_with`] used the articulated-body algorithm.
+    used_articulated: bool,
+}
+
+/// Open chains with at least this many coordinates (DOF(1)) are solved by the articulated-body
+/// algorithm under [`ForwardSolver::Auto`]; below it M is formed and factorised (CRBA and
+/// Cholesky), which is as fast or faster there. Picked from `cargo bench --bench dynamics --
+/// forward_dynamics` (see ARCHITECTURE.md, "Equations of motion").
+pub const ARTICULATED_BODY_MIN_DOF: usize = 8;
+
+/// The forward-dynamics algorithm of [`Dynamics::accelerations_with`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ForwardSolver {
+    /// The articulated-body algorithm when it applies (no closure rows, every seated slot a tree
+    /// coordinate) and DOF(1) ≥ [`ARTICULATED_BODY_MIN_DOF`]; otherwise [`Self::Cholesky`].
+    #[default]
+    Auto,
+    /// Always M by composite rigid bodies, Cholesky, and Gauss' principle for the constraint rows.
+    Cholesky,
+    /// The articulated-body algorithm whenever it applies (open chains with seated tree
+    /// coordinates only), whatever DOF(1); otherwise [`Self::Cholesky`].
+    ArticulatedBody,
 }
 
 /// A generalized force added to the equations of motion (e.g. the regularised Dirac-delta law).
@@ -176,6 +214,11 @@ impl Dynamics {
             seated: Vec::new(),
             seat_reactions: DVector::zeros(0),
             extra_force: DVector::zeros(n),
+            solver: ForwardSolver::Auto,
+            articulated: ArticulatedBody::new(model),
+            mass_current: false,
+            factor_current: false,
+            used_articulated: false,
         }
     }
 
@@ -191,6 +234,8 @@ impl Dynamics {
     ) {
         forward_kinematics(model, &mut self.kin, q, &self.pivots);
         mass_matrix(model, &mut self.kin);
+        self.mass_current = true;
+        self.factor_current = false;
         velocities(model, &mut self.kin, qdot);
         velocity_product(model, &mut self.kin);
         let a = ground.acceleration(t);
@@ -210,14 +255,111 @@ impl Dynamics {
     /// Factorises M (after [`Self::evaluate`]).
     fn factorise(&mut self, model: &Model) -> Result<(), DynamicsError> {
         self.factor.copy_from(&self.kin.mass_matrix);
-        cholesky_in_place(&mut self.factor).map_err(|k| DynamicsError::SingularMassMatrix {
-            coordinate: model.coords[k].name.clone(),
-        })
+        let result =
+            cholesky_in_place(&mut self.factor).map_err(|k| DynamicsError::SingularMassMatrix {
+                coordinate: model.coords[k].name.clone(),
+            });
+        self.factor_current = result.is_ok();
+        result
     }
 
-    /// Solves M x = b with the current factor.
+    /// Makes `kin.mass_matrix` hold M(q) of the last evaluation: the articulated-body path does
+    /// not form M, so readers of M after [`Self::accelerations`] call this first (O(DOF(1) ×
+    /// depth), nothing done when M is already current).
+    pub fn ensure_mass_matrix(&mut self, model: &Model) {
+        if !self.mass_current {
+            mass_matrix(model, &mut self.kin);
+            self.mass_current = true;
+        }
+    }
+
+    /// Makes the Cholesky factor used by [`Self::solve_mass`] that of the current M.
+    pub fn ensure_factor(&mut self, model: &Model) -> Result<(), DynamicsError> {
+        self.ensure_mass_matrix(model);
+        if self.factor_current {
+            Ok(())
+        } else {
+            self.factorise(model)
+        }
+    }
+
+    /// True when the last [`Self::accelerations_with`] used the articulated-body algorithm.
+    pub fn used_articulated_body(&self) -> bool {
+        self.used_articulated
+    }
+
+    /// Solves M x = b with the current factor (after [`Self::accelerations`] on the Cholesky path,
+    /// or [`Self::ensure_factor`]).
+    ///
+    /// # Panics
+    /// If the factor is not that of the current M.
     pub fn solve_mass(&self, b: &mut DVector<f64>) {
+        assert!(
+            self.factor_current,
+            "Dynamics::solve_mass: call ensure_factor first (the articulated-body path forms no M)"
+        );
         cholesky_solve(&self.factor, b.as_mut_slice());
+    }
+
+    /// Whether [`Self::accelerations_with`] takes the articulated-body path at this state.
+    fn articulated_applies(&self, model: &Model) -> bool {
+        let n = model.dof();
+        let threshold = match self.solver {
+            ForwardSolver::Auto => ARTICULATED_BODY_MIN_DOF,
+            ForwardSolver::Cholesky => return false,
+            ForwardSolver::ArticulatedBody => 0,
+        };
+        n >= threshold && model.constraint_rows == 0 && self.seated.iter().all(|&s| s < n)
+    }
+
+    /// The articulated-body path of [`Self::accelerations_with`]: kinematics, Q, Q_g and (only
+    /// when an extra force needs them, see [`GeneralizedForce::add`]) M and h; then q̈ and the
+    /// seat reactions in O(DOF(1)).
+    fn accelerations_articulated(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) -> Result<(), DynamicsError> {
+        let g_eff = effective_gravity(model, ground, t);
+        self.extra_force.fill(0.0);
+        if let Some(f) = extra {
+            // The extra force is promised the full evaluation (M, V, A, h …) of this state.
+            self.evaluate(model, ground, t, q, qdot);
+            f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
+        } else {
+            forward_kinematics(model, &mut self.kin, q, &self.pivots);
+            self.mass_current = false;
+            self.factor_current = false;
+            generalized_gravity(model, &mut self.kin, &g_eff, &mut self.load);
+            // Q_g from the same subtree sums: Q_gₖ = (−a_g) · (wₖ × (Sₖ − mₖpₖ)).
+            let a = ground.acceleration(t);
+            for k in 0..model.dof() {
+                let kin = &self.kin;
+                let lever = kin.subtree_moment[k] - kin.pivot[k] * kin.subtree_mass[k];
+                self.ground_force[k] = -a.dot(&kin.axis[k].cross(&lever));
+            }
+        }
+        if self.seat_reactions.len() != self.seated.len() {
+            self.seat_reactions = DVector::zeros(self.seated.len());
+        }
+        self.articulated
+            .solve(
+                model,
+                &mut self.kin,
+                qdot,
+                &g_eff,
+                &self.extra_force,
+                &self.seated,
+                &mut self.qddot,
+                self.seat_reactions.as_mut_slice(),
+            )
+            .map_err(|k| DynamicsError::SingularMassMatrix {
+                coordinate: model.coords[k].name.clone(),
+            })
     }
 
     /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains with nothing seated do not
@@ -243,6 +385,10 @@ impl Dynamics {
         qdot: &DVector<f64>,
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
+        self.used_articulated = self.articulated_applies(model);
+        if self.used_articulated {
+            return self.accelerations_articulated(model, ground, t, q, qdot, extra);
+        }
         self.evaluate(model, ground, t, q, qdot);
         self.factorise(model)?;
         self.extra_force.fill(0.0);
