@@ -9,8 +9,8 @@
 //! its pseudo-inverse (one-sided Jacobi SVD, singular values below √[`RANK_TOLERANCE`]·σ_max
 //! dropped) gives the minimum-norm λ, and q̈ is unique.
 //!
-//! Open chains whose seated slots are all tree coordinates (no closure rows) are solved, from
-//! [`ARTICULATED_BODY_MIN_DOF`] coordinates on, by the articulated-body algorithm
+//! Open chains whose seated slots are all tree coordinates (no closure rows) are solved (from
+//! [`ARTICULATED_BODY_MIN_DOF`] coordinates on) by the articulated-body algorithm
 //! ([`crate::articulated_body`]) in O(DOF(1)) without forming M; M and its factor are then
 //! computed only on request ([`Dynamics::ensure_mass_matrix`], [`Dynamics::ensure_factor`]).
 
@@ -113,10 +113,12 @@ pub struct Dynamics {
 }
 
 /// Open chains with at least this many coordinates (DOF(1)) are solved by the articulated-body
-/// algorithm under [`ForwardSolver::Auto`]; below it M is formed and factorised (CRBA and
-/// Cholesky), which is as fast or faster there. Picked from `cargo bench --bench dynamics --
-/// forward_dynamics` (see ARCHITECTURE.md, "Equations of motion").
-pub const ARTICULATED_BODY_MIN_DOF: usize = 8;
+/// algorithm under [`ForwardSolver::Auto`], below it by M (composite rigid bodies) and Cholesky.
+/// On the serial chains of `benches/dynamics.rs` (`forward_dynamics_aba` against
+/// `forward_dynamics_cholesky`, N = 1 … 128) the articulated-body path is the faster one at every
+/// N, 0.21 µs against 0.27 µs already at N = 1 (it skips h and the second pass of Q), so the
+/// crossover is 1: every eligible chain uses it. See ARCHITECTURE.md, "Equations of motion".
+pub const ARTICULATED_BODY_MIN_DOF: usize = 1;
 
 /// The forward-dynamics algorithm of [`Dynamics::accelerations_with`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
