@@ -55,12 +55,28 @@ pub struct ArticulatedBody {
     u: Vec<f64>,
     /// Whether each coordinate is locked.
     locked: Vec<bool>,
+    /// The bodies moving with coordinate k: `bodies[body_start[k]..body_start[k + 1]]`.
+    body_start: Vec<usize>,
+    bodies: Vec<usize>,
 }
 
 impl ArticulatedBody {
     /// Allocates the workspace for `model`.
     pub fn new(model: &Model) -> Self {
         let n = model.dof();
+        let mut body_start = vec![0; n + 1];
+        for &k in &model.body_coord {
+            body_start[k + 1] += 1;
+        }
+        for k in 0..n {
+            body_start[k + 1] += body_start[k];
+        }
+        let mut bodies = vec![0; model.bodies.len()];
+        let mut next = body_start.clone();
+        for (b, &k) in model.body_coord.iter().enumerate() {
+            bodies[next[k]] = b;
+            next[k] += 1;
+        }
         Self {
             axis: vec![Vector6::zeros(); n],
             velocity_product: vec![Vector6::zeros(); n],
@@ -71,6 +87,8 @@ impl ArticulatedBody {
             d: vec![0.0; n],
             u: vec![0.0; n],
             locked: vec![false; n],
+            body_start,
+            bodies,
         }
     }
 
@@ -102,8 +120,8 @@ impl ArticulatedBody {
         for &k in locked {
             self.locked[k] = true;
         }
-        // Pass 1 (outwards): velocities, velocity-product accelerations; the bodies' inertias and
-        // bias forces start the articulated quantities.
+        // Pass 1 (outwards): velocities, velocity-product accelerations; the inertias and bias
+        // forces of the bodies moving with each coordinate start its articulated quantities.
         for (k, coord) in model.coords.iter().enumerate() {
             let s = spatial_axis(data, k);
             let sq = s * qdot[k];
@@ -117,16 +135,17 @@ impl ArticulatedBody {
             data.bias_acceleration[k] = ap + c;
             self.axis[k] = s;
             self.velocity_product[k] = c;
-            self.inertia[k] = Matrix6::zeros();
-            self.bias_force[k] = Vector6::zeros();
-        }
-        for (b, body) in model.bodies.iter().enumerate() {
-            let k = model.body_coord[b];
-            let i_w = world_inertia(body, &data.rot_ops[k]);
-            let inertia = body_spatial_inertia(body.mass, &data.com[b], &i_w);
-            let v = data.spatial_velocity[k];
-            add_assign(&mut self.inertia[k], &inertia);
-            self.bias_force[k] += cross_force(&v, &(inertia * v));
+            let mut inertia = Matrix6::zeros();
+            let mut momentum = Vector6::zeros();
+            for &b in &self.bodies[self.body_start[k]..self.body_start[k + 1]] {
+                let body = &model.bodies[b];
+                let i_w = world_inertia(body, &data.rot_ops[k]);
+                let i_b = body_spatial_inertia(body.mass, &data.com[b], &i_w);
+                momentum += i_b * v;
+                add_assign(&mut inertia, &i_b);
+            }
+            self.inertia[k] = inertia;
+            self.bias_force[k] = cross_force(&v, &momentum);
         }
         // Pass 2 (inwards): articulated inertias and bias forces. The parent receives
         // Iᵃ = Iᴬ − UUᵀ/D and pᵃ = pᴬ + Iᵃc + Uu/D = pᴬ + Iᴬc + U(u − Uᵀc)/D.
@@ -185,7 +204,7 @@ impl ArticulatedBody {
 }
 
 /// a += b, element by element (a plain loop over the 36 entries, which the compiler vectorises).
-#[inline]
+#[inline(always)]
 fn add_assign(a: &mut Matrix6<f64>, b: &Matrix6<f64>) {
     for (x, y) in a.as_mut_slice().iter_mut().zip(b.as_slice()) {
         *x += *y;

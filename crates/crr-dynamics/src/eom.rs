@@ -115,8 +115,8 @@ pub struct Dynamics {
 /// Open chains with at least this many coordinates (DOF(1)) are solved by the articulated-body
 /// algorithm under [`ForwardSolver::Auto`], below it by M (composite rigid bodies) and Cholesky.
 /// On the serial chains of `benches/dynamics.rs` (`forward_dynamics_aba` against
-/// `forward_dynamics_cholesky`, N = 1 … 128) the articulated-body path is the faster one at every
-/// N, 0.21 µs against 0.27 µs already at N = 1 (it skips h and the second pass of Q), so the
+/// `forward_dynamics_cholesky`, N = 1 … 128) the articulated-body path is never the slower one,
+/// 0.21 µs against 0.25 µs already at N = 1 (it skips h and the second pass of Q), so the
 /// crossover is 1: every eligible chain uses it. See ARCHITECTURE.md, "Equations of motion".
 pub const ARTICULATED_BODY_MIN_DOF: usize = 1;
 
