@@ -1,4 +1,5 @@
 //! Benchmarks of the dynamics: q̈ from the equations of motion on open serial chains of N bodies
+//! (as `Dynamics` picks the solver, by the articulated-body algorithm, by CRBA and Cholesky)
 //! and on three closed chains (a trilithon, a four-hinge arch, a 2×2 colonnade) at consistent states, and the
 //! smooth integration of 1 s of the closed chains (constrained form, DOP853).
 
@@ -11,7 +12,9 @@ use nalgebra::DVector;
 
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::integrator::{Method, Options};
-use crr_dynamics::{Dynamics, Form, InitialSpec, InitialState, integrate_smooth, solve_initial};
+use crr_dynamics::{
+    Dynamics, Form, ForwardSolver, InitialSpec, InitialState, integrate_smooth, solve_initial,
+};
 use crr_kinematics::fixtures::{colonnade, four_hinge_arch, serial_chain, trilithon};
 use crr_kinematics::{ActivePivots, Model, Side, StructureSpec};
 
@@ -55,8 +58,9 @@ fn consistent(model: &Model, coord: &str, angle: f64, rate: f64) -> InitialState
     solve_initial(model, &spec).expect("consistent initial state")
 }
 
-fn forward_dynamics(c: &mut Criterion) {
-    let mut group = c.benchmark_group("forward_dynamics");
+/// q̈ of the serial chains of N bodies with the given solver, as the group `name`.
+fn forward_dynamics_with(c: &mut Criterion, name: &str, solver: ForwardSolver) {
+    let mut group = c.benchmark_group(name);
     group
         .sample_size(20)
         .warm_up_time(Duration::from_millis(500))
@@ -69,6 +73,7 @@ fn forward_dynamics(c: &mut Criterion) {
         let mut pivots = ActivePivots::uniform(&model, Side::Positive);
         pivots.follow_coordinates(&q);
         let mut dynamics = Dynamics::new(&model, pivots);
+        dynamics.solver = solver;
         group.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
                 dynamics
@@ -79,6 +84,21 @@ fn forward_dynamics(c: &mut Criterion) {
         });
     }
     group.finish();
+}
+
+/// What `Dynamics::accelerations` picks (`ForwardSolver::Auto`).
+fn forward_dynamics(c: &mut Criterion) {
+    forward_dynamics_with(c, "forward_dynamics", ForwardSolver::Auto);
+}
+
+/// The articulated-body algorithm at every N (kinematics, Q, Q_g and q̈ in O(N)).
+fn forward_dynamics_aba(c: &mut Criterion) {
+    forward_dynamics_with(c, "forward_dynamics_aba", ForwardSolver::ArticulatedBody);
+}
+
+/// M by composite rigid bodies, h, Q, Cholesky at every N (the crossover's other side).
+fn forward_dynamics_cholesky(c: &mut Criterion) {
+    forward_dynamics_with(c, "forward_dynamics_cholesky", ForwardSolver::Cholesky);
 }
 
 fn closed_chain_accelerations(c: &mut Criterion) {
@@ -146,6 +166,8 @@ fn integrate_1s(c: &mut Criterion) {
 criterion_group!(
     benches,
     forward_dynamics,
+    forward_dynamics_aba,
+    forward_dynamics_cholesky,
     closed_chain_accelerations,
     integrate_1s
 );

@@ -8,6 +8,11 @@
 //! Φ_qᵀλ = L(z − z_free). Redundant closures (a colonnade under a rigid slab) make B rank-deficient:
 //! its pseudo-inverse (one-sided Jacobi SVD, singular values below √[`RANK_TOLERANCE`]·σ_max
 //! dropped) gives the minimum-norm λ, and q̈ is unique.
+//!
+//! Open chains whose seated slots are all tree coordinates (no closure rows) are solved (from
+//! [`ARTICULATED_BODY_MIN_DOF`] coordinates on) by the articulated-body algorithm
+//! ([`crate::articulated_body`]) in O(DOF(1)) without forming M; M is then computed only on
+//! request ([`Dynamics::ensure_mass_matrix`]).
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -16,6 +21,7 @@ use crr_kinematics::{
     generalized_gravity, mass_matrix, velocities, velocity_product,
 };
 
+use crate::articulated_body::ArticulatedBody;
 use crate::ground_motion::GroundMotion;
 use crate::linalg::{
     JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, forward_substitute,
@@ -69,7 +75,10 @@ pub fn constraint_row_scale(model: &Model) -> DVector<f64> {
 /// Workspace and results of one evaluation of the equations of motion (allocated once).
 #[derive(Clone, Debug)]
 pub struct Dynamics {
-    /// The kinematics workspace (Γ, M, h, Φ_q …).
+    /// The kinematics workspace (Γ, M, h, Φ_q …). After [`Self::accelerations`] on the
+    /// articulated-body path it holds the frames, V and A (and Q's subtree sums) but neither M nor
+    /// h: call [`Self::ensure_mass_matrix`] before reading `kin.mass_matrix` (or
+    /// [`Self::evaluate`] for everything).
     pub kin: Data,
     /// The dynamic chain: the active pivots, held fixed between impacts.
     pub pivots: ActivePivots,
@@ -95,6 +104,8 @@ pub struct Dynamics {
     /// at a fraction of the cost, but an indeterminate split of the reactions between the loops
     /// and the seats (the integration and the uplift test need q̈ only).
     pub min_norm_multipliers: bool,
+    /// The algorithm [`Self::accelerations_with`] uses ([`ForwardSolver::Auto`] by default).
+    pub solver: ForwardSolver,
     /// Cholesky factor L of M_ff, the block of M over the free (not seated) coordinates.
     factor: DMatrix<f64>,
     row_scale: DVector<f64>,
@@ -106,6 +117,36 @@ pub struct Dynamics {
     residual: DVector<f64>,
     /// Working vector over the free coordinates: z_free, then q̈_f.
     z: DVector<f64>,
+    articulated: ArticulatedBody,
+    /// g_eff of the last evaluation (m/s²).
+    g_eff: Vector3<f64>,
+    /// `kin.mass_matrix` holds M of the current kinematics.
+    mass_current: bool,
+    /// The last [`Self::accelerations_with`] used the articulated-body algorithm.
+    used_articulated: bool,
+}
+
+/// Open chains with at least this many coordinates (DOF(1)) are solved by the articulated-body
+/// algorithm under [`ForwardSolver::Auto`], below it by M (composite rigid bodies) and Cholesky.
+/// On the serial chains of `benches/dynamics.rs` (`forward_dynamics_aba` against
+/// `forward_dynamics_cholesky`, N = 1 … 128) the articulated-body path is never the slower one,
+/// 0.21 µs against 0.25 µs already at N = 1 (it skips h and the second pass of Q), so the
+/// crossover is 1: every eligible chain uses it. See ARCHITECTURE.md, "Equations of motion".
+pub const ARTICULATED_BODY_MIN_DOF: usize = 1;
+
+/// The forward-dynamics algorithm of [`Dynamics::accelerations_with`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ForwardSolver {
+    /// The articulated-body algorithm when it applies (no closure rows, every seated slot a tree
+    /// coordinate) and DOF(1) ≥ [`ARTICULATED_BODY_MIN_DOF`]; otherwise [`Self::Cholesky`].
+    #[default]
+    Auto,
+    /// Always M by composite rigid bodies, Cholesky of its free block, and Gauss' principle for
+    /// the constraint rows.
+    Cholesky,
+    /// The articulated-body algorithm whenever it applies (open chains with seated tree
+    /// coordinates only), whatever DOF(1); otherwise [`Self::Cholesky`].
+    ArticulatedBody,
 }
 
 /// A generalized force added to the equations of motion (e.g. the regularised Dirac-delta law).
@@ -191,6 +232,11 @@ impl Dynamics {
             seat_reactions: DVector::zeros(0),
             extra_force: DVector::zeros(n),
             min_norm_multipliers: true,
+            solver: ForwardSolver::Auto,
+            articulated: ArticulatedBody::new(model),
+            g_eff: Vector3::zeros(),
+            mass_current: false,
+            used_articulated: false,
             locked: vec![false; n],
             free: (0..n).collect(),
             residual: DVector::zeros(n),
@@ -210,11 +256,13 @@ impl Dynamics {
     ) {
         forward_kinematics(model, &mut self.kin, q, &self.pivots);
         mass_matrix(model, &mut self.kin);
+        self.mass_current = true;
         velocities(model, &mut self.kin, qdot);
         velocity_product(model, &mut self.kin);
         // One look-up of a_g(t) (a record's is a binary search) for both loads.
         let a = ground.acceleration(t);
         let g_eff = Vector3::new(-a.x, -a.y, -model.gravity - a.z);
+        self.g_eff = g_eff;
         generalized_gravity(model, &mut self.kin, &g_eff, &mut self.load);
         generalized_gravity(model, &mut self.kin, &(-a), &mut self.ground_force);
         if model.constraint_rows > 0 {
@@ -286,8 +334,103 @@ impl Dynamics {
         qdot: &DVector<f64>,
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
+        if self.articulated_applies(model) {
+            return self.accelerations_articulated(model, ground, t, q, qdot, extra);
+        }
         self.evaluate(model, ground, t, q, qdot);
         self.solve_evaluated(model, t, q, qdot, extra)
+    }
+
+    /// Makes `kin.mass_matrix` hold M(q) of the last evaluation: the articulated-body path does
+    /// not form M, so readers of M after [`Self::accelerations`] call this first (O(DOF(1) ×
+    /// depth), nothing done when M is already current).
+    pub fn ensure_mass_matrix(&mut self, model: &Model) {
+        if !self.mass_current {
+            mass_matrix(model, &mut self.kin);
+            self.mass_current = true;
+        }
+    }
+
+    /// True when the last [`Self::accelerations_with`] used the articulated-body algorithm.
+    pub fn used_articulated_body(&self) -> bool {
+        self.used_articulated
+    }
+
+    /// Whether [`Self::accelerations_with`] takes the articulated-body path at this state.
+    fn articulated_applies(&self, model: &Model) -> bool {
+        let n = model.dof();
+        let threshold = match self.solver {
+            ForwardSolver::Auto => ARTICULATED_BODY_MIN_DOF,
+            ForwardSolver::Cholesky => return false,
+            ForwardSolver::ArticulatedBody => 0,
+        };
+        n >= threshold && model.constraint_rows == 0 && self.seated.iter().all(|&s| s < n)
+    }
+
+    /// The articulated-body path of [`Self::accelerations_with`]: kinematics, Q, Q_g and (only
+    /// when an extra force needs them, see [`GeneralizedForce::add`]) M and h; then q̈ and the
+    /// seat reactions in O(DOF(1)).
+    fn accelerations_articulated(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) -> Result<(), DynamicsError> {
+        if extra.is_some() {
+            // The extra force is promised the full evaluation (M, V, A, h …) of this state.
+            self.evaluate(model, ground, t, q, qdot);
+        } else {
+            forward_kinematics(model, &mut self.kin, q, &self.pivots);
+            self.mass_current = false;
+            let a = ground.acceleration(t);
+            self.g_eff = Vector3::new(-a.x, -a.y, -model.gravity - a.z);
+            generalized_gravity(model, &mut self.kin, &self.g_eff, &mut self.load);
+            // Q_g from the same subtree sums: Q_gₖ = (−a_g) · (wₖ × (Sₖ − mₖpₖ)).
+            for k in 0..model.dof() {
+                let kin = &self.kin;
+                let lever = kin.subtree_moment[k] - kin.pivot[k] * kin.subtree_mass[k];
+                self.ground_force[k] = -a.dot(&kin.axis[k].cross(&lever));
+            }
+        }
+        self.solve_articulated(model, t, q, qdot, extra)
+    }
+
+    /// q̈ and the seat reactions by the articulated-body algorithm on the kinematics, Q and
+    /// g_eff of this state (V and A are filled by its first pass).
+    fn solve_articulated(
+        &mut self,
+        model: &Model,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) -> Result<(), DynamicsError> {
+        self.used_articulated = true;
+        self.extra_force.fill(0.0);
+        if let Some(f) = extra {
+            f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
+        }
+        if self.seat_reactions.len() != self.seated.len() {
+            self.seat_reactions = DVector::zeros(self.seated.len());
+        }
+        self.articulated
+            .solve(
+                model,
+                &mut self.kin,
+                qdot,
+                &self.g_eff,
+                &self.extra_force,
+                &self.seated,
+                &mut self.qddot,
+                self.seat_reactions.as_mut_slice(),
+            )
+            .map_err(|k| DynamicsError::SingularMassMatrix {
+                coordinate: model.coords[k].name.clone(),
+            })?;
+        self.check_finite(t)
     }
 
     /// The solve of [`Self::accelerations_with`] on the state last given to [`Self::evaluate`]:
@@ -302,6 +445,10 @@ impl Dynamics {
         qdot: &DVector<f64>,
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
+        if self.articulated_applies(model) {
+            return self.solve_articulated(model, t, q, qdot, extra);
+        }
+        self.used_articulated = false;
         self.factorise(model)?;
         self.extra_force.fill(0.0);
         if let Some(f) = extra {

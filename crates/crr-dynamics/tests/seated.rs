@@ -1,11 +1,12 @@
-//! Seated coordinates held by elimination (q̈ₖ = 0, the free block of M solved alone), checked
+//! Seated coordinates held by elimination (q̈ₖ = 0: the free block of M solved alone, or locked
+//! joints of the articulated-body algorithm), both paths checked
 //! against Newton–Euler on the bodies: the accelerations of the bodies come from central
 //! differences of the forward kinematics along q(t) = q + q̇t + ½q̈t², never from M, h or Q.
 
 use nalgebra::{DVector, Vector3};
 
-use crr_dynamics::Dynamics;
 use crr_dynamics::ground_motion::GroundMotion;
+use crr_dynamics::{Dynamics, ForwardSolver};
 use crr_kinematics::fixtures::serial_chain;
 use crr_kinematics::mass_matrix::world_inertia;
 use crr_kinematics::{ActivePivots, Data, Model, Side, forward_kinematics};
@@ -87,7 +88,15 @@ fn seated_coordinates_carry_the_newton_euler_moments() {
     let ground = GroundMotion::none();
     // Scale of the joint moments: m g L of the whole chain.
     let scale = model.total_mass() * model.gravity * model.size;
-    for seated in [vec![1], vec![0, 2], vec![3], vec![0, 1, 2, 3]] {
+    for (seated, solver) in [vec![1], vec![0, 2], vec![3], vec![0, 1, 2, 3]]
+        .into_iter()
+        .flat_map(|s| {
+            [
+                (s.clone(), ForwardSolver::Cholesky),
+                (s, ForwardSolver::ArticulatedBody),
+            ]
+        })
+    {
         let q = DVector::from_fn(4, |k, _| {
             if seated.contains(&k) {
                 0.0
@@ -104,6 +113,7 @@ fn seated_coordinates_carry_the_newton_euler_moments() {
         });
         let mut dynamics = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
         dynamics.seated = seated.clone();
+        dynamics.solver = solver;
         dynamics
             .accelerations(&model, &ground, 0.0, &q, &qdot)
             .unwrap();
@@ -111,13 +121,16 @@ fn seated_coordinates_carry_the_newton_euler_moments() {
         for k in 0..4 {
             match seated.iter().position(|&s| s == k) {
                 Some(i) => {
-                    assert_eq!(dynamics.qddot[k], 0.0, "seated {seated:?}: q̈{k}");
+                    assert_eq!(
+                        dynamics.qddot[k], 0.0,
+                        "seated {seated:?} ({solver:?}): q̈{k}"
+                    );
                     // Central differences with h = 1e-4: truncation ~h²·|d⁴x/dt⁴|, round-off
                     // ~ε/h² of the positions: both below 1e-6 of m g L here.
                     let err = (dynamics.seat_reactions[i] - moments[k]).abs() / scale;
                     assert!(
                         err < 1e-6,
-                        "seated {seated:?}: reaction {k} = {} vs Newton–Euler {} ({err:e})",
+                        "seated {seated:?} ({solver:?}): reaction {k} = {} vs Newton–Euler {} ({err:e})",
                         dynamics.seat_reactions[i],
                         moments[k]
                     );
@@ -126,7 +139,7 @@ fn seated_coordinates_carry_the_newton_euler_moments() {
                     let err = moments[k].abs() / scale;
                     assert!(
                         err < 1e-6,
-                        "seated {seated:?}: free joint {k} carries {err:e} m g L"
+                        "seated {seated:?} ({solver:?}): free joint {k} carries {err:e} m g L"
                     );
                 }
             }

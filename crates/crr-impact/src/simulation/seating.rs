@@ -309,6 +309,7 @@ impl Simulation<'_> {
             &self.dynamics.pivots,
             &held,
         );
+        d.ensure_mass_matrix(model);
         let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * &qdot));
         let u_before = potential_energy(model, &d.kin);
         for &s in &closing {
