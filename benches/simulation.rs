@@ -67,7 +67,7 @@ fn check(name: &str, traj: &Trajectory, collapse_expected: Option<bool>) {
         traj.end_time,
         traj.energy_balance_error,
         traj.solver_stats.steps,
-        traj.solver_stats.rhs_evaluations,
+        traj.solver_stats.rhs_evals,
     );
     assert!(!traj.impacts.is_empty(), "{name}: no impact");
     assert_eq!(gains, 0, "{name}: impacts flagged as gaining energy");
