@@ -288,22 +288,6 @@ pub fn coordinate_alpha(model: &Model, coordinate: usize) -> Option<f64> {
     }
 }
 
-/// The `<interface>_state` code of every interface at a sample: the slot codes (`seated`, `+`,
-/// `-`), joined by `/` for a rocking base (tilt `.1` then `.2`).
-fn interface_states(model: &Model, states: &[crr_impact::simulation::SlotState]) -> Vec<String> {
-    model
-        .interfaces
-        .iter()
-        .map(|i| {
-            i.slots
-                .clone()
-                .map(|s| states.get(s).map_or("?", |st| st.code()))
-                .collect::<Vec<_>>()
-                .join("/")
-        })
-        .collect()
-}
-
 fn num(x: f64) -> String {
     format!("{x:e}")
 }
@@ -328,28 +312,40 @@ pub fn history_header(model: &Model) -> String {
 
 /// One line of `history.csv`.
 pub fn history_row(model: &Model, x: &Sample) -> String {
-    let mut s = num(x.t);
+    let mut s = String::with_capacity(24 * (2 * x.q.len() + 5) + 8 * model.interfaces.len());
+    push_history_row(&mut s, model, x);
+    s
+}
+
+/// Appends one line of `history.csv` to `s`, formatting in place (no string per value: writing
+/// the history was a quarter of a short run's time).
+pub fn push_history_row(s: &mut String, model: &Model, x: &Sample) {
+    use std::fmt::Write;
+    // Writing to a String cannot fail.
+    let _ = write!(s, "{:e}", x.t);
     for v in x.q.iter().chain(x.qdot.iter()) {
-        s.push(',');
-        s.push_str(&num(*v));
+        let _ = write!(s, ",{v:e}");
     }
     for v in [x.kinetic, x.potential, x.work_in, x.dissipated] {
-        s.push(',');
-        s.push_str(&num(v));
+        let _ = write!(s, ",{v:e}");
     }
-    for st in interface_states(model, &x.states) {
+    for i in &model.interfaces {
         s.push(',');
-        s.push_str(&st);
+        for (k, slot) in i.slots.clone().enumerate() {
+            if k > 0 {
+                s.push('/');
+            }
+            s.push_str(x.states.get(slot).map_or("?", |st| st.code()));
+        }
     }
     s.push('\n');
-    s
 }
 
 /// The text of `history.csv` for the samples a trajectory holds.
 pub fn history_csv(model: &Model, t: &Trajectory) -> String {
     let mut s = history_header(model);
     for x in &t.samples {
-        s.push_str(&history_row(model, x));
+        push_history_row(&mut s, model, x);
     }
     s
 }
@@ -673,12 +669,14 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
         .write_all(history_header(&p.model).as_bytes())
         .map_err(output_error)?;
     let mut stats = SampleStats::default();
+    let mut rows = String::new();
     let sink = |samples: &[Sample]| -> std::io::Result<()> {
         stats.add(samples);
+        rows.clear();
         for x in samples {
-            history.write_all(history_row(&p.model, x).as_bytes())?;
+            push_history_row(&mut rows, &p.model, x);
         }
-        Ok(())
+        history.write_all(rows.as_bytes())
     };
     let (trajectory, error) = match run_with_sink(&p, progress, sink, true) {
         Ok(o) => (o.trajectory, o.error.map(|e| e.to_string())),
