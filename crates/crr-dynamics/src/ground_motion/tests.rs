@@ -711,3 +711,43 @@ fn spec_enums_parse_from_strings() {
     assert!("w".parse::<Axis>().is_err());
     assert_eq!(Units::G.to_si(1.0), 9.80665);
 }
+
+/// `is_affine_on` claims a(t) is affine on an interval without breakpoints: where it says so,
+/// five equally spaced values lie on the line through the ends (to round-off of the
+/// interpolation, 1e-12 of the peak); a sine inside its window is not affine (its second
+/// difference is of order A(2πΔt/T)², far above round-off), and it is after its window.
+#[test]
+fn is_affine_on_holds_where_claimed() {
+    let collinear = |gm: &GroundMotion, t0: f64, t1: f64| {
+        let (a0, a1) = (gm.acceleration(t0).x, gm.acceleration(t1).x);
+        (1..4).all(|i| {
+            let t = t0 + (t1 - t0) * i as f64 / 4.0;
+            let line = a0 + (a1 - a0) * i as f64 / 4.0;
+            (gm.acceleration(t).x - line).abs() <= 1e-12 * a0.abs().max(a1.abs()).max(1.0)
+        })
+    };
+    let record = GroundMotion::from_record(
+        Axis::X,
+        Record::uniform(0.01, vec![0.0, 1.5, -2.0, 0.3, 0.0]).unwrap(),
+        1.0,
+    )
+    .unwrap();
+    let mut t = 0.0;
+    while let Some(b) = record.next_breakpoint(t) {
+        assert!(
+            record.is_affine_on(t, b) && collinear(&record, t, b),
+            "[{t}, {b}]"
+        );
+        t = b;
+    }
+    let pulse = component(sine(2.0, 0.5, 0.0, Some(1.0), 0.1));
+    assert!(pulse.is_affine_on(0.0, 0.1) && collinear(&pulse, 0.0, 0.1));
+    assert!(!pulse.is_affine_on(0.2, 0.3) && !collinear(&pulse, 0.2, 0.3));
+    assert!(pulse.is_affine_on(0.6, 2.0) && collinear(&pulse, 0.6, 2.0));
+    let step = component(SignalSpec::RectangularPulse(RectangularPulseSpec {
+        amplitude: 1.0,
+        duration: 0.2,
+        start: 0.1,
+    }));
+    assert!(step.is_affine_on(0.1, 0.3) && collinear(&step, 0.15, 0.25));
+}
