@@ -356,6 +356,13 @@ impl Dynamics {
         self.used_articulated
     }
 
+    /// Whether [`Self::accelerations_with`] (and [`Self::solve_evaluated`]) take the
+    /// articulated-body path with the current solver choice and seated slots, which needs no
+    /// [`Self::evaluate`] (M is not used).
+    pub fn articulated_body_applies(&self, model: &Model) -> bool {
+        self.articulated_applies(model)
+    }
+
     /// Whether [`Self::accelerations_with`] takes the articulated-body path at this state.
     fn articulated_applies(&self, model: &Model) -> bool {
         let n = model.dof();

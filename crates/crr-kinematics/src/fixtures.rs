@@ -660,3 +660,41 @@ pub fn serial_chain(n: usize) -> StructureSpec {
         symmetry: Vec::new(),
     }
 }
+
+/// Several structures side by side as one: part i is `parts[i]` translated by `spacing`·i along
+/// x, its body and interface names prefixed with `p<i>_`. Nothing joins the parts (each keeps its
+/// own interfaces to the ground), so the model has at least `parts.len()` connected parts.
+pub fn forest(parts: &[StructureSpec], spacing: f64) -> StructureSpec {
+    let mut out = StructureSpec {
+        name: "forest".into(),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body: Vec::new(),
+        interface: Vec::new(),
+        symmetry: Vec::new(),
+    };
+    for (i, spec) in parts.iter().enumerate() {
+        let moved = transformed(
+            spec,
+            &Matrix3::identity(),
+            &Vector3::new(spacing * i as f64, 0.0, 0.0),
+        );
+        let name = |n: &str| format!("p{i}_{n}");
+        for mut b in moved.body {
+            b.name = name(&b.name);
+            out.body.push(b);
+        }
+        for mut f in moved.interface {
+            f.name = name(&f.name);
+            if f.parent != "ground" {
+                f.parent = name(&f.parent);
+            }
+            f.child = name(&f.child);
+            out.interface.push(f);
+        }
+        for mut s in moved.symmetry {
+            s.coordinates = [name(&s.coordinates[0]), name(&s.coordinates[1])];
+            out.symmetry.push(s);
+        }
+    }
+    out
+}

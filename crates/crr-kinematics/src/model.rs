@@ -904,6 +904,101 @@ impl Model {
             Parent::Body(b) => Some(self.body_coord[b]),
         }
     }
+
+    /// The partition of the structure into its connected parts: the coordinates joined by
+    /// parent links (one tree rooted at the ground each), by loop closures between bodies
+    /// (a closure to the ground joins nothing) and by symmetry rows. The equations of motion of
+    /// different parts do not couple (M is block-diagonal over them, each constraint row lies in
+    /// one part), so a quantity of one part depends on that part's state alone.
+    pub fn parts(&self) -> Parts {
+        let n = self.dof();
+        let mut up: Vec<usize> = (0..n).collect();
+        fn root(up: &mut [usize], mut k: usize) -> usize {
+            while up[k] != k {
+                up[k] = up[up[k]];
+                k = up[k];
+            }
+            k
+        }
+        let mut join = |a: usize, b: usize| {
+            let (ra, rb) = (root(&mut up, a), root(&mut up, b));
+            // The smaller index stays the root, so a part's root is its first coordinate.
+            if ra != rb {
+                up[ra.max(rb)] = ra.min(rb);
+            }
+        };
+        for (k, c) in self.coords.iter().enumerate() {
+            if let Some(p) = c.parent {
+                join(p, k);
+            }
+        }
+        for cl in &self.closures {
+            let iface = &self.interfaces[cl.interface];
+            if let Some(a) = self.frame_of(iface.parent) {
+                join(a, self.body_coord[iface.child]);
+            }
+        }
+        for &(a, b, _) in &self.symmetries {
+            join(a, b);
+        }
+        let mut index = vec![usize::MAX; n];
+        let mut of_coord = vec![0; n];
+        let mut coords: Vec<Vec<usize>> = Vec::new();
+        for k in 0..n {
+            let r = root(&mut up, k);
+            if index[r] == usize::MAX {
+                index[r] = coords.len();
+                coords.push(Vec::new());
+            }
+            of_coord[k] = index[r];
+            coords[index[r]].push(k);
+        }
+        let mut bodies = vec![Vec::new(); coords.len()];
+        for (b, &k) in self.body_coord.iter().enumerate() {
+            bodies[of_coord[k]].push(b);
+        }
+        let mut of_slot = vec![0; self.slot_count];
+        of_slot[..n].copy_from_slice(&of_coord);
+        for iface in &self.interfaces {
+            if let Role::Closure { .. } = iface.role {
+                for s in iface.slots.clone() {
+                    of_slot[s] = of_coord[self.body_coord[iface.child]];
+                }
+            }
+        }
+        Parts {
+            of_coord,
+            of_slot,
+            coords,
+            bodies,
+        }
+    }
+}
+
+/// The connected parts of a [`Model`] ([`Model::parts`]), numbered in the order of their first
+/// coordinate.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Parts {
+    /// The part of each coordinate.
+    pub of_coord: Vec<usize>,
+    /// The part of each pivot-side slot (a closure angle's is its interface's part).
+    pub of_slot: Vec<usize>,
+    /// The coordinates of each part, in increasing order (closed under parents).
+    pub coords: Vec<Vec<usize>>,
+    /// The bodies of each part, in increasing order.
+    pub bodies: Vec<Vec<usize>>,
+}
+
+impl Parts {
+    /// The number of parts.
+    pub fn len(&self) -> usize {
+        self.coords.len()
+    }
+
+    /// True for a model without coordinates.
+    pub fn is_empty(&self) -> bool {
+        self.coords.is_empty()
+    }
 }
 
 fn check_impact_law(law: &ImpactLaw, item: &str) -> Result<(), ModelError> {

@@ -276,6 +276,8 @@ pub struct Simulation<'a> {
     /// Workspaces reused by every segment and sample: the events' kinematics, the uplift test's
     /// dynamics and the monitor's dynamics (the run allocates them once, not per step).
     spare: Workspaces,
+    /// The model's connected parts (the uplift test batches its releases over them).
+    parts: crr_kinematics::Parts,
     /// State [q, q̇, W, D] at the current time.
     y: Vec<f64>,
     t: f64,
@@ -392,6 +394,7 @@ impl<'a> Simulation<'a> {
                 trial: Some(trial),
                 monitor: Dynamics::new(model, initial.pivots.clone()),
             },
+            parts: model.parts(),
             y,
             t: 0.0,
             seated,
@@ -582,6 +585,7 @@ impl<'a> Simulation<'a> {
                 .trial
                 .take()
                 .unwrap_or_else(|| self.dynamics.clone()),
+            slot_part: self.parts.of_slot.clone(),
             q: DVector::zeros(n),
             qdot: DVector::zeros(n),
             u_rest: self.u_rest,

@@ -18,17 +18,38 @@ pub fn opening_mode(
     qdot: &DVector<f64>,
 ) -> Option<Vec<(usize, Side)>> {
     let mut trial = template.clone();
-    opening_mode_in(model, ground, template, &mut trial, t, q, qdot)
+    let parts = model.parts();
+    opening_mode_in(
+        model,
+        ground,
+        template,
+        &mut trial,
+        &parts.of_slot,
+        t,
+        q,
+        qdot,
+    )
 }
 
 /// [`opening_mode`] with a workspace: `trial` is any [`Dynamics`] of the same model (its pivots
 /// and seated slots are overwritten), so that the uplift test at every step allocates no
-/// workspace of the dynamics.
+/// workspace of the dynamics; `slot_part` is [`crr_kinematics::Parts::of_slot`] of the model.
+///
+/// On open chains the single releases are batched over the model's connected parts: the
+/// accelerations of one part do not depend on another part's pivots or seated slots (M is
+/// block-diagonal over the parts, the articulated-body recursions never combine two trees), so
+/// one solve releasing one slot in each of several parts gives each of them the opening
+/// acceleration of its release alone. Round r releases the r-th seated slot of every part, and
+/// the test costs 2·(most seated slots in one part) solves of O(DOF(1)) instead of 2·|seated|:
+/// O(DOF(1)) for a structure of independent blocks. A round whose solve fails (a singular part)
+/// is redone slot by slot, so every release keeps the result it has alone.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn opening_mode_in(
     model: &Model,
     ground: &GroundMotion,
     template: &Dynamics,
     trial: &mut Dynamics,
+    slot_part: &[usize],
     t: f64,
     q: &DVector<f64>,
     qdot: &DVector<f64>,
@@ -39,33 +60,110 @@ pub(super) fn opening_mode_in(
     }
     let tol = 1e-9 * model.gravity / model.size;
     let mut row = DVector::zeros(model.dof());
-    let mut accel = |trial: &mut Dynamics, slot: usize, evaluated: bool| -> Option<f64> {
-        if evaluated {
-            trial.solve_evaluated(model, t, q, qdot, None).ok()?;
+    let n = model.dof();
+    // The opening acceleration of slot k in the last solve (a tree coordinate's is q̈ₖ).
+    let slot_accel = |trial: &Dynamics, row: &mut DVector<f64>, k: usize| -> f64 {
+        if k < n {
+            trial.qddot[k]
         } else {
-            trial.accelerations(model, ground, t, q, qdot).ok()?;
+            let bias = slot_row(model, &trial.kin, k, row);
+            row.dot(&trial.qddot) + bias
         }
-        let bias = slot_row(model, &trial.kin, slot, &mut row);
-        Some(row.dot(&trial.qddot) + bias)
     };
     // Opening acceleration of each single release (slot, side), indexed 2i (positive side) and
     // 2i + 1 (negative). The releases on the slots' current sides share the template's chain,
     // evaluated once; a release on the other side changes the chain and is evaluated anew.
     let mut opening: Vec<Option<f64>> = vec![None; 2 * seated.len()];
     let side_index = |side: Side| usize::from(side == Side::Negative);
+    // Rounds of releases: on open chains slot i goes to round (its rank among the seated slots
+    // of its part); with loops every release is a round of its own (the rank threshold of the
+    // closed-chain solve is taken over the whole Jacobian, which couples the parts' round-off).
+    let mut round = vec![0; seated.len()];
+    let rounds = if model.constraint_rows == 0 {
+        let mut count = vec![0usize; slot_part.iter().max().map_or(0, |&p| p + 1)];
+        for (i, &k) in seated.iter().enumerate() {
+            round[i] = count[slot_part[k]];
+            count[slot_part[k]] += 1;
+        }
+        count.into_iter().max().unwrap_or(0)
+    } else {
+        for (i, r) in round.iter_mut().enumerate() {
+            *r = i;
+        }
+        seated.len()
+    };
+    // Solves with the slots of `batch` (indices into `seated`) released, on their current sides
+    // (the template's chain, already evaluated in `trial` when `evaluated`) or flipped; returns
+    // their opening accelerations with their indices into `opening`, None if the solve failed.
+    let mut in_batch = vec![false; seated.len()];
+    let mut release = |trial: &mut Dynamics, batch: &[usize], flip: bool, evaluated: bool| {
+        for &i in batch {
+            in_batch[i] = true;
+        }
+        trial.seated.clear();
+        trial.seated.extend(
+            seated
+                .iter()
+                .zip(&in_batch)
+                .filter(|&(_, &released)| !released)
+                .map(|(&s, _)| s),
+        );
+        for &i in batch {
+            in_batch[i] = false;
+        }
+        let ok = if flip {
+            trial.pivots.clone_from(&template.pivots);
+            for &i in batch {
+                let k = seated[i];
+                trial.pivots.sides[k] = trial.pivots.sides[k].flipped();
+            }
+            trial.accelerations(model, ground, t, q, qdot).is_ok()
+        } else if evaluated {
+            trial.solve_evaluated(model, t, q, qdot, None).is_ok()
+        } else {
+            trial.accelerations(model, ground, t, q, qdot).is_ok()
+        };
+        ok.then(|| {
+            batch
+                .iter()
+                .map(|&i| {
+                    let k = seated[i];
+                    let side = trial.pivots.sides[k];
+                    (
+                        2 * i + side_index(side),
+                        side.sign() * slot_accel(trial, &mut row, k),
+                    )
+                })
+                .collect::<Vec<_>>()
+        })
+    };
+    // The current sides: one evaluation of the state (M, h …) serves every solve, unless the
+    // articulated-body algorithm solves (it does not use M, and its solve is as cheap as the
+    // evaluation).
     trial.pivots.clone_from(&template.pivots);
-    trial.evaluate(model, ground, t, q, qdot);
-    for (i, &k) in seated.iter().enumerate() {
-        let side = template.pivots.sides[k];
-        trial.seated = seated.iter().copied().filter(|&s| s != k).collect();
-        opening[2 * i + side_index(side)] = accel(trial, k, true).map(|a| side.sign() * a);
+    trial.seated.clone_from(&seated);
+    let evaluated = !trial.articulated_body_applies(model);
+    if evaluated {
+        trial.evaluate(model, ground, t, q, qdot);
     }
-    for (i, &k) in seated.iter().enumerate() {
-        let side = template.pivots.sides[k].flipped();
-        trial.seated = seated.iter().copied().filter(|&s| s != k).collect();
-        trial.pivots.clone_from(&template.pivots);
-        trial.pivots.sides[k] = side;
-        opening[2 * i + side_index(side)] = accel(trial, k, false).map(|a| side.sign() * a);
+    let mut batch = Vec::with_capacity(seated.len());
+    for flip in [false, true] {
+        for r in 0..rounds {
+            batch.clear();
+            batch.extend((0..seated.len()).filter(|&i| round[i] == r));
+            let results = match release(trial, &batch, flip, evaluated) {
+                Some(results) => results,
+                None if batch.len() > 1 => batch
+                    .iter()
+                    .filter_map(|&i| release(trial, &[i], flip, evaluated))
+                    .flatten()
+                    .collect(),
+                None => Vec::new(),
+            };
+            for (j, a) in results {
+                opening[j] = Some(a);
+            }
+        }
     }
     let mut best: Option<(usize, Side, f64)> = None;
     for (i, &k) in seated.iter().enumerate() {
@@ -144,7 +242,22 @@ impl Simulation<'_> {
             return Ok(None);
         }
         let (q, qdot) = (self.q(), self.qdot());
-        let mode = opening_mode(self.model, self.ground, &self.dynamics, self.t, &q, &qdot);
+        let mut trial = self
+            .spare
+            .trial
+            .take()
+            .unwrap_or_else(|| self.dynamics.clone());
+        let mode = opening_mode_in(
+            self.model,
+            self.ground,
+            &self.dynamics,
+            &mut trial,
+            &self.parts.of_slot,
+            self.t,
+            &q,
+            &qdot,
+        );
+        self.spare.trial = Some(trial);
         if let Some(mode) = &mode {
             for &(s, side) in mode {
                 self.seated[s] = false;
@@ -189,9 +302,10 @@ impl Simulation<'_> {
             .trial
             .take()
             .unwrap_or_else(|| self.dynamics.clone());
-        let (ground, template) = (self.ground, &self.dynamics);
-        let mut opens =
-            |t: f64| opening_mode_in(model, ground, template, &mut trial, t, &q, &qdot).is_some();
+        let (ground, template, parts) = (self.ground, &self.dynamics, &self.parts.of_slot);
+        let mut opens = |t: f64| {
+            opening_mode_in(model, ground, template, &mut trial, parts, t, &q, &qdot).is_some()
+        };
         let mut found = None;
         let mut t0 = self.t;
         while t0 < t_stop {
