@@ -7,7 +7,12 @@
 //! z = Lᵀq̈, z is the point of B z = −Φ̇_q q̇ (B = Φ_q L⁻ᵀ) nearest to z_free = L⁻¹(Q − h), and
 //! Φ_qᵀλ = L(z − z_free). Redundant closures (a colonnade under a rigid slab) make B rank-deficient:
 //! its pseudo-inverse (one-sided Jacobi SVD, singular values below √[`RANK_TOLERANCE`]·σ_max
-//! dropped) gives the minimum-norm λ, and q̈ is unique.
+//! dropped) gives the minimum-norm λ, and q̈ is unique. The rank structure of B changes with the
+//! chain (pivots, seated set), not within a segment: the SVD picks r independent rows S once
+//! (pivoted Gram–Schmidt), and later evaluations solve on them through the Cholesky factor of
+//! B_S B_Sᵀ (r × r), after checking that the SVD would make the same rank decision (σ_min(B_S)
+//! above its threshold, the other rows in the span of B_S to 1e-9); the minimum-norm λ over all
+//! rows follows from the null space of Bᵀ, [−Cᵀ; I] with B_D = C B_S ([`ClosedChainSolve`]).
 //!
 //! Open chains whose seated slots are all tree coordinates (no closure rows) are solved (from
 //! [`ARTICULATED_BODY_MIN_DOF`] coordinates on) by the articulated-body algorithm
@@ -168,7 +173,7 @@ pub enum ForwardSolver {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ClosedChainSolve {
     /// A set of independent rows of B chosen by the SVD is reused while it stays independent
-    /// and spans the other rows (checked at every evaluation, see [`solve_selected_rows`]):
+    /// and spans the other rows (checked at every evaluation against the SVD's rank rule):
     /// B_S B_Sᵀ = L_G L_Gᵀ (rank × rank) instead of a Jacobi SVD of B; the SVD runs (and
     /// re-selects) when the check fails or the chain changes. Same q̈ and λ as [`Self::Svd`] to
     /// round-off when the other rows are dependent to round-off.
@@ -765,30 +770,28 @@ impl Dynamics {
         };
         self.used_selected = fast;
         if !fast {
-            {
-                let svd = JacobiSvd::thin(&bt.transpose());
-                // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
-                let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt()).max(floor);
-                dz = -svd.solve_with(&residual, tol);
-                // z − z_free = Bᵀ λ': the minimum-norm multipliers.
-                lambda_scaled = svd.solve_transposed_with(&dz, tol);
-                if self.closed_chain_solve == ClosedChainSolve::SelectedRows {
-                    let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
-                    let selection = RowSelection {
-                        rows,
-                        free: nf,
-                        seated: self.seated.clone(),
-                        selected: pivot_columns(&bt, rank),
-                    };
-                    match cached {
-                        Some(c) => self.selections[c] = selection,
-                        None if self.selections.len() < SELECTION_CACHE => {
-                            self.selections.push(selection);
-                        }
-                        None => {
-                            self.selections[self.next_evicted] = selection;
-                            self.next_evicted = (self.next_evicted + 1) % SELECTION_CACHE;
-                        }
+            let svd = JacobiSvd::thin(&bt.transpose());
+            // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
+            let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt()).max(floor);
+            dz = -svd.solve_with(&residual, tol);
+            // z − z_free = Bᵀ λ': the minimum-norm multipliers.
+            lambda_scaled = svd.solve_transposed_with(&dz, tol);
+            if self.closed_chain_solve == ClosedChainSolve::SelectedRows {
+                let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
+                let selection = RowSelection {
+                    rows,
+                    free: nf,
+                    seated: self.seated.clone(),
+                    selected: pivot_columns(&bt, rank),
+                };
+                match cached {
+                    Some(c) => self.selections[c] = selection,
+                    None if self.selections.len() < SELECTION_CACHE => {
+                        self.selections.push(selection);
+                    }
+                    None => {
+                        self.selections[self.next_evicted] = selection;
+                        self.next_evicted = (self.next_evicted + 1) % SELECTION_CACHE;
                     }
                 }
             }
