@@ -293,7 +293,9 @@ fn solve_selected_rows(
         forward_substitute(&work.g, e);
         inv_norm2 += e.iter().map(|x| x * x).sum::<f64>();
     }
-    if r > 0 && !(1.0 / inv_norm2.sqrt() > RANK_MARGIN * threshold) {
+    // A NaN fails the check too.
+    let sigma_min = 1.0 / inv_norm2.sqrt();
+    if r > 0 && (sigma_min.is_nan() || sigma_min <= RANK_MARGIN * threshold) {
         return false;
     }
     // C (rows D in the basis of B_S) and ‖R_D‖_F.
@@ -315,7 +317,10 @@ fn solve_selected_rows(
         }
     }
     let outside = outside.sqrt();
-    if !(outside <= DEPENDENT_ROW_TOLERANCE * b_norm && RANK_MARGIN * outside <= threshold) {
+    if outside.is_nan()
+        || outside > DEPENDENT_ROW_TOLERANCE * b_norm
+        || RANK_MARGIN * outside > threshold
+    {
         return false;
     }
     work.y.clear();
