@@ -196,7 +196,7 @@ struct RowSelection {
 /// the uplift test's single releases (two per seated slot, one per side) and active sets.
 const SELECTION_CACHE: usize = 32;
 
-/// Largest ‖R_D‖_F/‖B‖_F accepted by [`solve_selected_rows`], R_D the part of the rows not
+/// Largest ‖R_D‖_F/‖B‖_F accepted by the solve on selected rows, R_D the part of the rows not
 /// selected outside the span of the selected ones. Redundant closures that are exactly closed
 /// leave round-off there (1e-16 … 1e-14); the projection after each step closes the loops to
 /// 1e-10 relative or better, so the rows are dependent to about that. Far below the SVD's rank
