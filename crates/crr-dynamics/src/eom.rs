@@ -7,7 +7,12 @@
 //! z = Lᵀq̈, z is the point of B z = −Φ̇_q q̇ (B = Φ_q L⁻ᵀ) nearest to z_free = L⁻¹(Q − h), and
 //! Φ_qᵀλ = L(z − z_free). Redundant closures (a colonnade under a rigid slab) make B rank-deficient:
 //! its pseudo-inverse (one-sided Jacobi SVD, singular values below √[`RANK_TOLERANCE`]·σ_max
-//! dropped) gives the minimum-norm λ, and q̈ is unique.
+//! dropped) gives the minimum-norm λ, and q̈ is unique. The rank structure of B changes with the
+//! chain (pivots, seated set), not within a segment: the SVD picks r independent rows S once
+//! (pivoted Gram–Schmidt), and later evaluations solve on them through the Cholesky factor of
+//! B_S B_Sᵀ (r × r), after checking that the SVD would make the same rank decision (σ_min(B_S)
+//! above its threshold, the other rows in the span of B_S to 1e-9); the minimum-norm λ over all
+//! rows follows from the null space of Bᵀ, [−Cᵀ; I] with B_D = C B_S ([`ClosedChainSolve`]).
 //!
 //! Open chains whose seated slots are all tree coordinates (no closure rows) are solved (from
 //! [`ARTICULATED_BODY_MIN_DOF`] coordinates on) by the articulated-body algorithm
@@ -24,7 +29,8 @@ use crr_kinematics::{
 use crate::articulated_body::ArticulatedBody;
 use crate::ground_motion::GroundMotion;
 use crate::linalg::{
-    JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, forward_substitute,
+    JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, cholesky_solve,
+    forward_substitute, pivot_columns,
 };
 
 /// A failure of the equations of motion at some state.
@@ -106,6 +112,19 @@ pub struct Dynamics {
     pub min_norm_multipliers: bool,
     /// The algorithm [`Self::accelerations_with`] uses ([`ForwardSolver::Auto`] by default).
     pub solver: ForwardSolver,
+    /// How Gauss' principle is solved on the constraint rows ([`ClosedChainSolve::SelectedRows`]
+    /// by default).
+    pub closed_chain_solve: ClosedChainSolve,
+    /// Independent rows of B chosen by the SVD, with the (rows, free coordinates, seated slots)
+    /// they were chosen for: reused, after a check, while they pass it. Several sets, since the
+    /// uplift test solves a few seated sets at every step ([`SELECTION_CACHE`] at most).
+    selections: Vec<RowSelection>,
+    /// The entry of `selections` replaced next when it is full.
+    next_evicted: usize,
+    /// Workspace of the solve on the selected rows.
+    rows_work: SelectedRowsWork,
+    /// The last closed-chain solve used the selected rows (not the SVD).
+    used_selected: bool,
     /// Cholesky factor L of M_ff, the block of M over the free (not seated) coordinates.
     factor: DMatrix<f64>,
     row_scale: DVector<f64>,
@@ -147,6 +166,205 @@ pub enum ForwardSolver {
     /// The articulated-body algorithm whenever it applies (open chains with seated tree
     /// coordinates only), whatever DOF(1); otherwise [`Self::Cholesky`].
     ArticulatedBody,
+}
+
+/// How [`Dynamics::solve_evaluated`] solves Gauss' principle on the constraint rows of a closed
+/// chain (or on seated closure angles).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ClosedChainSolve {
+    /// A set of independent rows of B chosen by the SVD is reused while it stays independent
+    /// and spans the other rows (checked at every evaluation against the SVD's rank rule):
+    /// B_S B_Sᵀ = L_G L_Gᵀ (rank × rank) instead of a Jacobi SVD of B; the SVD runs (and
+    /// re-selects) when the check fails or the chain changes. Same q̈ and λ as [`Self::Svd`] to
+    /// round-off when the other rows are dependent to round-off.
+    #[default]
+    SelectedRows,
+    /// The one-sided Jacobi SVD of B at every evaluation (the reference).
+    Svd,
+}
+
+/// Independent rows of B, and the problem they were chosen for.
+#[derive(Clone, Debug)]
+struct RowSelection {
+    rows: usize,
+    free: usize,
+    seated: Vec<usize>,
+    selected: Vec<usize>,
+}
+
+/// Number of seated sets whose row selections [`Dynamics`] keeps: the integration's set, and
+/// the uplift test's single releases (two per seated slot, one per side) and active sets.
+const SELECTION_CACHE: usize = 32;
+
+/// Largest ‖R_D‖_F/‖B‖_F accepted by the solve on selected rows, R_D the part of the rows not
+/// selected outside the span of the selected ones. Redundant closures that are exactly closed
+/// leave round-off there (1e-16 … 1e-14); the projection after each step closes the loops to
+/// 1e-10 relative or better, so the rows are dependent to about that. Far below the SVD's rank
+/// threshold √RANK_TOLERANCE/√rows ≥ 3e-6: the rank decision is the SVD's.
+pub const DEPENDENT_ROW_TOLERANCE: f64 = 1e-9;
+
+/// Safety factor between the lower bound on σ_min(B_S) and the SVD's rank threshold, and
+/// between ‖R_D‖ and that threshold (a margin for the round-off of both computations).
+const RANK_MARGIN: f64 = 10.0;
+
+/// Workspace of [`solve_selected_rows`], kept in [`Dynamics`] so that the solve allocates
+/// nothing once sized.
+#[derive(Clone, Debug, Default)]
+struct SelectedRowsWork {
+    /// Whether each row of B is selected.
+    is_selected: Vec<bool>,
+    /// The rows not selected, in order.
+    others: Vec<usize>,
+    /// L_G, the Cholesky factor of G = B_S B_Sᵀ (r × r).
+    g: DMatrix<f64>,
+    /// C, row-major (rows D × r): B_D ≈ C B_S.
+    c: Vec<f64>,
+    /// I + C Cᵀ, then its Cholesky factor.
+    nn: DMatrix<f64>,
+    /// Scratch of length max(r, rows D).
+    e: Vec<f64>,
+    /// y = −G⁻¹ e_S.
+    y: Vec<f64>,
+}
+
+/// Gauss' principle on the rows `selected` of B, given as the columns of `bt` = Bᵀ
+/// (n_f × m): with G = B_S B_Sᵀ = L_G L_Gᵀ, y = −G⁻¹ e_S and dz = B_Sᵀ y (e = B z + bias, the
+/// constraint residual at z_free), and, when `min_norm`, the minimum-norm multipliers over all
+/// rows, Bᵀλ = dz (otherwise λ_S = y, λ_D = 0: another solution of the same equations). Returns
+/// false (use the SVD) unless the rank decision is provably the SVD's, within [`RANK_MARGIN`]:
+/// σ_min(B_S)² ≥ 1/‖L_G⁻¹‖_F² must exceed the SVD's threshold
+/// max(√RANK_TOLERANCE·σ_max(B), `floor`) (bounded above by √RANK_TOLERANCE·‖B‖_F), so the SVD
+/// keeps r = |S| singular values; and the rows D not selected must lie in the span of B_S:
+/// B_D = C B_S + R_D with ‖R_D‖_F ≤ [`DEPENDENT_ROW_TOLERANCE`]·‖B‖_F, which bounds
+/// σ_{r+1}(B) ≤ ‖R_D‖₂ far below the threshold, so the SVD drops the rest.
+///
+/// The multipliers: λ_p = (y, 0) solves Bᵀλ = dz; the null space of Bᵀ is spanned by the
+/// columns of N = [−Cᵀ; I] (rows S then D), so the minimum-norm solution is
+/// λ = λ_p − N (NᵀN)⁻¹ Nᵀλ_p, with NᵀN = I + C Cᵀ and Nᵀλ_p = −C y: λ_S = y + Cᵀw,
+/// λ_D = −w, w = −(I + C Cᵀ)⁻¹ C y. Work: O(m r n_f + r³) (+ O(d² r + d³) for the multipliers,
+/// d = m − r), against a Jacobi SVD's sweeps of O(m² n_f) each.
+#[allow(clippy::too_many_arguments)]
+fn solve_selected_rows(
+    work: &mut SelectedRowsWork,
+    bt: &DMatrix<f64>,
+    residual: &DVector<f64>,
+    selected: &[usize],
+    floor: f64,
+    min_norm: bool,
+    dz: &mut DVector<f64>,
+    lambda: &mut DVector<f64>,
+) -> bool {
+    let (nf, m) = (bt.nrows(), bt.ncols());
+    let r = selected.len();
+    let row = |i: usize| &bt.as_slice()[i * nf..(i + 1) * nf];
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
+    let b_norm = bt.norm();
+    let threshold = (RANK_TOLERANCE.sqrt() * b_norm).max(floor);
+    work.is_selected.clear();
+    work.is_selected.resize(m, false);
+    for &i in selected {
+        if i >= m || work.is_selected[i] {
+            return false;
+        }
+        work.is_selected[i] = true;
+    }
+    work.others.clear();
+    work.others.extend((0..m).filter(|&i| !work.is_selected[i]));
+    let d = work.others.len();
+    if work.g.nrows() != r {
+        work.g = DMatrix::zeros(r, r);
+    }
+    for k in 0..r {
+        for l in 0..=k {
+            work.g[(k, l)] = dot(row(selected[k]), row(selected[l]));
+        }
+    }
+    if cholesky_in_place(&mut work.g).is_err() {
+        return false;
+    }
+    // ‖L_G⁻¹‖_F² ≥ ‖G⁻¹‖₂ = 1/σ_min(B_S)².
+    let mut inv_norm2 = 0.0;
+    work.e.clear();
+    work.e.resize(r.max(d), 0.0);
+    for k in 0..r {
+        let e = &mut work.e[..r];
+        e.fill(0.0);
+        e[k] = 1.0;
+        forward_substitute(&work.g, e);
+        inv_norm2 += e.iter().map(|x| x * x).sum::<f64>();
+    }
+    // A NaN fails the check too.
+    let sigma_min = 1.0 / inv_norm2.sqrt();
+    if r > 0 && (sigma_min.is_nan() || sigma_min <= RANK_MARGIN * threshold) {
+        return false;
+    }
+    // C (rows D in the basis of B_S) and ‖R_D‖_F.
+    work.c.clear();
+    work.c.resize(d * r, 0.0);
+    let mut outside = 0.0;
+    for (a, &i) in work.others.iter().enumerate() {
+        let coef = &mut work.c[a * r..(a + 1) * r];
+        for (k, x) in coef.iter_mut().enumerate() {
+            *x = dot(row(i), row(selected[k]));
+        }
+        cholesky_solve(&work.g, coef);
+        for (j, &bij) in row(i).iter().enumerate() {
+            let mut rest = bij;
+            for (k, &ck) in coef.iter().enumerate() {
+                rest -= ck * bt[(j, selected[k])];
+            }
+            outside += rest * rest;
+        }
+    }
+    let outside = outside.sqrt();
+    if outside.is_nan()
+        || outside > DEPENDENT_ROW_TOLERANCE * b_norm
+        || RANK_MARGIN * outside > threshold
+    {
+        return false;
+    }
+    work.y.clear();
+    work.y.extend(selected.iter().map(|&i| -residual[i]));
+    cholesky_solve(&work.g, &mut work.y);
+    dz.resize_vertically_mut(nf, 0.0);
+    dz.fill(0.0);
+    for (k, &i) in selected.iter().enumerate() {
+        for (x, b) in dz.iter_mut().zip(row(i)) {
+            *x += work.y[k] * b;
+        }
+    }
+    lambda.resize_vertically_mut(m, 0.0);
+    lambda.fill(0.0);
+    for (k, &i) in selected.iter().enumerate() {
+        lambda[i] = work.y[k];
+    }
+    if min_norm && d > 0 {
+        if work.nn.nrows() != d {
+            work.nn = DMatrix::zeros(d, d);
+        }
+        let c = &work.c;
+        for a in 0..d {
+            for b in 0..=a {
+                work.nn[(a, b)] =
+                    dot(&c[a * r..(a + 1) * r], &c[b * r..(b + 1) * r]) + f64::from(a == b);
+            }
+        }
+        if cholesky_in_place(&mut work.nn).is_err() {
+            return false;
+        }
+        let w = &mut work.e[..d];
+        for (a, x) in w.iter_mut().enumerate() {
+            *x = -dot(&c[a * r..(a + 1) * r], &work.y);
+        }
+        cholesky_solve(&work.nn, w);
+        for (a, &i) in work.others.iter().enumerate() {
+            for (k, &s) in selected.iter().enumerate() {
+                lambda[s] += c[a * r + k] * w[a];
+            }
+            lambda[i] = -w[a];
+        }
+    }
+    true
 }
 
 /// A generalized force added to the equations of motion (e.g. the regularised Dirac-delta law).
@@ -233,6 +451,11 @@ impl Dynamics {
             extra_force: DVector::zeros(n),
             min_norm_multipliers: true,
             solver: ForwardSolver::Auto,
+            closed_chain_solve: ClosedChainSolve::SelectedRows,
+            selections: Vec::new(),
+            next_evicted: 0,
+            rows_work: SelectedRowsWork::default(),
+            used_selected: false,
             articulated: ArticulatedBody::new(model),
             g_eff: Vector3::zeros(),
             mass_current: false,
@@ -363,6 +586,12 @@ impl Dynamics {
         self.articulated_applies(model)
     }
 
+    /// True when the last closed-chain solve of [`Self::solve_evaluated`] used the cached
+    /// selection of independent rows ([`ClosedChainSolve::SelectedRows`]) rather than the SVD.
+    pub fn used_selected_rows(&self) -> bool {
+        self.used_selected
+    }
+
     /// Whether [`Self::accelerations_with`] takes the articulated-body path at this state.
     fn articulated_applies(&self, model: &Model) -> bool {
         let n = model.dof();
@@ -456,6 +685,7 @@ impl Dynamics {
             return self.solve_articulated(model, t, q, qdot, extra);
         }
         self.used_articulated = false;
+        self.used_selected = false;
         self.factorise(model)?;
         self.extra_force.fill(0.0);
         if let Some(f) = extra {
@@ -511,15 +741,12 @@ impl Dynamics {
         for mut col in bt.column_iter_mut() {
             forward_substitute(&self.factor, col.as_mut_slice());
         }
-        let b = bt.transpose();
-        let svd = JacobiSvd::thin(&b);
-        // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
-        let mut tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt());
+        // With seated coordinates eliminated, B's own σ_max can be round-off (a loop whose free
+        // coordinates do not enter its closure here): the rank threshold is then taken against the
+        // whole row-scaled Jacobian with every column, Jacobi-scaled by M's diagonal
+        // (‖Φ'_j‖/√M_jj, the size of B's column j), so that noise is never inverted.
+        let mut floor = 0.0;
         if nf < n {
-            // With seated coordinates eliminated, B's own σ_max can be round-off (a loop whose
-            // free coordinates do not enter its closure here): the threshold is then taken
-            // against the whole row-scaled Jacobian with every column, Jacobi-scaled by M's
-            // diagonal (‖Φ'_j‖/√M_jj, the size of B's column j), so that noise is never inverted.
             let mut whole = 0.0;
             for j in 0..n {
                 let mut col = 0.0;
@@ -531,12 +758,56 @@ impl Dynamics {
                 }
                 whole += col / self.kin.mass_matrix[(j, j)];
             }
-            tol = tol.max(RANK_TOLERANCE.sqrt() * whole.sqrt());
+            floor = RANK_TOLERANCE.sqrt() * whole.sqrt();
         }
-        let residual = &b * &self.z + &bias;
-        let dz = -svd.solve_with(&residual, tol);
-        // z − z_free = Bᵀ λ': the minimum-norm multipliers.
-        let lambda_scaled = svd.solve_transposed_with(&dz, tol);
+        let residual = bt.tr_mul(&self.z) + &bias;
+        let cached = self
+            .selections
+            .iter()
+            .position(|sel| sel.rows == rows && sel.free == nf && sel.seated == self.seated);
+        let mut dz = DVector::zeros(nf);
+        let mut lambda_scaled = DVector::zeros(rows);
+        let fast = match (cached, self.closed_chain_solve) {
+            (Some(c), ClosedChainSolve::SelectedRows) => solve_selected_rows(
+                &mut self.rows_work,
+                &bt,
+                &residual,
+                &self.selections[c].selected,
+                floor,
+                self.min_norm_multipliers,
+                &mut dz,
+                &mut lambda_scaled,
+            ),
+            _ => false,
+        };
+        self.used_selected = fast;
+        if !fast {
+            let svd = JacobiSvd::thin(&bt.transpose());
+            // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
+            let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt()).max(floor);
+            dz = -svd.solve_with(&residual, tol);
+            // z − z_free = Bᵀ λ': the minimum-norm multipliers.
+            lambda_scaled = svd.solve_transposed_with(&dz, tol);
+            if self.closed_chain_solve == ClosedChainSolve::SelectedRows {
+                let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
+                let selection = RowSelection {
+                    rows,
+                    free: nf,
+                    seated: self.seated.clone(),
+                    selected: pivot_columns(&bt, rank),
+                };
+                match cached {
+                    Some(c) => self.selections[c] = selection,
+                    None if self.selections.len() < SELECTION_CACHE => {
+                        self.selections.push(selection);
+                    }
+                    None => {
+                        self.selections[self.next_evicted] = selection;
+                        self.next_evicted = (self.next_evicted + 1) % SELECTION_CACHE;
+                    }
+                }
+            }
+        }
         self.z += &dz;
         back_substitute_transposed(&self.factor, self.z.as_mut_slice());
         self.scatter_accelerations();

@@ -28,7 +28,7 @@ pub use closed_chain::{
     partition, solve_initial,
 };
 pub use energy::{Energies, energies};
-pub use eom::{Dynamics, DynamicsError, ForwardSolver, effective_gravity};
+pub use eom::{ClosedChainSolve, Dynamics, DynamicsError, ForwardSolver, effective_gravity};
 pub use mechanism::{EquivalentBlock, equivalent_block};
 pub use run::{Form, Sample, integrate_smooth};
 pub use system::{ConstrainedSystem, ReducedSystem};

@@ -1,0 +1,206 @@
+//! The closed-chain solve on a cached selection of independent rows of B
+//! ([`ClosedChainSolve::SelectedRows`]) against the Jacobi SVD of B at every evaluation
+//! ([`ClosedChainSolve::Svd`]), on the colonnade (12 closure rows of rank 8), the trilithon, the
+//! arch and random closed chains, with and without seated slots (which add rows dependent on the
+//! loops'), at rest and away from it.
+//!
+//! Tolerances: both paths solve the same consistent system B dz = −e of rank r, the selected one
+//! through G = B_S B_Sᵀ (see [`Q_TOLERANCE`], [`LAMBDA_TOLERANCE`]). The constraint
+//! residual Φ'q̈ + Φ̇'q̇ (row-scaled) is checked against 1e3·ε·(‖Φ'‖(‖q̈‖ + g/L) + ‖Φ̇'q̇‖), the size of
+//! the round-off in forming its terms times a small factor for the solves.
+
+use std::collections::BTreeMap;
+
+use nalgebra::DVector;
+
+use crr_dynamics::closed_chain::{InitialSpec, solve_initial};
+use crr_dynamics::ground_motion::GroundMotion;
+use crr_dynamics::linalg::JacobiSvd;
+use crr_dynamics::{ClosedChainSolve, Dynamics};
+use crr_kinematics::fixtures::{SplitMix, colonnade, four_hinge_arch, random_chain, trilithon};
+use crr_kinematics::{ActivePivots, Model, StructureSpec};
+
+/// A consistent state: q with `angle` on the first coordinate (rest when that does not close),
+/// q̇ a random combination of the null space of Φ_q.
+fn state(model: &Model, angle: f64, seed: u64) -> (DVector<f64>, DVector<f64>, ActivePivots) {
+    let mut angles = BTreeMap::new();
+    angles.insert(model.coords[0].name.clone(), angle);
+    let spec = InitialSpec {
+        angles,
+        rates: BTreeMap::new(),
+    };
+    let init = solve_initial(model, &spec).unwrap_or_else(|_| {
+        solve_initial(
+            model,
+            &InitialSpec {
+                angles: BTreeMap::new(),
+                rates: BTreeMap::new(),
+            },
+        )
+        .expect("the rest state is consistent")
+    });
+    let mut d = Dynamics::new(model, init.pivots.clone());
+    d.evaluate(
+        model,
+        &GroundMotion::none(),
+        0.0,
+        &init.q,
+        &DVector::zeros(model.dof()),
+    );
+    let null = JacobiSvd::new(&d.kin.phi_q).null_space();
+    let mut rng = SplitMix(seed);
+    let coef = DVector::from_fn(null.ncols(), |_, _| rng.uniform(-1.0, 1.0));
+    (init.q, &null * coef, init.pivots)
+}
+
+/// Solves at (q, q̇) with both paths (the selected one twice: the first call selects the rows
+/// by the SVD, the second uses them) and checks the agreement and the constraint residual.
+/// Returns whether the second call took the selected rows.
+fn compare(
+    model: &Model,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    pivots: &ActivePivots,
+    seated: &[usize],
+    min_norm: bool,
+    reused: Option<&mut Dynamics>,
+) -> bool {
+    let ground = GroundMotion::none();
+    let mut svd = Dynamics::new(model, pivots.clone());
+    svd.closed_chain_solve = ClosedChainSolve::Svd;
+    svd.seated = seated.to_vec();
+    svd.min_norm_multipliers = min_norm;
+    svd.accelerations(model, &ground, 0.0, q, qdot).unwrap();
+    assert!(!svd.used_selected_rows());
+
+    let mut own = Dynamics::new(model, pivots.clone());
+    let fast = match reused {
+        Some(d) => d,
+        None => &mut own,
+    };
+    fast.seated = seated.to_vec();
+    fast.min_norm_multipliers = min_norm;
+    fast.accelerations(model, &ground, 0.0, q, qdot).unwrap();
+    fast.accelerations(model, &ground, 0.0, q, qdot).unwrap();
+
+    let bound = Q_TOLERANCE;
+    // At rest with every coordinate seated q̈ is 0 and both paths return round-off of the
+    // natural acceleration scale g/L: relative to ‖q̈‖ + g/L.
+    let scale = svd.qddot.norm() + model.gravity / model.size;
+    let diff = (&fast.qddot - &svd.qddot).norm();
+    assert!(
+        diff <= bound * scale,
+        "q̈ differs by {diff:e} relative {:e}",
+        diff / scale
+    );
+    if min_norm {
+        // The minimum-norm multipliers are unique.
+        let ls = svd.lambda.norm() + svd.seat_reactions.norm();
+        let dl = (&fast.lambda - &svd.lambda).norm()
+            + (&fast.seat_reactions - &svd.seat_reactions).norm();
+        assert!(
+            dl <= LAMBDA_TOLERANCE * ls.max(1e-300),
+            "λ differs by {dl:e} of {ls:e}"
+        );
+    }
+    // Φ'q̈ + Φ̇'q̇ = 0 on the loop rows (scaled as the solver scales them).
+    let scaled_bias = fast.kin.phi_bias.component_mul(fast.row_scale());
+    let phi = fast.scaled_jacobian();
+    let residual = (&phi * &fast.qddot + &scaled_bias).norm();
+    let size = phi.norm() * scale + scaled_bias.norm();
+    assert!(
+        residual <= 1e3 * f64::EPSILON * size.max(1e-300),
+        "constraint residual {residual:e} of {size:e}"
+    );
+    fast.used_selected_rows()
+}
+
+/// Relative agreement of q̈: both paths solve the same consistent system of rank r, the selected
+/// one through G = B_S B_Sᵀ, whose forward error is about κ(G)·ε = κ(B_S)²·ε; the bodies of
+/// these fixtures have comparable sizes and masses (κ(B_S)² ≲ 1e2), hence ≲ 2e-14, and 1e-12
+/// leaves a factor 50 for the differing orders of summation.
+const Q_TOLERANCE: f64 = 1e-12;
+
+/// Relative agreement of the minimum-norm multipliers: one more solve (I + C Cᵀ, C the
+/// coefficients of the dependent rows) than q̈, and λ scales like the inverse of B's smallest
+/// kept singular value rather than its largest, so a hundred times the q̈ tolerance.
+const LAMBDA_TOLERANCE: f64 = 1e-10;
+
+fn run(spec: &StructureSpec, angle: f64, seated_sets: &[Vec<usize>]) -> usize {
+    let model = Model::from_spec(spec).expect("valid fixture");
+    let mut reused = 0;
+    for (seed, a) in [(1, 0.0), (2, angle)] {
+        let (q, qdot, pivots) = state(&model, a, seed);
+        for seated in seated_sets {
+            for min_norm in [true, false] {
+                if compare(&model, &q, &qdot, &pivots, seated, min_norm, None) {
+                    reused += 1;
+                }
+            }
+        }
+    }
+    reused
+}
+
+#[test]
+fn selected_rows_agree_with_the_svd_on_the_colonnade() {
+    // Seated slots add rows: the bases of both front columns (rows dependent on the loops').
+    let spec = colonnade(0.2, 1.5, 1.0, 0.3);
+    let n = Model::from_spec(&spec).unwrap().dof();
+    let reused = run(
+        &spec,
+        0.02,
+        &[vec![], vec![0], vec![0, 1], (0..n).collect()],
+    );
+    assert!(reused > 0, "the selected rows were never reused");
+}
+
+#[test]
+fn selected_rows_agree_with_the_svd_on_the_trilithon() {
+    let reused = run(
+        &trilithon(0.25, 1.5, 2.0, 0.5, 1.0),
+        0.05,
+        &[vec![], vec![0], vec![0, 2]],
+    );
+    assert!(reused > 0, "the selected rows were never reused");
+}
+
+#[test]
+fn selected_rows_agree_with_the_svd_on_the_arch() {
+    let reused = run(
+        &four_hinge_arch(4.0, 4.6, 1.0, false),
+        0.01,
+        &[vec![], vec![1]],
+    );
+    assert!(reused > 0, "the selected rows were never reused");
+}
+
+#[test]
+fn selected_rows_agree_with_the_svd_on_random_closed_chains() {
+    let mut reused = 0;
+    for seed in 0..12 {
+        let spec = random_chain(seed, 4 + (seed as usize % 4), 1 + (seed as usize % 2));
+        let Ok(model) = Model::from_spec(&spec) else {
+            continue;
+        };
+        let n = model.dof();
+        reused += run(&spec, 0.01, &[vec![], vec![0], vec![n - 1], vec![0, n]]);
+    }
+    assert!(reused > 0, "the selected rows were never reused");
+}
+
+/// A selection made at one state is checked, not trusted, at another: carried from the rest of
+/// the colonnade (where the seated rows make a different set dependent) to a tilted state and
+/// back, the solve still agrees with the SVD.
+#[test]
+fn a_selection_carried_to_another_state_is_checked() {
+    let spec = colonnade(0.2, 1.5, 1.0, 0.3);
+    let model = Model::from_spec(&spec).unwrap();
+    let (q0, qd0, p0) = state(&model, 0.0, 3);
+    let (q1, qd1, p1) = state(&model, 0.05, 4);
+    let mut d = Dynamics::new(&model, p0.clone());
+    for (q, qd, p) in [(&q0, &qd0, &p0), (&q1, &qd1, &p1), (&q0, &qd0, &p0)] {
+        d.pivots = p.clone();
+        compare(&model, q, qd, p, &[0], true, Some(&mut d));
+    }
+}
