@@ -64,6 +64,11 @@ pub enum DynamicsError {
 /// the ground.
 pub fn effective_gravity(model: &Model, ground: &GroundMotion, t: f64) -> Vector3<f64> {
     let a = ground.acceleration(t);
+    gravity_with_ground(model, &a)
+}
+
+/// g_eff = (−a_x, −a_y, −g − a_z) for a ground acceleration a_g already looked up.
+fn gravity_with_ground(model: &Model, a: &Vector3<f64>) -> Vector3<f64> {
     Vector3::new(-a.x, -a.y, -model.gravity - a.z)
 }
 
@@ -484,7 +489,7 @@ impl Dynamics {
         velocity_product(model, &mut self.kin);
         // One look-up of a_g(t) (a record's is a binary search) for both loads.
         let a = ground.acceleration(t);
-        let g_eff = Vector3::new(-a.x, -a.y, -model.gravity - a.z);
+        let g_eff = gravity_with_ground(model, &a);
         self.g_eff = g_eff;
         generalized_gravity(model, &mut self.kin, &g_eff, &mut self.load);
         generalized_gravity(model, &mut self.kin, &(-a), &mut self.ground_force);
@@ -622,7 +627,7 @@ impl Dynamics {
             forward_kinematics(model, &mut self.kin, q, &self.pivots);
             self.mass_current = false;
             let a = ground.acceleration(t);
-            self.g_eff = Vector3::new(-a.x, -a.y, -model.gravity - a.z);
+            self.g_eff = gravity_with_ground(model, &a);
             generalized_gravity(model, &mut self.kin, &self.g_eff, &mut self.load);
             // Q_g from the same subtree sums: Q_gₖ = (−a_g) · (wₖ × (Sₖ − mₖpₖ)).
             for k in 0..model.dof() {

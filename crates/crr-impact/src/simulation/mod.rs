@@ -580,11 +580,7 @@ impl<'a> Simulation<'a> {
             pivots: self.dynamics.pivots.clone(),
             angles: vec![0.0; model.slot_count],
             uplift: (!self.dynamics.seated.is_empty()).then(|| self.dynamics.clone()),
-            trial: self
-                .spare
-                .trial
-                .take()
-                .unwrap_or_else(|| self.dynamics.clone()),
+            trial: self.take_trial(),
             slot_part: self.parts.of_slot.clone(),
             q: DVector::zeros(n),
             qdot: DVector::zeros(n),

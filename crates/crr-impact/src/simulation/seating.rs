@@ -234,6 +234,14 @@ pub(super) fn opening_mode_in(
 }
 
 impl Simulation<'_> {
+    /// The uplift test's workspace (give it back to `spare.trial` after use).
+    pub(super) fn take_trial(&mut self) -> Dynamics {
+        self.spare
+            .trial
+            .take()
+            .unwrap_or_else(|| self.dynamics.clone())
+    }
+
     /// Releases seated slots if the seated state cannot hold now.
     pub(super) fn release_if_opening(
         &mut self,
@@ -242,11 +250,7 @@ impl Simulation<'_> {
             return Ok(None);
         }
         let (q, qdot) = (self.q(), self.qdot());
-        let mut trial = self
-            .spare
-            .trial
-            .take()
-            .unwrap_or_else(|| self.dynamics.clone());
+        let mut trial = self.take_trial();
         let mode = opening_mode_in(
             self.model,
             self.ground,
@@ -297,11 +301,7 @@ impl Simulation<'_> {
             self.y[n + k] = 0.0;
         }
         let (q, qdot) = (self.q(), self.qdot());
-        let mut trial = self
-            .spare
-            .trial
-            .take()
-            .unwrap_or_else(|| self.dynamics.clone());
+        let mut trial = self.take_trial();
         let (ground, template, parts) = (self.ground, &self.dynamics, &self.parts.of_slot);
         let mut opens = |t: f64| {
             opening_mode_in(model, ground, template, &mut trial, parts, t, &q, &qdot).is_some()
