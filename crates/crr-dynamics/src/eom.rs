@@ -650,10 +650,7 @@ impl Dynamics {
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
         self.used_articulated = true;
-        self.extra_force.fill(0.0);
-        if let Some(f) = extra {
-            f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
-        }
+        self.add_extra_force(model, t, q, qdot, extra);
         if self.seat_reactions.len() != self.seated.len() {
             self.seat_reactions = DVector::zeros(self.seated.len());
         }
@@ -692,10 +689,7 @@ impl Dynamics {
         self.used_articulated = false;
         self.used_selected = false;
         self.factorise(model)?;
-        self.extra_force.fill(0.0);
-        if let Some(f) = extra {
-            f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
-        }
+        self.add_extra_force(model, t, q, qdot, extra);
         let n = model.dof();
         let nf = self.free.len();
         // r = Q + F_extra − h: the generalized force left for inertia and constraints.
@@ -836,6 +830,21 @@ impl Dynamics {
         self.check_finite(t)
     }
 
+    /// Sets `extra_force` to the extra generalized force at this state (0 without one).
+    fn add_extra_force(
+        &mut self,
+        model: &Model,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) {
+        self.extra_force.fill(0.0);
+        if let Some(f) = extra {
+            f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
+        }
+    }
+
     /// True if seated slot `s` is held by a constraint row (a closure angle, or any slot of a
     /// closed chain), false if eliminated (a tree coordinate of an open chain).
     fn is_row(&self, s: usize) -> bool {
@@ -850,17 +859,21 @@ impl Dynamics {
         }
     }
 
-    /// Reactions of the seated tree coordinates: the residual of their rows of the equations of
-    /// motion, M_k· q̈ − r_k − (Φ_qᵀλ)_k − (angle rows' force)_k, written in the order of `seated`
-    /// (`seat_reactions` is sized to `seated` unless only tree coordinates are seated, when the
-    /// two coincide).
+    /// Reactions of the eliminated seated coordinates: the residual of their rows of the
+    /// equations of motion, M_k· q̈ − r_k − (Φ_qᵀλ)_k − (seated rows' force)_k, written at their
+    /// places in `seat_reactions` (sized to `seated`). q̈ vanishes on the seated coordinates, so
+    /// M_k· q̈ sums over the free ones only.
     fn tree_reactions(&mut self, row_force: Option<&DVector<f64>>) {
         for (i, &s) in self.seated.iter().enumerate() {
             if self.is_row(s) {
                 continue;
             }
-            let mut reaction =
-                self.kin.mass_matrix.row(s).dot(&self.qddot.transpose()) - self.residual[s];
+            let inertial: f64 = self
+                .free
+                .iter()
+                .map(|&j| self.kin.mass_matrix[(s, j)] * self.qddot[j])
+                .sum();
+            let mut reaction = inertial - self.residual[s];
             for r in 0..self.lambda.len() {
                 reaction -= self.kin.phi_q[(r, s)] * self.lambda[r];
             }
