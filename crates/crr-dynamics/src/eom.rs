@@ -19,7 +19,7 @@
 //! ([`crate::articulated_body`]) in O(DOF(1)) without forming M; M is then computed only on
 //! request ([`Dynamics::ensure_mass_matrix`]).
 
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3, Vector6};
 
 use crr_kinematics::{
     ActivePivots, Data, Model, constraint_bias, constraint_jacobian, forward_kinematics,
@@ -582,6 +582,20 @@ impl Dynamics {
     /// True when the last [`Self::accelerations_with`] used the articulated-body algorithm.
     pub fn used_articulated_body(&self) -> bool {
         self.used_articulated
+    }
+
+    /// The spatial force fₖ = Iᴬₖaₖ + pᴬₖ = [n₀; f] (N m about the world origin; N) that the
+    /// parent side transmits across coordinate k's joint to the bodies beyond it, gravity and
+    /// inertia included, from the last solve when it was the articulated-body algorithm (None
+    /// after a solve on M). Its component along the joint's spatial axis is sₖᵀfₖ = τₖ + rₖ (rₖ = 0
+    /// for a free coordinate); along any other axis through any other point it is the moment the
+    /// joint would have to carry about that axis with the same motion, e.g. the reaction of a
+    /// seated joint about the pivot on its other side.
+    pub fn joint_force(&self, k: usize) -> Option<Vector6<f64>> {
+        self.used_articulated.then(|| {
+            self.articulated.inertia[k] * self.articulated.acceleration[k]
+                + self.articulated.bias_force[k]
+        })
     }
 
     /// Whether [`Self::accelerations_with`] (and [`Self::solve_evaluated`]) take the

@@ -7,9 +7,9 @@ use nalgebra::{DVector, Vector3};
 
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::{Dynamics, ForwardSolver};
-use crr_kinematics::fixtures::serial_chain;
+use crr_kinematics::fixtures::{box_body, hinge, serial_chain};
 use crr_kinematics::mass_matrix::world_inertia;
-use crr_kinematics::{ActivePivots, Data, Model, Side, forward_kinematics};
+use crr_kinematics::{ActivePivots, Data, Model, Side, StructureSpec, forward_kinematics};
 
 /// Centres and angular momenta about the centres of the bodies at q(t), q̇(t).
 fn bodies_at(
@@ -48,15 +48,28 @@ fn joint_moments(
     qddot: &DVector<f64>,
 ) -> Vec<f64> {
     let pivots = ActivePivots::uniform(model, Side::Positive);
+    joint_moments_about(model, &pivots, &pivots, q, qdot, qddot)
+}
+
+/// [`joint_moments`] of the motion on `pivots`, taken about the pivots (and axes) that the
+/// kinematics on `about` puts at q.
+fn joint_moments_about(
+    model: &Model,
+    pivots: &ActivePivots,
+    about: &ActivePivots,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    qddot: &DVector<f64>,
+) -> Vec<f64> {
     let mut data = Data::new(model);
     let h = 1e-4;
     let mut at = |t: f64| {
         let qt = q + qdot * t + qddot * (0.5 * t * t);
         let qdt = qdot + qddot * t;
-        bodies_at(model, &mut data, &pivots, &qt, &qdt)
+        bodies_at(model, &mut data, pivots, &qt, &qdt)
     };
     let (minus, zero, plus) = (at(-h), at(0.0), at(h));
-    forward_kinematics(model, &mut data, q, &pivots);
+    forward_kinematics(model, &mut data, q, about);
     let g = Vector3::new(0.0, 0.0, -model.gravity);
     (0..model.dof())
         .map(|k| {
@@ -143,6 +156,117 @@ fn seated_coordinates_carry_the_newton_euler_moments() {
                     );
                 }
             }
+        }
+    }
+}
+
+/// The joint force of the articulated-body solve gives a seated joint's reaction about the pivot
+/// on its other side (what the uplift test reads for the other side's release): equal to the seat
+/// reaction of a separate solve on the flipped pivot (the same locked motion) and to Newton–Euler
+/// about that pivot.
+/// Four drums 0.6 m wide and 0.5 m high, stacked on two-sided hinges whose axes alternate
+/// between y and x (a pivot on each edge: 0.3 m either side of the axis), so that the stack moves
+/// in 3D.
+fn drum_stack() -> StructureSpec {
+    let (b, h) = (0.3, 0.5);
+    let mut body = Vec::new();
+    let mut interface = Vec::new();
+    for k in 0..4 {
+        let z = k as f64 * h;
+        body.push(box_body(
+            &format!("drum{k}"),
+            2500.0,
+            [0.02 * k as f64, 0.0, z + 0.5 * h],
+            [2.0 * b, 2.0 * b, h],
+        ));
+        let parent = if k == 0 {
+            "ground".to_string()
+        } else {
+            format!("drum{}", k - 1)
+        };
+        let (axis, pos, neg) = if k % 2 == 0 {
+            ([0.0, 1.0, 0.0], [b, 0.0, z], [-b, 0.0, z])
+        } else {
+            ([-1.0, 0.0, 0.0], [0.0, b, z], [0.0, -b, z])
+        };
+        interface.push(hinge(
+            &format!("j{k}"),
+            &parent,
+            &format!("drum{k}"),
+            axis,
+            pos,
+            neg,
+        ));
+    }
+    StructureSpec {
+        name: "drum_stack".into(),
+        gravity: 9.81,
+        body,
+        interface,
+        symmetry: Vec::new(),
+    }
+}
+
+#[test]
+fn joint_force_gives_the_reaction_about_the_other_pivot() {
+    let model = Model::from_spec(&drum_stack()).unwrap();
+    let ground = GroundMotion::none();
+    let scale = model.total_mass() * model.gravity * model.size;
+    for seated in [vec![1], vec![0, 2], vec![1, 3], vec![0, 1, 2, 3]] {
+        let q = DVector::from_fn(4, |k, _| {
+            if seated.contains(&k) {
+                0.0
+            } else {
+                0.3 * ((k + 2) as f64).sin()
+            }
+        });
+        let qdot = DVector::from_fn(4, |k, _| {
+            if seated.contains(&k) {
+                0.0
+            } else {
+                0.9 * ((3 * k + 1) as f64).cos()
+            }
+        });
+        let pivots = ActivePivots::uniform(&model, Side::Positive);
+        let mut dynamics = Dynamics::new(&model, pivots.clone());
+        dynamics.seated = seated.clone();
+        dynamics.solver = ForwardSolver::ArticulatedBody;
+        dynamics
+            .accelerations(&model, &ground, 0.0, &q, &qdot)
+            .unwrap();
+        for (i, &k) in seated.iter().enumerate() {
+            let f = dynamics.joint_force(k).expect("an articulated-body solve");
+            // Along the joint's own axis: the seat reaction (no applied joint torque here).
+            let own = crr_kinematics::mass_matrix::spatial_axis(&dynamics.kin, k).dot(&f);
+            assert!((own - dynamics.seat_reactions[i]).abs() < 1e-12 * scale);
+            let mut flipped = pivots.clone();
+            flipped.sides[k] = Side::Negative;
+            let mut other = Dynamics::new(&model, flipped.clone());
+            other.seated = seated.clone();
+            other.solver = ForwardSolver::Cholesky;
+            other
+                .accelerations(&model, &ground, 0.0, &q, &qdot)
+                .unwrap();
+            // The locked motion does not depend on the seated joint's pivot.
+            assert!((&other.qddot - &dynamics.qddot).amax() < 1e-12 * model.gravity / model.size);
+            let mut data = Data::new(&model);
+            forward_kinematics(&model, &mut data, &q, &flipped);
+            assert!((data.pivot[k] - dynamics.kin.pivot[k]).norm() > 0.5);
+            let about_other = crr_kinematics::mass_matrix::spatial_axis(&data, k).dot(&f);
+            let err = (about_other - other.seat_reactions[i]).abs() / scale;
+            assert!(
+                err < 1e-12,
+                "seated {seated:?}: slot {k}: {about_other} vs {} ({err:e})",
+                other.seat_reactions[i]
+            );
+            let newton_euler =
+                joint_moments_about(&model, &pivots, &flipped, &q, &qdot, &dynamics.qddot);
+            let err = (about_other - newton_euler[k]).abs() / scale;
+            assert!(
+                err < 1e-6,
+                "seated {seated:?}: slot {k}: {about_other} vs Newton–Euler {} ({err:e})",
+                newton_euler[k]
+            );
         }
     }
 }

@@ -146,11 +146,26 @@ pub(super) fn opening_mode_in(
     if evaluated {
         trial.evaluate(model, ground, t, q, qdot);
     }
+    // Releases that cannot open are known from one solve with every seated slot locked.
+    let may_open = releases_that_may_open(model, ground, template, trial, t, q, qdot);
     let mut batch = Vec::with_capacity(seated.len());
     for flip in [false, true] {
         for r in 0..rounds {
             batch.clear();
-            batch.extend((0..seated.len()).filter(|&i| round[i] == r));
+            batch.extend((0..seated.len()).filter(|&i| {
+                let side = if flip {
+                    template.pivots.sides[seated[i]].flipped()
+                } else {
+                    template.pivots.sides[seated[i]]
+                };
+                round[i] == r
+                    && may_open
+                        .as_ref()
+                        .is_none_or(|m| m[2 * i + side_index(side)])
+            }));
+            if batch.is_empty() {
+                continue;
+            }
             let results = match release(trial, &batch, flip, evaluated) {
                 Some(results) => results,
                 None if batch.len() > 1 => batch
@@ -231,6 +246,79 @@ pub(super) fn opening_mode_in(
         released = next;
     }
     None
+}
+
+/// Which single releases of `template`'s seated slots may open, indexed like `opening_mode_in`'s
+/// `opening` (2i: slot `seated[i]` on the positive side, 2i + 1: negative), from one solve with
+/// every seated slot locked; None when the test does not apply (loops, or a solve not by the
+/// articulated-body algorithm), and then every release is solved.
+///
+/// Releasing seated slot k alone on its current pivot changes q̈ by −(M̃⁻¹)eₖrₖ, M̃ the mass
+/// matrix over the free coordinates and k, so that its opening acceleration is
+/// q̈ₖ = −rₖ (M̃⁻¹)ₖₖ with (M̃⁻¹)ₖₖ > 0: the release opens on side σ only if −σ rₖ > 0, rₖ the
+/// seat reaction of the locked solve. On the other pivot the locked motion is the same (at
+/// qₖ = q̇ₖ = 0 the pivot moves no frame, and a locked joint is a weld whatever its axis), so
+/// that the reaction there is the joint force's moment about the other axis,
+/// rₖ′ = rₖ + (sₖ′ − sₖ)ᵀfₖ = rₖ + ((pₖ′ − pₖ) × wₖ)·fₖ — unless the flip also moves the pivot of
+/// a free coordinate (the other tilt of a rocking base), whose release is then solved. Skipped
+/// releases are exactly those whose solve would give σq̈ₖ ≤ 0, below the opening threshold:
+/// the uplift test's answer is unchanged, and a seated state that holds costs one solve.
+fn releases_that_may_open(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<Vec<bool>> {
+    let n = model.dof();
+    let seated = &template.seated;
+    if model.constraint_rows != 0
+        || seated
+            .iter()
+            .any(|&k| k >= n || q[k] != 0.0 || qdot[k] != 0.0)
+    {
+        return None;
+    }
+    trial.pivots.clone_from(&template.pivots);
+    trial.seated.clone_from(seated);
+    if !trial.articulated_body_applies(model) {
+        return None;
+    }
+    trial.accelerations(model, ground, t, q, qdot).ok()?;
+    let mut is_seated = vec![false; model.slot_count];
+    for &k in seated {
+        is_seated[k] = true;
+    }
+    let mut may_open = vec![true; 2 * seated.len()];
+    let mut sides = template.pivots.sides.clone();
+    for (i, &k) in seated.iter().enumerate() {
+        let f = trial.joint_force(k)?;
+        let r = trial.seat_reactions[i];
+        let side = template.pivots.sides[k];
+        let index = |s: Side| 2 * i + usize::from(s == Side::Negative);
+        may_open[index(side)] = -side.sign() * r > 0.0;
+        // The other pivot, where the flip moves no free coordinate's pivot.
+        let coord = &model.coords[k];
+        let iface = &model.interfaces[coord.interface];
+        let moves_free = iface.slots.clone().any(|s| s != k && !is_seated[s]);
+        if moves_free {
+            continue;
+        }
+        let other = side.flipped();
+        sides[k] = other;
+        let p_rest = iface.kind.pivot(&sides[iface.slots.clone()]);
+        sides[k] = side;
+        let pivot = match coord.parent {
+            Some(p) => trial.kin.rot_ops[p] * p_rest + trial.kin.frame_translation[p],
+            None => p_rest,
+        };
+        let arm = (pivot - trial.kin.pivot[k]).cross(&trial.kin.axis[k]);
+        let r_other = r + arm.dot(&f.fixed_rows::<3>(3));
+        may_open[index(other)] = -other.sign() * r_other > 0.0;
+    }
+    Some(may_open)
 }
 
 impl Simulation<'_> {
