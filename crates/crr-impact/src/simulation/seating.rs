@@ -260,7 +260,8 @@ pub(super) fn opening_mode_in(
 /// qₖ = q̇ₖ = 0 the pivot moves no frame, and a locked joint is a weld whatever its axis), so
 /// that the reaction there is the joint force's moment about the other axis,
 /// rₖ′ = rₖ + (sₖ′ − sₖ)ᵀfₖ = rₖ + ((pₖ′ − pₖ) × wₖ)·fₖ — unless the flip also moves the pivot of
-/// a free coordinate (the other tilt of a rocking base), whose release is then solved. Skipped
+/// a free coordinate (the other tilt of a rocking base) or qₖ, q̇ₖ are not 0 to round-off, and
+/// the release is then solved. Skipped
 /// releases are exactly those whose solve would give σq̈ₖ ≤ 0, below the opening threshold:
 /// the uplift test's answer is unchanged, and a seated state that holds costs one solve.
 fn releases_that_may_open(
@@ -274,13 +275,14 @@ fn releases_that_may_open(
 ) -> Option<Vec<bool>> {
     let n = model.dof();
     let seated = &template.seated;
-    if model.constraint_rows != 0
-        || seated
-            .iter()
-            .any(|&k| k >= n || q[k] != 0.0 || qdot[k] != 0.0)
-    {
+    if model.constraint_rows != 0 || seated.iter().any(|&k| k >= n) {
         return None;
     }
+    // Seated coordinates sit at q = 0, q̇ = 0 up to round-off (the projections leave ~1e-16):
+    // there the other pivot's reaction is off by some 1e-12 W·L at most, 1e-3 of the opening
+    // threshold (1e-9 g/size on an inertia of order m·size²), so no release that opens is skipped.
+    let rate_scale = (model.gravity / model.size).sqrt();
+    let at_seat = |k: usize| q[k].abs() <= 1e-12 && qdot[k].abs() <= 1e-12 * rate_scale;
     trial.pivots.clone_from(&template.pivots);
     trial.seated.clone_from(seated);
     if !trial.articulated_body_applies(model) {
@@ -303,7 +305,7 @@ fn releases_that_may_open(
         let coord = &model.coords[k];
         let iface = &model.interfaces[coord.interface];
         let moves_free = iface.slots.clone().any(|s| s != k && !is_seated[s]);
-        if moves_free {
+        if moves_free || !at_seat(k) {
             continue;
         }
         let other = side.flipped();
