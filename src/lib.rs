@@ -13,6 +13,7 @@
 //! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
 //! - [`synthetic`]: the reproducible synthetic accelerogram `examples/records/synthetic.AT2`.
 //! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
+//! - [`study`]: `crr study` (many cases of one model in parallel: maps, fragility studies).
 //! - [`fuzzing`]: the entry points of the fuzz targets in `fuzz/` and of their corpus replay.
 
 pub use crr_dynamics as dynamics;
@@ -25,6 +26,7 @@ pub mod inspect;
 pub mod model_file;
 pub mod plot;
 pub mod simulate;
+pub mod study;
 pub mod synthetic;
 
 pub use model_file::{InputError, load_model};
