@@ -5,9 +5,11 @@
 //!
 //! - [`spec`]: the study file;
 //! - [`cases`]: the study expanded into cases with stable ids;
-//! - [`run`]: running the cases, resuming, sharding, merging.
+//! - [`run`]: running the cases, resuming, sharding, merging;
+//! - [`fragility`]: lognormal fragility functions fitted by maximum likelihood.
 
 pub mod cases;
+pub mod fragility;
 pub mod run;
 pub mod spec;
 
