@@ -94,10 +94,14 @@ enum Command {
         plot: Option<PathBuf>,
         /// Scale the model geometrically by n factors from s0 to s1 and report the frequency
         /// against size (size_sweep.png, .svg with --plot).
-        #[arg(long, value_name = "S0:S1:N")]
+        #[arg(long, value_name = "S0:S1:N", allow_hyphen_values = true)]
         size_sweep: Option<String>,
         /// θm/α_eq of the size sweep's frequencies (between 0 and 1).
-        #[arg(long, value_name = "R", default_value_t = crr::size_sweep::DEFAULT_AMPLITUDE_RATIO)]
+        #[arg(
+            long,
+            value_name = "R",
+            allow_hyphen_values = true,
+            default_value_t = crr::size_sweep::DEFAULT_AMPLITUDE_RATIO)]
         amplitude_ratio: f64,
     },
 }

@@ -167,24 +167,29 @@ pub fn size_sweep(spec: &StructureSpec, scales: &[f64], ratio: f64) -> Result<Si
     let mut rows = Vec::with_capacity(scales.len());
     let mut coordinate = String::new();
     for &s in scales {
+        let at = if (1e-3..1e4).contains(&s) {
+            format!("scaled by {s}")
+        } else {
+            format!("scaled by {s:e}")
+        };
         let scaled = scale_structure(spec, s);
-        let model = Model::from_spec(&scaled).map_err(|e| format!("scaled by {s}: {e}"))?;
+        let model = Model::from_spec(&scaled).map_err(|e| format!("{at}: {e}"))?;
         coordinate = model
             .coords
             .first()
             .map(|c| c.name.clone())
             .unwrap_or_default();
-        let pivots = opening_pivots(&model, 0, 1.0).map_err(|e| format!("scaled by {s}: {e}"))?;
+        let pivots = opening_pivots(&model, 0, 1.0).map_err(|e| format!("{at}: {e}"))?;
         let mut d = model.coords[0].axis.cross(&Vector3::z());
         if d.norm() < 1e-9 {
             d = Vector3::x();
         }
         let eq = equivalent_block(&model, &pivots, 0, &d.normalize())
-            .map_err(|e| format!("scaled by {s}: {e}"))?;
+            .map_err(|e| format!("{at}: {e}"))?;
         let (p, alpha) = (eq.p_squared.sqrt(), eq.alpha);
         if !(p.is_finite() && p > 0.0 && alpha.is_finite() && alpha > 0.0) {
             return Err(format!(
-                "scaled by {s}: no equivalent block (p_eq² = {}, α_eq = {alpha})",
+                "{at}: no equivalent block (p_eq² = {}, α_eq = {alpha})",
                 eq.p_squared
             ));
         }
