@@ -221,3 +221,109 @@ fn bad_sweeps_are_input_errors() {
         "{err}"
     );
 }
+
+/// `scale_structure` scales every kind of input length: on the bundled models (boxes, annular
+/// sectors, hinges with point and segment pivots, rocking bases) and on a polyhedron and a prism
+/// given by its mass (the examples of docs/model-format.md), the scaled model built by
+/// `Model::from_spec` (exact mass properties from the shapes) has every mass × s³, density kept,
+/// centre × s, inertia tensor × s⁵, pivot points and corners × s and the same axes, to round-off
+/// (1e-12 relative).
+#[test]
+fn scaling_multiplies_every_length() {
+    use crr::kinematics::{InterfaceKind, Model};
+    use crr::model_file::parse_model_file;
+    use crr::size_sweep::scale_structure;
+    let frustum = r#"
+name = "frustum"
+[[body]]
+name = "stele"
+density = 2400.0
+polyhedron = { vertices = [
+  [-0.5, -0.5, 0.0], [0.5, -0.5, 0.0], [0.5, 0.5, 0.0], [-0.5, 0.5, 0.0],
+  [-0.3, -0.3, 1.5], [0.3, -0.3, 1.5], [0.3, 0.3, 1.5], [-0.3, 0.3, 1.5],
+] }
+[[interface]]
+name = "base"
+parent = "ground"
+child = "stele"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [[0.5, -0.5, 0.0], [0.5, 0.5, 0.0]]
+pivot_negative = [[-0.5, -0.5, 0.0], [-0.5, 0.5, 0.0]]
+"#;
+    let wall = r#"
+name = "tapered_wall"
+[[body]]
+name = "wall"
+mass = 3000.0
+prism = { polygon = [[-0.3, -1.0, 0.0], [0.3, -1.0, 0.0], [0.2, -1.0, 2.0], [-0.2, -1.0, 2.0]], extrude = [0.0, 2.0, 0.0] }
+[[interface]]
+name = "toe"
+parent = "ground"
+child = "wall"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [0.3, 0.0, 0.0]
+pivot_negative = [-0.3, 0.0, 0.0]
+"#;
+    let mut files = vec![
+        parse_model_file(Path::new("frustum.toml"), frustum).unwrap(),
+        parse_model_file(Path::new("wall.toml"), wall).unwrap(),
+    ];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            files.push(crr::load_model(&p).unwrap().0);
+        }
+    }
+    assert!(files.len() >= 10);
+    let s = 2.5f64;
+    let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-12 * scale;
+    for file in &files {
+        let spec = file.structure();
+        let m1 = Model::from_spec(&spec).unwrap();
+        let ms = Model::from_spec(&scale_structure(&spec, s)).unwrap();
+        let l = m1.size * s;
+        for (a, b) in m1.bodies.iter().zip(&ms.bodies) {
+            assert!(close(b.mass, a.mass * s.powi(3), b.mass), "{}", a.name);
+            assert!(close(b.density, a.density, a.density), "{}", a.name);
+            assert!((b.com - a.com * s).amax() <= 1e-12 * l, "{}", a.name);
+            let i = a.inertia.norm() * s.powi(5);
+            assert!(
+                (b.inertia - a.inertia * s.powi(5)).amax() <= 1e-12 * i,
+                "{}",
+                a.name
+            );
+        }
+        for (a, b) in m1.interfaces.iter().zip(&ms.interfaces) {
+            match (&a.kind, &b.kind) {
+                (
+                    InterfaceKind::Hinge {
+                        axis: a0,
+                        pivot_positive: a1,
+                        pivot_negative: a2,
+                        ..
+                    },
+                    InterfaceKind::Hinge {
+                        axis: b0,
+                        pivot_positive: b1,
+                        pivot_negative: b2,
+                        ..
+                    },
+                ) => {
+                    assert!((b0 - a0).amax() <= 1e-15, "{}", a.name);
+                    assert!((b1 - a1 * s).amax() <= 1e-12 * l, "{}", a.name);
+                    assert!((b2 - a2 * s).amax() <= 1e-12 * l, "{}", a.name);
+                }
+                (
+                    InterfaceKind::RockingBase { corners: ca, .. },
+                    InterfaceKind::RockingBase { corners: cb, .. },
+                ) => {
+                    for (p, q) in ca.iter().zip(cb) {
+                        assert!((q - p * s).amax() <= 1e-12 * l, "{}", a.name);
+                    }
+                }
+                _ => panic!("{}: the interface kind changed", a.name),
+            }
+        }
+    }
+}
