@@ -93,7 +93,7 @@ pub struct MechanismLevels {
     /// The θ > 0 side.
     pub positive: SideLevels,
     /// The separatrix energy (J above rest): the lower of the two overturning energies, `None`
-    /// when neither side overturns.
+    /// when neither side overturns or a side locks at a lower energy.
     pub separatrix: Option<f64>,
     /// The energies of the drawn levels below the separatrix (J above rest), increasing.
     pub energies: Vec<f64>,
@@ -164,6 +164,12 @@ pub fn evaluate(
     let r = reduce_at(model, &q, pivots, coordinate, &d).map_err(|e| e.to_string())?;
     if !(r.mass.is_finite() && r.potential_slope.is_finite() && u.is_finite()) {
         return Err("non-finite reduced mass or potential".into());
+    }
+    if r.mass <= 0.0 {
+        return Err(format!(
+            "the reduced mass M(θ) = {:e} is not positive",
+            r.mass
+        ));
     }
     Ok((
         q,
@@ -285,9 +291,14 @@ pub fn mechanism_levels(model: &Model, step: f64) -> Result<MechanismLevels, Str
         .filter(|s| s.end == SideEnd::Overturning)
         .map(|s| s.last().potential)
         .collect();
-    let separatrix = tops.iter().copied().reduce(f64::min);
     // Levels: U at fractions of the θ > 0 side's reach, below the lowest end energy of both sides.
     let ceiling = positive.last().potential.min(negative.last().potential);
+    // The separatrix closes only if no side locks below it.
+    let separatrix = tops
+        .iter()
+        .copied()
+        .reduce(f64::min)
+        .filter(|top| *top <= ceiling);
     let reach = positive.last().theta;
     let energies = LEVEL_FRACTIONS
         .iter()

@@ -101,6 +101,7 @@ enum Command {
             long,
             value_name = "R",
             allow_hyphen_values = true,
+            requires = "size_sweep",
             default_value_t = crr::size_sweep::DEFAULT_AMPLITUDE_RATIO)]
         amplitude_ratio: f64,
     },
@@ -181,10 +182,10 @@ fn check_models(
         .collect::<Result<Vec<_>, _>>()?;
     let reports: Vec<_> = loaded.iter().map(|(_, m)| crr::check::check(m)).collect();
     // The sweep needs a one-DOF mechanism; its failure is reported after the reports.
-    let mut sweeps = Vec::new();
+    let mut sweeps: Vec<Option<crr::size_sweep::SizeSweep>> = vec![None; reports.len()];
     let mut sweep_error = None;
     if let Some(scales) = &scales {
-        for ((file, _), report) in loaded.iter().zip(&reports) {
+        for (((file, _), report), slot) in loaded.iter().zip(&reports).zip(&mut sweeps) {
             let result = match &report.mechanism {
                 None => Err(report
                     .note
@@ -193,20 +194,20 @@ fn check_models(
                 Some(_) => crr::size_sweep::size_sweep(&file.structure(), scales, ratio),
             };
             match result {
-                Ok(s) => sweeps.push(s),
+                Ok(s) => *slot = Some(s),
                 Err(e) => {
                     sweep_error.get_or_insert(format!("--size-sweep: {}: {e}", report.model));
                 }
             }
         }
     }
-    let sweep_of = |name: &str| sweeps.iter().find(|s| s.model == name);
     if json {
         let values: Vec<serde_json::Value> = reports
             .iter()
-            .map(|r| {
+            .zip(&sweeps)
+            .map(|(r, sweep)| {
                 let mut v = serde_json::to_value(r).expect("report serialises");
-                if let Some(s) = sweep_of(&r.model) {
+                if let Some(s) = sweep {
                     v["size_sweep"] = serde_json::to_value(s).expect("sweep serialises");
                 }
                 v
@@ -222,12 +223,12 @@ fn check_models(
             serde_json::to_string_pretty(&out).expect("report serialises")
         );
     } else {
-        for (i, r) in reports.iter().enumerate() {
+        for (i, (r, sweep)) in reports.iter().zip(&sweeps).enumerate() {
             if i > 0 {
                 println!();
             }
             print!("{}", crr::check::to_text(r));
-            if let Some(s) = sweep_of(&r.model) {
+            if let Some(s) = sweep {
                 print!("{}", crr::size_sweep::to_text(s));
             }
         }
@@ -277,6 +278,7 @@ fn check_models(
             );
         }
     }
+    let sweeps: Vec<_> = sweeps.into_iter().flatten().collect();
     if !sweeps.is_empty() {
         plot_size_sweep(dir, &sweeps)?;
     }

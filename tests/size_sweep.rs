@@ -198,7 +198,11 @@ fn bad_sweeps_are_input_errors() {
             vec!["--size-sweep", "1:2:2", "--amplitude-ratio", "NaN"],
             "--amplitude-ratio",
         ),
-        (vec!["--amplitude-ratio", "-0.5"], "--amplitude-ratio"),
+        (
+            vec!["--size-sweep", "1:2:2", "--amplitude-ratio", "-0.5"],
+            "--amplitude-ratio",
+        ),
+        (vec!["--amplitude-ratio", "0.5"], "--size-sweep"),
     ] {
         let mut all = vec!["check", model];
         all.extend(&args);

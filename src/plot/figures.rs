@@ -43,7 +43,10 @@ pub(super) fn draw_level_curves<'a, DB: DrawingBackend + 'a>(
             chart
                 .draw_series(LineSeries::new(curve, BLACK.stroke_width(2 * k)))
                 .map_err(err)?
-                .label(format!("separatrix E = {e:.4e} J (overturning)"))
+                .label(format!(
+                    "separatrix of {}, E = {e:.4e} J (overturning)",
+                    levels.coordinate
+                ))
                 .legend(line_key(BLACK, k));
         } else {
             let c = level_colour(i, n_below);
@@ -57,7 +60,8 @@ pub(super) fn draw_level_curves<'a, DB: DrawingBackend + 'a>(
                 .map_err(err)?;
             if i == 0 {
                 s.label(format!(
-                    "levels E = {} J",
+                    "levels of {}, E = {} J",
+                    levels.coordinate,
                     drawn
                         .iter()
                         .filter(|d| !d.1)
