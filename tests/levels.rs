@@ -340,3 +340,48 @@ fn phase_plot_of_a_closed_chain_has_the_levels() {
     let svg = std::fs::read_to_string(dir.join("phase.svg")).unwrap();
     assert!(!svg.contains("separatrix"));
 }
+
+/// The drawn level curves of the trilithon: every point holds U(θ) + ½ M θ̇² = E with the closed
+/// forms of U and M above (1e-9 of the energy scale, as the samples), the curve is closed (starts
+/// and ends at the left turning point with θ̇ = 0) and its turning points are the roots of
+/// U(θ*) = E, θ* = ±(α − arccos(cos α + E/k_u)), to the linear interpolation between samples
+/// 1e-3 rad apart: h² |U″| / (8 |U′|) < 1e-5 rad away from the top, where U′ > 0.05 k_u.
+#[test]
+fn trilithon_level_curves_hold_their_energy() {
+    let m = model("trilithon");
+    let levels = mechanism_levels(&m, 1e-3).unwrap();
+    let (b, h) = (0.25f64, 2.0f64);
+    let m_c = 2500.0 * 0.5 * 0.5 * 4.0;
+    let m_b = 2500.0 * 3.5 * 0.5 * 0.6;
+    let r = b.hypot(h);
+    let alpha = (b / h).atan();
+    let k_u = G * (2.0 * m_c + 2.0 * m_b) * r;
+    let m0 = 2.0 * 4.0 / 3.0 * m_c * r * r + m_b * 4.0 * r * r;
+    assert_eq!(levels.energies.len(), 3);
+    for e in levels.energies.clone() {
+        let curve = levels.curve(e);
+        assert!(curve.len() > 100);
+        let turning = alpha - ((alpha.cos() + e / k_u).acos());
+        let (first, last) = (curve[0], curve[curve.len() - 1]);
+        assert_eq!(first, last, "closed curve");
+        assert_eq!(first.1, 0.0);
+        assert!(
+            (first.0 + turning).abs() < 1e-5,
+            "{} against −{turning}",
+            first.0
+        );
+        let right = curve.iter().map(|p| p.0).fold(f64::MIN, f64::max);
+        assert!((right - turning).abs() < 1e-5, "{right} against {turning}");
+        for &(theta, rate) in &curve {
+            if rate == 0.0 {
+                continue;
+            }
+            let u = k_u * ((alpha - theta.abs()).cos() - alpha.cos());
+            let total = u + 0.5 * m0 * rate * rate;
+            assert!(
+                (total - e).abs() <= 1e-9 * k_u,
+                "θ = {theta}: {total} against {e}"
+            );
+        }
+    }
+}
