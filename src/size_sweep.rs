@@ -124,6 +124,63 @@ pub fn scale_structure(spec: &StructureSpec, s: f64) -> StructureSpec {
     out
 }
 
+/// The height of the structure at rest (m): the highest point of its shapes minus the lowest one
+/// (exact for every shape kind: box corners, polyhedron vertices, prism vertices, and the extreme
+/// heights of an annular sector's arcs). `None` when a shape is degenerate (the model would not
+/// build either).
+pub fn structure_height(spec: &StructureSpec) -> Option<f64> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut add = |z: f64| {
+        lo = lo.min(z);
+        hi = hi.max(z);
+    };
+    let v = |p: &[f64; 3]| Vector3::new(p[0], p[1], p[2]);
+    for b in &spec.body {
+        if let Some(x) = &b.box_shape {
+            let r = x.rotation_matrix();
+            for i in 0..8 {
+                let sgn = |k: usize| if i & (1 << k) == 0 { -0.5 } else { 0.5 };
+                let local =
+                    Vector3::new(sgn(0) * x.size[0], sgn(1) * x.size[1], sgn(2) * x.size[2]);
+                add((v(&x.center) + r * local).z);
+            }
+        }
+        if let Some(x) = &b.polyhedron {
+            x.vertices.iter().for_each(|p| add(p[2]));
+        }
+        if let Some(x) = &b.prism {
+            x.polygon.iter().for_each(|p| {
+                add(p[2]);
+                add(p[2] + x.extrude[2]);
+            });
+        }
+        if let Some(x) = &b.annular_sector {
+            let f = x.frame().ok()?;
+            let (es, et, w) = (f.column(0), f.column(1), f.column(2));
+            // z(θ) = c + ρ (A cos θ + B sin θ) + ζ w_z: extremes at the ends of the arc and where
+            // tan θ = B/A (θ* and θ* + π) if inside it.
+            let (a, bb) = (es.z, et.z);
+            let star = bb.atan2(a);
+            let two_pi = std::f64::consts::TAU;
+            let mut angles = vec![x.from_angle, x.to_angle];
+            for c in [star, star + std::f64::consts::PI] {
+                let shifted = x.from_angle + (c - x.from_angle).rem_euclid(two_pi);
+                if shifted <= x.to_angle {
+                    angles.push(shifted);
+                }
+            }
+            for t in angles {
+                for rho in [x.inner_radius, x.outer_radius] {
+                    for zeta in [-0.5 * x.thickness, 0.5 * x.thickness] {
+                        add(x.center[2] + rho * (a * t.cos() + bb * t.sin()) + zeta * w.z);
+                    }
+                }
+            }
+        }
+    }
+    (hi - lo).is_finite().then_some(hi - lo)
+}
+
 /// One scaled model of the sweep.
 #[derive(Clone, Debug, Serialize)]
 pub struct SizeRow {
@@ -131,6 +188,9 @@ pub struct SizeRow {
     pub scale: f64,
     /// The scaled model's length scale (`Model::size`: largest extent of the centres and pivots, m).
     pub size: f64,
+    /// Height of the scaled structure at rest (m): its highest point minus its lowest
+    /// ([`structure_height`]); `None` if it cannot be computed.
+    pub height: Option<f64>,
     /// Total mass (kg): s³ times the unscaled one.
     pub mass: f64,
     /// λ (g).
@@ -201,6 +261,7 @@ pub fn size_sweep(spec: &StructureSpec, scales: &[f64], ratio: f64) -> Result<Si
         rows.push(SizeRow {
             scale: s,
             size: model.size,
+            height: structure_height(&scaled),
             mass: model.total_mass(),
             lambda: eq.lambda,
             alpha_eq: alpha,
@@ -225,15 +286,22 @@ pub fn to_text(sw: &SizeSweep) -> String {
         "\nfree-rocking frequency versus size ({}, θm/α_eq = {})\n",
         sw.model, sw.amplitude_ratio
     );
-    s += "scale   size (m)   mass (kg)      α_eq (rad)  p_eq (rad/s)  F_H Housner (Hz)  engine (Hz)  engine/F_H\n";
+    s += "scale   height (m)  mass (kg)      α_eq (rad)  p_eq (rad/s)  F_H Housner (Hz)  engine (Hz)  engine/F_H\n";
     for r in &sw.rows {
         let (e, q) = match (r.engine_hz, r.ratio) {
             (Some(e), Some(q)) => (format!("{e:.6}"), format!("{q:.5}")),
             _ => ("–".to_string(), "–".to_string()),
         };
         s += &format!(
-            "{:<7.4} {:<10.4} {:<14.6e} {:<11.6} {:<13.6} {:<17.6} {:<12} {}\n",
-            r.scale, r.size, r.mass, r.alpha_eq, r.p_eq, r.housner_hz, e, q
+            "{:<7.4} {:<11} {:<14.6e} {:<11.6} {:<13.6} {:<17.6} {:<12} {}\n",
+            r.scale,
+            r.height.map_or("–".to_string(), |h| format!("{h:.4}")),
+            r.mass,
+            r.alpha_eq,
+            r.p_eq,
+            r.housner_hz,
+            e,
+            q
         );
     }
     s

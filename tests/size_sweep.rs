@@ -39,7 +39,7 @@ fn f(v: &Value, k: &str) -> f64 {
 /// free fall is the same motion on the time scale √s, but its error control (rtol 1e-10,
 /// atol 1e-12 on θ and θ̇, with θ̇ ∝ 1/√s) does not scale exactly: tolerance 1e-8, a hundred
 /// times the integrator's rtol (measured: below 1e-10). Returns the unscaled row.
-fn assert_scaling(sweep: &Value, scales: &[f64], mass1: f64) -> Value {
+fn assert_scaling(sweep: &Value, scales: &[f64], mass1: f64, height1: f64) -> Value {
     let rows = sweep["rows"].as_array().unwrap();
     assert_eq!(rows.len(), scales.len());
     let one = rows
@@ -53,6 +53,11 @@ fn assert_scaling(sweep: &Value, scales: &[f64], mass1: f64) -> Value {
         assert!(
             (m - mass1 * s.powi(3)).abs() <= 1e-12 * m,
             "mass {m} at s = {s}"
+        );
+        let h = f(r, "height");
+        assert!(
+            (h - height1 * s).abs() <= 1e-12 * h,
+            "height {h} at s = {s}"
         );
         for k in ["alpha_eq", "lambda"] {
             assert!(
@@ -100,7 +105,7 @@ fn single_block_frequency_scales_as_one_over_root_size() {
     let sweep = &v["size_sweep"];
     assert_eq!(sweep["amplitude_ratio"], 0.5);
     assert_eq!(sweep["coordinate"], "base");
-    let one = assert_scaling(sweep, &[0.5, 1.0, 1.5, 2.0], 800.0);
+    let one = assert_scaling(sweep, &[0.5, 1.0, 1.5, 2.0], 800.0, 2.0);
     let (b, h, g): (f64, f64, f64) = (0.2, 1.0, 9.81);
     let r = b.hypot(h);
     assert!((f(&one, "alpha_eq") - (b / h).atan()).abs() < 1e-9);
@@ -116,7 +121,7 @@ fn single_block_frequency_scales_as_one_over_root_size() {
 }
 
 /// Several models: one JSON array, each report with its sweep; the scaling law holds for the
-/// trilithon (7625 kg) and the arch (a closed chain with no closed form; total mass from the
+/// trilithon (7625 kg, 4.6 m high) and the arch (2.5 m high) (a closed chain with no closed form; total mass from the
 /// annular sectors: 2200 × π (2.5² − 2²)/2 × 1 m); `--plot` draws one housner figure, one
 /// size_sweep figure and each model's levels under its own name.
 #[test]
@@ -139,9 +144,10 @@ fn several_models_share_the_figures_and_obey_the_scaling() {
     assert_eq!(a[0]["model"], "trilithon");
     assert_eq!(a[1]["model"], "arch");
     let arch_mass = 2200.0 * std::f64::consts::PI * (2.5f64.powi(2) - 4.0) / 2.0;
-    for (r, mass) in a.iter().zip([7625.0, arch_mass]) {
+    // Heights: columns 4 m + architrave 0.6 m; the arch's extrados crown 2.5 m above the springings.
+    for (r, mass, height) in [(&a[0], 7625.0, 4.6), (&a[1], arch_mass, 2.5)] {
         assert_eq!(r["size_sweep"]["amplitude_ratio"], 0.3);
-        assert_scaling(&r["size_sweep"], &[1.0, 2.5, 4.0], mass);
+        assert_scaling(&r["size_sweep"], &[1.0, 2.5, 4.0], mass, height);
     }
     for file in [
         "housner.png",
@@ -161,7 +167,11 @@ fn several_models_share_the_figures_and_obey_the_scaling() {
     let svg = std::fs::read_to_string(dir.join("housner.svg")).unwrap();
     assert!(svg.contains("trilithon") && svg.contains("arch"));
     let svg = std::fs::read_to_string(dir.join("size_sweep.svg")).unwrap();
-    assert!(svg.contains("trilithon") && svg.contains("arch") && svg.contains("scale factor"));
+    assert!(
+        svg.contains("trilithon")
+            && svg.contains("arch")
+            && svg.contains("height of the structure")
+    );
 }
 
 /// Without the new options a single model's JSON stays one object with no sweep.
@@ -230,8 +240,8 @@ fn bad_sweeps_are_input_errors() {
 /// sectors, hinges with point and segment pivots, rocking bases) and on a polyhedron and a prism
 /// given by its mass (the examples of docs/model-format.md), the scaled model built by
 /// `Model::from_spec` (exact mass properties from the shapes) has every mass × s³, density kept,
-/// centre × s, inertia tensor × s⁵, pivot points and corners × s and the same axes, to round-off
-/// (1e-12 relative).
+/// centre × s, inertia tensor × s⁵, pivot points and corners × s and the same axes, and the
+/// structure's height × s, to round-off (1e-12 relative).
 #[test]
 fn scaling_multiplies_every_length() {
     use crr::kinematics::{InterfaceKind, Model};
@@ -280,6 +290,9 @@ pivot_negative = [-0.3, 0.0, 0.0]
         }
     }
     assert!(files.len() >= 10);
+    // Heights from the shapes: the frustum 1.5 m, the wall 2 m.
+    let height = |i: usize| crr::size_sweep::structure_height(&files[i].structure()).unwrap();
+    assert!((height(0) - 1.5).abs() < 1e-15 && (height(1) - 2.0).abs() < 1e-15);
     let s = 2.5f64;
     let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-12 * scale;
     for file in &files {
@@ -287,6 +300,11 @@ pivot_negative = [-0.3, 0.0, 0.0]
         let m1 = Model::from_spec(&spec).unwrap();
         let ms = Model::from_spec(&scale_structure(&spec, s)).unwrap();
         let l = m1.size * s;
+        let (h1, hs) = (
+            crr::size_sweep::structure_height(&spec).unwrap(),
+            crr::size_sweep::structure_height(&scale_structure(&spec, s)).unwrap(),
+        );
+        assert!((hs - h1 * s).abs() <= 1e-12 * hs, "{}: height", spec.name);
         for (a, b) in m1.bodies.iter().zip(&ms.bodies) {
             assert!(close(b.mass, a.mass * s.powi(3), b.mass), "{}", a.name);
             assert!(close(b.density, a.density, a.density), "{}", a.name);

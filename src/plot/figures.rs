@@ -215,7 +215,16 @@ pub fn draw_size_sweep<DB: DrawingBackend>(
 ) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
     let all = sweeps.iter().flat_map(|s| s.rows.iter());
-    let xr = padded(all.clone().map(|r| r.scale));
+    // Against the structure's height (the paper's Fig. 10) when every row has one, else s.
+    let by_height = all.clone().all(|r| r.height.is_some());
+    let x = move |r: &crate::size_sweep::SizeRow| {
+        if by_height {
+            r.height.unwrap_or(r.scale)
+        } else {
+            r.scale
+        }
+    };
+    let xr = padded(all.clone().map(x));
     let xr = 0f64.min(xr.start)..xr.end;
     let yr = 0f64..headroom(
         padded(
@@ -239,7 +248,11 @@ pub fn draw_size_sweep<DB: DrawingBackend>(
     configure(
         &mut chart,
         k,
-        "scale factor s (every length × s)",
+        if by_height {
+            "height of the structure H (m), every length × s"
+        } else {
+            "scale factor s (every length × s)"
+        },
         "frequency (Hz)",
         &|v| tick(*v, &xr),
         &|v| tick(*v, &yr),
@@ -248,7 +261,7 @@ pub fn draw_size_sweep<DB: DrawingBackend>(
         let c = colour(i);
         chart
             .draw_series(LineSeries::new(
-                sw.rows.iter().map(|r| (r.scale, r.housner_hz)),
+                sw.rows.iter().map(|r| (x(r), r.housner_hz)),
                 c.stroke_width(2 * k),
             ))
             .map_err(err)?
@@ -258,7 +271,7 @@ pub fn draw_size_sweep<DB: DrawingBackend>(
             .draw_series(
                 sw.rows
                     .iter()
-                    .filter_map(|r| r.engine_hz.map(|e| (r.scale, e)))
+                    .filter_map(|r| r.engine_hz.map(|e| (x(r), e)))
                     .map(|q| Circle::new(q, 6 * k, c.filled())),
             )
             .map_err(err)?;
