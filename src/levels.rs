@@ -30,6 +30,10 @@ pub const THETA_LIMIT: f64 = std::f64::consts::FRAC_PI_2;
 /// Default step of θ (rad) between samples.
 pub const DEFAULT_STEP: f64 = 1e-3;
 
+/// Fewest steps on a side: a side reached in fewer steps of the given size is followed again with
+/// its reach divided by this.
+pub const MIN_STEPS: usize = 100;
+
 /// Amplitude fractions of the overturning angle on the θ > 0 side that set the drawn levels
 /// (θm/θ_over = 0.25, 0.5, 0.75, as the single block's θm/α of `crr plot`); the separatrix is
 /// added to them.
@@ -271,7 +275,8 @@ fn follow_side(
     })
 }
 
-/// Follows the mechanism of coordinate 0 on both sides of rest with the given step (rad) and sets
+/// Follows the mechanism of coordinate 0 on both sides of rest with the given step (rad; finer
+/// when a side ends within [`MIN_STEPS`] steps) and sets
 /// the energy levels. Errors when the model is not a one-DOF mechanism there, or rest is not a
 /// minimum of U.
 pub fn mechanism_levels(model: &Model, step: f64) -> Result<MechanismLevels, String> {
@@ -284,8 +289,18 @@ pub fn mechanism_levels(model: &Model, step: f64) -> Result<MechanismLevels, Str
         ));
     }
     let coordinate = 0;
-    let positive = follow_side(model, coordinate, 1.0, step)?;
-    let negative = follow_side(model, coordinate, -1.0, step)?;
+    // A side shorter than MIN_STEPS steps (a slender mechanism) is followed again with finer steps.
+    let side = |sign: f64| -> Result<SideLevels, String> {
+        let s = follow_side(model, coordinate, sign, step)?;
+        let reach = s.last().theta.abs();
+        if s.samples.len() < MIN_STEPS && reach > 0.0 {
+            follow_side(model, coordinate, sign, reach / MIN_STEPS as f64)
+        } else {
+            Ok(s)
+        }
+    };
+    let positive = side(1.0)?;
+    let negative = side(-1.0)?;
     let tops: Vec<f64> = [&positive, &negative]
         .iter()
         .filter(|s| s.end == SideEnd::Overturning)

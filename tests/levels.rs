@@ -385,3 +385,39 @@ fn trilithon_level_curves_hold_their_energy() {
         }
     }
 }
+
+/// A slender block (b/h = 0.02, α = 0.02 rad, 20 steps of 1e-3 rad) is followed again in finer steps
+/// (at least 100 per side), and its levels are still the block formula to 1e-10.
+#[test]
+fn slender_block_levels_are_refined() {
+    let text = r#"
+name = "slender"
+[[body]]
+name = "block"
+density = 2000.0
+box = { center = [0.0, 0.0, 2.5], size = [0.2, 0.2, 5.0] }
+[[interface]]
+name = "base"
+parent = "ground"
+child = "block"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [0.1, 0.0, 0.0]
+pivot_negative = [-0.1, 0.0, 0.0]
+"#;
+    let file = crr::model_file::parse_model_file(Path::new("slender.toml"), text).unwrap();
+    let m = crr::kinematics::Model::from_spec(&file.structure()).unwrap();
+    let levels = mechanism_levels(&m, 1e-3).unwrap();
+    for side in [&levels.negative, &levels.positive] {
+        assert!(side.samples.len() > 100, "{} samples", side.samples.len());
+    }
+    let (b, h) = (0.1f64, 2.5f64);
+    let mass = 2000.0 * 0.2 * 0.2 * 5.0;
+    let r = b.hypot(h);
+    assert_block_like(
+        &levels,
+        (b / h).atan(),
+        mass * G * r,
+        4.0 / 3.0 * mass * r * r,
+        1e-10,
+    );
+}
