@@ -10,8 +10,8 @@ use serde::Serialize;
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::mechanism::reduce_at;
 use crr_dynamics::{
-    FiniteMobility, InitialSpec, Mobility, equivalent_block, mobility, mobility_after_step,
-    solve_initial,
+    FiniteMobility, InitialSpec, LagrangianParameters, Mobility, equivalent_block,
+    lagrangian_parameters, mobility, mobility_after_step, solve_initial,
 };
 use crr_impact::laws::momentum_law;
 use crr_impact::simulation::{Parameters, Simulation, StopReason};
@@ -69,6 +69,8 @@ pub struct MechanismReport {
     /// max |q̇⁺ − r q̇⁻| / max |q̇⁻|: how far the velocity after the impact is from a multiple of
     /// the velocity before (0 for a symmetric mechanism).
     pub mode_change: f64,
+    /// The paper's one-DOF Lagrangian (eq 4): ν, ξ, η, χ, and eq 6's χ and ε (NOTATION.md).
+    pub lagrangian: LagrangianParameters,
     /// Generalized Housner frequency against the engine's free rocking.
     pub frequencies: Vec<FrequencyRow>,
 }
@@ -158,6 +160,7 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
     }
     let d = d.normalize();
     let eq = equivalent_block(model, &pivots, 0, &d).map_err(|e| e.to_string())?;
+    let lagrangian = lagrangian_parameters(model, &pivots, 0, &d).map_err(|e| e.to_string())?;
     // r from the momentum law: closing velocity on the opening pivots, after the flip.
     let zero = DVector::zeros(model.dof());
     let b = reduce_at(model, &zero, &pivots, 0, &d)
@@ -207,6 +210,7 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
         r,
         energy_ratio: res.energy_ratio(),
         mode_change,
+        lagrangian,
         frequencies,
     })
 }
@@ -342,6 +346,16 @@ pub fn to_text(r: &CheckReport) -> String {
         s += &format!(
             "  r (momentum law) = {:.6}, T⁺/T⁻ = {:.6}, mode change {:.1e}\n",
             k.r, k.energy_ratio, k.mode_change
+        );
+        let l = &k.lagrangian;
+        s += "one-DOF Lagrangian (eq 4): L/M(0) = ½(1 ± νθ + ξθ²)θ̇² ∓ ηθ + ½χθ² (NOTATION.md)\n";
+        s += &format!(
+            "  ν = {:.6e} 1/rad, ξ = {:.6e} 1/rad², η = {:.6} 1/s², χ = {:.6} 1/s²\n",
+            l.nu, l.xi, l.eta, l.chi
+        );
+        s += &format!(
+            "  eq 6: χ = p_eq² = {:.6} 1/s², ε = 1/α_eq = {:.6} 1/rad\n",
+            l.chi_housner, l.epsilon
         );
         s += "\nfree-rocking frequency versus amplitude\n";
         s += "θm/α    θm (rad)   F_H Housner (Hz)   engine (Hz)   engine/F_H\n";

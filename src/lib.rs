@@ -15,6 +15,7 @@
 //! - [`levels`]: energy levels of any one-DOF mechanism from the engine's M(θ) and U(θ).
 //! - [`size_sweep`]: `crr check --size-sweep`, the frequencies of geometrically scaled models.
 //! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
+//! - [`study`]: `crr study` (many cases of one model in parallel: maps, fragility studies).
 //! - [`fuzzing`]: the entry points of the fuzz targets in `fuzz/` and of their corpus replay.
 
 pub use crr_dynamics as dynamics;
@@ -29,6 +30,7 @@ pub mod model_file;
 pub mod plot;
 pub mod simulate;
 pub mod size_sweep;
+pub mod study;
 pub mod synthetic;
 
 pub use model_file::{InputError, load_model};

@@ -105,6 +105,41 @@ enum Command {
             default_value_t = crr::size_sweep::DEFAULT_AMPLITUDE_RATIO)]
         amplitude_ratio: f64,
     },
+    /// Run every case of a study file (a pulse family's amplitude × frequency grid, or records
+    /// scaled to intensity levels) in parallel into cases.csv and study.json (docs/studies.md);
+    /// rerunning into the same folder resumes. `crr study merge DIR... --out DIR` joins shards.
+    #[command(args_conflicts_with_subcommands = true)]
+    Study {
+        #[command(subcommand)]
+        action: Option<StudyAction>,
+        /// Study file (TOML).
+        study: Option<PathBuf>,
+        /// Output folder (default results/<study name>).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Worker threads (default: one per core).
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Run only the i-th of n disjoint parts (1 ≤ i ≤ n), e.g. one task of a job array.
+        #[arg(long, value_name = "i/n")]
+        shard: Option<String>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+}
+
+#[derive(Subcommand)]
+enum StudyAction {
+    /// Join the cases.csv of shard folders (same study) into one folder, in case-id order.
+    Merge {
+        /// The shards' output folders.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Folder of the merged cases.csv and study.json.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
 }
 
 /// Input problems and plots that cannot be drawn exit with 2, a simulation that failed part-way
@@ -380,6 +415,62 @@ fn run(cli: Cli) -> Result<(), Failure> {
             size_sweep.as_deref(),
             amplitude_ratio,
         )?,
+        Command::Study {
+            action: Some(StudyAction::Merge { dirs, out }),
+            ..
+        } => {
+            let n = crr::study::merge(&dirs, &out)?;
+            println!(
+                "{n} case(s) merged into {}",
+                out.join("cases.csv").display()
+            );
+        }
+        Command::Study {
+            action: None,
+            study,
+            out,
+            jobs,
+            shard,
+            quiet,
+        } => {
+            let Some(path) = study else {
+                return Err(Failure::Input(InputError::Argument(
+                    "crr study needs a study file (or `merge DIR... --out DIR`)".into(),
+                )));
+            };
+            if jobs == Some(0) {
+                return Err(Failure::Input(InputError::Argument(
+                    "--jobs must be at least 1".into(),
+                )));
+            }
+            let shard = match shard {
+                Some(s) => s.parse().map_err(InputError::Argument)?,
+                None => crr::study::Shard::ALL,
+            };
+            let study = crr::study::Study::load(&path)?;
+            let out = out.unwrap_or_else(|| PathBuf::from("results").join(&study.name));
+            let outcome = crr::study::run_study(
+                &study,
+                &path,
+                &crr::study::StudyOptions {
+                    out: out.clone(),
+                    jobs,
+                    shard,
+                    quiet,
+                },
+            )?;
+            if !quiet {
+                println!(
+                    "{}: {} case(s) in this part, {} already done, {} run, {} with an error; results in {}",
+                    path.display(),
+                    outcome.cases,
+                    outcome.skipped,
+                    outcome.ran,
+                    outcome.failed,
+                    out.display()
+                );
+            }
+        }
         Command::Plot { dir } => {
             for f in plot_results(&dir)? {
                 println!("{}", f.display());

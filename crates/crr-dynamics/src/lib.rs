@@ -29,6 +29,8 @@ pub use closed_chain::{
 };
 pub use energy::{Energies, energies};
 pub use eom::{ClosedChainSolve, Dynamics, DynamicsError, ForwardSolver, effective_gravity};
-pub use mechanism::{EquivalentBlock, equivalent_block};
+pub use mechanism::{
+    EquivalentBlock, LagrangianParameters, equivalent_block, lagrangian_parameters,
+};
 pub use run::{Form, Sample, integrate_smooth};
 pub use system::{ConstrainedSystem, ReducedSystem};

@@ -156,3 +156,68 @@ pub fn equivalent_block(
         p_squared_linearised: -curvature / r0.mass,
     })
 }
+
+/// The parameters of the paper's one-DOF Lagrangian (eq 4) for a mechanism at rest, with the
+/// generalized Housner frequency's χ and ε (eq 6).
+///
+/// Eq 4 is read as the second-order expansion about θ = 0 of the Lagrangian per unit of the
+/// reduced inertia at rest, on the side σ = sgn θ (σ = +1 on the opening side the pivots are
+/// given for, mirrored on the other):
+///
+/// ```text
+/// L / M(0) = ½ (1 + σνθ + ξθ²) θ̇² − σηθ + ½χθ² + O(θ³)
+/// ```
+///
+/// so that M(θ) = M(0)(1 + σνθ + ξθ²) and U(θ) − U(0) = M(0)(σηθ − ½χθ²). The text of eq 4 as
+/// extracted puts dots on the last two θ's; dimensions (L/M(0) in 1/s², ν and ξ in 1/rad and
+/// 1/rad², η and χ in 1/s²) and eq 6, whose χ and ε are the same block's p² and 1/α, require this
+/// form (NOTATION.md). The mechanism's linearised equation is θ̈ = −σ η + χθ, the block's
+/// θ̈ = −p²(σα − θ) with η = p² sin α ≈ p²α and χ = p² cos α ≈ p².
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct LagrangianParameters {
+    /// ν = M′(0)/M(0) (1/rad): the first-order change of the reduced inertia; 0 when M is
+    /// constant along the mechanism (a block, a frame of identical columns).
+    pub nu: f64,
+    /// ξ = M″(0)/(2M(0)) (1/rad²).
+    pub xi: f64,
+    /// η = U′(0)/M(0) (1/s²): the restoring term, p_eq² sin α_eq.
+    pub eta: f64,
+    /// χ = −U″(0)/M(0) (1/s²): the overturning term, p_eq² cos α_eq.
+    pub chi: f64,
+    /// χ of eq 6: p_eq² = √(η² + χ²) (1/s²).
+    pub chi_housner: f64,
+    /// ε of eq 6: 1/α_eq = 1/atan(η/χ) (1/rad).
+    pub epsilon: f64,
+}
+
+/// [`LagrangianParameters`] of the mechanism driven by `coordinate` on `pivots` (the opening
+/// side), from the engine's M and U along the mechanism: U′ and U″ as in [`equivalent_block`],
+/// M′ and M″ by central differences of the reduced inertia Bᵀ M B of closed configurations.
+pub fn lagrangian_parameters(
+    model: &Model,
+    pivots: &ActivePivots,
+    coordinate: usize,
+    direction: &Vector3<f64>,
+) -> Result<LagrangianParameters, DynamicsError> {
+    let eq = equivalent_block(model, pivots, coordinate, direction)?;
+    let zero = DVector::zeros(model.dof());
+    let mass_at = |theta: f64| -> Result<f64, DynamicsError> {
+        let q = configuration(model, &zero, pivots, coordinate, theta)?;
+        Ok(reduce_at(model, &q, pivots, coordinate, direction)?.mass)
+    };
+    // M′ with h = 1e-4 rad: truncation h²M‴/6 ~ 1e-9 M, round-off ~1e-16 M/h ~ 1e-12 M. M″ with
+    // h = 1e-3 rad: truncation h²M⁗/12 ~ 1e-7 M, round-off of the closed configurations (~1e-14 M)
+    // over h² ~ 1e-8 M.
+    let (h1, h2) = (1e-4, 1e-3);
+    let m0 = eq.mass;
+    let nu = (mass_at(h1)? - mass_at(-h1)?) / (2.0 * h1 * m0);
+    let xi = (mass_at(h2)? - 2.0 * m0 + mass_at(-h2)?) / (2.0 * h2 * h2 * m0);
+    Ok(LagrangianParameters {
+        nu,
+        xi,
+        eta: eq.potential_slope / m0,
+        chi: -eq.potential_curvature / m0,
+        chi_housner: eq.p_squared,
+        epsilon: 1.0 / eq.alpha,
+    })
+}

@@ -1,0 +1,440 @@
+//! A study file expanded into its cases: the model read once, the records read once, and one
+//! case per (pulse amplitude, pulse frequency) or (record, intensity level), in a fixed order
+//! that gives every case a stable id (`c000000`, `c000001`, … in that order).
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+
+use crr_dynamics::ground_motion::{
+    Axis, ComponentSpec, GroundMotion, GroundMotionSpec, PulseSpec, Record, RickerSpec,
+    STANDARD_GRAVITY, SignalSpec, read_record,
+};
+use crr_dynamics::{InitialState, equivalent_block, solve_initial};
+use crr_impact::Parameters;
+use crr_kinematics::Model;
+
+use super::spec::{PulseKind, Start, StudySpec, Values};
+use crate::InputError;
+use crate::model_file::load_model;
+use crate::simulate::default_duration;
+
+/// What drives one case.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    /// A pulse of amplitude a_p (m/s²) and period T_p = 2π/ω_p (s).
+    Pulse {
+        /// a_p (m/s²).
+        amplitude: f64,
+        /// T_p (s).
+        period: f64,
+        /// a_p/(g tan α), when the grid was given so.
+        amplitude_ratio: Option<f64>,
+        /// ω_p/p, when the grid was given so.
+        frequency_ratio: Option<f64>,
+    },
+    /// Record `record` (index into [`Study::records`]) times `factor`, at intensity `level` (the
+    /// target PGA in g, PGV in m/s, or the factor itself).
+    Record {
+        /// Index of the record.
+        record: usize,
+        /// Intensity level as given.
+        level: f64,
+        /// Factor on the record's accelerations (None when the record could not be read or has
+        /// a zero intensity).
+        factor: Option<f64>,
+    },
+}
+
+/// One case of a study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Case {
+    /// Position in the study's order.
+    pub index: usize,
+    /// Stable id: `c` and the index on six digits.
+    pub id: String,
+    /// Its ground motion.
+    pub motion: Motion,
+}
+
+/// A record of the study, read once.
+#[derive(Clone, Debug)]
+pub struct StudyRecord {
+    /// The file as named in the study.
+    pub file: PathBuf,
+    /// The record, or why it could not be read (its cases then fail with this message).
+    pub record: Result<Record, String>,
+}
+
+/// The intensity measure of a records study.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntensityMeasure {
+    /// Factors on the record.
+    Factor,
+    /// Peak ground acceleration, g.
+    Pga,
+    /// Peak ground velocity, m/s.
+    Pgv,
+}
+
+impl IntensityMeasure {
+    /// Column name of the level.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntensityMeasure::Factor => "factor",
+            IntensityMeasure::Pga => "pga_g",
+            IntensityMeasure::Pgv => "pgv_m_s",
+        }
+    }
+}
+
+/// A study ready to run.
+#[derive(Clone, Debug)]
+pub struct Study {
+    /// The study file as read.
+    pub spec: StudySpec,
+    /// Its name.
+    pub name: String,
+    /// The model.
+    pub model: Model,
+    /// The model's initial state.
+    pub initial: InitialState,
+    /// Parameters from the model's `[analysis]` (the duration is set per case).
+    pub params: Parameters,
+    /// The driven axis.
+    pub axis: Axis,
+    /// Pulse kind (pulse studies).
+    pub pulse_kind: Option<PulseKind>,
+    /// The records (records studies).
+    pub records: Vec<StudyRecord>,
+    /// The intensity measure (records studies).
+    pub intensity: IntensityMeasure,
+    /// Activation multiplier λ (g tan α for a block is λg) and frequency parameter p_eq (rad/s)
+    /// of the model's one-DOF mechanism, when it has one.
+    pub lambda_p: Option<(f64, f64)>,
+    /// The cases, in id order.
+    pub cases: Vec<Case>,
+}
+
+/// Peak ground velocity of a record (m/s): the largest |∫a dt| by the trapezoid rule (the record
+/// is linear between samples, so this is its velocity at the samples exactly).
+pub fn peak_ground_velocity(record: &Record) -> f64 {
+    let mut v: f64 = 0.0;
+    let mut peak: f64 = 0.0;
+    let times: Vec<f64> = record.times().collect();
+    let a = record.accel();
+    for i in 1..a.len() {
+        v += 0.5 * (a[i] + a[i - 1]) * (times[i] - times[i - 1]);
+        peak = peak.max(v.abs());
+    }
+    peak
+}
+
+fn bad(path: &Path, msg: String) -> InputError {
+    InputError::Argument(format!("{}: {msg}", path.display()))
+}
+
+impl Study {
+    /// Reads the study file, its model and its records, and lists the cases. Errors name the
+    /// study file and the key; a record that cannot be read is not an error here (its cases fail
+    /// one by one).
+    pub fn load(path: &Path) -> Result<Self, InputError> {
+        let spec = StudySpec::read(path)?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let name = spec.name.clone().unwrap_or_else(|| {
+            path.file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("study")
+                .to_string()
+        });
+        let (file, model) = load_model(&base.join(&spec.model))?;
+        let axis: Axis = spec
+            .component
+            .parse()
+            .map_err(|e: String| bad(path, format!("component: {e}")))?;
+        if axis == Axis::Z {
+            return Err(bad(
+                path,
+                "component: the study drives a horizontal component, x or y".into(),
+            ));
+        }
+        if let Some(d) = spec.duration
+            && !(d.is_finite() && d > 0.0)
+        {
+            return Err(bad(
+                path,
+                format!("duration must be a positive number of seconds, got {d}"),
+            ));
+        }
+        let initial_spec = match spec.start {
+            Start::Rest => Default::default(),
+            Start::Model => file.initial.clone().unwrap_or_default(),
+        };
+        let initial = solve_initial(&model, &initial_spec)
+            .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
+        let params = Parameters::from_analysis(&file.analysis.clone().unwrap_or_default(), 10.0)
+            .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
+        let lambda_p = mechanism_scales(&model, axis);
+        let mut study = Study {
+            spec: spec.clone(),
+            name,
+            model,
+            initial,
+            params,
+            axis,
+            pulse_kind: None,
+            records: Vec::new(),
+            intensity: IntensityMeasure::Factor,
+            lambda_p,
+            cases: Vec::new(),
+        };
+        match (&spec.pulses, &spec.records) {
+            (Some(_), Some(_)) | (None, None) => {
+                return Err(bad(
+                    path,
+                    "give exactly one of [pulses] and [records]".into(),
+                ));
+            }
+            (Some(p), None) => {
+                if spec.intensity.is_some() {
+                    return Err(bad(
+                        path,
+                        "[intensity] scales records; a pulse family sets its amplitudes in [pulses]"
+                            .into(),
+                    ));
+                }
+                study.pulse_kind = Some(p.kind);
+                let (amplitudes, ratios_a) = study.pulse_axis(
+                    path,
+                    &p.amplitudes,
+                    &p.amplitude_ratios,
+                    "pulses.amplitudes",
+                    "pulses.amplitude_ratios",
+                )?;
+                let (periods, ratios_f) = study.pulse_axis(
+                    path,
+                    &p.periods,
+                    &p.frequency_ratios,
+                    "pulses.periods",
+                    "pulses.frequency_ratios",
+                )?;
+                if let Some(t) = periods.iter().find(|t| **t <= 0.0) {
+                    return Err(bad(
+                        path,
+                        format!("pulses: a period must be > 0, got {t} s"),
+                    ));
+                }
+                for (i, &a) in amplitudes.iter().enumerate() {
+                    for (j, &t) in periods.iter().enumerate() {
+                        study.push(Motion::Pulse {
+                            amplitude: a,
+                            period: t,
+                            amplitude_ratio: ratios_a.as_ref().map(|r| r[i]),
+                            frequency_ratio: ratios_f.as_ref().map(|r| r[j]),
+                        });
+                    }
+                }
+            }
+            (None, Some(r)) => {
+                let mut files: Vec<PathBuf> = r.files.clone();
+                if let Some(folder) = &r.folder {
+                    let ext = r.extension.clone().unwrap_or_else(|| "AT2".into());
+                    let dir = base.join(folder);
+                    let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
+                        .map_err(|e| {
+                            bad(path, format!("records.folder {}: {e}", folder.display()))
+                        })?
+                        .filter_map(|e| e.ok().map(|e| e.path()))
+                        .filter(|p| {
+                            p.extension()
+                                .and_then(|x| x.to_str())
+                                .is_some_and(|x| x.eq_ignore_ascii_case(&ext))
+                        })
+                        .map(|p| folder.join(p.file_name().expect("a file name")))
+                        .collect();
+                    found.sort();
+                    files.extend(found);
+                }
+                if files.is_empty() {
+                    return Err(bad(path, "records: no record files".into()));
+                }
+                study.records = files
+                    .iter()
+                    .map(|f| StudyRecord {
+                        file: f.clone(),
+                        record: read_record(&base.join(f), r.format, r.units)
+                            .map_err(|e| e.to_string()),
+                    })
+                    .collect();
+                let (measure, levels) = match &spec.intensity {
+                    None => (IntensityMeasure::Factor, vec![1.0]),
+                    Some(i) => {
+                        let given: Vec<(IntensityMeasure, &Values, &str)> = [
+                            (IntensityMeasure::Factor, &i.factors, "intensity.factors"),
+                            (IntensityMeasure::Pga, &i.pga, "intensity.pga"),
+                            (IntensityMeasure::Pgv, &i.pgv, "intensity.pgv"),
+                        ]
+                        .into_iter()
+                        .filter_map(|(m, v, k)| v.as_ref().map(|v| (m, v, k)))
+                        .collect();
+                        if given.len() != 1 {
+                            return Err(bad(
+                                path,
+                                "[intensity]: give exactly one of factors, pga and pgv".into(),
+                            ));
+                        }
+                        let (m, v, key) = given[0];
+                        let levels = v.expand(key).map_err(|e| bad(path, e))?;
+                        if let Some(x) = levels.iter().find(|x| **x < 0.0) {
+                            return Err(bad(path, format!("{key}: {x} is negative")));
+                        }
+                        (m, levels)
+                    }
+                };
+                study.intensity = measure;
+                for k in 0..study.records.len() {
+                    for &level in &levels {
+                        let factor = study.records[k].record.as_ref().ok().and_then(|rec| {
+                            let im = match measure {
+                                IntensityMeasure::Factor => return Some(level),
+                                IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
+                                IntensityMeasure::Pgv => peak_ground_velocity(rec),
+                            };
+                            (im > 0.0).then(|| level / im)
+                        });
+                        study.push(Motion::Record {
+                            record: k,
+                            level,
+                            factor,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(study)
+    }
+
+    fn push(&mut self, motion: Motion) {
+        let index = self.cases.len();
+        self.cases.push(Case {
+            index,
+            id: format!("c{index:06}"),
+            motion,
+        });
+    }
+
+    /// One axis of the pulse grid: values in physical units, and the dimensionless ratios when
+    /// given so (converted with λg or p_eq).
+    fn pulse_axis(
+        &self,
+        path: &Path,
+        physical: &Option<Values>,
+        ratio: &Option<Values>,
+        physical_key: &str,
+        ratio_key: &str,
+    ) -> Result<(Vec<f64>, Option<Vec<f64>>), InputError> {
+        match (physical, ratio) {
+            (Some(v), None) => Ok((v.expand(physical_key).map_err(|e| bad(path, e))?, None)),
+            (None, Some(r)) => {
+                let ratios = r.expand(ratio_key).map_err(|e| bad(path, e))?;
+                let Some((lambda, p)) = self.lambda_p else {
+                    return Err(bad(
+                        path,
+                        format!(
+                            "{ratio_key}: the model has no one-DOF mechanism to take g tan α and p \
+                             from; give {physical_key} instead"
+                        ),
+                    ));
+                };
+                let values = if ratio_key.ends_with("amplitude_ratios") {
+                    ratios
+                        .iter()
+                        .map(|r| r * lambda * self.model.gravity)
+                        .collect()
+                } else {
+                    ratios
+                        .iter()
+                        .map(|r| 2.0 * std::f64::consts::PI / (r * p))
+                        .collect()
+                };
+                Ok((values, Some(ratios)))
+            }
+            _ => Err(bad(
+                path,
+                format!("give exactly one of {physical_key} and {ratio_key}"),
+            )),
+        }
+    }
+
+    /// The ground motion of a case, or why it cannot be built.
+    pub fn ground_motion(&self, case: &Case) -> Result<GroundMotion, String> {
+        match &case.motion {
+            Motion::Pulse {
+                amplitude, period, ..
+            } => {
+                let kind = self.pulse_kind.expect("a pulse study has a kind");
+                let signal = match kind {
+                    PulseKind::OneSinePulse => SignalSpec::OneSinePulse(PulseSpec {
+                        amplitude: *amplitude,
+                        period: *period,
+                        start: 0.0,
+                    }),
+                    PulseKind::OneCosinePulse => SignalSpec::OneCosinePulse(PulseSpec {
+                        amplitude: *amplitude,
+                        period: *period,
+                        start: 0.0,
+                    }),
+                    PulseKind::Ricker => SignalSpec::Ricker(RickerSpec {
+                        amplitude: *amplitude,
+                        frequency: 1.0 / *period,
+                        center: *period,
+                    }),
+                };
+                let mut spec = GroundMotionSpec::default();
+                let component = Some(ComponentSpec::new(signal));
+                match self.axis {
+                    Axis::Y => spec.y = component,
+                    _ => spec.x = component,
+                }
+                GroundMotion::from_spec(&spec, Path::new(".")).map_err(|e| e.to_string())
+            }
+            Motion::Record { record, factor, .. } => {
+                let r = &self.records[*record];
+                let rec = r
+                    .record
+                    .as_ref()
+                    .map_err(|e| format!("record {}: {e}", r.file.display()))?;
+                let factor = factor.ok_or_else(|| {
+                    format!(
+                        "record {}: zero intensity, cannot be scaled to a level",
+                        r.file.display()
+                    )
+                })?;
+                GroundMotion::from_record(self.axis, rec.clone(), factor).map_err(|e| e.to_string())
+            }
+        }
+    }
+
+    /// Duration of a case: the study's, else the motion's duration + 5 s.
+    pub fn duration(&self, ground: &GroundMotion) -> f64 {
+        self.spec
+            .duration
+            .unwrap_or_else(|| default_duration(ground))
+    }
+}
+
+/// λ and p_eq of the model's one-DOF mechanism opening under the driven axis, if it has one.
+fn mechanism_scales(model: &Model, axis: Axis) -> Option<(f64, f64)> {
+    let name = model.coords.first()?.name.clone();
+    let opening = crr_dynamics::InitialSpec {
+        angles: [(name, 0.01)].into_iter().collect(),
+        rates: Default::default(),
+    };
+    let open = solve_initial(model, &opening).ok()?;
+    let d = match axis {
+        Axis::Y => Vector3::y(),
+        _ => Vector3::x(),
+    };
+    let eq = equivalent_block(model, &open.pivots, 0, &d).ok()?;
+    (eq.lambda.is_finite() && eq.p_squared > 0.0).then(|| (eq.lambda, eq.p_squared.sqrt()))
+}

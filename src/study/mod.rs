@@ -1,0 +1,16 @@
+//! `crr study`: many runs of one model as one job: an overturning map over a pulse family's
+//! amplitude × frequency grid, or a set of records scaled to intensity levels (fragility).
+//! Cases run in parallel, stream their rows to `cases.csv`, resume after an interruption and
+//! split into shards for a cluster (`docs/studies.md`).
+//!
+//! - [`spec`]: the study file;
+//! - [`cases`]: the study expanded into cases with stable ids;
+//! - [`run`]: running the cases, resuming, sharding, merging.
+
+pub mod cases;
+pub mod run;
+pub mod spec;
+
+pub use cases::{Case, Motion, Study};
+pub use run::{Shard, StudyOptions, StudyOutcome, merge, run_study};
+pub use spec::StudySpec;

@@ -1,0 +1,520 @@
+//! Running a study: every case of this shard on a pool of threads, one row of `cases.csv` per
+//! finished case, appended and flushed as it finishes (an interrupted run loses only the cases in
+//! flight); a rerun into the same folder skips the cases already there. When every case of the
+//! shard is done the file is rewritten in case-id order, so that a run's `cases.csv` does not
+//! depend on the number of threads, and merged shards equal a single run byte for byte.
+
+use std::collections::BTreeMap;
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crr_impact::{Simulation, StopReason};
+
+use super::cases::{Case, Motion, Study};
+use crate::InputError;
+use crate::simulate::coordinate_alpha;
+
+/// `i/n`: the i-th (1-based) of n disjoint parts of a study; case k belongs to part k mod n + 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    /// 1 … n.
+    pub index: usize,
+    /// Number of parts.
+    pub count: usize,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (i, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("--shard must be i/n (e.g. 2/8), got `{s}`"))?;
+        let parse = |x: &str| x.trim().parse::<usize>().ok();
+        match (parse(i), parse(n)) {
+            (Some(index), Some(count)) if count >= 1 && (1..=count).contains(&index) => {
+                Ok(Shard { index, count })
+            }
+            _ => Err(format!(
+                "--shard must be i/n with 1 ≤ i ≤ n (e.g. 2/8), got `{s}`"
+            )),
+        }
+    }
+}
+
+impl Shard {
+    /// The whole study.
+    pub const ALL: Shard = Shard { index: 1, count: 1 };
+
+    /// Whether case `k` is in this shard.
+    pub fn contains(&self, k: usize) -> bool {
+        k % self.count + 1 == self.index
+    }
+}
+
+/// How to run a study.
+#[derive(Clone, Debug)]
+pub struct StudyOptions {
+    /// Output folder.
+    pub out: PathBuf,
+    /// Worker threads (None: one per core).
+    pub jobs: Option<usize>,
+    /// The part to run.
+    pub shard: Shard,
+    /// No progress bar.
+    pub quiet: bool,
+}
+
+/// What a run did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StudyOutcome {
+    /// Cases of this shard.
+    pub cases: usize,
+    /// Cases found done in the folder and skipped.
+    pub skipped: usize,
+    /// Cases run now.
+    pub ran: usize,
+    /// Cases whose row holds an error.
+    pub failed: usize,
+}
+
+/// The measures of one case.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measures {
+    /// Peak |φ| of every coordinate (rad).
+    pub peak: Vec<f64>,
+    /// Collapse time (s), if it collapsed.
+    pub collapse: Option<f64>,
+    /// Number of impacts.
+    pub impacts: usize,
+    /// Largest |q| at the end (rad): the residual rotation (0 when the structure is back at rest).
+    pub residual: f64,
+    /// Energy dissipated (J).
+    pub dissipated: f64,
+    /// Time reached (s).
+    pub end_time: f64,
+}
+
+/// Runs one case to its end (or collapse), keeping only its measures: the samples are drained
+/// after every step, so memory does not grow with the duration.
+pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
+    let ground = study.ground_motion(case)?;
+    let mut params = study.params.clone();
+    params.duration = study.duration(&ground);
+    let mut sim = Simulation::new(&study.model, &ground, &study.initial, params)
+        .map_err(|e| e.to_string())?;
+    let mut last = None;
+    loop {
+        let stop = sim.step().map_err(|e| e.to_string())?;
+        if let Some(s) = sim.drain_samples().pop() {
+            last = Some(s);
+        }
+        if matches!(stop, StopReason::End(_) | StopReason::Collapse(_)) {
+            break;
+        }
+    }
+    let t = sim.into_trajectory();
+    let (residual, dissipated) = last.map_or((0.0, 0.0), |s| {
+        (s.q.iter().fold(0.0f64, |m, q| m.max(q.abs())), s.dissipated)
+    });
+    Ok(Measures {
+        peak: t.peak_abs.clone(),
+        collapse: t.collapse.as_ref().map(|c| c.t),
+        impacts: t.impacts.len(),
+        residual,
+        dissipated,
+        end_time: t.end_time,
+    })
+}
+
+/// Shortest text that reads back as the same f64.
+fn num(x: f64) -> String {
+    format!("{x}")
+}
+
+fn quoted(s: &str) -> String {
+    format!("\"{}\"", s.replace('"', "\"\""))
+}
+
+/// The header of `cases.csv`.
+pub fn header(study: &Study) -> String {
+    let mut cols: Vec<String> = vec!["id".into()];
+    if study.pulse_kind.is_some() {
+        cols.extend(
+            [
+                "amplitude_m_s2",
+                "period_s",
+                "amplitude_ratio",
+                "frequency_ratio",
+            ]
+            .map(String::from),
+        );
+    } else {
+        cols.extend([
+            "record".into(),
+            study.intensity.name().into(),
+            "factor".into(),
+        ]);
+    }
+    cols.extend(["status", "collapse", "collapse_time_s", "impacts"].map(String::from));
+    for c in &study.model.coords {
+        cols.push(format!("peak_{}_rad", c.name));
+    }
+    for k in 0..study.model.dof() {
+        if coordinate_alpha(&study.model, k).is_some() {
+            cols.push(format!("peak_{}_over_alpha", study.model.coords[k].name));
+        }
+    }
+    cols.extend(["residual_rad", "dissipated_j", "end_time_s", "error"].map(String::from));
+    cols.join(",")
+}
+
+/// The row of a case (without its newline).
+pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> String {
+    let mut cols: Vec<String> = vec![case.id.clone()];
+    let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    match &case.motion {
+        Motion::Pulse {
+            amplitude,
+            period,
+            amplitude_ratio,
+            frequency_ratio,
+        } => {
+            cols.extend([
+                num(*amplitude),
+                num(*period),
+                opt(*amplitude_ratio),
+                opt(*frequency_ratio),
+            ]);
+        }
+        Motion::Record {
+            record,
+            level,
+            factor,
+        } => {
+            cols.extend([
+                quoted(&study.records[*record].file.display().to_string()),
+                num(*level),
+                opt(*factor),
+            ]);
+        }
+    }
+    let n = study.model.dof();
+    let alphas: Vec<Option<f64>> = (0..n).map(|k| coordinate_alpha(&study.model, k)).collect();
+    let with_alpha = alphas.iter().filter(|a| a.is_some()).count();
+    match result {
+        Ok(m) => {
+            cols.extend([
+                "ok".into(),
+                if m.collapse.is_some() { "1" } else { "0" }.into(),
+                opt(m.collapse),
+                m.impacts.to_string(),
+            ]);
+            cols.extend(m.peak.iter().map(|p| num(*p)));
+            for (k, a) in alphas.iter().enumerate() {
+                if let Some(a) = a {
+                    cols.push(num(m.peak[k] / a));
+                }
+            }
+            cols.extend([
+                num(m.residual),
+                num(m.dissipated),
+                num(m.end_time),
+                String::new(),
+            ]);
+        }
+        Err(e) => {
+            cols.extend(["error".into(), String::new(), String::new(), String::new()]);
+            cols.extend(std::iter::repeat_n(String::new(), n + with_alpha + 3));
+            cols.push(quoted(e));
+        }
+    }
+    cols.join(",")
+}
+
+/// The ids of the complete rows of an existing `cases.csv` (a row is complete when its line ends
+/// with a newline), and the length of the file up to the last complete row. A file whose header
+/// differs is an error: it belongs to another study.
+fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64), InputError> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((BTreeMap::new(), 0)),
+        Err(source) => {
+            return Err(InputError::Io {
+                file: path.to_path_buf(),
+                source,
+            });
+        }
+    };
+    let mut rows = BTreeMap::new();
+    let mut complete = 0u64;
+    let mut first = true;
+    for line in text.split_inclusive('\n') {
+        if !line.ends_with('\n') {
+            break;
+        }
+        let body = line.trim_end_matches('\n');
+        if first {
+            if body != header {
+                return Err(InputError::Argument(format!(
+                    "{}: the folder holds the cases of another study (different columns); use \
+                     another --out folder",
+                    path.display()
+                )));
+            }
+            first = false;
+        } else if let Some((id, _)) = body.split_once(',') {
+            rows.insert(id.to_string(), body.to_string());
+        }
+        complete += line.len() as u64;
+    }
+    Ok((rows, complete))
+}
+
+/// A progress line on stderr: cases done, rate and estimated time left, at most 5 times a second.
+struct Progress {
+    total: usize,
+    done: usize,
+    start: Instant,
+    shown: Instant,
+    quiet: bool,
+}
+
+impl Progress {
+    fn tick(&mut self, force: bool) {
+        self.done += 1;
+        if self.quiet || (!force && self.shown.elapsed().as_secs_f64() < 0.2) {
+            return;
+        }
+        self.shown = Instant::now();
+        let elapsed = self.start.elapsed().as_secs_f64();
+        let eta = if self.done > 0 {
+            elapsed / self.done as f64 * (self.total - self.done) as f64
+        } else {
+            0.0
+        };
+        let width = 30;
+        let filled = (width * self.done) / self.total.max(1);
+        eprint!(
+            "\rcrr: study [{}{}] {}/{} cases, {:.0} s elapsed, ETA {:.0} s   ",
+            "#".repeat(filled),
+            "-".repeat(width - filled),
+            self.done,
+            self.total,
+            elapsed,
+            eta
+        );
+        if self.done == self.total {
+            eprintln!();
+        }
+    }
+}
+
+/// Runs the study's cases of `opts.shard` into `opts.out` (resuming), then writes `cases.csv` in
+/// id order and `study.json`.
+pub fn run_study(
+    study: &Study,
+    study_file: &Path,
+    opts: &StudyOptions,
+) -> Result<StudyOutcome, InputError> {
+    let out_err = |source: std::io::Error| InputError::Output {
+        dir: opts.out.clone(),
+        source,
+    };
+    std::fs::create_dir_all(&opts.out).map_err(out_err)?;
+    let csv = opts.out.join("cases.csv");
+    let header = header(study);
+    let (done, complete_len) = done_rows(&csv, &header)?;
+    let mine: Vec<&Case> = study
+        .cases
+        .iter()
+        .filter(|c| opts.shard.contains(c.index))
+        .collect();
+    if let Some(id) = done.keys().find(|id| !mine.iter().any(|c| &c.id == *id)) {
+        return Err(InputError::Argument(format!(
+            "{}: case {id} is not one of this study's cases for shard {}/{}; use another --out \
+             folder",
+            csv.display(),
+            opts.shard.index,
+            opts.shard.count
+        )));
+    }
+    let todo: Vec<&Case> = mine
+        .iter()
+        .copied()
+        .filter(|c| !done.contains_key(&c.id))
+        .collect();
+    // Drop a partial last row (a run killed while writing it), then append.
+    let mut file = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&csv)
+        .map_err(out_err)?;
+    file.set_len(complete_len).map_err(out_err)?;
+    if complete_len == 0 {
+        writeln!(file, "{header}").map_err(out_err)?;
+    }
+    let started = Instant::now();
+    let progress = Mutex::new(Progress {
+        total: todo.len(),
+        done: 0,
+        start: started,
+        shown: started,
+        quiet: opts.quiet || todo.is_empty(),
+    });
+    let sink = Mutex::new(file);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs.unwrap_or(0))
+        .build()
+        .map_err(|e| InputError::Argument(format!("--jobs: {e}")))?;
+    let write_result: Result<(), std::io::Error> = pool.install(|| {
+        todo.par_iter().try_for_each(|case| {
+            let result = run_case(study, case);
+            let line = row(study, case, &result);
+            {
+                let mut f = sink.lock().expect("the cases file");
+                writeln!(f, "{line}")?;
+                f.flush()?;
+            }
+            let mut p = progress.lock().expect("progress");
+            let last = p.done + 1 == p.total;
+            p.tick(last);
+            Ok(())
+        })
+    });
+    write_result.map_err(out_err)?;
+    let wall = started.elapsed().as_secs_f64();
+    drop(sink);
+    // Every case of the shard is done: rewrite in id order.
+    let (rows, _) = done_rows(&csv, &header)?;
+    let mut text = String::with_capacity(rows.values().map(|r| r.len() + 1).sum::<usize>());
+    text.push_str(&header);
+    text.push('\n');
+    for r in rows.values() {
+        text.push_str(r);
+        text.push('\n');
+    }
+    let tmp = opts.out.join("cases.csv.partial");
+    std::fs::write(&tmp, &text).map_err(out_err)?;
+    std::fs::rename(&tmp, &csv).map_err(out_err)?;
+    let failed = rows.values().filter(|r| r.contains(",error,")).count();
+    let summary = serde_json::json!({
+        "study": study.spec,
+        "study_file": study_file.display().to_string(),
+        "name": study.name,
+        "crr_version": env!("CARGO_PKG_VERSION"),
+        "model": study.model.name,
+        "cases_in_study": study.cases.len(),
+        "shard": format!("{}/{}", opts.shard.index, opts.shard.count),
+        "cases_in_shard": mine.len(),
+        "cases_skipped": done.len(),
+        "cases_run": todo.len(),
+        "cases_failed": failed,
+        "threads": pool.current_num_threads(),
+        "wall_time_s": wall,
+        "lambda": study.lambda_p.map(|x| x.0),
+        "p_eq_rad_s": study.lambda_p.map(|x| x.1),
+    });
+    std::fs::write(
+        opts.out.join("study.json"),
+        serde_json::to_string_pretty(&summary).expect("json") + "\n",
+    )
+    .map_err(out_err)?;
+    Ok(StudyOutcome {
+        cases: mine.len(),
+        skipped: done.len(),
+        ran: todo.len(),
+        failed,
+    })
+}
+
+/// `crr study merge`: joins the `cases.csv` of shard folders into `out` (rows by id; the same id
+/// twice must be the same row), checking that they come from the same study.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
+    let mut header: Option<String> = None;
+    let mut study: Option<serde_json::Value> = None;
+    let mut rows: BTreeMap<String, String> = BTreeMap::new();
+    for dir in dirs {
+        let csv = dir.join("cases.csv");
+        let text = std::fs::read_to_string(&csv).map_err(|source| InputError::Io {
+            file: csv.clone(),
+            source,
+        })?;
+        let json_path = dir.join("study.json");
+        let json: serde_json::Value = std::fs::read_to_string(&json_path)
+            .map_err(|source| InputError::Io {
+                file: json_path.clone(),
+                source,
+            })
+            .and_then(|t| {
+                serde_json::from_str(&t).map_err(|e| InputError::Parse {
+                    file: json_path.clone(),
+                    message: e.to_string(),
+                })
+            })?;
+        match &study {
+            None => study = Some(json["study"].clone()),
+            Some(s) if *s != json["study"] => {
+                return Err(InputError::Argument(format!(
+                    "{}: a different study from {}'s",
+                    json_path.display(),
+                    dirs[0].display()
+                )));
+            }
+            _ => {}
+        }
+        let mut lines = text.lines();
+        let h = lines.next().unwrap_or_default().to_string();
+        match &header {
+            None => header = Some(h),
+            Some(x) if *x != h => {
+                return Err(InputError::Argument(format!(
+                    "{}: columns differ from {}'s",
+                    csv.display(),
+                    dirs[0].display()
+                )));
+            }
+            _ => {}
+        }
+        for line in lines {
+            let Some((id, _)) = line.split_once(',') else {
+                continue;
+            };
+            if let Some(prev) = rows.get(id)
+                && prev != line
+            {
+                return Err(InputError::Argument(format!(
+                    "{}: case {id} differs from the same case in another folder",
+                    csv.display()
+                )));
+            }
+            rows.insert(id.to_string(), line.to_string());
+        }
+    }
+    let out_err = |source: std::io::Error| InputError::Output {
+        dir: out.to_path_buf(),
+        source,
+    };
+    std::fs::create_dir_all(out).map_err(out_err)?;
+    let mut f = File::create(out.join("cases.csv")).map_err(out_err)?;
+    writeln!(f, "{}", header.unwrap_or_default()).map_err(out_err)?;
+    for r in rows.values() {
+        writeln!(f, "{r}").map_err(out_err)?;
+    }
+    let summary = serde_json::json!({
+        "study": study,
+        "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
+        "cases": rows.len(),
+        "crr_version": env!("CARGO_PKG_VERSION"),
+    });
+    std::fs::write(
+        out.join("study.json"),
+        serde_json::to_string_pretty(&summary).expect("json") + "\n",
+    )
+    .map_err(out_err)?;
+    Ok(rows.len())
+}
