@@ -199,6 +199,10 @@ pub struct SizeRow {
     pub alpha_eq: f64,
     /// p_eq (rad/s).
     pub p_eq: f64,
+    /// χ of eq 6: p_eq² (1/s²).
+    pub chi: f64,
+    /// ε of eq 6: 1/α_eq (1/rad).
+    pub epsilon: f64,
     /// θ_m = ratio · α_eq (rad).
     pub theta_m: f64,
     /// F_H of eq 6 with χ = p_eq², ε = 1/α_eq (Hz).
@@ -266,6 +270,8 @@ pub fn size_sweep(spec: &StructureSpec, scales: &[f64], ratio: f64) -> Result<Si
             lambda: eq.lambda,
             alpha_eq: alpha,
             p_eq: p,
+            chi: p * p,
+            epsilon: 1.0 / alpha,
             theta_m,
             housner_hz: fh,
             engine_hz: engine,

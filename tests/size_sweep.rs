@@ -59,12 +59,14 @@ fn assert_scaling(sweep: &Value, scales: &[f64], mass1: f64, height1: f64) -> Va
             (h - height1 * s).abs() <= 1e-12 * h,
             "height {h} at s = {s}"
         );
-        for k in ["alpha_eq", "lambda"] {
+        for k in ["alpha_eq", "lambda", "epsilon"] {
             assert!(
                 (f(r, k) - f(&one, k)).abs() <= 1e-9 * f(&one, k),
                 "{k} at s = {s}"
             );
         }
+        let chi = f(r, "chi") * s;
+        assert!((chi - f(&one, "chi")).abs() <= 1e-9 * chi, "χ s at s = {s}");
         for k in ["p_eq", "housner_hz"] {
             let scaled = f(r, k) * s.sqrt();
             assert!(
