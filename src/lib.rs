@@ -12,6 +12,8 @@
 //! - [`simulate`]: `crr simulate` (history, impacts and summary files, `docs/outputs.md`).
 //! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
 //! - [`synthetic`]: the reproducible synthetic accelerogram `examples/records/synthetic.AT2`.
+//! - [`levels`]: energy levels of any one-DOF mechanism from the engine's M(θ) and U(θ).
+//! - [`size_sweep`]: `crr check --size-sweep`, the frequencies of geometrically scaled models.
 //! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
 //! - [`study`]: `crr study` (many cases of one model in parallel: maps, fragility studies).
 //! - [`fuzzing`]: the entry points of the fuzz targets in `fuzz/` and of their corpus replay.
@@ -23,9 +25,11 @@ pub use crr_kinematics as kinematics;
 pub mod check;
 pub mod fuzzing;
 pub mod inspect;
+pub mod levels;
 pub mod model_file;
 pub mod plot;
 pub mod simulate;
+pub mod size_sweep;
 pub mod study;
 pub mod synthetic;
 

@@ -1,13 +1,15 @@
 //! The `crr` command line.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 use crr::dynamics::ground_motion::{Axis, RecordFormat, Units};
 use crr::inspect::{configuration, inspect, to_text};
-use crr::plot::{PlotError, plot_check, plot_results};
+use crr::plot::{
+    PlotError, plot_check, plot_housner_models, plot_levels, plot_results, plot_size_sweep,
+};
 use crr::simulate::{RecordArg, SimulateOptions, SimulateResult, simulate};
 use crr::{InputError, load_model};
 
@@ -79,14 +81,29 @@ enum Command {
     /// Mobility report; for a one-DOF mechanism λ, the equivalent block, r and the free-rocking
     /// frequencies (docs/outputs.md).
     Check {
-        /// Model file (TOML, or JSON when it ends in .json).
-        model: PathBuf,
-        /// Print JSON instead of text.
+        /// Model file(s) (TOML, or JSON when it ends in .json); several models are reported one
+        /// after the other and share the frequency figures.
+        #[arg(required = true)]
+        models: Vec<PathBuf>,
+        /// Print JSON instead of text (an array of reports for several models).
         #[arg(long)]
         json: bool,
-        /// Draw the frequency versus amplitude plot (housner.png, housner.svg) into DIR.
+        /// Draw the frequency versus amplitude plot (housner.png, .svg) and the energy levels
+        /// (levels.png, .svg, .csv) into DIR.
         #[arg(long, value_name = "DIR")]
         plot: Option<PathBuf>,
+        /// Scale the model geometrically by n factors from s0 to s1 and report the frequency
+        /// against size (size_sweep.png, .svg with --plot).
+        #[arg(long, value_name = "S0:S1:N", allow_hyphen_values = true)]
+        size_sweep: Option<String>,
+        /// θm/α_eq of the size sweep's frequencies (between 0 and 1).
+        #[arg(
+            long,
+            value_name = "R",
+            allow_hyphen_values = true,
+            requires = "size_sweep",
+            default_value_t = crr::size_sweep::DEFAULT_AMPLITUDE_RATIO)]
+        amplitude_ratio: f64,
     },
     /// Run every case of a study file (a pulse family's amplitude × frequency grid, or records
     /// scaled to intensity levels) in parallel into cases.csv and study.json (docs/studies.md);
@@ -182,6 +199,127 @@ fn record_arg(
     }))
 }
 
+/// `crr check MODEL… [--json] [--plot DIR] [--size-sweep s0:s1:n] [--amplitude-ratio R]`.
+fn check_models(
+    paths: &[PathBuf],
+    json: bool,
+    plot: Option<&Path>,
+    size_sweep: Option<&str>,
+    amplitude_ratio: f64,
+) -> Result<(), Failure> {
+    use crr::levels::{DEFAULT_STEP, mechanism_levels};
+    use crr::size_sweep::{check_amplitude_ratio, parse_sweep};
+    let scales = size_sweep.map(parse_sweep).transpose()?;
+    let ratio = check_amplitude_ratio(amplitude_ratio)?;
+    let loaded = paths
+        .iter()
+        .map(|p| load_model(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let reports: Vec<_> = loaded.iter().map(|(_, m)| crr::check::check(m)).collect();
+    // The sweep needs a one-DOF mechanism; its failure is reported after the reports.
+    let mut sweeps: Vec<Option<crr::size_sweep::SizeSweep>> = vec![None; reports.len()];
+    let mut sweep_error = None;
+    if let Some(scales) = &scales {
+        for (((file, _), report), slot) in loaded.iter().zip(&reports).zip(&mut sweeps) {
+            let result = match &report.mechanism {
+                None => Err(report
+                    .note
+                    .clone()
+                    .unwrap_or_else(|| "not a one-DOF mechanism".into())),
+                Some(_) => crr::size_sweep::size_sweep(&file.structure(), scales, ratio),
+            };
+            match result {
+                Ok(s) => *slot = Some(s),
+                Err(e) => {
+                    sweep_error.get_or_insert(format!("--size-sweep: {}: {e}", report.model));
+                }
+            }
+        }
+    }
+    if json {
+        let values: Vec<serde_json::Value> = reports
+            .iter()
+            .zip(&sweeps)
+            .map(|(r, sweep)| {
+                let mut v = serde_json::to_value(r).expect("report serialises");
+                if let Some(s) = sweep {
+                    v["size_sweep"] = serde_json::to_value(s).expect("sweep serialises");
+                }
+                v
+            })
+            .collect();
+        let out = if values.len() == 1 {
+            values.into_iter().next().expect("one report")
+        } else {
+            serde_json::Value::Array(values)
+        };
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("report serialises")
+        );
+    } else {
+        for (i, (r, sweep)) in reports.iter().zip(&sweeps).enumerate() {
+            if i > 0 {
+                println!();
+            }
+            print!("{}", crr::check::to_text(r));
+            if let Some(s) = sweep {
+                print!("{}", crr::size_sweep::to_text(s));
+            }
+        }
+    }
+    if let Some(e) = sweep_error {
+        return Err(Failure::Input(InputError::Argument(e)));
+    }
+    let Some(dir) = plot else {
+        return Ok(());
+    };
+    if reports.len() == 1 {
+        plot_check(dir, &reports[0])?;
+    } else {
+        plot_housner_models(dir, &reports)?;
+    }
+    let mut used = Vec::new();
+    for ((_, m), r) in loaded.iter().zip(&reports) {
+        let levels = mechanism_levels(m, DEFAULT_STEP)
+            .map_err(|e| PlotError::NoLevels(format!("{}: {e}", r.model)))?;
+        let prefix = if reports.len() == 1 {
+            String::new()
+        } else {
+            let mut p: String = r
+                .model
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            while used.contains(&p) {
+                p.push('_');
+            }
+            used.push(p.clone());
+            p + "_"
+        };
+        plot_levels(dir, &prefix, &r.model, &levels)?;
+        if !json {
+            println!(
+                "energy levels of {} ({}): {}",
+                r.model,
+                levels.coordinate,
+                levels.ends_text()
+            );
+        }
+    }
+    let sweeps: Vec<_> = sweeps.into_iter().flatten().collect();
+    if !sweeps.is_empty() {
+        plot_size_sweep(dir, &sweeps)?;
+    }
+    Ok(())
+}
+
 fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Inspect { model, q, json } => {
@@ -264,21 +402,19 @@ fn run(cli: Cli) -> Result<(), Failure> {
                 }
             }
         }
-        Command::Check { model, json, plot } => {
-            let (_, m) = load_model(&model)?;
-            let report = crr::check::check(&m);
-            if json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&report).expect("report serialises")
-                );
-            } else {
-                print!("{}", crr::check::to_text(&report));
-            }
-            if let Some(dir) = plot {
-                plot_check(&dir, &report)?;
-            }
-        }
+        Command::Check {
+            models,
+            json,
+            plot,
+            size_sweep,
+            amplitude_ratio,
+        } => check_models(
+            &models,
+            json,
+            plot.as_deref(),
+            size_sweep.as_deref(),
+            amplitude_ratio,
+        )?,
         Command::Study {
             action: Some(StudyAction::Merge { dirs, out }),
             ..

@@ -19,7 +19,14 @@ use crr_dynamics::equivalent_block;
 use crr_kinematics::{ActivePivots, Model, Side};
 
 use crate::check::{CheckReport, housner_frequency};
+use crate::levels::{DEFAULT_STEP, MechanismLevels, mechanism_levels};
 use crate::model_file::ModelFile;
+
+mod figures;
+pub use figures::{
+    draw_housner_models, draw_levels, draw_size_sweep, plot_housner_models, plot_levels,
+    plot_size_sweep,
+};
 
 /// Size of every image (pixels; the SVG uses the same user units).
 pub const SIZE: (u32, u32) = (1000, 700);
@@ -44,6 +51,9 @@ pub enum PlotError {
     /// `crr check --plot` on a model that is not a one-DOF mechanism.
     #[error("no frequency plot: {0}")]
     NoMechanism(String),
+    /// `crr check --plot`: the energy levels of the mechanism cannot be followed.
+    #[error("no energy levels: {0}")]
+    NoLevels(String),
     /// An image could not be drawn or written.
     #[error("{file}: cannot draw the plot: {message}")]
     Draw {
@@ -120,6 +130,9 @@ pub struct Results {
     pub impacts: Vec<(f64, Vec<String>)>,
     /// The free-rocking energy levels, when the model is a one-coordinate block.
     pub free_rocking: Option<FreeRocking>,
+    /// The energy levels of the first coordinate from the engine's M(θ) and U(θ), when the model
+    /// is any other one-DOF mechanism (DOF(2) = 1, e.g. a trilithon or an arch).
+    pub levels: Option<MechanismLevels>,
 }
 
 fn read_text(file: &Path) -> Result<String, PlotError> {
@@ -154,6 +167,24 @@ fn free_rocking(summary: &Value) -> Option<FreeRocking> {
         p: eq.p_squared.sqrt(),
         alpha: eq.alpha,
     })
+}
+
+/// The energy levels of a one-DOF mechanism rebuilt from the model echoed in summary.json, when
+/// it is not a single block (those have [`FreeRocking`]); None otherwise or when they cannot be
+/// followed.
+fn mechanism_levels_of(summary: &Value) -> Option<MechanismLevels> {
+    let file: ModelFile = serde_json::from_value(summary["model"].clone()).ok()?;
+    let model = Model::from_spec(&file.structure()).ok()?;
+    let zero = nalgebra::DVector::zeros(model.dof());
+    let mob = crr_dynamics::mobility(
+        &model,
+        &zero,
+        &ActivePivots::uniform(&model, Side::Positive),
+    );
+    if mob.dof2 != 1 {
+        return None;
+    }
+    mechanism_levels(&model, DEFAULT_STEP).ok()
 }
 
 /// Reads `history.csv`, `impacts.csv` and `summary.json` of a results folder.
@@ -236,7 +267,11 @@ pub fn parse_results(
         dissipated: Vec::new(),
         impacts: Vec::new(),
         free_rocking: free_rocking(&summary),
+        levels: None,
     };
+    if r.free_rocking.is_none() {
+        r.levels = mechanism_levels_of(&summary);
+    }
     for (row, line) in lines.enumerate() {
         if line.trim().is_empty() {
             continue;
@@ -625,7 +660,8 @@ pub fn draw_energy<DB: DrawingBackend>(
 /// The amplitudes θ_m/α of the free-rocking energy levels drawn on the phase portrait.
 pub const LEVELS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
 
-/// (c) The phase portraits θ̇ versus θ, with the free-rocking energy levels of a single block.
+/// (c) The phase portraits θ̇ versus θ, with the free-rocking energy levels of a single block, or
+/// the engine's energy levels of the first coordinate for any other one-DOF mechanism.
 pub fn draw_phase<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     r: &Results,
@@ -652,11 +688,17 @@ pub fn draw_phase<DB: DrawingBackend>(
             .collect(),
         None => Vec::new(),
     };
+    let mech: Vec<(f64, f64)> = r
+        .levels
+        .as_ref()
+        .map(figures::level_points)
+        .unwrap_or_default();
     let xr = padded(
         r.q.iter()
             .flatten()
             .copied()
-            .chain(levels.iter().flatten().map(|p| p.0)),
+            .chain(levels.iter().flatten().map(|p| p.0))
+            .chain(mech.iter().map(|p| p.0)),
     );
     let yr = headroom(
         padded(
@@ -664,9 +706,11 @@ pub fn draw_phase<DB: DrawingBackend>(
                 .iter()
                 .flatten()
                 .copied()
-                .chain(levels.iter().flatten().map(|p| p.1)),
+                .chain(levels.iter().flatten().map(|p| p.1))
+                .chain(mech.iter().map(|p| p.1)),
         ),
-        0.1 * (r.coordinates.len() + usize::from(r.free_rocking.is_some())) as f64,
+        0.1 * (r.coordinates.len()
+            + 2 * usize::from(r.free_rocking.is_some() || r.levels.is_some())) as f64,
     );
     let mut chart = ChartBuilder::on(root)
         .caption(
@@ -712,6 +756,9 @@ pub fn draw_phase<DB: DrawingBackend>(
                 });
             }
         }
+    }
+    if let Some(l) = &r.levels {
+        figures::draw_level_curves(&mut chart, l, k)?;
     }
     let n = r.coordinates.len();
     for (i, name) in r.coordinates.iter().enumerate() {
