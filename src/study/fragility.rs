@@ -67,7 +67,11 @@ fn log_likelihood(points: &[FragilityPoint], ln_median: f64, dispersion: f64) ->
 /// curve: fewer than two levels, a level that is not positive, or no transition (every run
 /// exceeding, or none).
 pub fn fit_lognormal(points: &[FragilityPoint]) -> Option<LognormalFit> {
-    if points.len() < 2 || points.iter().any(|p| !(p.im > 0.0) || p.trials <= 0.0) {
+    if points.len() < 2
+        || points
+            .iter()
+            .any(|p| p.im.is_nan() || p.im <= 0.0 || p.trials <= 0.0)
+    {
         return None;
     }
     let exceed: f64 = points.iter().map(|p| p.exceed).sum();
