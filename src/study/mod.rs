@@ -6,12 +6,15 @@
 //! - [`spec`]: the study file;
 //! - [`cases`]: the study expanded into cases with stable ids;
 //! - [`run`]: running the cases, resuming, sharding, merging;
-//! - [`fragility`]: lognormal fragility functions fitted by maximum likelihood.
+//! - [`fragility`]: lognormal fragility functions fitted by maximum likelihood;
+//! - [`zhang_makris`]: the analytic minimum overturning amplitude of a block under one-sine and
+//!   one-cosine pulses (the boundary of an overturning map).
 
 pub mod cases;
 pub mod fragility;
 pub mod run;
 pub mod spec;
+pub mod zhang_makris;
 
 pub use cases::{Case, Motion, Study};
 pub use run::{Shard, StudyOptions, StudyOutcome, merge, run_study};
