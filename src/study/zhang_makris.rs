@@ -28,7 +28,7 @@ fn shape(kind: PulseKind, x: f64) -> (f64, f64) {
 /// Whether the linearised block overturns (modes 1 and 2) under the pulse of amplitude ratio β
 /// and frequency ratio Ω, with restitution r.
 pub fn overturns(kind: PulseKind, beta: f64, omega: f64, r: f64) -> bool {
-    if !(beta > 1.0) || !(omega > 0.0) {
+    if beta.is_nan() || omega.is_nan() || beta <= 1.0 || omega <= 0.0 {
         return false;
     }
     let end = 2.0 * std::f64::consts::PI / omega;
@@ -173,7 +173,7 @@ mod tests {
                 }
                 impacts += 1;
                 psi = 0.0;
-                rate = -r * rate;
+                rate *= -r;
                 side = -side;
             }
         }
