@@ -13,6 +13,8 @@
 //! - [`check`]: `crr check` (mobility, activation multiplier, equivalent block, frequencies).
 //! - [`synthetic`]: the reproducible synthetic accelerogram `examples/records/synthetic.AT2`.
 //! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
+//! - [`poincare`]: `crr poincare`, Poincaré sections under harmonic ground motion, bifurcation
+//!   diagrams and basins (`docs/poincare.md`); [`poincare_plot`] draws them.
 //! - [`fuzzing`]: the entry points of the fuzz targets in `fuzz/` and of their corpus replay.
 
 pub use crr_dynamics as dynamics;
@@ -24,6 +26,8 @@ pub mod fuzzing;
 pub mod inspect;
 pub mod model_file;
 pub mod plot;
+pub mod poincare;
+pub mod poincare_plot;
 pub mod simulate;
 pub mod synthetic;
 
