@@ -100,10 +100,15 @@ enum Command {
         model: PathBuf,
         /// Amplitude A of the ground acceleration, in m/s² (or in g as `0.3g`, g = 9.80665 m/s²);
         /// it replaces the model's ground motion. 0: no ground motion, a crossing section.
-        #[arg(long, value_name = "A", default_value = "0")]
+        #[arg(
+            long,
+            value_name = "A",
+            default_value = "0",
+            allow_hyphen_values = true
+        )]
         amplitude: String,
         /// Frequency F of the ground acceleration (Hz); the section is taken at t = k/F.
-        #[arg(long, value_name = "F")]
+        #[arg(long, value_name = "F", allow_negative_numbers = true)]
         frequency: Option<f64>,
         /// Ground-motion component driven: x, y or z.
         #[arg(long, value_name = "AXIS", default_value = "x")]
@@ -137,10 +142,20 @@ enum Command {
         #[arg(long)]
         rest: bool,
         /// Bifurcation diagram against the amplitude: A0:A1:n (m/s², or g as 0.1g:0.3g:n).
-        #[arg(long, value_name = "A0:A1:N", conflicts_with_all = ["frequencies", "grid"])]
+        #[arg(
+            long,
+            value_name = "A0:A1:N",
+            conflicts_with_all = ["frequencies", "grid"],
+            allow_hyphen_values = true
+        )]
         amplitudes: Option<String>,
         /// Bifurcation diagram against the frequency: F0:F1:n (Hz).
-        #[arg(long, value_name = "F0:F1:N", conflicts_with = "grid")]
+        #[arg(
+            long,
+            value_name = "F0:F1:N",
+            conflicts_with = "grid",
+            allow_hyphen_values = true
+        )]
         frequencies: Option<String>,
         /// Basins: initial angle θ0:θ1:n (rad) × initial rate ω0:ω1:m (rad/s) of the coordinate.
         #[arg(long, value_name = "T0:T1:N,W0:W1:M", allow_hyphen_values = true)]

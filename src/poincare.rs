@@ -1049,7 +1049,8 @@ pub fn summary(path: &Path, p: &Prepared, opts: &PoincareOptions, computed: &Com
 
 /// The hidden temporary name a result file is written to before it is renamed into place.
 pub fn partial(dir: &Path, name: &str) -> PathBuf {
-    dir.join(format!(".{name}.partial"))
+    // The extension stays last: the image encoder picks the format from it.
+    dir.join(format!(".partial.{name}"))
 }
 
 /// Writes `files` into `dir`, each to its temporary name ([`partial`]); then the earlier run's
