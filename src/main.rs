@@ -316,8 +316,9 @@ fn poincare_options(a: PoincareArgs) -> Result<PoincareOptions, InputError> {
     })
 }
 
-/// The summary line of `crr poincare` on stdout, and its overturning and failures on stderr.
-fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) {
+/// The summary line of `crr poincare` on stdout, and its overturning on stderr; a section that
+/// stopped early with an error is returned (exit code 1, as `crr simulate`).
+fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) -> Option<String> {
     let s = &r.summary;
     if let Some(sec) = s.get("section") {
         if sec["overturned"] == true {
@@ -331,10 +332,11 @@ fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) {
             );
         }
         if let Some(e) = sec["error"].as_str() {
-            eprintln!(
-                "crr: {}: the run stopped early: {e} (the points until then are written)",
-                model.display()
-            );
+            return Some(format!(
+                "{}: the run stopped early: {e} (the points until then are written to {})",
+                model.display(),
+                r.out.display()
+            ));
         }
         if !quiet {
             println!(
@@ -377,6 +379,7 @@ fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) {
             );
         }
     }
+    None
 }
 
 fn run(cli: Cli) -> Result<(), Failure> {
@@ -517,7 +520,9 @@ fn run(cli: Cli) -> Result<(), Failure> {
                 quiet,
             })?;
             let result = poincare(&model, &opts, plot)?;
-            report_poincare(&model, &result, quiet);
+            if let Some(e) = report_poincare(&model, &result, quiet) {
+                return Err(Failure::Simulation(e));
+            }
         }
         Command::Plot { dir } => {
             for f in plot_results(&dir)? {

@@ -140,7 +140,8 @@ pub struct Section {
     pub collapse: Option<Collapse>,
     /// Time reached (s).
     pub end_time: f64,
-    /// Every slot seated at the end (the structure at rest on its seats).
+    /// Every slot seated at the end and, for a stroboscopic section, at every kept point (the
+    /// structure at rest on its seats).
     pub at_rest: bool,
     /// The simulation error that stopped the run early, if any.
     pub error: Option<String>,
@@ -273,8 +274,19 @@ pub fn run_section(
             }
         }
     }
+    // A start beyond the point of no return is a collapse at t = 0 that `step` never reports.
+    if section.collapse.is_none() {
+        section.collapse = sim.collapse.clone();
+    }
     section.end_time = sim.time();
-    section.at_rest = sim.states().iter().all(|s| *s == SlotState::Seated);
+    // At rest: seated at the end and, for a stroboscopic section, at every kept point (a forced
+    // orbit with seated phases may end in one of them without being at rest).
+    section.at_rest = sim.states().iter().all(|s| *s == SlotState::Seated)
+        && (settings.kind != SectionKind::Stroboscopic
+            || section
+                .points
+                .iter()
+                .all(|p| p.states.iter().all(|s| *s == SlotState::Seated)));
     section
 }
 
@@ -671,6 +683,13 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, InputErr
         None => SectionKind::Stroboscopic,
     };
     let sweeps_frequency = matches!(opts.sweep, Sweep::Frequencies(_));
+    if sweeps_frequency && opts.amplitude == 0.0 {
+        return Err(arg(
+            "--frequencies needs --amplitude A > 0 (m/s²): without forcing the frequency plays \
+             no part"
+                .into(),
+        ));
+    }
     if opts.frequency.is_some() && sweeps_frequency {
         return Err(arg(
             "--frequency and --frequencies cannot be given together".into(),

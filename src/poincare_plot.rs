@@ -62,6 +62,19 @@ fn padded(values: impl IntoIterator<Item = f64>) -> Range<f64> {
     (lo - pad)..(hi + pad)
 }
 
+/// Tick text with as many decimals as the spacing needs ("0" at zero, never "-0.000").
+fn tick(v: f64, range: &Range<f64>) -> String {
+    let span = (range.end - range.start).abs();
+    if v.abs() <= 1e-9 * span {
+        return "0".into();
+    }
+    if span < 1e-4 || range.start.abs().max(range.end.abs()) >= 1e5 {
+        return format!("{v:.3e}");
+    }
+    let decimals = (-(span / 8.0).log10().floor()).max(0.0) as usize + 1;
+    format!("{v:.decimals$}")
+}
+
 const POINT: RGBColor = RGBColor(31, 119, 180);
 const GREY: RGBColor = RGBColor(150, 150, 150);
 
@@ -79,7 +92,7 @@ fn chart<'a, DB: DrawingBackend + 'a>(
         .margin(15 * k)
         .x_label_area_size(50 * k)
         .y_label_area_size(80 * k)
-        .build_cartesian_2d(x, y)
+        .build_cartesian_2d(x.clone(), y.clone())
         .map_err(err)?;
     c.configure_mesh()
         .x_desc(x_desc)
@@ -91,8 +104,8 @@ fn chart<'a, DB: DrawingBackend + 'a>(
         .axis_style(BLACK.stroke_width(k))
         .x_labels(8)
         .y_labels(8)
-        .x_label_formatter(&|v| format!("{v:.3}"))
-        .y_label_formatter(&|v| format!("{v:.3}"))
+        .x_label_formatter(&|v| tick(*v, &x))
+        .y_label_formatter(&|v| tick(*v, &y))
         .draw()
         .map_err(err)?;
     Ok(c)
@@ -195,7 +208,7 @@ pub fn draw_section<DB: DrawingBackend>(
             .label(format!("{} section point(s)", pts.len()))
             .legend(move |(x, y)| Circle::new((x + 10 * k as i32, y), 3 * k, POINT.filled()));
         c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(SeriesLabelPosition::LowerRight)
             .background_style(WHITE.mix(0.85))
             .border_style(GREY.stroke_width(k))
             .label_font((FONT, 14 * k))
