@@ -671,6 +671,11 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, InputErr
     }
     let (file, model) = load_model(path)?;
     let here = |m: String| InputError::Argument(format!("{}: {m}", path.display()));
+    if model.dof() == 0 {
+        return Err(here(
+            "the model has no coordinate: there is nothing to section".into(),
+        ));
+    }
     let crossing = match &opts.section {
         Some(name) => Some(coordinate_index(&model, name, "--section")?),
         None => None,

@@ -130,6 +130,9 @@ pub fn draw_section<DB: DrawingBackend>(
 ) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
     let n = d.model.dof();
+    if n == 0 {
+        return Ok(());
+    }
     let cols = n.min(2);
     let rows = n.div_ceil(cols);
     let panels = root.split_evenly((rows, cols));
