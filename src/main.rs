@@ -331,6 +331,16 @@ fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) -> 
                 sec["points"]
             );
         }
+        let v = &sec["hypothesis_violation"];
+        if !v.is_null() {
+            eprintln!(
+                "crr: warning: the rigid-contact hypotheses fail at t = {} s: interface \"{}\" \
+                 ({}); the points after that time are outside crr's model",
+                v["time"],
+                v["interface"].as_str().unwrap_or_default(),
+                v["kind"].as_str().unwrap_or_default()
+            );
+        }
         if let Some(e) = sec["error"].as_str() {
             return Some(format!(
                 "{}: the run stopped early: {e} (the points until then are written to {})",

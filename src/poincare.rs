@@ -145,6 +145,10 @@ pub struct Section {
     pub at_rest: bool,
     /// The simulation error that stopped the run early, if any.
     pub error: Option<String>,
+    /// The first failure of the rigid-contact hypotheses (a contact in tension: flight; or
+    /// sliding when `[analysis].friction` is given), checked at the simulation's samples and
+    /// impacts; the points after it are outside crr's model.
+    pub violation: Option<crr_impact::monitor::Violation>,
 }
 
 /// Runs one section of `model` from `initial`; `params` gives the solver settings (its duration
@@ -162,6 +166,7 @@ pub fn run_section(
         end_time: 0.0,
         at_rest: false,
         error: None,
+        violation: None,
     };
     let ground = match settings.forcing.ground_motion() {
         Ok(g) => g,
@@ -278,6 +283,7 @@ pub fn run_section(
     if section.collapse.is_none() {
         section.collapse = sim.collapse.clone();
     }
+    section.violation = sim.violation.clone();
     section.end_time = sim.time();
     // At rest: seated at the end and, for a stroboscopic section, at every kept point (a forced
     // orbit with seated phases may end in one of them without being at rest).
@@ -886,6 +892,11 @@ pub fn section_json(section: &Section) -> Value {
         "at_rest": section.at_rest,
         "end_time": section.end_time,
         "error": section.error,
+        "hypothesis_violation": section.violation.as_ref().map(|v| json!({
+            "time": v.t,
+            "interface": v.interface,
+            "kind": v.kind,
+        })),
     })
 }
 
@@ -974,6 +985,7 @@ pub fn compute(p: &Prepared, opts: &PoincareOptions, progress: bool) -> Result<C
                         end_time: 0.0,
                         at_rest: false,
                         error: Some(format!("initial state: {e}")),
+                        violation: None,
                     },
                 }
             })?;
