@@ -143,9 +143,10 @@ fn section_points_are_the_simulation_states_at_multiples_of_the_period() {
 /// Hogan (1989, "On the dynamics of rigid-block motion under harmonic forcing", Proc. R. Soc.
 /// Lond. A 425) constructs these symmetric single-impact-per-half-cycle orbits and shows that they
 /// exist once the forcing amplitude is large enough for the frequency and are stable in a band of
-/// amplitudes above that threshold (below, the block settles or moves on non-periodic orbits;
-/// further above, it overturns); Spanos & Koh (1984) find the same 1:1 "fundamental mode" regions
-/// by harmonic balance. The setting here, F = 2 Hz (ω/p = 4.68) and A = 4 m/s² (2.04 g tan α),
+/// amplitudes above that threshold; at a fixed frequency, raising the amplitude past the band's
+/// upper stability boundary destroys the symmetric response (period doubling towards chaos, or
+/// overturning). Spanos & Koh (1984) find the same 1:1 "fundamental mode" regions by harmonic
+/// balance. The setting here, F = 2 Hz (ω/p = 4.68) and A = 4 m/s² (2.04 g tan α),
 /// with r = 1 − 1.5 sin²α = 0.942 from the momentum law, lies in that band: the sweep
 /// `crr poincare single_block.toml --rest --frequency 2 --amplitudes 2:12:11 --transient 200`
 /// gives one-point sections for A = 3 … 7 m/s² and overturning from 8 m/s² on.
