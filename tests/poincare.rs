@@ -370,6 +370,33 @@ fn sweeps_are_identical_for_one_and_two_threads() {
     assert_eq!(amplitudes[0], 3.0);
     assert_eq!(amplitudes[5 * n - 1], 7.0);
 
+    // A frequency sweep at A = 4 m/s² over 2, 3 and 4 Hz (amplitude sweeps at each of these
+    // frequencies find A = 4 m/s² on a bounded orbit, not overturning): 3 × N rows, identical for
+    // 1 and 2 threads.
+    let freq = [
+        "--amplitude",
+        "4",
+        "--frequencies",
+        "2:4:3",
+        "--transient",
+        "20",
+        "--periods",
+        ns.as_str(),
+    ];
+    let (a, b) = (scratch("pc_freq_1"), scratch("pc_freq_2"));
+    sweep(&a, "1", &freq);
+    sweep(&b, "2", &freq);
+    let csv = std::fs::read_to_string(a.join("bifurcation.csv")).unwrap();
+    assert_eq!(
+        csv,
+        std::fs::read_to_string(b.join("bifurcation.csv")).unwrap()
+    );
+    assert_eq!(
+        csv.lines().next(),
+        Some("case,frequency,k,t,base,base_rate")
+    );
+    assert_eq!(csv.lines().count(), 1 + 3 * n);
+
     let grid = [
         "--frequency",
         "2",
