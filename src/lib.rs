@@ -16,6 +16,8 @@
 //! - [`size_sweep`]: `crr check --size-sweep`, the frequencies of geometrically scaled models.
 //! - [`plot`]: PNG and SVG plots of the results (`crr plot`, `--plot`).
 //! - [`study`]: `crr study` (many cases of one model in parallel: maps, fragility studies).
+//! - [`poincare`]: `crr poincare`, Poincaré sections under harmonic ground motion, bifurcation
+//!   diagrams and basins (`docs/poincare.md`); [`poincare_plot`] draws them.
 //! - [`fuzzing`]: the entry points of the fuzz targets in `fuzz/` and of their corpus replay.
 
 pub use crr_dynamics as dynamics;
@@ -28,6 +30,8 @@ pub mod inspect;
 pub mod levels;
 pub mod model_file;
 pub mod plot;
+pub mod poincare;
+pub mod poincare_plot;
 pub mod simulate;
 pub mod size_sweep;
 pub mod study;

@@ -10,6 +10,10 @@ use crr::inspect::{configuration, inspect, to_text};
 use crr::plot::{
     PlotError, plot_check, plot_housner_models, plot_levels, plot_results, plot_size_sweep,
 };
+use crr::poincare::{
+    PoincareOptions, PoincareResult, Sweep, parse_acceleration, parse_finite, parse_frequency,
+    parse_range, poincare,
+};
 use crr::simulate::{RecordArg, SimulateOptions, SimulateResult, simulate};
 use crr::{InputError, load_model};
 
@@ -126,6 +130,90 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+    },
+    /// Poincaré section under the harmonic ground acceleration A sin(2πF t + φ): the states at
+    /// t = kT (T = 1/F), or where a coordinate crosses 0 upward (--section, or --amplitude 0);
+    /// sweeps give a bifurcation diagram or basins (docs/poincare.md).
+    Poincare {
+        /// Model file (TOML, or JSON when it ends in .json).
+        model: PathBuf,
+        /// Amplitude A of the ground acceleration, in m/s² (or in g as `0.3g`, g = 9.80665 m/s²);
+        /// it replaces the model's ground motion. 0: no ground motion, a crossing section.
+        #[arg(
+            long,
+            value_name = "A",
+            default_value = "0",
+            allow_hyphen_values = true
+        )]
+        amplitude: String,
+        /// Frequency F of the ground acceleration (Hz); the section is taken at t = k/F.
+        #[arg(long, value_name = "F", allow_negative_numbers = true)]
+        frequency: Option<f64>,
+        /// Ground-motion component driven: x, y or z.
+        #[arg(long, value_name = "AXIS", default_value = "x")]
+        component: String,
+        /// Phase φ of the sine (rad).
+        #[arg(
+            long,
+            value_name = "PHI",
+            default_value_t = 0.0,
+            allow_negative_numbers = true
+        )]
+        phase: f64,
+        /// N: section points kept (forcing periods, or crossings).
+        #[arg(long, value_name = "N", default_value_t = 100)]
+        periods: usize,
+        /// M: forcing periods (or crossings) dropped first as the transient.
+        #[arg(long, value_name = "M", default_value_t = 100)]
+        transient: usize,
+        /// Crossing section: the post-impact states where coordinate COORD crosses 0 from
+        /// negative to positive.
+        #[arg(long, value_name = "COORD")]
+        section: Option<String>,
+        /// The coordinate of the bifurcation diagram and of the --grid initial conditions
+        /// (default the first).
+        #[arg(long, value_name = "NAME")]
+        coordinate: Option<String>,
+        /// Time limit of a crossing section (s, default 1000).
+        #[arg(long, value_name = "T")]
+        duration: Option<f64>,
+        /// Start from rest instead of the model's [initial] state.
+        #[arg(long)]
+        rest: bool,
+        /// Bifurcation diagram against the amplitude: A0:A1:n (m/s², or g as 0.1g:0.3g:n).
+        #[arg(
+            long,
+            value_name = "A0:A1:N",
+            conflicts_with_all = ["frequencies", "grid"],
+            allow_hyphen_values = true
+        )]
+        amplitudes: Option<String>,
+        /// Bifurcation diagram against the frequency: F0:F1:n (Hz).
+        #[arg(
+            long,
+            value_name = "F0:F1:N",
+            conflicts_with = "grid",
+            allow_hyphen_values = true
+        )]
+        frequencies: Option<String>,
+        /// Basins: initial angle θ0:θ1:n (rad) × initial rate ω0:ω1:m (rad/s) of the coordinate.
+        #[arg(long, value_name = "T0:T1:N,W0:W1:M", allow_hyphen_values = true)]
+        grid: Option<String>,
+        /// Worker threads of a sweep (default one per core); results do not depend on it.
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Output folder (default results/<model name>_poincare).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Replace the results of an earlier run in the output folder.
+        #[arg(long)]
+        force: bool,
+        /// No progress indication and no summary line.
+        #[arg(long)]
+        quiet: bool,
+        /// Also draw the section (or the bifurcation diagram, or the basins) as PNG and SVG.
+        #[arg(long)]
+        plot: bool,
     },
 }
 
@@ -320,6 +408,163 @@ fn check_models(
     Ok(())
 }
 
+/// The raw options of `crr poincare`.
+struct PoincareArgs {
+    amplitude: String,
+    frequency: Option<f64>,
+    component: String,
+    phase: f64,
+    periods: usize,
+    transient: usize,
+    section: Option<String>,
+    coordinate: Option<String>,
+    duration: Option<f64>,
+    rest: bool,
+    amplitudes: Option<String>,
+    frequencies: Option<String>,
+    grid: Option<String>,
+    jobs: Option<usize>,
+    out: Option<PathBuf>,
+    force: bool,
+    quiet: bool,
+}
+
+fn poincare_options(a: PoincareArgs) -> Result<PoincareOptions, InputError> {
+    let arg = InputError::Argument;
+    let amplitude = parse_acceleration(&a.amplitude, "--amplitude").map_err(arg)?;
+    let axis: Axis = a
+        .component
+        .parse()
+        .map_err(|e| arg(format!("--component: {e}")))?;
+    let sweep = if let Some(r) = &a.amplitudes {
+        Sweep::Amplitudes(
+            parse_range(r, "--amplitudes", |v| parse_acceleration(v, "--amplitudes"))
+                .map_err(arg)?,
+        )
+    } else if let Some(r) = &a.frequencies {
+        Sweep::Frequencies(
+            parse_range(r, "--frequencies", |v| parse_frequency(v, "--frequencies"))
+                .map_err(arg)?,
+        )
+    } else if let Some(g) = &a.grid {
+        let Some((angle, rate)) = g.split_once(',') else {
+            return Err(arg(format!(
+                "--grid must be T0:T1:N,W0:W1:M (angles in rad, rates in rad/s), got `{g}`"
+            )));
+        };
+        Sweep::Grid {
+            angle: parse_range(angle, "--grid (angles)", |v| {
+                parse_finite(v, "--grid (angles)")
+            })
+            .map_err(arg)?,
+            rate: parse_range(rate, "--grid (rates)", |v| {
+                parse_finite(v, "--grid (rates)")
+            })
+            .map_err(arg)?,
+        }
+    } else {
+        Sweep::None
+    };
+    if a.amplitudes.is_some() && amplitude != 0.0 {
+        return Err(arg(
+            "--amplitude and --amplitudes cannot be given together".into()
+        ));
+    }
+    Ok(PoincareOptions {
+        amplitude,
+        frequency: a.frequency,
+        phase: a.phase,
+        axis,
+        periods: a.periods,
+        transient: a.transient,
+        section: a.section,
+        coordinate: a.coordinate,
+        duration: a.duration,
+        rest: a.rest,
+        sweep,
+        jobs: a.jobs,
+        out: a.out,
+        force: a.force,
+        quiet: a.quiet,
+    })
+}
+
+/// The summary line of `crr poincare` on stdout, and its overturning on stderr; a section that
+/// stopped early with an error is returned (exit code 1, as `crr simulate`).
+fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) -> Option<String> {
+    let s = &r.summary;
+    if let Some(sec) = s.get("section") {
+        if sec["overturned"] == true {
+            eprintln!(
+                "crr: {}: the structure overturned at t = {} s ({}): the section ends there, \
+                 with {} point(s)",
+                model.display(),
+                sec["overturn_time"],
+                sec["overturn_body"].as_str().unwrap_or_default(),
+                sec["points"]
+            );
+        }
+        let v = &sec["hypothesis_violation"];
+        if !v.is_null() {
+            eprintln!(
+                "crr: warning: the rigid-contact hypotheses fail at t = {} s: interface \"{}\" \
+                 ({}); the points after that time are outside crr's model",
+                v["time"],
+                v["interface"].as_str().unwrap_or_default(),
+                v["kind"].as_str().unwrap_or_default()
+            );
+        }
+        if let Some(e) = sec["error"].as_str() {
+            return Some(format!(
+                "{}: the run stopped early: {e} (the points until then are written to {})",
+                model.display(),
+                r.out.display()
+            ));
+        }
+        if !quiet {
+            println!(
+                "{}: {} section point(s), {} distinct, period {}; results in {}",
+                model.display(),
+                sec["points"],
+                sec["distinct_points"],
+                if sec["period"].is_null() {
+                    "not found".to_string()
+                } else {
+                    sec["period"].to_string()
+                },
+                r.out.display()
+            );
+        }
+    } else if let Some(cases) = s["cases"].as_array() {
+        let overturned = cases.iter().filter(|c| c["overturned"] == true).count();
+        let failed = cases.iter().filter(|c| !c["error"].is_null()).count();
+        if overturned > 0 {
+            eprintln!(
+                "crr: {}: {overturned} of {} case(s) overturned",
+                model.display(),
+                cases.len()
+            );
+        }
+        if failed > 0 {
+            eprintln!(
+                "crr: {}: {failed} of {} case(s) stopped early with an error (listed in {})",
+                model.display(),
+                cases.len(),
+                r.out.join("poincare.json").display()
+            );
+        }
+        if !quiet {
+            println!(
+                "{}: {} case(s); results in {}",
+                model.display(),
+                cases.len(),
+                r.out.display()
+            );
+        }
+    }
+    None
+}
+
 fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Inspect { model, q, json } => {
@@ -469,6 +714,51 @@ fn run(cli: Cli) -> Result<(), Failure> {
                     outcome.failed,
                     out.display()
                 );
+            }
+        }
+        Command::Poincare {
+            model,
+            amplitude,
+            frequency,
+            component,
+            phase,
+            periods,
+            transient,
+            section,
+            coordinate,
+            duration,
+            rest,
+            amplitudes,
+            frequencies,
+            grid,
+            jobs,
+            out,
+            force,
+            quiet,
+            plot,
+        } => {
+            let opts = poincare_options(PoincareArgs {
+                amplitude,
+                frequency,
+                component,
+                phase,
+                periods,
+                transient,
+                section,
+                coordinate,
+                duration,
+                rest,
+                amplitudes,
+                frequencies,
+                grid,
+                jobs,
+                out,
+                force,
+                quiet,
+            })?;
+            let result = poincare(&model, &opts, plot)?;
+            if let Some(e) = report_poincare(&model, &result, quiet) {
+                return Err(Failure::Simulation(e));
             }
         }
         Command::Plot { dir } => {

@@ -396,7 +396,8 @@ fn tick(v: f64, range: &std::ops::Range<f64>) -> String {
     format!("{v:.decimals$}")
 }
 
-type DrawResult = Result<(), String>;
+/// What a drawing function returns: the backend's error as text.
+pub type DrawResult = Result<(), String>;
 
 fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
@@ -877,7 +878,7 @@ fn downsample(big: &[u8], w: u32, h: u32, k: u32) -> Vec<u8> {
 }
 
 /// Writes one PNG: drawn at `SUPERSAMPLE` times [`SIZE`] in memory, averaged down, encoded.
-fn write_png(
+pub fn write_png(
     file: &Path,
     draw: impl Fn(&DrawingArea<BitMapBackend<'_>, Shift>, u32) -> DrawResult,
 ) -> Result<(), PlotError> {
@@ -900,7 +901,7 @@ fn write_png(
 }
 
 /// Writes one SVG of [`SIZE`].
-fn write_svg(
+pub fn write_svg(
     file: &Path,
     draw: impl Fn(&DrawingArea<SVGBackend<'_>, Shift>, u32) -> DrawResult,
 ) -> Result<(), PlotError> {
