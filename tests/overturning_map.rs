@@ -80,4 +80,12 @@ fn the_map_boundary_follows_zhang_and_makris() {
     }
     // The theory's regime covers about half of the map's frequencies (ω_p/p up to about 6).
     assert!(compared >= 25, "only {compared} columns compared");
+    // The curve drawn on the map takes r from the engine's momentum law: the block's
+    // 1 − (3/2) sin²α, so the same boundary to the bisection's 1e-6.
+    let drawn = crr::study::zhang_makris::map_boundary(&study, 1.0, 12.0, 12).expect("a block map");
+    assert!(drawn.len() >= 8);
+    for (w, b) in drawn {
+        let want = minimum_overturning_ratio(PulseKind::OneSinePulse, w, r, 50.0).unwrap();
+        assert!((b - want).abs() < 1e-5, "ω_p/p = {w}: {b} vs {want}");
+    }
 }

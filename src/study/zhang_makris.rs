@@ -132,6 +132,37 @@ pub fn minimum_overturning_ratio(
     None
 }
 
+/// The analytic boundary to draw on a study's overturning map: (ω_p/p, minimum a_p/(g tan α))
+/// at `count` frequency ratios from `from` to `to`, for a study of one-sine or one-cosine pulses
+/// with dimensionless axes on a single block (one coordinate), with the block's r from the
+/// momentum law (`crr check`). None for any other study.
+pub fn map_boundary(
+    study: &super::Study,
+    from: f64,
+    to: f64,
+    count: usize,
+) -> Option<Vec<(f64, f64)>> {
+    let kind = study.pulse_kind?;
+    let pulses = study.spec.pulses.as_ref()?;
+    if kind == PulseKind::Ricker
+        || study.model.dof() != 1
+        || pulses.amplitude_ratios.is_none()
+        || pulses.frequency_ratios.is_none()
+        || count < 2
+    {
+        return None;
+    }
+    let r = crate::check::check(&study.model).mechanism?.r;
+    Some(
+        (0..count)
+            .filter_map(|k| {
+                let w = from + (to - from) * k as f64 / (count - 1) as f64;
+                minimum_overturning_ratio(kind, w, r, 50.0).map(|b| (w, b))
+            })
+            .collect(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
