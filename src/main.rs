@@ -73,9 +73,11 @@ enum Command {
         plot: bool,
     },
     /// Draw the plots of a results folder written by `crr simulate`: coordinates, energy and
-    /// phase (.png and .svg, docs/outputs.md).
+    /// phase (.png and .svg, docs/outputs.md); of a study folder (cases.csv and study.json): the
+    /// overturning map, rocking spectrum and fragility curves (docs/studies.md).
     Plot {
-        /// The results folder (history.csv, impacts.csv, summary.json).
+        /// The results folder (history.csv, impacts.csv, summary.json; or cases.csv and
+        /// study.json).
         dir: PathBuf,
     },
     /// Mobility report; for a one-DOF mechanism λ, the equivalent block, r and the free-rocking
@@ -126,6 +128,9 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Also draw the study's figures into the output folder (as `crr plot DIR`).
+        #[arg(long)]
+        plot: bool,
     },
 }
 
@@ -432,6 +437,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             jobs,
             shard,
             quiet,
+            plot,
         } => {
             let Some(path) = study else {
                 return Err(Failure::Input(InputError::Argument(
@@ -470,9 +476,22 @@ fn run(cli: Cli) -> Result<(), Failure> {
                     out.display()
                 );
             }
+            if plot {
+                let files = crr::plot::plot_study(&out)?;
+                if !quiet {
+                    for f in files {
+                        println!("{}", f.display());
+                    }
+                }
+            }
         }
         Command::Plot { dir } => {
-            for f in plot_results(&dir)? {
+            let files = if crr::study::products::is_study_dir(&dir) {
+                crr::plot::plot_study(&dir)?
+            } else {
+                plot_results(&dir)?
+            };
+            for f in files {
                 println!("{}", f.display());
             }
         }

@@ -18,6 +18,7 @@ use super::spec::{PulseKind, Start, StudySpec, Values};
 use crate::InputError;
 use crate::model_file::load_model;
 use crate::simulate::default_duration;
+use crate::size_sweep::{scale_structure, structure_height};
 
 /// What drives one case.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,8 +54,25 @@ pub struct Case {
     pub index: usize,
     /// Stable id: `c` and the index on six digits.
     pub id: String,
+    /// Index of its model variant (scale factor) in [`Study::variants`].
+    pub variant: usize,
     /// Its ground motion.
     pub motion: Motion,
+}
+
+/// The model at one scale factor of the study's size axis.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    /// Scale factor s (every length × s; 1 without a size axis).
+    pub scale: f64,
+    /// The model scaled by s.
+    pub model: Model,
+    /// Its initial state.
+    pub initial: InitialState,
+    /// λ and p_eq of its one-DOF mechanism (p_eq ∝ 1/√s, λ unchanged).
+    pub lambda_p: Option<(f64, f64)>,
+    /// Height of the scaled structure at rest (m), when defined.
+    pub height: Option<f64>,
 }
 
 /// A record of the study, read once.
@@ -112,6 +130,11 @@ pub struct Study {
     /// Activation multiplier λ (g tan α for a block is λg) and frequency parameter p_eq (rad/s)
     /// of the model's one-DOF mechanism, when it has one.
     pub lambda_p: Option<(f64, f64)>,
+    /// The model at each scale factor (one variant, s = 1, without `scales`).
+    pub variants: Vec<Variant>,
+    /// Whether the study has a size axis (`scales`): then `cases.csv` has the columns `scale`
+    /// and `height_m`.
+    pub sized: bool,
     /// The cases, in id order.
     pub cases: Vec<Case>,
 }
@@ -175,6 +198,38 @@ impl Study {
         let params = Parameters::from_analysis(&file.analysis.clone().unwrap_or_default(), 10.0)
             .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
         let lambda_p = mechanism_scales(&model, axis);
+        let structure = file.structure();
+        let mut variants = Vec::new();
+        let sized = spec.scales.is_some();
+        match &spec.scales {
+            None => variants.push(Variant {
+                scale: 1.0,
+                model: model.clone(),
+                initial: initial.clone(),
+                lambda_p,
+                height: structure_height(&structure),
+            }),
+            Some(v) => {
+                let scales = v.expand("scales").map_err(|e| bad(path, e))?;
+                if let Some(s) = scales.iter().find(|s| **s <= 0.0) {
+                    return Err(bad(path, format!("scales: a factor must be > 0, got {s}")));
+                }
+                for s in scales {
+                    let scaled = scale_structure(&structure, s);
+                    let m = Model::from_spec(&scaled)
+                        .map_err(|e| bad(path, format!("scales: the model scaled by {s}: {e}")))?;
+                    let init = solve_initial(&m, &initial_spec)
+                        .map_err(|e| bad(path, format!("scales: the model scaled by {s}: {e}")))?;
+                    variants.push(Variant {
+                        scale: s,
+                        lambda_p: mechanism_scales(&m, axis),
+                        height: structure_height(&scaled),
+                        model: m,
+                        initial: init,
+                    });
+                }
+            }
+        }
         let mut study = Study {
             spec: spec.clone(),
             name,
@@ -186,6 +241,8 @@ impl Study {
             records: Vec::new(),
             intensity: IntensityMeasure::Factor,
             lambda_p,
+            variants,
+            sized,
             cases: Vec::new(),
         };
         match (&spec.pulses, &spec.records) {
@@ -204,34 +261,45 @@ impl Study {
                     ));
                 }
                 study.pulse_kind = Some(p.kind);
-                let (amplitudes, ratios_a) = study.pulse_axis(
-                    path,
-                    &p.amplitudes,
-                    &p.amplitude_ratios,
-                    "pulses.amplitudes",
-                    "pulses.amplitude_ratios",
-                )?;
-                let (periods, ratios_f) = study.pulse_axis(
-                    path,
-                    &p.periods,
-                    &p.frequency_ratios,
-                    "pulses.periods",
-                    "pulses.frequency_ratios",
-                )?;
-                if let Some(t) = periods.iter().find(|t| **t <= 0.0) {
-                    return Err(bad(
+                for v in 0..study.variants.len() {
+                    let lp = study.variants[v].lambda_p;
+                    let gravity = study.variants[v].model.gravity;
+                    let (amplitudes, ratios_a) = pulse_axis(
                         path,
-                        format!("pulses: a period must be > 0, got {t} s"),
-                    ));
-                }
-                for (i, &a) in amplitudes.iter().enumerate() {
-                    for (j, &t) in periods.iter().enumerate() {
-                        study.push(Motion::Pulse {
-                            amplitude: a,
-                            period: t,
-                            amplitude_ratio: ratios_a.as_ref().map(|r| r[i]),
-                            frequency_ratio: ratios_f.as_ref().map(|r| r[j]),
-                        });
+                        lp,
+                        gravity,
+                        &p.amplitudes,
+                        &p.amplitude_ratios,
+                        "pulses.amplitudes",
+                        "pulses.amplitude_ratios",
+                    )?;
+                    let (periods, ratios_f) = pulse_axis(
+                        path,
+                        lp,
+                        gravity,
+                        &p.periods,
+                        &p.frequency_ratios,
+                        "pulses.periods",
+                        "pulses.frequency_ratios",
+                    )?;
+                    if let Some(t) = periods.iter().find(|t| **t <= 0.0) {
+                        return Err(bad(
+                            path,
+                            format!("pulses: a period must be > 0, got {t} s"),
+                        ));
+                    }
+                    for (i, &a) in amplitudes.iter().enumerate() {
+                        for (j, &t) in periods.iter().enumerate() {
+                            study.push(
+                                v,
+                                Motion::Pulse {
+                                    amplitude: a,
+                                    period: t,
+                                    amplitude_ratio: ratios_a.as_ref().map(|r| r[i]),
+                                    frequency_ratio: ratios_f.as_ref().map(|r| r[j]),
+                                },
+                            );
+                        }
                     }
                 }
             }
@@ -250,22 +318,60 @@ impl Study {
                                 .and_then(|x| x.to_str())
                                 .is_some_and(|x| x.eq_ignore_ascii_case(&ext))
                         })
-                        .map(|p| folder.join(p.file_name().expect("a file name")))
+                        .filter_map(|p| p.file_name().map(|n| folder.join(n)))
                         .collect();
                     found.sort();
                     files.extend(found);
                 }
-                if files.is_empty() {
+                let seeds: Vec<u64> = match &r.synthetic {
+                    None => Vec::new(),
+                    Some(syn) => {
+                        let v = syn
+                            .seeds
+                            .expand("records.synthetic.seeds")
+                            .map_err(|e| bad(path, e))?;
+                        let mut seeds = Vec::with_capacity(v.len());
+                        for x in v {
+                            if !(x >= 0.0 && x.fract() == 0.0 && x < 9.0e15) {
+                                return Err(bad(
+                                    path,
+                                    format!(
+                                        "records.synthetic.seeds: {x} is not a whole number from \
+                                         0 to 9e15"
+                                    ),
+                                ));
+                            }
+                            seeds.push(x as u64);
+                        }
+                        seeds
+                    }
+                };
+                if files.is_empty() && seeds.is_empty() {
                     return Err(bad(path, "records: no record files".into()));
+                }
+                if !files.is_empty() && r.format.is_none() {
+                    return Err(bad(
+                        path,
+                        "records.format: give the format of the record files (peer-at2, csv, \
+                         text)"
+                            .into(),
+                    ));
                 }
                 study.records = files
                     .iter()
                     .map(|f| StudyRecord {
                         file: f.clone(),
-                        record: read_record(&base.join(f), r.format, r.units)
-                            .map_err(|e| e.to_string()),
+                        record: match r.format {
+                            Some(format) => read_record(&base.join(f), format, r.units)
+                                .map_err(|e| e.to_string()),
+                            None => Err("no format".into()),
+                        },
                     })
                     .collect();
+                study.records.extend(seeds.iter().map(|&seed| StudyRecord {
+                    file: PathBuf::from(format!("synthetic:{seed}")),
+                    record: synthetic_record(seed),
+                }));
                 let (measure, levels) = match &spec.intensity {
                     None => (IntensityMeasure::Factor, vec![1.0]),
                     Some(i) => {
@@ -292,21 +398,26 @@ impl Study {
                     }
                 };
                 study.intensity = measure;
-                for k in 0..study.records.len() {
-                    for &level in &levels {
-                        let factor = study.records[k].record.as_ref().ok().and_then(|rec| {
-                            let im = match measure {
-                                IntensityMeasure::Factor => return Some(level),
-                                IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
-                                IntensityMeasure::Pgv => peak_ground_velocity(rec),
-                            };
-                            (im > 0.0).then(|| level / im)
-                        });
-                        study.push(Motion::Record {
-                            record: k,
-                            level,
-                            factor,
-                        });
+                for v in 0..study.variants.len() {
+                    for k in 0..study.records.len() {
+                        for &level in &levels {
+                            let factor = study.records[k].record.as_ref().ok().and_then(|rec| {
+                                let im = match measure {
+                                    IntensityMeasure::Factor => return Some(level),
+                                    IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
+                                    IntensityMeasure::Pgv => peak_ground_velocity(rec),
+                                };
+                                (im > 0.0).then(|| level / im)
+                            });
+                            study.push(
+                                v,
+                                Motion::Record {
+                                    record: k,
+                                    level,
+                                    factor,
+                                },
+                            );
+                        }
                     }
                 }
             }
@@ -314,56 +425,14 @@ impl Study {
         Ok(study)
     }
 
-    fn push(&mut self, motion: Motion) {
+    fn push(&mut self, variant: usize, motion: Motion) {
         let index = self.cases.len();
         self.cases.push(Case {
             index,
             id: format!("c{index:06}"),
+            variant,
             motion,
         });
-    }
-
-    /// One axis of the pulse grid: values in physical units, and the dimensionless ratios when
-    /// given so (converted with λg or p_eq).
-    fn pulse_axis(
-        &self,
-        path: &Path,
-        physical: &Option<Values>,
-        ratio: &Option<Values>,
-        physical_key: &str,
-        ratio_key: &str,
-    ) -> Result<(Vec<f64>, Option<Vec<f64>>), InputError> {
-        match (physical, ratio) {
-            (Some(v), None) => Ok((v.expand(physical_key).map_err(|e| bad(path, e))?, None)),
-            (None, Some(r)) => {
-                let ratios = r.expand(ratio_key).map_err(|e| bad(path, e))?;
-                let Some((lambda, p)) = self.lambda_p else {
-                    return Err(bad(
-                        path,
-                        format!(
-                            "{ratio_key}: the model has no one-DOF mechanism to take g tan α and p \
-                             from; give {physical_key} instead"
-                        ),
-                    ));
-                };
-                let values = if ratio_key.ends_with("amplitude_ratios") {
-                    ratios
-                        .iter()
-                        .map(|r| r * lambda * self.model.gravity)
-                        .collect()
-                } else {
-                    ratios
-                        .iter()
-                        .map(|r| 2.0 * std::f64::consts::PI / (r * p))
-                        .collect()
-                };
-                Ok((values, Some(ratios)))
-            }
-            _ => Err(bad(
-                path,
-                format!("give exactly one of {physical_key} and {ratio_key}"),
-            )),
-        }
     }
 
     /// The ground motion of a case, or why it cannot be built.
@@ -420,6 +489,56 @@ impl Study {
         self.spec
             .duration
             .unwrap_or_else(|| default_duration(ground))
+    }
+}
+
+/// The synthetic record of `seed` (`crate::synthetic::accelerogram_with_seed`, in m/s²).
+pub fn synthetic_record(seed: u64) -> Result<Record, String> {
+    let a: Vec<f64> = crate::synthetic::accelerogram_with_seed(seed)
+        .into_iter()
+        .map(|g| g * STANDARD_GRAVITY)
+        .collect();
+    Record::uniform(crate::synthetic::DT, a).map_err(|e| e.to_string())
+}
+
+/// One axis of the pulse grid: values in physical units, and the dimensionless ratios when given
+/// so (converted with λg or p_eq of the case's model).
+fn pulse_axis(
+    path: &Path,
+    lambda_p: Option<(f64, f64)>,
+    gravity: f64,
+    physical: &Option<Values>,
+    ratio: &Option<Values>,
+    physical_key: &str,
+    ratio_key: &str,
+) -> Result<(Vec<f64>, Option<Vec<f64>>), InputError> {
+    match (physical, ratio) {
+        (Some(v), None) => Ok((v.expand(physical_key).map_err(|e| bad(path, e))?, None)),
+        (None, Some(r)) => {
+            let ratios = r.expand(ratio_key).map_err(|e| bad(path, e))?;
+            let Some((lambda, p)) = lambda_p else {
+                return Err(bad(
+                    path,
+                    format!(
+                        "{ratio_key}: the model has no one-DOF mechanism to take g tan α and p \
+                         from; give {physical_key} instead"
+                    ),
+                ));
+            };
+            let values = if ratio_key.ends_with("amplitude_ratios") {
+                ratios.iter().map(|r| r * lambda * gravity).collect()
+            } else {
+                ratios
+                    .iter()
+                    .map(|r| 2.0 * std::f64::consts::PI / (r * p))
+                    .collect()
+            };
+            Ok((values, Some(ratios)))
+        }
+        _ => Err(bad(
+            path,
+            format!("give exactly one of {physical_key} and {ratio_key}"),
+        )),
     }
 }
 

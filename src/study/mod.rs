@@ -10,6 +10,7 @@
 
 pub mod cases;
 pub mod fragility;
+pub mod products;
 pub mod run;
 pub mod spec;
 

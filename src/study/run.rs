@@ -105,7 +105,8 @@ pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
     let ground = study.ground_motion(case)?;
     let mut params = study.params.clone();
     params.duration = study.duration(&ground);
-    let mut sim = Simulation::new(&study.model, &ground, &study.initial, params)
+    let variant = &study.variants[case.variant];
+    let mut sim = Simulation::new(&variant.model, &ground, &variant.initial, params)
         .map_err(|e| e.to_string())?;
     let mut last = None;
     loop {
@@ -143,6 +144,9 @@ fn quoted(s: &str) -> String {
 /// The header of `cases.csv`.
 pub fn header(study: &Study) -> String {
     let mut cols: Vec<String> = vec!["id".into()];
+    if study.sized {
+        cols.extend(["scale", "height_m"].map(String::from));
+    }
     if study.pulse_kind.is_some() {
         cols.extend(
             [
@@ -177,6 +181,10 @@ pub fn header(study: &Study) -> String {
 pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> String {
     let mut cols: Vec<String> = vec![case.id.clone()];
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    if study.sized {
+        let v = &study.variants[case.variant];
+        cols.extend([num(v.scale), opt(v.height)]);
+    }
     match &case.motion {
         Motion::Pulse {
             amplitude,
@@ -418,6 +426,12 @@ pub fn run_study(
         "wall_time_s": wall,
         "lambda": study.lambda_p.map(|x| x.0),
         "p_eq_rad_s": study.lambda_p.map(|x| x.1),
+        "scales": study.variants.iter().map(|v| serde_json::json!({
+            "scale": v.scale,
+            "height_m": v.height,
+            "lambda": v.lambda_p.map(|x| x.0),
+            "p_eq_rad_s": v.lambda_p.map(|x| x.1),
+        })).collect::<Vec<_>>(),
     });
     std::fs::write(
         opts.out.join("study.json"),
