@@ -137,7 +137,7 @@ pub fn draw_spectrum<DB: DrawingBackend>(
         .filter(|y| y.is_finite())
         .fold(1.0f64, f64::max)
         * 1.08;
-    let yr = 0.0..headroom(0.0..top, 0.25).end;
+    let yr = 0.0..headroom(0.0..top, 0.45).end;
     let mut chart = ChartBuilder::on(root)
         .caption(
             format!("{}: rocking spectrum (peak θ/α against size)", r.name),
@@ -189,11 +189,11 @@ pub fn draw_spectrum<DB: DrawingBackend>(
             first = false;
         }
         chart
-            .draw_series(
-                s.iter()
-                    .filter(|p| !p.1.is_finite())
-                    .map(|p| Cross::new((p.0, top), 6 * k, c.stroke_width(2 * k))),
-            )
+            .draw_series(s.iter().filter(|p| !p.1.is_finite()).map(|p| {
+                // Staggered per motion, so that collapses at the same size stay visible.
+                let lift = if many { 0.0 } else { 0.035 * i as f64 };
+                Cross::new((p.0, top * (1.0 + lift)), 6 * k, c.stroke_width(2 * k))
+            }))
             .map_err(err)?;
     }
     let finite: Vec<(f64, f64)> = median.iter().copied().filter(|p| p.1.is_finite()).collect();

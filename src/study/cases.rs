@@ -130,6 +130,9 @@ pub struct Study {
     /// Activation multiplier λ (g tan α for a block is λg) and frequency parameter p_eq (rad/s)
     /// of the model's one-DOF mechanism, when it has one.
     pub lambda_p: Option<(f64, f64)>,
+    /// Slenderness α_eq of the equivalent block of that mechanism (rad; size-free), when it has
+    /// one: the study's products measure peak rotations in units of it.
+    pub alpha_eq: Option<f64>,
     /// The model at each scale factor (one variant, s = 1, without `scales`).
     pub variants: Vec<Variant>,
     /// Whether the study has a size axis (`scales`): then `cases.csv` has the columns `scale`
@@ -197,7 +200,9 @@ impl Study {
             .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
         let params = Parameters::from_analysis(&file.analysis.clone().unwrap_or_default(), 10.0)
             .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
-        let lambda_p = mechanism_scales(&model, axis);
+        let mechanism = mechanism_scales(&model, axis);
+        let lambda_p = mechanism.map(|m| (m.0, m.1));
+        let alpha_eq = mechanism.map(|m| m.2).filter(|a| a.is_finite() && *a > 0.0);
         let structure = file.structure();
         let mut variants = Vec::new();
         let sized = spec.scales.is_some();
@@ -222,7 +227,7 @@ impl Study {
                         .map_err(|e| bad(path, format!("scales: the model scaled by {s}: {e}")))?;
                     variants.push(Variant {
                         scale: s,
-                        lambda_p: mechanism_scales(&m, axis),
+                        lambda_p: mechanism_scales(&m, axis).map(|m| (m.0, m.1)),
                         height: structure_height(&scaled),
                         model: m,
                         initial: init,
@@ -241,6 +246,7 @@ impl Study {
             records: Vec::new(),
             intensity: IntensityMeasure::Factor,
             lambda_p,
+            alpha_eq,
             variants,
             sized,
             cases: Vec::new(),
@@ -542,8 +548,8 @@ fn pulse_axis(
     }
 }
 
-/// λ and p_eq of the model's one-DOF mechanism opening under the driven axis, if it has one.
-fn mechanism_scales(model: &Model, axis: Axis) -> Option<(f64, f64)> {
+/// λ, p_eq and α_eq of the model's one-DOF mechanism opening under the driven axis, if it has one.
+fn mechanism_scales(model: &Model, axis: Axis) -> Option<(f64, f64, f64)> {
     let name = model.coords.first()?.name.clone();
     let opening = crr_dynamics::InitialSpec {
         angles: [(name, 0.01)].into_iter().collect(),
@@ -555,5 +561,6 @@ fn mechanism_scales(model: &Model, axis: Axis) -> Option<(f64, f64)> {
         _ => Vector3::x(),
     };
     let eq = equivalent_block(model, &open.pivots, 0, &d).ok()?;
-    (eq.lambda.is_finite() && eq.p_squared > 0.0).then(|| (eq.lambda, eq.p_squared.sqrt()))
+    (eq.lambda.is_finite() && eq.p_squared > 0.0)
+        .then(|| (eq.lambda, eq.p_squared.sqrt(), eq.alpha))
 }

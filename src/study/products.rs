@@ -3,9 +3,11 @@
 //! exceedance fractions per intensity level and their lognormal fit, written to `fragility.csv`).
 //! The figures are drawn by `crate::plot::plot_study`.
 //!
-//! The response measure is **peak θ/α**: the largest of the `peak_<coordinate>_over_alpha`
-//! columns of a case (for one block, its peak rotation over its slenderness; for a drum column,
-//! the worst joint). A collapsed case counts as exceeding every threshold and, in medians, as
+//! The response measure is **peak θ/α**: the largest peak joint rotation of a case
+//! (`peak_<coordinate>_rad`) over the slenderness α_eq of the model's equivalent block
+//! (`alpha_eq_rad` of `study.json`: α itself for one block; for a drum column the whole column
+//! rocking on its base joint, atan(b/h_cm)). Without α_eq (a model that is not a one-DOF
+//! mechanism at rest) it is the largest of the `peak_<coordinate>_over_alpha` columns. A collapsed case counts as exceeding every threshold and, in medians, as
 //! +∞; a case whose row holds an error is left out (and counted in `errors`).
 
 use std::collections::BTreeMap;
@@ -16,6 +18,9 @@ use crate::InputError;
 
 /// The thresholds of peak θ/α of the fragility curves (besides collapse).
 pub const THRESHOLDS: [f64; 3] = [0.2, 0.5, 1.0];
+
+/// One motion's spectrum: its name and (size, peak θ/α) points, sizes ascending.
+pub type Spectrum = (String, Vec<(f64, f64)>);
 
 /// One case read back from `cases.csv`.
 #[derive(Clone, Debug, PartialEq)]
@@ -115,10 +120,20 @@ impl StudyResults {
         let status = col("status").ok_or_else(|| bad("no `status` column".into()))?;
         let pulses = col("amplitude_m_s2").is_some();
         let ratio_cols = (col("frequency_ratio"), col("amplitude_ratio"));
-        let intensity = ["factor", "pga_g", "pgv_m_s"]
+        // The level's column comes before the `factor` column in records studies.
+        let intensity = ["pga_g", "pgv_m_s", "factor"]
             .into_iter()
             .find(|n| !pulses && col(n).is_some())
             .map(String::from);
+        let alpha_eq = json["alpha_eq_rad"]
+            .as_f64()
+            .filter(|a| a.is_finite() && *a > 0.0);
+        let rad: Vec<usize> = header
+            .iter()
+            .enumerate()
+            .filter(|(_, h)| h.starts_with("peak_") && h.ends_with("_rad"))
+            .map(|(i, _)| i)
+            .collect();
         let over: Vec<usize> = header
             .iter()
             .enumerate()
@@ -167,7 +182,14 @@ impl StudyResults {
             } else {
                 f[col("record").unwrap_or(0)].clone()
             };
-            let peaks: Vec<f64> = over.iter().filter_map(|&i| f[i].parse().ok()).collect();
+            let peaks: Vec<f64> = match alpha_eq {
+                Some(a) => rad
+                    .iter()
+                    .filter_map(|&i| f[i].parse::<f64>().ok())
+                    .map(|p| p / a)
+                    .collect(),
+                None => over.iter().filter_map(|&i| f[i].parse().ok()).collect(),
+            };
             let peak_ratio =
                 (!peaks.is_empty()).then(|| peaks.iter().fold(0.0f64, |m, p| m.max(*p)));
             cases.push(CaseResult {
@@ -195,7 +217,7 @@ impl StudyResults {
     /// The rocking spectra: for each motion (record or pulse), peak θ/α at each size (x = height
     /// when every case has one, else the scale factor), with collapse as +∞; and the median over
     /// the motions at each size (+∞ when at least half collapsed). Sizes ascending.
-    pub fn spectra(&self) -> (Vec<(String, Vec<(f64, f64)>)>, Vec<(f64, f64)>) {
+    pub fn spectra(&self) -> (Vec<Spectrum>, Vec<(f64, f64)>) {
         let by_height = self.cases.iter().all(|c| c.height.is_some());
         let x = |c: &CaseResult| {
             if by_height {
@@ -223,7 +245,7 @@ impl StudyResults {
                 .1
                 .push(y);
         }
-        let mut series: Vec<(String, Vec<(f64, f64)>)> = series.into_iter().collect();
+        let mut series: Vec<Spectrum> = series.into_iter().collect();
         for (_, s) in &mut series {
             s.sort_by(|a, b| a.0.total_cmp(&b.0));
         }
@@ -252,7 +274,8 @@ impl StudyResults {
         let mut measures: Vec<Option<f64>> = vec![None];
         measures.extend(THRESHOLDS.iter().map(|t| Some(*t)));
         for threshold in measures {
-            let mut by_level: BTreeMap<u64, FragilityPoint> = BTreeMap::new();
+            // Levels equal to 12 significant digits are one level.
+            let mut by_level: BTreeMap<String, FragilityPoint> = BTreeMap::new();
             for c in &self.cases {
                 let (Some(level), Some(collapse)) = (c.level, c.collapse) else {
                     continue;
@@ -264,11 +287,13 @@ impl StudyResults {
                     None => collapse,
                     Some(t) => collapse || c.peak_ratio.is_some_and(|p| p > t),
                 };
-                let p = by_level.entry(level.to_bits()).or_insert(FragilityPoint {
-                    im: level,
-                    trials: 0.0,
-                    exceed: 0.0,
-                });
+                let p = by_level
+                    .entry(format!("{level:.11e}"))
+                    .or_insert(FragilityPoint {
+                        im: level,
+                        trials: 0.0,
+                        exceed: 0.0,
+                    });
                 p.trials += 1.0;
                 if exceed {
                     p.exceed += 1.0;

@@ -426,6 +426,7 @@ pub fn run_study(
         "wall_time_s": wall,
         "lambda": study.lambda_p.map(|x| x.0),
         "p_eq_rad_s": study.lambda_p.map(|x| x.1),
+        "alpha_eq_rad": study.alpha_eq,
         "scales": study.variants.iter().map(|v| serde_json::json!({
             "scale": v.scale,
             "height_m": v.height,
@@ -451,6 +452,7 @@ pub fn run_study(
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
     let mut header: Option<String> = None;
     let mut study: Option<serde_json::Value> = None;
+    let mut first_json: Option<serde_json::Value> = None;
     let mut rows: BTreeMap<String, String> = BTreeMap::new();
     for dir in dirs {
         let csv = dir.join("cases.csv");
@@ -470,6 +472,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
                     message: e.to_string(),
                 })
             })?;
+        if first_json.is_none() {
+            first_json = Some(json.clone());
+        }
         match &study {
             None => study = Some(json["study"].clone()),
             Some(s) if *s != json["study"] => {
@@ -521,6 +526,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
     }
     let summary = serde_json::json!({
         "study": study,
+        "name": first_json.as_ref().map(|j| j["name"].clone()),
+        "alpha_eq_rad": first_json.as_ref().map(|j| j["alpha_eq_rad"].clone()),
         "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
         "cases": rows.len(),
         "crr_version": env!("CARGO_PKG_VERSION"),
