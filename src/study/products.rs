@@ -164,10 +164,8 @@ impl StudyResults {
                     (Some(x), Some(y)) => Some((x, y)),
                     _ => {
                         ratios = false;
-                        Some((
-                            num(col("period_s")).unwrap_or(f64::NAN),
-                            num(col("amplitude_m_s2")).unwrap_or(f64::NAN),
-                        ))
+                        // (None, and no map cell, when the row's numbers do not parse.)
+                        num(col("period_s")).zip(num(col("amplitude_m_s2")))
                     }
                 }
             } else {
