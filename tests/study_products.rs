@@ -290,3 +290,36 @@ fn map_has_one_cell_per_case() {
         "no fragility for pulses"
     );
 }
+
+/// The bundled studies load with the documented numbers of cases, in size-major order, and a
+/// scale factor that is not positive is refused naming `scales`.
+#[test]
+fn bundled_studies_load() {
+    let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/studies");
+    let spectrum = Study::load(&studies.join("block_spectrum.toml")).unwrap();
+    assert_eq!(spectrum.variants.len(), 20);
+    assert_eq!(spectrum.records.len(), 5, "the bundled record and 4 seeds");
+    assert_eq!(spectrum.cases.len(), 100);
+    // Case k is at size k div 5 (5 records × 1 level per size).
+    assert!(spectrum.cases.iter().all(|c| c.variant == c.index / 5));
+    assert!((spectrum.variants[19].height.unwrap() - 10.0).abs() < 1e-12);
+    let drum = Study::load(&studies.join("drum_fragility.toml")).unwrap();
+    assert_eq!(drum.records.len(), 20);
+    assert_eq!(drum.cases.len(), 200);
+    assert!(!drum.sized);
+    let map = Study::load(&studies.join("housner_map.toml")).unwrap();
+    assert_eq!(map.cases.len(), 3600);
+
+    let dir = scratch("study_bad_scales");
+    let bad = write(
+        &dir,
+        "bad.toml",
+        &format!(
+            "model = \"{}\"\nscales = [1.0, 0.0]\n\n[pulses]\nkind = \"ricker\"\n\
+             amplitudes = [1.0]\nperiods = [0.5]\n",
+            models().join("single_block.toml").display()
+        ),
+    );
+    let e = Study::load(&bad).unwrap_err().to_string();
+    assert!(e.contains("scales") && e.contains("> 0"), "{e}");
+}
