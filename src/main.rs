@@ -77,9 +77,11 @@ enum Command {
         plot: bool,
     },
     /// Draw the plots of a results folder written by `crr simulate`: coordinates, energy and
-    /// phase (.png and .svg, docs/outputs.md).
+    /// phase (.png and .svg, docs/outputs.md); of a study folder (cases.csv and study.json): the
+    /// overturning map, rocking spectrum and fragility curves (docs/studies.md).
     Plot {
-        /// The results folder (history.csv, impacts.csv, summary.json).
+        /// The results folder (history.csv, impacts.csv, summary.json; or cases.csv and
+        /// study.json).
         dir: PathBuf,
     },
     /// Mobility report; for a one-DOF mechanism λ, the equivalent block, r and the free-rocking
@@ -130,6 +132,9 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Also draw the study's figures into the output folder (as `crr plot DIR`).
+        #[arg(long)]
+        plot: bool,
     },
     /// Poincaré section under the harmonic ground acceleration A sin(2πF t + φ): the states at
     /// t = kT (T = 1/F), or where a coordinate crosses 0 upward (--section, or --amplitude 0);
@@ -677,6 +682,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             jobs,
             shard,
             quiet,
+            plot,
         } => {
             let Some(path) = study else {
                 return Err(Failure::Input(InputError::Argument(
@@ -714,6 +720,14 @@ fn run(cli: Cli) -> Result<(), Failure> {
                     outcome.failed,
                     out.display()
                 );
+            }
+            if plot {
+                let files = crr::plot::plot_study(&out)?;
+                if !quiet {
+                    for f in files {
+                        println!("{}", f.display());
+                    }
+                }
             }
         }
         Command::Poincare {
@@ -762,7 +776,12 @@ fn run(cli: Cli) -> Result<(), Failure> {
             }
         }
         Command::Plot { dir } => {
-            for f in plot_results(&dir)? {
+            let files = if crr::study::products::is_study_dir(&dir) {
+                crr::plot::plot_study(&dir)?
+            } else {
+                plot_results(&dir)?
+            };
+            for f in files {
                 println!("{}", f.display());
             }
         }

@@ -23,10 +23,12 @@ use crate::levels::{DEFAULT_STEP, MechanismLevels, mechanism_levels};
 use crate::model_file::ModelFile;
 
 mod figures;
+mod study;
 pub use figures::{
     draw_housner_models, draw_levels, draw_size_sweep, plot_housner_models, plot_levels,
     plot_size_sweep,
 };
+pub use study::{FragilityFigure, draw_fragility, draw_map, draw_spectrum, plot_study};
 
 /// Size of every image (pixels; the SVG uses the same user units).
 pub const SIZE: (u32, u32) = (1000, 700);

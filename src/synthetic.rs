@@ -19,6 +19,9 @@
 //!    (round-off, then the 7 significant digits of the file: |v(20 s)| < 1e-6 m/s).
 //! 5. **Scale** to a peak |a| of exactly [`PGA_G`] = 0.25 g.
 //!
+//! Any other seed gives another record of the same family ([`accelerogram_with_seed`]): studies
+//! generate their synthetic records this way instead of reading committed files.
+//!
 //! Values are written in g, 5 per line, in the Fortran form `-.1234567E-01` (7 significant
 //! digits, 14 characters each), after a 4-line header whose 4th line is
 //! `NPTS=  2001, DT=   .0100 SEC`.
@@ -83,10 +86,19 @@ pub fn half_power_frequency() -> f64 {
     0.5 * (lo + hi)
 }
 
-/// The accelerogram in g: [`NPTS`] samples at t_i = i·[`DT`] (steps 1–5 of the module doc).
+/// The accelerogram in g: [`NPTS`] samples at t_i = i·[`DT`] (steps 1–5 of the module doc),
+/// from the bundled seed [`SEED`].
 pub fn accelerogram() -> Vec<f64> {
+    accelerogram_with_seed(SEED)
+}
+
+/// The accelerogram in g of the same procedure (steps 1–5 of the module doc) with another seed of
+/// the white noise: every seed gives a record of the same duration, band, envelope and PGA
+/// ([`PGA_G`]), with a different phase content. `accelerogram_with_seed(SEED)` is the bundled
+/// record; `crr study` generates records by seed with it (`[records] synthetic`).
+pub fn accelerogram_with_seed(seed: u64) -> Vec<f64> {
     let n = NPTS;
-    let mut rng = SplitMix(SEED);
+    let mut rng = SplitMix(seed);
     let mut a: Vec<f64> = (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect();
     let half = SMOOTHING_WIDTH / 2;
     for _ in 0..SMOOTHING_PASSES {

@@ -12,6 +12,7 @@
 
 pub mod cases;
 pub mod fragility;
+pub mod products;
 pub mod run;
 pub mod spec;
 pub mod zhang_makris;

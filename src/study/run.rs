@@ -105,7 +105,8 @@ pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
     let ground = study.ground_motion(case)?;
     let mut params = study.params.clone();
     params.duration = study.duration(&ground);
-    let mut sim = Simulation::new(&study.model, &ground, &study.initial, params)
+    let variant = &study.variants[case.variant];
+    let mut sim = Simulation::new(&variant.model, &ground, &variant.initial, params)
         .map_err(|e| e.to_string())?;
     let mut last = None;
     loop {
@@ -143,6 +144,9 @@ fn quoted(s: &str) -> String {
 /// The header of `cases.csv`.
 pub fn header(study: &Study) -> String {
     let mut cols: Vec<String> = vec!["id".into()];
+    if study.sized {
+        cols.extend(["scale", "height_m"].map(String::from));
+    }
     if study.pulse_kind.is_some() {
         cols.extend(
             [
@@ -177,6 +181,10 @@ pub fn header(study: &Study) -> String {
 pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> String {
     let mut cols: Vec<String> = vec![case.id.clone()];
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    if study.sized {
+        let v = &study.variants[case.variant];
+        cols.extend([num(v.scale), opt(v.height)]);
+    }
     match &case.motion {
         Motion::Pulse {
             amplitude,
@@ -418,6 +426,13 @@ pub fn run_study(
         "wall_time_s": wall,
         "lambda": study.lambda_p.map(|x| x.0),
         "p_eq_rad_s": study.lambda_p.map(|x| x.1),
+        "alpha_eq_rad": study.alpha_eq,
+        "scales": study.variants.iter().map(|v| serde_json::json!({
+            "scale": v.scale,
+            "height_m": v.height,
+            "lambda": v.lambda_p.map(|x| x.0),
+            "p_eq_rad_s": v.lambda_p.map(|x| x.1),
+        })).collect::<Vec<_>>(),
     });
     std::fs::write(
         opts.out.join("study.json"),
@@ -437,6 +452,7 @@ pub fn run_study(
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
     let mut header: Option<String> = None;
     let mut study: Option<serde_json::Value> = None;
+    let mut first_json: Option<serde_json::Value> = None;
     let mut rows: BTreeMap<String, String> = BTreeMap::new();
     for dir in dirs {
         let csv = dir.join("cases.csv");
@@ -456,6 +472,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
                     message: e.to_string(),
                 })
             })?;
+        if first_json.is_none() {
+            first_json = Some(json.clone());
+        }
         match &study {
             None => study = Some(json["study"].clone()),
             Some(s) if *s != json["study"] => {
@@ -507,6 +526,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
     }
     let summary = serde_json::json!({
         "study": study,
+        "name": first_json.as_ref().map(|j| j["name"].clone()),
+        "alpha_eq_rad": first_json.as_ref().map(|j| j["alpha_eq_rad"].clone()),
         "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
         "cases": rows.len(),
         "crr_version": env!("CARGO_PKG_VERSION"),
