@@ -80,6 +80,25 @@ fn the_map_boundary_follows_zhang_and_makris() {
     }
     // The theory's regime covers about half of the map's frequencies (ω_p/p up to about 6).
     assert!(compared >= 25, "only {compared} columns compared");
+    // The run wrote the boundary for the map: the theory at 120 frequency ratios from 1 to 12,
+    // up to 1.2 × 7 = 8.4, and the map draws it.
+    let csv = std::fs::read_to_string(out.join("boundary.csv")).expect("boundary.csv");
+    let points: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (x, y) = l.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect();
+    assert!(points.len() > 60 && points.len() <= 120, "{}", points.len());
+    for &(w, b) in points.iter().step_by(10) {
+        let want = minimum_overturning_ratio(PulseKind::OneSinePulse, w, r, 8.4).unwrap();
+        assert!((b - want).abs() < 1e-5, "ω_p/p = {w}: {b} vs {want}");
+    }
+    crr::plot::plot_study(&out).expect("the map is drawn");
+    let svg = std::fs::read_to_string(out.join("map.svg")).unwrap();
+    assert!(svg.contains("Zhang &amp; Makris") || svg.contains("Zhang & Makris"));
     // The curve drawn on the map takes r from the engine's momentum law: the block's
     // 1 − (3/2) sin²α, so the same boundary to the bisection's 1e-6.
     let drawn = crr::study::zhang_makris::map_boundary(&study, 1.0, 12.0, 12).expect("a block map");

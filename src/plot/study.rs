@@ -13,6 +13,7 @@ use super::{
 };
 use crate::study::fragility::normal_cdf;
 use crate::study::products::{FragilityCurve, StudyResults, fragility_csv};
+use crate::study::run::BOUNDARY_FILE;
 
 /// Colour of a survivor's peak θ/α (0 pale yellow … 1 and above dark red).
 fn ratio_colour(r: f64) -> RGBColor {
@@ -101,6 +102,28 @@ pub fn draw_map<DB: DrawingBackend>(
             Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], c.filled())
         }))
         .map_err(err)?;
+    // Zhang & Makris's analytic minimum overturning amplitude (`boundary.csv`, written by the
+    // study for a single block on dimensionless axes), inside the plotted range.
+    if r.ratios {
+        let boundary: Vec<(f64, f64)> = std::fs::read_to_string(r.dir.join(BOUNDARY_FILE))
+            .unwrap_or_default()
+            .lines()
+            .skip(1)
+            .filter_map(|l| {
+                let (x, y) = l.split_once(',')?;
+                Some((x.parse().ok()?, y.parse().ok()?))
+            })
+            .filter(|&(x, y): &(f64, f64)| xr.contains(&x) && yr.contains(&y))
+            .collect();
+        if !boundary.is_empty() {
+            let blue = RGBColor(30, 90, 200);
+            chart
+                .draw_series(LineSeries::new(boundary, blue.stroke_width(3 * k)))
+                .map_err(err)?
+                .label("Zhang & Makris (2001), linearised: minimum overturning")
+                .legend(line_key(blue, k));
+        }
+    }
     let key = |c: RGBColor| {
         let w = 20 * k as i32;
         move |(x, y): (i32, i32)| Rectangle::new([(x, y - w / 2), (x + w, y + w / 2)], c.filled())

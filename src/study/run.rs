@@ -439,6 +439,9 @@ pub fn run_study(
         serde_json::to_string_pretty(&summary).expect("json") + "\n",
     )
     .map_err(out_err)?;
+    if let Some(text) = boundary_csv(study) {
+        std::fs::write(opts.out.join(BOUNDARY_FILE), text).map_err(out_err)?;
+    }
     Ok(StudyOutcome {
         cases: mine.len(),
         skipped: done.len(),
@@ -537,5 +540,39 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
         serde_json::to_string_pretty(&summary).expect("json") + "\n",
     )
     .map_err(out_err)?;
+    if let Ok(text) = std::fs::read_to_string(dirs[0].join(BOUNDARY_FILE)) {
+        std::fs::write(out.join(BOUNDARY_FILE), text).map_err(out_err)?;
+    }
     Ok(rows.len())
+}
+
+/// The file holding the analytic overturning boundary of a block map (`boundary.csv`).
+pub const BOUNDARY_FILE: &str = "boundary.csv";
+
+/// `boundary.csv` for a map of a single block under one-sine or one-cosine pulses on
+/// dimensionless axes: Zhang & Makris's minimum a_p/(g tan α) at twice as many ω_p/p as the map
+/// has, over its range, up to 1.2 times its largest amplitude ratio (`study::zhang_makris`).
+fn boundary_csv(study: &Study) -> Option<String> {
+    let (mut w, mut a): (Vec<f64>, Vec<f64>) = study
+        .cases
+        .iter()
+        .filter_map(|c| match c.motion {
+            Motion::Pulse {
+                amplitude_ratio: Some(a),
+                frequency_ratio: Some(w),
+                ..
+            } => Some((w, a)),
+            _ => None,
+        })
+        .unzip();
+    w.sort_by(f64::total_cmp);
+    w.dedup();
+    a.sort_by(f64::total_cmp);
+    let (lo, hi, top) = (*w.first()?, *w.last()?, *a.last()?);
+    let points = super::zhang_makris::map_boundary_up_to(study, lo, hi, 2 * w.len(), 1.2 * top)?;
+    let mut text = String::from("frequency_ratio,amplitude_ratio\n");
+    for (x, y) in points {
+        text += &format!("{x},{y}\n");
+    }
+    Some(text)
 }

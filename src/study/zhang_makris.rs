@@ -142,6 +142,18 @@ pub fn map_boundary(
     to: f64,
     count: usize,
 ) -> Option<Vec<(f64, f64)>> {
+    map_boundary_up_to(study, from, to, count, 50.0)
+}
+
+/// [`map_boundary`] searched up to a_p/(g tan α) = `beta_max` (the frequencies above which the
+/// minimum is larger are left out).
+pub fn map_boundary_up_to(
+    study: &super::Study,
+    from: f64,
+    to: f64,
+    count: usize,
+    beta_max: f64,
+) -> Option<Vec<(f64, f64)>> {
     let kind = study.pulse_kind?;
     let pulses = study.spec.pulses.as_ref()?;
     if kind == PulseKind::Ricker
@@ -157,7 +169,7 @@ pub fn map_boundary(
         (0..count)
             .filter_map(|k| {
                 let w = from + (to - from) * k as f64 / (count - 1) as f64;
-                minimum_overturning_ratio(kind, w, r, 50.0).map(|b| (w, b))
+                minimum_overturning_ratio(kind, w, r, beta_max).map(|b| (w, b))
             })
             .collect(),
     )
