@@ -478,12 +478,20 @@ fn many_bodies(c: &mut Criterion) {
     group.finish();
 }
 
+// The Poincaré section and study benches share this binary (one LTO link fewer each in CI).
+#[path = "groups/poincare.rs"]
+mod poincare_group;
+#[path = "groups/study.rs"]
+mod study_group;
+
 criterion_group!(
     benches,
     free_rocking,
     pulse,
     drum_column_record,
     bundled_models,
-    many_bodies
+    many_bodies,
+    poincare_group::section_200_periods,
+    study_group::bench_study
 );
 criterion_main!(benches);

@@ -8,13 +8,13 @@ use std::hint::black_box;
 use std::path::Path;
 use std::time::Duration;
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::Criterion;
 
 use crr::poincare::{
     PoincareOptions, SAME_POINT_TOLERANCE, SectionKind, distinct_points, prepare, run_section,
 };
 
-fn section_200_periods(c: &mut Criterion) {
+pub fn section_200_periods(c: &mut Criterion) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
     let opts = PoincareOptions {
         amplitude: 4.0,
@@ -50,5 +50,3 @@ fn section_200_periods(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, section_200_periods);
-criterion_main!(benches);

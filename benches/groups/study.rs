@@ -10,7 +10,7 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion};
 
 use crr::study::{Shard, Study, StudyOptions, run_study};
 
@@ -49,7 +49,7 @@ fn run(study: &Study, file: &Path, out: &Path, jobs: usize) -> usize {
     outcome.ran
 }
 
-fn bench_study(c: &mut Criterion) {
+pub fn bench_study(c: &mut Criterion) {
     let dir = scratch();
     let file = small_map(&dir);
     let study = Study::load(&file).expect("the study loads");
@@ -71,5 +71,3 @@ fn bench_study(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-criterion_group!(benches, bench_study);
-criterion_main!(benches);
