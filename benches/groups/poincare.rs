@@ -49,4 +49,3 @@ pub fn section_200_periods(c: &mut Criterion) {
     });
     group.finish();
 }
-

@@ -70,4 +70,3 @@ pub fn bench_study(c: &mut Criterion) {
     group.finish();
     let _ = std::fs::remove_dir_all(&dir);
 }
-
