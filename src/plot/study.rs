@@ -361,6 +361,7 @@ pub fn plot_study(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
                 intensity: match im.as_str() {
                     "pga_g" => "peak ground acceleration (g)".into(),
                     "pgv_m_s" => "peak ground velocity (m/s)".into(),
+                    "sa_g" => "spectral acceleration Sa(T₁) (g)".into(),
                     _ => "factor on the records".into(),
                 },
                 curves,

@@ -87,7 +87,7 @@ pub struct StudyRecord {
 }
 
 /// The intensity measure of a records study.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum IntensityMeasure {
     /// Factors on the record.
     Factor,
@@ -95,6 +95,13 @@ pub enum IntensityMeasure {
     Pga,
     /// Peak ground velocity, m/s.
     Pgv,
+    /// Pseudo-spectral acceleration Sa(T₁) of a linear oscillator (period s, damping ratio), g.
+    Sa {
+        /// T₁ (s).
+        period: f64,
+        /// ζ.
+        damping: f64,
+    },
 }
 
 impl IntensityMeasure {
@@ -104,6 +111,7 @@ impl IntensityMeasure {
             IntensityMeasure::Factor => "factor",
             IntensityMeasure::Pga => "pga_g",
             IntensityMeasure::Pgv => "pgv_m_s",
+            IntensityMeasure::Sa { .. } => "sa_g",
         }
     }
 }
@@ -158,6 +166,65 @@ pub fn peak_ground_velocity(record: &Record) -> f64 {
     peak
 }
 
+/// Pseudo-spectral acceleration Sa = ω²max|u| (m/s²) of the linear oscillator
+/// ü + 2ζωu̇ + ω²u = −a(t), ω = 2π/T, from rest, over the record and as long again after it (the
+/// free vibration can still peak): each interval between samples is integrated exactly for the
+/// record's piecewise-linear acceleration, by the exponential of the augmented system
+/// [u, u̇, a, ȧ]′ (one 4 × 4 exponential per distinct interval). The peak is taken at the
+/// samples. None for a record of fewer than two samples.
+pub fn spectral_acceleration(record: &Record, period: f64, damping: f64) -> Option<f64> {
+    use nalgebra::{Matrix4, Vector4};
+    let w = 2.0 * std::f64::consts::PI / period;
+    let times: Vec<f64> = record.times().collect();
+    let a = record.accel();
+    if a.len() < 2 {
+        return None;
+    }
+    let system = |h: f64| -> Matrix4<f64> {
+        #[rustfmt::skip]
+        let m = Matrix4::new(
+            0.0, 1.0, 0.0, 0.0,
+            -w * w, -2.0 * damping * w, -1.0, 0.0,
+            0.0, 0.0, 0.0, 1.0,
+            0.0, 0.0, 0.0, 0.0,
+        );
+        (m * h).exp()
+    };
+    let mut cache: Option<(f64, Matrix4<f64>)> = None;
+    let (mut u, mut v) = (0.0f64, 0.0f64);
+    let mut peak = 0.0f64;
+    let mut step = |u: &mut f64, v: &mut f64, h: f64, a0: f64, a1: f64| {
+        let e = match cache {
+            Some((hc, e)) if hc == h => e,
+            _ => {
+                let e = system(h);
+                cache = Some((h, e));
+                e
+            }
+        };
+        let z = e * Vector4::new(*u, *v, a0, (a1 - a0) / h);
+        *u = z[0];
+        *v = z[1];
+    };
+    for i in 1..a.len() {
+        let h = times[i] - times[i - 1];
+        if h > 0.0 {
+            step(&mut u, &mut v, h, a[i - 1], a[i]);
+            peak = peak.max(u.abs());
+        }
+    }
+    // Free vibration after the record, sampled at its last interval (or T/50, the smaller).
+    let h = (times[a.len() - 1] - times[a.len() - 2]).min(period / 50.0);
+    let free = times[a.len() - 1] - times[0];
+    let mut t = 0.0;
+    while t < free {
+        step(&mut u, &mut v, h, 0.0, 0.0);
+        peak = peak.max(u.abs());
+        t += h;
+    }
+    Some(w * w * peak)
+}
+
 fn bad(path: &Path, msg: String) -> InputError {
     InputError::Argument(format!("{}: {msg}", path.display()))
 }
@@ -175,7 +242,14 @@ impl Study {
                 .unwrap_or("study")
                 .to_string()
         });
-        let (file, model) = load_model(&base.join(&spec.model))?;
+        let (file, mut model) = load_model(&base.join(&spec.model))?;
+        let mut structure = file.structure();
+        if let Some(law) = spec.impact {
+            for i in &mut structure.interface {
+                i.impact = law;
+            }
+            model = Model::from_spec(&structure).map_err(|e| bad(path, format!("impact: {e}")))?;
+        }
         let axis: Axis = spec
             .component
             .parse()
@@ -205,7 +279,6 @@ impl Study {
         let mechanism = mechanism_scales(&model, axis);
         let lambda_p = mechanism.map(|m| (m.0, m.1));
         let alpha_eq = mechanism.map(|m| m.2).filter(|a| a.is_finite() && *a > 0.0);
-        let structure = file.structure();
         let mut variants = Vec::new();
         let sized = spec.scales.is_some();
         match &spec.scales {
@@ -383,6 +456,37 @@ impl Study {
                 let (measure, levels) = match &spec.intensity {
                     None => (IntensityMeasure::Factor, vec![1.0]),
                     Some(i) => {
+                        let sa = match &i.sa {
+                            Some(sa) => {
+                                if !(sa.period.is_finite() && sa.period > 0.0) {
+                                    return Err(bad(
+                                        path,
+                                        format!(
+                                            "intensity.sa.period must be > 0 s, got {}",
+                                            sa.period
+                                        ),
+                                    ));
+                                }
+                                if !(sa.damping.is_finite() && (0.0..1.0).contains(&sa.damping)) {
+                                    return Err(bad(
+                                        path,
+                                        format!(
+                                            "intensity.sa.damping must be in [0, 1), got {}",
+                                            sa.damping
+                                        ),
+                                    ));
+                                }
+                                Some((
+                                    IntensityMeasure::Sa {
+                                        period: sa.period,
+                                        damping: sa.damping,
+                                    },
+                                    &sa.levels,
+                                    "intensity.sa.levels",
+                                ))
+                            }
+                            None => None,
+                        };
                         let given: Vec<(IntensityMeasure, &Values, &str)> = [
                             (IntensityMeasure::Factor, &i.factors, "intensity.factors"),
                             (IntensityMeasure::Pga, &i.pga, "intensity.pga"),
@@ -390,11 +494,12 @@ impl Study {
                         ]
                         .into_iter()
                         .filter_map(|(m, v, k)| v.as_ref().map(|v| (m, v, k)))
+                        .chain(sa)
                         .collect();
                         if given.len() != 1 {
                             return Err(bad(
                                 path,
-                                "[intensity]: give exactly one of factors, pga and pgv".into(),
+                                "[intensity]: give exactly one of factors, pga, pgv and sa".into(),
                             ));
                         }
                         let (m, v, key) = given[0];
@@ -414,6 +519,10 @@ impl Study {
                                     IntensityMeasure::Factor => return Some(level),
                                     IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
                                     IntensityMeasure::Pgv => peak_ground_velocity(rec),
+                                    IntensityMeasure::Sa { period, damping } => {
+                                        spectral_acceleration(rec, period, damping)?
+                                            / STANDARD_GRAVITY
+                                    }
                                 };
                                 (im > 0.0).then(|| level / im)
                             });

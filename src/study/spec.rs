@@ -138,6 +138,27 @@ pub struct IntensitySpec {
     /// Target peak ground velocity, in m/s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pgv: Option<Values>,
+    /// Target 5 %-damped pseudo-spectral acceleration Sa(T₁), in g.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sa: Option<SpectralSpec>,
+}
+
+/// `sa = { period, damping, levels }`: levels of the pseudo-spectral acceleration
+/// Sa(T₁) = ω²max|u| of a linear oscillator of period T₁ and damping ratio ζ (default 0.05).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpectralSpec {
+    /// T₁, s (> 0).
+    pub period: f64,
+    /// ζ (default 0.05, 0 ≤ ζ < 1).
+    #[serde(default = "default_damping")]
+    pub damping: f64,
+    /// Sa(T₁) levels, in g.
+    pub levels: Values,
+}
+
+fn default_damping() -> f64 {
+    0.05
 }
 
 /// The whole study file.
@@ -153,6 +174,10 @@ pub struct StudySpec {
     /// The horizontal component driven: `x` (default) or `y`.
     #[serde(default = "default_component")]
     pub component: String,
+    /// Replaces the impact law of every interface of the model (as the model file's `impact`
+    /// key: `"momentum"`, `{ restitution = r }`, `{ dirac = { r, c } }`, …).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub impact: Option<crr_kinematics::ImpactLaw>,
     /// Where every case starts: `"rest"` (default; maps and fragility studies start at rest) or
     /// `"model"` (the model file's `[initial]` state).
     #[serde(default)]

@@ -1,0 +1,113 @@
+//! Study inputs beyond the ground motion: the spectral-acceleration intensity measure and the
+//! impact law of the whole model.
+
+use std::path::Path;
+
+use crr::dynamics::ground_motion::Record;
+use crr::kinematics::ImpactLaw;
+use crr::study::Study;
+use crr::study::cases::{IntensityMeasure, Motion, spectral_acceleration};
+
+/// A harmonic record at the oscillator's own period: after the transient (e^(−ζωt) ≈ e^(−31)
+/// after 100 periods at ζ = 0.05) the response is A/(2ζω²), so Sa = ω²·max|u| = A/(2ζ); the
+/// peak is read at samples T/200 apart (1 − cos(π/200) ≈ 1.2e-4 below the crest).
+#[test]
+fn spectral_acceleration_at_resonance_is_a_over_two_zeta() {
+    let (period, amplitude) = (0.5, 1.3);
+    let dt = period / 200.0;
+    let w = 2.0 * std::f64::consts::PI / period;
+    let accel: Vec<f64> = (0..=20_000)
+        .map(|i| amplitude * (w * i as f64 * dt).sin())
+        .collect();
+    let record = Record::uniform(dt, accel).unwrap();
+    for zeta in [0.05, 0.02] {
+        let sa = spectral_acceleration(&record, period, zeta).unwrap();
+        let want = amplitude / (2.0 * zeta);
+        assert!(
+            (sa / want - 1.0).abs() < 1e-3,
+            "ζ = {zeta}: Sa {sa} vs {want}"
+        );
+    }
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn records_scale_to_spectral_levels_and_the_impact_law_is_replaced() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("study_inputs");
+    let model = root.join("examples/models/single_block.toml");
+    let record = root.join("examples/records/synthetic.AT2");
+    let file = write(
+        &dir,
+        "sa.toml",
+        &format!(
+            "model = \"{}\"\nimpact = {{ restitution = 0.9 }}\n[records]\nfiles = [\"{}\"]\nformat = \"peer-at2\"\n\
+             [intensity]\nsa = {{ period = 0.8, levels = [0.2, 0.5] }}\n",
+            model.display(),
+            record.display()
+        ),
+    );
+    let study = Study::load(&file).expect("a valid study");
+    assert!(
+        study
+            .model
+            .interfaces
+            .iter()
+            .all(|i| i.impact == ImpactLaw::Restitution(0.9))
+    );
+    assert_eq!(
+        study.intensity,
+        IntensityMeasure::Sa {
+            period: 0.8,
+            damping: 0.05
+        }
+    );
+    // The factor brings the record's Sa(0.8 s) to the level: Sa is linear in the record.
+    let rec = study.records[0].record.as_ref().unwrap();
+    let sa = spectral_acceleration(rec, 0.8, 0.05).unwrap() / 9.80665;
+    for case in &study.cases {
+        let Motion::Record { level, factor, .. } = case.motion else {
+            panic!("a records study");
+        };
+        assert!((factor.unwrap() * sa - level).abs() < 1e-12 * level);
+    }
+    // Bad values are refused naming the key.
+    for (text, key) in [
+        (
+            "sa = { period = 0.0, levels = [0.2] }",
+            "intensity.sa.period",
+        ),
+        (
+            "sa = { period = 1.0, damping = 1.5, levels = [0.2] }",
+            "intensity.sa.damping",
+        ),
+    ] {
+        let bad = write(
+            &dir,
+            "bad.toml",
+            &format!(
+                "model = \"{}\"\n[records]\nfiles = [\"{}\"]\nformat = \"peer-at2\"\n[intensity]\n{text}\n",
+                model.display(),
+                record.display()
+            ),
+        );
+        let err = Study::load(&bad).unwrap_err().to_string();
+        assert!(err.contains(key), "{err}");
+    }
+    let bad = write(
+        &dir,
+        "bad_impact.toml",
+        &format!(
+            "model = \"{}\"\nimpact = {{ restitution = 1.5 }}\n[pulses]\nkind = \"one_sine_pulse\"\namplitudes = [3.0]\nperiods = [0.5]\n",
+            model.display()
+        ),
+    );
+    let err = Study::load(&bad).unwrap_err().to_string();
+    assert!(err.contains("impact"), "{err}");
+}
