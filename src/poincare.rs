@@ -572,29 +572,12 @@ pub fn default_poincare_dir(model_name: &str) -> PathBuf {
 }
 
 fn check_out_dir(out: &Path, force: bool) -> Result<(), InputError> {
-    if !out.exists() {
-        return Ok(());
-    }
-    if !out.is_dir() {
-        return Err(InputError::Argument(format!(
-            "--out {}: the path exists and is not a folder",
-            out.display()
-        )));
-    }
-    let earlier: Vec<&str> = RESULT_FILES
-        .iter()
-        .copied()
-        .filter(|f| out.join(f).exists())
-        .collect();
-    if earlier.is_empty() || force {
-        return Ok(());
-    }
-    Err(InputError::Argument(format!(
-        "--out {}: the folder holds the results of an earlier run ({}): pass --force to replace \
-         them, or --out DIR for another folder",
-        out.display(),
-        earlier.join(", ")
-    )))
+    crate::simulate::refuse_earlier_results(
+        out,
+        force,
+        &RESULT_FILES,
+        &format!("--out {}", out.display()),
+    )
 }
 
 /// A checked run of `crr poincare`: the model, its solver settings and the section settings.

@@ -85,16 +85,26 @@ pub fn default_out_dir(model_name: &str) -> PathBuf {
 
 /// An output folder that already holds results is only written to with `force`.
 fn check_out_dir(out: &Path, force: bool) -> Result<(), InputError> {
+    refuse_earlier_results(out, force, &RESULT_FILES, &out.display().to_string())
+}
+
+/// Refuses an output folder that holds any of `files` from an earlier run unless `force`, or a
+/// path that is not a folder; `label` names the folder in the message (e.g. `--out DIR`).
+pub fn refuse_earlier_results(
+    out: &Path,
+    force: bool,
+    files: &[&str],
+    label: &str,
+) -> Result<(), InputError> {
     if !out.exists() {
         return Ok(());
     }
     if !out.is_dir() {
         return Err(InputError::Argument(format!(
-            "{}: the output path exists and is not a folder",
-            out.display()
+            "{label}: the output path exists and is not a folder"
         )));
     }
-    let earlier: Vec<&str> = RESULT_FILES
+    let earlier: Vec<&str> = files
         .iter()
         .copied()
         .filter(|f| out.join(f).exists())
@@ -103,9 +113,8 @@ fn check_out_dir(out: &Path, force: bool) -> Result<(), InputError> {
         return Ok(());
     }
     Err(InputError::Argument(format!(
-        "{}: the folder holds the results of an earlier run ({}): pass --force to replace them, \
-         or --out DIR for another folder",
-        out.display(),
+        "{label}: the folder holds the results of an earlier run ({}): pass --force to replace \
+         them, or --out DIR for another folder",
         earlier.join(", ")
     )))
 }
