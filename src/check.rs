@@ -17,6 +17,8 @@ use crr_impact::laws::momentum_law;
 use crr_impact::simulation::{Parameters, Simulation, StopReason};
 use crr_kinematics::{ActivePivots, Data, Model, Side};
 
+use crate::static_multiplier::{StaticMultiplier, static_multipliers};
+
 /// One line of the frequency table.
 #[derive(Clone, Debug, Serialize)]
 pub struct FrequencyRow {
@@ -97,6 +99,12 @@ pub struct CheckReport {
     pub mechanism: Option<MechanismReport>,
     /// Why the mechanism part is missing or incomplete.
     pub note: Option<String>,
+    /// The static multipliers of the structure at rest along +x, −x, +y and −y
+    /// ([`crate::static_multiplier`]): any structure, whatever its DOF(2); empty when the search
+    /// failed (`static_multipliers_note` says why).
+    pub static_multipliers: Vec<StaticMultiplier>,
+    /// Why `static_multipliers` is empty, else `None`.
+    pub static_multipliers_note: Option<String>,
 }
 
 /// Housner's linearised frequency (Hz) at amplitude θ_m.
@@ -252,6 +260,17 @@ pub fn check(model: &Model) -> CheckReport {
             )),
         )
     };
+    let (statics, statics_note) = if mob.locked {
+        (
+            Vec::new(),
+            Some("locked: the structure cannot move".to_string()),
+        )
+    } else {
+        match static_multipliers(model) {
+            Ok(v) => (v, None),
+            Err(e) => (Vec::new(), Some(e)),
+        }
+    };
     CheckReport {
         model: model.name.clone(),
         gravity: model.gravity,
@@ -266,6 +285,8 @@ pub fn check(model: &Model) -> CheckReport {
         finite_mobility_note: finite_note,
         mechanism: mech,
         note,
+        static_multipliers: statics,
+        static_multipliers_note: statics_note,
     }
 }
 
@@ -316,6 +337,39 @@ pub fn to_text(r: &CheckReport) -> String {
     }
     if let Some(note) = &r.note {
         s += &format!("note: {note}\n");
+    }
+    if !r.static_multipliers.is_empty() {
+        s += "static multiplier at rest (constant ground acceleration λ g along d; the joints that open):\n";
+        for m in &r.static_multipliers {
+            let d = m.direction;
+            let dir = if d == [1.0, 0.0, 0.0] {
+                "+x".to_string()
+            } else if d == [-1.0, 0.0, 0.0] {
+                "−x".to_string()
+            } else if d == [0.0, 1.0, 0.0] {
+                "+y".to_string()
+            } else if d == [0.0, -1.0, 0.0] {
+                "−y".to_string()
+            } else {
+                format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2])
+            };
+            match m.lambda {
+                Some(l) => {
+                    let joints: Vec<String> =
+                        m.opening.iter().map(|(k, v)| format!("{k} {v}")).collect();
+                    s += &format!("  d = {dir}: λ = {l:.6} opening {}\n", joints.join(", "));
+                }
+                None => {
+                    s += &format!(
+                        "  d = {dir}: holds up to λ = {}\n",
+                        crate::static_multiplier::LAMBDA_MAX
+                    )
+                }
+            }
+        }
+    }
+    if let Some(note) = &r.static_multipliers_note {
+        s += &format!("static multiplier: {note}\n");
     }
     if let Some(k) = &r.mechanism {
         s += &format!(

@@ -34,6 +34,7 @@ pub mod poincare;
 pub mod poincare_plot;
 pub mod simulate;
 pub mod size_sweep;
+pub mod static_multiplier;
 pub mod study;
 pub mod synthetic;
 

@@ -40,6 +40,7 @@ mod events;
 mod impacts;
 mod seating;
 mod slots;
+mod uplift_from_rest;
 
 use events::*;
 use impacts::*;
@@ -47,6 +48,7 @@ pub use seating::opening_mode;
 use seating::opening_mode_in;
 pub use slots::check_initial_state;
 use slots::*;
+use uplift_from_rest::opening_from_rest;
 
 /// Largest step while joints are seated and the ground moves (s): the time resolution of the
 /// uplift test (exact location then by bisection on the release test).

@@ -1,0 +1,304 @@
+//! Uplift of a structure at rest with loops, by Gauss' principle over the pivot sides of its
+//! seated joints.
+//!
+//! At rest (q̇ = 0) the accelerations of a structure whose seated joints may open are the
+//! admissible q̈ nearest to the free one in the kinetic metric (Gauss' principle):
+//! min ½(q̈ − q̈_free)ᵀM(q̈ − q̈_free) over Φ_q q̈ = 0 and, for every seated slot k on its pivot
+//! side σₖ, σₖψ̈ₖ ≥ 0 (it opens on that side or stays). For a fixed choice of sides σ this is a
+//! convex problem; in the coordinates z = Lᵀq̈ (M = LLᵀ) restricted to the closures' null space,
+//! z = N y (N orthonormal), it reads min ½‖y − y_free‖² subject to Gᵀy ≥ 0, whose dual is a
+//! non-negative least-squares problem, min_{μ≥0} ‖y_free + Gμ‖², solved exactly by
+//! Lawson–Hanson; then y = y_free + Gμ. A hyperstatic locked structure (an arch, a colonnade)
+//! makes the seat reactions indeterminate, which defeats any test built on them, but not this
+//! one: μ may be indeterminate, y is not.
+//!
+//! The sides are a discrete choice (a joint pivots on one edge or the other), searched from the
+//! current ones ([`opening_from_rest`]).
+
+use nalgebra::{DMatrix, DVector};
+
+use crr_dynamics::eom::{Dynamics, slot_row};
+use crr_dynamics::ground_motion::GroundMotion;
+use crr_dynamics::linalg::{JacobiSvd, RANK_TOLERANCE, pinv_solve};
+use crr_kinematics::{ActivePivots, Model, Side};
+
+/// The opening mode at rest for one choice of pivot sides.
+struct SidesSolution {
+    /// The Gauss function relative to staying at rest, ½‖y − y_free‖² − ½‖y_free‖² (≤ 0).
+    gauss: f64,
+    /// The dual multipliers μ of the seated slots (in the order of `seated`).
+    mu: DVector<f64>,
+    /// σₖψ̈ₖ of every seated slot (in the order of `seated`).
+    opening: Vec<f64>,
+    /// σₖψ̈ₖ with every seated slot free on both sides (y = y_free).
+    free_opening: Vec<f64>,
+}
+
+impl SidesSolution {
+    fn opens(&self, tol: f64) -> bool {
+        self.opening.iter().any(|&o| o > tol)
+    }
+}
+
+/// Largest number of choices of sides tried in one uplift test.
+const MAX_SIDE_CHOICES: usize = 12;
+
+/// The seated slots that open from rest, with their sides, or None when the structure holds (or
+/// the test does not apply: a singular mass matrix). `tol` is the opening threshold on σψ̈
+/// (rad/s²).
+///
+/// The sides are searched from the current ones. While the structure holds on them, the next
+/// choice is the one each slot would open on if every seated slot were free (the signs of the
+/// unconstrained accelerations), then the slots that push on their seat (μₖ > 0) flipped one at
+/// a time and all together; the first choice on which it opens is kept, and improved by the same
+/// flips while the Gauss function decreases. At most [`MAX_SIDE_CHOICES`] choices are solved.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn opening_from_rest(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    tol: f64,
+) -> Option<Vec<(usize, Side)>> {
+    let seated = &template.seated;
+    if seated.is_empty() {
+        return None;
+    }
+    let key = |p: &ActivePivots| -> Vec<bool> {
+        seated
+            .iter()
+            .map(|&k| p.sides[k] == Side::Positive)
+            .collect()
+    };
+    let mut sides = template.pivots.clone();
+    let mut current = solve_for_sides(model, ground, trial, &sides, seated, t, q, qdot)?;
+    let mut visited = vec![key(&sides)];
+    let mut solved = 1;
+    while solved < MAX_SIDE_CHOICES {
+        let opens = current.opens(tol);
+        // Candidate flips, as index sets into `seated`.
+        let mut candidates: Vec<Vec<usize>> = Vec::new();
+        if !opens {
+            let free: Vec<usize> = (0..seated.len())
+                .filter(|&i| current.free_opening[i] < -tol)
+                .collect();
+            if !free.is_empty() {
+                candidates.push(free);
+            }
+        }
+        let push_tol = 1e-9 * current.mu.amax();
+        let mut pushing: Vec<usize> = (0..seated.len())
+            .filter(|&i| current.mu[i] > push_tol && current.opening[i].abs() <= tol)
+            .collect();
+        pushing.sort_by(|&a, &b| current.mu[b].total_cmp(&current.mu[a]));
+        candidates.extend(pushing.iter().map(|&i| vec![i]));
+        if pushing.len() > 1 {
+            candidates.push(pushing);
+        }
+        let mut moved = false;
+        for flip in candidates {
+            if solved >= MAX_SIDE_CHOICES {
+                break;
+            }
+            let mut next_sides = sides.clone();
+            for &i in &flip {
+                let k = seated[i];
+                next_sides.sides[k] = next_sides.sides[k].flipped();
+            }
+            let next_key = key(&next_sides);
+            if visited.contains(&next_key) {
+                continue;
+            }
+            visited.push(next_key);
+            solved += 1;
+            let Some(next) = solve_for_sides(model, ground, trial, &next_sides, seated, t, q, qdot)
+            else {
+                continue;
+            };
+            // Holding: move to the first choice that opens. Opening: to a lower Gauss function
+            // (by more than round-off).
+            let better = if opens {
+                next.opens(tol) && next.gauss < current.gauss * (1.0 + 1e-9)
+            } else {
+                next.opens(tol)
+            };
+            if better {
+                sides = next_sides;
+                current = next;
+                moved = true;
+                break;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    if !current.opens(tol) {
+        return None;
+    }
+    // Every slot the mechanism moves opens, also those whose acceleration is still below the
+    // threshold just above the activation (it grows in proportion to the others').
+    let largest = current.opening.iter().fold(0.0_f64, |a, &o| a.max(o));
+    let floor = tol.min(1e-6 * largest);
+    Some(
+        seated
+            .iter()
+            .zip(&current.opening)
+            .filter(|&(_, &o)| o > floor)
+            .map(|(&k, _)| (k, sides.sides[k]))
+            .collect(),
+    )
+}
+
+/// Gauss' principle at rest on the pivot sides `sides`: every seated slot free to open on its
+/// side or stay.
+#[allow(clippy::too_many_arguments)]
+fn solve_for_sides(
+    model: &Model,
+    ground: &GroundMotion,
+    trial: &mut Dynamics,
+    sides: &ActivePivots,
+    seated: &[usize],
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<SidesSolution> {
+    let n = model.dof();
+    trial.pivots.clone_from(sides);
+    trial.seated.clear();
+    trial.evaluate(model, ground, t, q, qdot);
+    let l = trial.kin.mass_matrix.clone().cholesky()?;
+    let l = l.l();
+    // z_free = L⁻¹ (Q − h).
+    let r = &trial.load - &trial.kin.velocity_product;
+    let z_free = l.solve_lower_triangular(&r)?;
+    // Closures in z: Φ_q L⁻ᵀ, rows normalised for the rank decision; N its null space.
+    let null = if model.constraint_rows == 0 {
+        DMatrix::identity(n, n)
+    } else {
+        let lt_inv_t = |row: DVector<f64>| l.solve_lower_triangular(&row);
+        let mut a = DMatrix::zeros(model.constraint_rows, n);
+        for i in 0..model.constraint_rows {
+            let row = lt_inv_t(trial.kin.phi_q.row(i).transpose())?;
+            let norm = row.norm();
+            if norm > 0.0 {
+                a.row_mut(i).copy_from(&(row / norm).transpose());
+            }
+        }
+        let svd = JacobiSvd::new(&a);
+        let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt());
+        let cols: Vec<usize> = (0..svd.singular_values.len())
+            .filter(|&j| svd.singular_values[j] <= tol)
+            .collect();
+        DMatrix::from_fn(n, cols.len(), |i, c| svd.v[(i, cols[c])])
+    };
+    let d = null.ncols();
+    let y_free = null.tr_mul(&z_free);
+    // Gₖ = σₖ Nᵀ L⁻¹ sₖ: ψ̈ₖ = sₖᵀq̈ = (L⁻¹sₖ)ᵀz (no bias at rest).
+    let mut row = DVector::zeros(n);
+    let mut g = DMatrix::zeros(d, seated.len());
+    for (i, &k) in seated.iter().enumerate() {
+        slot_row(model, &trial.kin, k, &mut row);
+        let gk = l.solve_lower_triangular(&row)?;
+        let col = null.tr_mul(&gk) * sides.sides[k].sign();
+        g.column_mut(i).copy_from(&col);
+    }
+    let mu = nnls(&g, &(-&y_free));
+    let y = &y_free + &g * &mu;
+    let opening = (0..seated.len()).map(|i| g.column(i).dot(&y)).collect();
+    let free_opening = (0..seated.len())
+        .map(|i| g.column(i).dot(&y_free))
+        .collect();
+    let gauss = 0.5 * (&y - &y_free).norm_squared() - 0.5 * y_free.norm_squared();
+    Some(SidesSolution {
+        gauss,
+        mu,
+        opening,
+        free_opening,
+    })
+}
+
+/// Non-negative least squares, min ‖A x − b‖ over x ≥ 0 (Lawson & Hanson 1974, ch. 23): the
+/// passive set grows by the most negative gradient component and the iterate is pulled back
+/// into x ≥ 0 along the segment to each unconstrained least-squares solution; rank-deficient
+/// passive sets are solved by the minimum-norm pseudo-inverse.
+fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
+    let s = a.ncols();
+    let mut x = DVector::zeros(s);
+    let mut passive = vec![false; s];
+    let scale = a.norm() * b.norm();
+    let w_tol = 1e-13 * scale.max(f64::MIN_POSITIVE);
+    for _ in 0..3 * s + 3 {
+        let w = a.tr_mul(&(b - a * &x));
+        let Some(j) = (0..s)
+            .filter(|&j| !passive[j] && w[j] > w_tol)
+            .max_by(|&i, &j| w[i].total_cmp(&w[j]))
+        else {
+            break;
+        };
+        passive[j] = true;
+        for _ in 0..3 * s + 3 {
+            let cols: Vec<usize> = (0..s).filter(|&i| passive[i]).collect();
+            let ap = DMatrix::from_fn(a.nrows(), cols.len(), |r, c| a[(r, cols[c])]);
+            let (sp, _) = pinv_solve(&ap, b);
+            if sp.iter().all(|&v| v > 0.0) {
+                x.fill(0.0);
+                for (c, &i) in cols.iter().enumerate() {
+                    x[i] = sp[c];
+                }
+                break;
+            }
+            // Step from x towards the solution until the first passive component reaches 0.
+            let mut alpha: f64 = 1.0;
+            for (c, &i) in cols.iter().enumerate() {
+                if sp[c] <= 0.0 {
+                    alpha = alpha.min(x[i] / (x[i] - sp[c]));
+                }
+            }
+            for (c, &i) in cols.iter().enumerate() {
+                x[i] += alpha * (sp[c] - x[i]);
+                if x[i] <= 1e-15 * (1.0 + x.amax()) {
+                    x[i] = 0.0;
+                    passive[i] = false;
+                }
+            }
+            if !passive.iter().any(|&p| p) {
+                break;
+            }
+        }
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// NNLS against the closed form of a 2 × 2 problem with one active bound, and the
+    /// Karush–Kuhn–Tucker conditions of a random one.
+    #[test]
+    fn nnls_satisfies_the_kkt_conditions() {
+        // min (x₁ − 1)² + (x₂ + 1)²: x = (1, 0).
+        let a = DMatrix::identity(2, 2);
+        let b = DVector::from_vec(vec![1.0, -1.0]);
+        let x = nnls(&a, &b);
+        assert!((x[0] - 1.0).abs() < 1e-15 && x[1] == 0.0);
+        // A wide, rank-deficient A (3 × 6): x ≥ 0, w = Aᵀ(b − Ax) ≤ 0, and w = 0 where x > 0.
+        let a = DMatrix::from_fn(3, 6, |i, j| {
+            ((i * 7 + j * 3) % 5) as f64 - 2.0 + 0.1 * j as f64
+        });
+        let b = DVector::from_vec(vec![1.0, -2.0, 0.5]);
+        let x = nnls(&a, &b);
+        let w = a.tr_mul(&(&b - &a * &x));
+        for j in 0..6 {
+            assert!(x[j] >= 0.0);
+            assert!(w[j] <= 1e-12, "gradient {j}: {}", w[j]);
+            if x[j] > 0.0 {
+                assert!(w[j].abs() <= 1e-12, "passive gradient {j}: {}", w[j]);
+            }
+        }
+    }
+}
