@@ -32,6 +32,8 @@ struct SidesSolution {
     opening: Vec<f64>,
     /// σₖψ̈ₖ with every seated slot free on both sides (y = y_free).
     free_opening: Vec<f64>,
+    /// σₖψ̈ₖ of that free motion under the ground motion's inertial load alone (no gravity).
+    load_opening: Vec<f64>,
 }
 
 impl SidesSolution {
@@ -82,11 +84,11 @@ pub(super) fn opening_from_rest(
         // Candidate flips, as index sets into `seated`.
         let mut candidates: Vec<Vec<usize>> = Vec::new();
         if !opens {
-            let free: Vec<usize> = (0..seated.len())
-                .filter(|&i| current.free_opening[i] < -tol)
-                .collect();
-            if !free.is_empty() {
-                candidates.push(free);
+            for guide in [&current.load_opening, &current.free_opening] {
+                let flip: Vec<usize> = (0..seated.len()).filter(|&i| guide[i] < -tol).collect();
+                if !flip.is_empty() {
+                    candidates.push(flip);
+                }
             }
         }
         let push_tol = 1e-9 * current.mu.amax();
@@ -212,12 +214,17 @@ fn solve_for_sides(
     let free_opening = (0..seated.len())
         .map(|i| g.column(i).dot(&y_free))
         .collect();
+    let y_load = null.tr_mul(&l.solve_lower_triangular(&trial.ground_force)?);
+    let load_opening = (0..seated.len())
+        .map(|i| g.column(i).dot(&y_load))
+        .collect();
     let gauss = 0.5 * (&y - &y_free).norm_squared() - 0.5 * y_free.norm_squared();
     Some(SidesSolution {
         gauss,
         mu,
         opening,
         free_opening,
+        load_opening,
     })
 }
 
