@@ -186,6 +186,25 @@ fn time_value(path: &Path) -> f64 {
     rest[from..to].trim().parse().unwrap()
 }
 
+/// The `body_names` field of a .vtu: VTK's ASCII `String` array, each name as its bytes and a 0
+/// (vtkio skips field data, so it is read here from the text).
+fn body_names(path: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let i = text.find("Name=\"body_names\"").unwrap();
+    let rest = &text[i..];
+    let from = rest.find('>').unwrap() + 1;
+    let to = rest.find("</DataArray>").unwrap();
+    let bytes: Vec<u8> = rest[from..to]
+        .split_whitespace()
+        .map(|b| b.parse().unwrap())
+        .collect();
+    assert_eq!(bytes.last(), Some(&0), "every name ends with a 0");
+    bytes[..bytes.len() - 1]
+        .split(|&b| b == 0)
+        .map(|n| String::from_utf8(n.to_vec()).unwrap())
+        .collect()
+}
+
 /// The (timestep, file) pairs of a .pvd, in order.
 fn pvd_entries(path: &Path) -> Vec<(f64, String)> {
     let text = std::fs::read_to_string(path).unwrap();
@@ -238,6 +257,9 @@ fn check_series(results: &Path, model_name: &str, every: usize) {
         assert_eq!(*t, distinct[j * every], "{model_name}: frame {j}'s time");
         let path = anim.join(file);
         assert_eq!(time_value(&path), *t);
+        // Body k of the `body` cell array is named body_names[k], the model's k-th body.
+        let names: Vec<String> = model.bodies.iter().map(|b| b.name.clone()).collect();
+        assert_eq!(body_names(&path), names);
         let vtu = read_vtu(&path);
         assert_eq!(vtu.points.len(), vertices + 4);
         assert_eq!(vtu.types.len(), faces + 1);
