@@ -225,7 +225,17 @@ fn pvd_entries(path: &Path) -> Vec<(f64, String)> {
 /// history row of its time, to 1e-12 × the model size: both routes round a few tens of
 /// products of numbers up to the model size (ε = 2.2e-16), and the file keeps every digit.
 fn check_series(results: &Path, model_name: &str, every: usize) {
-    let (_, model) = load_model(Path::new(&format!("examples/models/{model_name}.toml"))).unwrap();
+    check_series_of(
+        results,
+        &format!("examples/models/{model_name}.toml"),
+        model_name,
+        every,
+    );
+}
+
+/// [`check_series`] of a model file given by its path.
+fn check_series_of(results: &Path, model_path: &str, model_name: &str, every: usize) {
+    let (_, model) = load_model(Path::new(model_path)).unwrap();
     let surfaces: Vec<_> = model
         .bodies
         .iter()
@@ -366,6 +376,18 @@ fn chains_loops_rocking_bases_and_sectors_match_the_kinematics() {
         check_series(&results, model, every);
         assert!(!results.join("animation/animation.gif").exists());
     }
+}
+
+#[test]
+fn prisms_and_polyhedra_match_the_kinematics() {
+    // A pentagonal prism rocking under a frustum given as a point cloud (with an interior
+    // point): the shapes no bundled model uses.
+    let dir = scratch("animate_prism_polyhedron");
+    let results = dir.join("r");
+    let model = "tests/data/prism_polyhedron.toml";
+    ok(&["simulate", model, "--out", s(&results), "--quiet"]);
+    ok(&["animate", s(&results), "--every", "3", "--format", "vtk"]);
+    check_series_of(&results, model, "prism_polyhedron", 3);
 }
 
 #[test]
