@@ -84,6 +84,7 @@ enum Command {
     /// and animation.pvd) and an animated GIF (docs/animation.md).
     Animate {
         /// The results folder (history.csv and summary.json).
+        #[arg(value_name = "RESULTS_DIR")]
         dir: PathBuf,
         /// Keep every K-th state of history.csv (default: about 0.05 s between frames, at most
         /// 400 frames).

@@ -11,14 +11,13 @@ use std::borrow::Cow;
 
 use nalgebra::Vector3;
 
-use crr_kinematics::Model;
 use crr_kinematics::shapes::Surface;
 
 use super::render::{
     BACKGROUND, BASE_COLOURS, Face, GROUND_COLOUR, HEIGHT, OUTLINE, Renderer, SHADE_LEVELS, WIDTH,
     ground_slab, shade,
 };
-use super::{AnimateOptions, Ground, State};
+use super::{Ground, State};
 use crate::model_file::InputError;
 
 /// Grey levels of the palette (white to black), for the text's anti-aliasing.
@@ -119,17 +118,28 @@ pub fn caption(state: &State) -> String {
     )
 }
 
-/// The GIF of the frames: `poses[j]` the bodies' world vertices at `frames[j]`.
-pub fn animation_gif(
-    model: &Model,
-    surfaces: &[Surface],
-    ground: &Ground,
-    frames: &[&State],
-    poses: &[Vec<Vec<Vector3<f64>>>],
-    opts: &AnimateOptions,
-) -> Result<Vec<u8>, InputError> {
+/// Writes the animated GIF frame by frame (so that a long animation never holds more than
+/// one frame): [`GifWriter::new`] with the renderer (fitted to every frame beforehand) and the
+/// frames' times, then [`GifWriter::add`] for each frame in order, then [`GifWriter::finish`].
+pub struct GifWriter<W: std::io::Write> {
+    encoder: ::gif::Encoder<W>,
+    renderer: Renderer,
+    quantiser: Quantiser,
+    ground_faces: Vec<Face>,
+    delays: Vec<u16>,
+    rgb: Vec<u8>,
+    previous: Option<Vec<u8>>,
+    written: usize,
+}
+
+fn encode_error(e: ::gif::EncodingError) -> InputError {
+    InputError::Argument(format!("cannot encode the GIF: {e}"))
+}
+
+/// The faces of the ground slab ([`ground_slab`]), in the ground's colour.
+pub fn ground_faces(ground: &Ground) -> (Surface, Vec<Face>) {
     let slab = ground_slab(ground);
-    let ground_faces: Vec<Face> = slab
+    let faces = slab
         .faces
         .iter()
         .map(|f| Face {
@@ -137,58 +147,88 @@ pub fn animation_gif(
             colour: GROUND_COLOUR,
         })
         .collect();
-    let renderer = Renderer::new(
-        opts.view,
-        poses.iter().flatten().flatten().chain(slab.vertices.iter()),
-    );
-    let palette = palette();
-    let quantiser = Quantiser::new(&palette);
-    let flat: Vec<u8> = palette.iter().flatten().copied().collect();
-    let mut bytes = Vec::new();
-    let encode_error =
-        |e: ::gif::EncodingError| InputError::Argument(format!("cannot encode the GIF: {e}"));
-    {
-        let mut encoder = ::gif::Encoder::new(&mut bytes, WIDTH as u16, HEIGHT as u16, &flat)
-            .map_err(encode_error)?;
+    (slab, faces)
+}
+
+impl<W: std::io::Write> GifWriter<W> {
+    /// Starts the GIF on `out`: `renderer` fitted to every frame, `times` the frames' times
+    /// (s), played at `speed`.
+    pub fn new(
+        out: W,
+        renderer: Renderer,
+        ground: &Ground,
+        times: &[f64],
+        speed: f64,
+    ) -> Result<Self, InputError> {
+        let palette = palette();
+        let flat: Vec<u8> = palette.iter().flatten().copied().collect();
+        let mut encoder =
+            ::gif::Encoder::new(out, WIDTH as u16, HEIGHT as u16, &flat).map_err(encode_error)?;
         encoder
             .set_repeat(::gif::Repeat::Infinite)
             .map_err(encode_error)?;
-        let times: Vec<f64> = frames.iter().map(|s| s.t).collect();
-        let delays = delays(&times, opts.speed);
-        let n_pixels = (WIDTH * HEIGHT) as usize;
-        let mut rgb = vec![0u8; 3 * n_pixels];
-        let mut previous: Option<Vec<u8>> = None;
-        for (j, (state, pose)) in frames.iter().zip(poses).enumerate() {
-            let mut faces = ground_faces.clone();
-            for (b, (surface, verts)) in surfaces.iter().zip(pose).enumerate() {
-                let colour = if model.bodies.len() == 1 {
-                    0
-                } else {
-                    b % GROUND_COLOUR
-                };
-                faces.extend(surface.faces.iter().map(|f| Face {
-                    points: f.iter().map(|&i| verts[i]).collect(),
-                    colour,
-                }));
-            }
-            renderer.draw(&faces, &caption(state), &mut rgb);
-            let indexed: Vec<u8> = rgb.chunks_exact(3).map(|c| quantiser.index(c)).collect();
-            let frame = match &previous {
-                None => ::gif::Frame {
-                    width: WIDTH as u16,
-                    height: HEIGHT as u16,
-                    buffer: Cow::Borrowed(&indexed),
-                    delay: delays[j],
-                    dispose: ::gif::DisposalMethod::Keep,
-                    ..::gif::Frame::default()
-                },
-                Some(prev) => changed_rect(prev, &indexed, delays[j]),
-            };
-            encoder.write_frame(&frame).map_err(encode_error)?;
-            previous = Some(indexed);
-        }
+        Ok(GifWriter {
+            encoder,
+            renderer,
+            quantiser: Quantiser::new(&palette),
+            ground_faces: ground_faces(ground).1,
+            delays: delays(times, speed),
+            rgb: vec![0u8; 3 * (WIDTH * HEIGHT) as usize],
+            previous: None,
+            written: 0,
+        })
     }
-    Ok(bytes)
+
+    /// Draws and writes the next frame: `state` (for the caption) and the bodies' world
+    /// vertices `pose` (one vector per body, as [`super::pose_vertices`] gives), with the
+    /// bodies' `surfaces`.
+    pub fn add(
+        &mut self,
+        state: &State,
+        surfaces: &[Surface],
+        pose: &[Vec<Vector3<f64>>],
+    ) -> Result<(), InputError> {
+        let j = self.written;
+        let delay = *self.delays.get(j).ok_or_else(|| {
+            InputError::Argument(format!("GIF frame {j} is beyond the frames announced"))
+        })?;
+        let mut faces = self.ground_faces.clone();
+        for (b, (surface, verts)) in surfaces.iter().zip(pose).enumerate() {
+            let colour = b % GROUND_COLOUR;
+            faces.extend(surface.faces.iter().map(|f| Face {
+                points: f.iter().map(|&i| verts[i]).collect(),
+                colour,
+            }));
+        }
+        self.renderer.draw(&faces, &caption(state), &mut self.rgb);
+        let indexed: Vec<u8> = self
+            .rgb
+            .chunks_exact(3)
+            .map(|c| self.quantiser.index(c))
+            .collect();
+        let frame = match &self.previous {
+            None => ::gif::Frame {
+                width: WIDTH as u16,
+                height: HEIGHT as u16,
+                buffer: Cow::Borrowed(&indexed),
+                delay,
+                dispose: ::gif::DisposalMethod::Keep,
+                ..::gif::Frame::default()
+            },
+            Some(prev) => changed_rect(prev, &indexed, delay),
+        };
+        self.encoder.write_frame(&frame).map_err(encode_error)?;
+        self.previous = Some(indexed);
+        self.written += 1;
+        Ok(())
+    }
+
+    /// Ends the GIF (its trailer) and returns the writer.
+    pub fn finish(self) -> Result<W, InputError> {
+        self.encoder
+            .into_inner()
+            .map_err(|e| InputError::Argument(format!("cannot write the GIF: {e}")))
+    }
 }
 
 /// The part of `next` that differs from `prev` as a frame drawn over it: the bounding

@@ -504,11 +504,8 @@ pub fn animate(dir: &Path, opts: &AnimateOptions) -> Result<AnimateReport, Input
     let frames = frame_states(&run.states, k);
     let surfaces = body_surfaces(&run.model)?;
     let ground = Ground::of(&run.model, &surfaces);
-    let mut data = Data::new(&run.model);
-    let poses: Vec<Vec<Vec<Vector3<f64>>>> = frames
-        .iter()
-        .map(|s| pose_vertices(&run.model, &mut data, &surfaces, s))
-        .collect();
+    let model = &run.model;
+    let mut data = Data::new(model);
 
     let output_error = |source| InputError::Output {
         dir: out.clone(),
@@ -520,30 +517,59 @@ pub fn animate(dir: &Path, opts: &AnimateOptions) -> Result<AnimateReport, Input
         std::fs::remove_dir_all(&tmp).map_err(output_error)?;
     }
     std::fs::create_dir_all(&tmp).map_err(output_error)?;
+    let vtk = matches!(opts.format, Format::Vtk | Format::Both);
+    let mut gif_writer = None;
+    if matches!(opts.format, Format::Gif | Format::Both) {
+        // The picture's framing is fixed: fitted to every frame first (poses recomputed below,
+        // one frame at a time, rather than kept).
+        let (slab, _) = gif::ground_faces(&ground);
+        let points = frames
+            .iter()
+            .flat_map(|s| pose_vertices(model, &mut data, &surfaces, s))
+            .flatten()
+            .chain(slab.vertices.iter().copied());
+        let renderer = render::Renderer::new(opts.view, points);
+        let file = std::fs::File::create(tmp.join(GIF_FILE)).map_err(output_error)?;
+        let times: Vec<f64> = frames.iter().map(|s| s.t).collect();
+        gif_writer = Some(gif::GifWriter::new(
+            std::io::BufWriter::new(file),
+            renderer,
+            &ground,
+            &times,
+            opts.speed,
+        )?);
+    }
+    let names_of_bodies: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
     let mut names: Vec<String> = Vec::new();
-    if matches!(opts.format, Format::Vtk | Format::Both) {
-        let names_of_bodies: Vec<&str> = run.model.bodies.iter().map(|b| b.name.as_str()).collect();
-        for (j, pose) in poses.iter().enumerate() {
-            let text = vtk::vtu(&names_of_bodies, &surfaces, pose, &ground, frames[j].t);
+    for (j, state) in frames.iter().enumerate() {
+        let pose = pose_vertices(model, &mut data, &surfaces, state);
+        if vtk {
+            let text = vtk::vtu(&names_of_bodies, &surfaces, &pose, &ground, state.t);
             let name = frame_name(j);
             std::fs::write(tmp.join(&name), text).map_err(output_error)?;
             names.push(name);
         }
+        if let Some(g) = gif_writer.as_mut() {
+            g.add(state, &surfaces, &pose)?;
+        }
+    }
+    let mut gif_bytes = None;
+    if let Some(g) = gif_writer {
+        let file = g
+            .finish()?
+            .into_inner()
+            .map_err(|e| output_error(e.into_error()))?;
+        file.sync_all().map_err(output_error)?;
+        gif_bytes = Some(file.metadata().map_err(output_error)?.len());
+        names.push(GIF_FILE.to_string());
+    }
+    if vtk {
         let entries: Vec<(f64, String)> = frames
             .iter()
             .enumerate()
             .map(|(j, s)| (s.t, frame_name(j)))
             .collect();
         std::fs::write(tmp.join(PVD_FILE), vtk::pvd(&entries)).map_err(output_error)?;
-    }
-    let mut gif_bytes = None;
-    if matches!(opts.format, Format::Gif | Format::Both) {
-        let bytes = gif::animation_gif(&run.model, &surfaces, &ground, &frames, &poses, opts)?;
-        gif_bytes = Some(bytes.len() as u64);
-        std::fs::write(tmp.join(GIF_FILE), bytes).map_err(output_error)?;
-        names.push(GIF_FILE.to_string());
-    }
-    if matches!(opts.format, Format::Vtk | Format::Both) {
         // The index last: a folder with an index holds all its frames.
         names.push(PVD_FILE.to_string());
     }

@@ -164,11 +164,11 @@ pub struct Renderer {
 impl Renderer {
     /// A renderer for `view` that fits every point of `points` (all frames' vertices and the
     /// ground) in the image below the text band, with equal scales on both screen axes.
-    pub fn new<'a>(view: View, points: impl IntoIterator<Item = &'a Vector3<f64>>) -> Renderer {
+    pub fn new(view: View, points: impl IntoIterator<Item = Vector3<f64>>) -> Renderer {
         let camera = view.camera();
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for p in points {
-            let (x, y) = (camera.right.dot(p), camera.up.dot(p));
+            let (x, y) = (camera.right.dot(&p), camera.up.dot(&p));
             x0 = x0.min(x);
             x1 = x1.max(x);
             y0 = y0.min(y);
@@ -461,7 +461,7 @@ mod tests {
             Vector3::new(0.2, -0.3, 1.0),
         ];
         for view in [View::X, View::Y, View::Z, View::Iso] {
-            let r = Renderer::new(view, &pts);
+            let r = Renderer::new(view, pts);
             for p in &pts {
                 let (x, y) = r.project(p);
                 // Inside the margins, to round-off (1e-9 px).
