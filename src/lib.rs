@@ -18,12 +18,15 @@
 //! - [`study`]: `crr study` (many cases of one model in parallel: maps, fragility studies).
 //! - [`poincare`]: `crr poincare`, Poincaré sections under harmonic ground motion, bifurcation
 //!   diagrams and basins (`docs/poincare.md`); [`poincare_plot`] draws them.
+//! - [`animate`]: `crr animate`, the motion as a ParaView series and an animated GIF
+//!   (`docs/animation.md`).
 //! - [`fuzzing`]: the entry points of the fuzz targets in `fuzz/` and of their corpus replay.
 
 pub use crr_dynamics as dynamics;
 pub use crr_impact as impact;
 pub use crr_kinematics as kinematics;
 
+pub mod animate;
 pub mod check;
 pub mod fuzzing;
 pub mod inspect;

@@ -75,6 +75,36 @@ enum Command {
         /// Also draw coordinates, energy and phase plots (PNG and SVG) into the output folder.
         #[arg(long)]
         plot: bool,
+        /// Also animate the run (ParaView series and GIF, default options of `crr animate`)
+        /// into DIR/animation.
+        #[arg(long)]
+        animate: bool,
+    },
+    /// Animate a results folder written by `crr simulate`: a ParaView series (frame_NNNNN.vtu
+    /// and animation.pvd) and an animated GIF (docs/animation.md).
+    Animate {
+        /// The results folder (history.csv and summary.json).
+        #[arg(value_name = "RESULTS_DIR")]
+        dir: PathBuf,
+        /// Keep every K-th state of history.csv (default: about 0.05 s between frames, at most
+        /// 400 frames).
+        #[arg(long, value_name = "K")]
+        every: Option<usize>,
+        /// Output folder (default RESULTS_DIR/animation).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// The GIF's view: x, y, z (orthographic along that axis) or iso (isometric).
+        #[arg(long, value_name = "VIEW", default_value = "iso")]
+        view: String,
+        /// Files to write: vtk (the ParaView series), gif, or both.
+        #[arg(long, value_name = "FORMAT", default_value = "both")]
+        format: String,
+        /// GIF playback speed: 1 is real time, 0.5 half speed.
+        #[arg(long, value_name = "S", default_value_t = 1.0)]
+        speed: f64,
+        /// Replace an earlier animation in the output folder.
+        #[arg(long)]
+        force: bool,
     },
     /// Draw the plots of a results folder written by `crr simulate`: coordinates, energy and
     /// phase (.png and .svg, docs/outputs.md); of a study folder (cases.csv and study.json): the
@@ -570,6 +600,26 @@ fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) -> 
     None
 }
 
+/// The lines `crr animate` prints: what was written.
+fn print_animation(r: &crr::animate::AnimateReport) {
+    println!(
+        "{} frame(s) (every {} state(s) of history.csv) in {}",
+        r.frames,
+        r.every,
+        r.out.display()
+    );
+    if let Some(bytes) = r.gif_bytes {
+        println!(
+            "{} ({:.1} kB)",
+            r.out.join(crr::animate::GIF_FILE).display(),
+            bytes as f64 / 1000.0
+        );
+    }
+    if r.files.iter().any(|f| f.ends_with(crr::animate::PVD_FILE)) {
+        println!("{}", r.out.join(crr::animate::PVD_FILE).display());
+    }
+}
+
 fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Inspect { model, q, json } => {
@@ -597,6 +647,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             quiet,
             force,
             plot,
+            animate,
         } => {
             let opts = SimulateOptions {
                 out,
@@ -611,6 +662,19 @@ fn run(cli: Cli) -> Result<(), Failure> {
                     SimulateResult::Done(dir, _) | SimulateResult::Failed(dir, _) => dir,
                 };
                 plot_results(dir)?;
+            }
+            if animate {
+                let dir = match &result {
+                    SimulateResult::Done(dir, _) | SimulateResult::Failed(dir, _) => dir,
+                };
+                let opts = crr::animate::AnimateOptions {
+                    force,
+                    ..Default::default()
+                };
+                let report = crr::animate::animate(dir, &opts)?;
+                if !quiet {
+                    print_animation(&report);
+                }
             }
             match result {
                 SimulateResult::Done(dir, summary) => {
@@ -774,6 +838,27 @@ fn run(cli: Cli) -> Result<(), Failure> {
             if let Some(e) = report_poincare(&model, &result, quiet) {
                 return Err(Failure::Simulation(e));
             }
+        }
+        Command::Animate {
+            dir,
+            every,
+            out,
+            view,
+            format,
+            speed,
+            force,
+        } => {
+            let arg = InputError::Argument;
+            let opts = crr::animate::AnimateOptions {
+                every,
+                out,
+                view: view.parse().map_err(|e| arg(format!("--view: {e}")))?,
+                format: format.parse().map_err(|e| arg(format!("--format: {e}")))?,
+                speed,
+                force,
+            };
+            let report = crr::animate::animate(&dir, &opts)?;
+            print_animation(&report);
         }
         Command::Plot { dir } => {
             let files = if crr::study::products::is_study_dir(&dir) {

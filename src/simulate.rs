@@ -47,9 +47,12 @@ pub struct SimulateOptions {
     pub force: bool,
 }
 
-/// The files `crr simulate` writes, and those `--plot` adds: an earlier run's set is replaced
-/// whole (with `--force`), never mixed with a new one.
-const RESULT_FILES: [&str; 9] = [
+/// The files `crr simulate` writes, and those `--plot` and `--animate` add (the animation's
+/// index and GIF; its frames go with them): an earlier run's set is replaced whole (with
+/// `--force`), never mixed with a new one.
+const RESULT_FILES: [&str; 11] = [
+    "animation/animation.pvd",
+    "animation/animation.gif",
     "history.csv",
     "impacts.csv",
     "summary.json",
@@ -640,6 +643,8 @@ pub fn write_outputs_with(
             _ => {}
         }
     }
+    // The earlier run's animation frames (only the files `crr animate` writes).
+    crate::animate::remove_animation(&dir.join(crate::animate::DEFAULT_DIR))?;
     for (tmp, dst) in temps {
         std::fs::rename(tmp, dst)?;
     }

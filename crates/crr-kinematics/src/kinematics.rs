@@ -52,6 +52,22 @@ pub fn body_point(model: &Model, data: &Data, b: usize, x_rest: &Vector3<f64>) -
     frame_point(data, Some(model.body_coord[b]), x_rest)
 }
 
+/// World positions of the points of body `b` that are at `rest` at rest (e.g. the vertices of
+/// its [`crate::shapes::Surface`]), after [`forward_kinematics`]: `out[i] = Γ rest[i] + t` with Γ
+/// and t the body's frame. `out` is cleared first.
+pub fn body_points(
+    model: &Model,
+    data: &Data,
+    b: usize,
+    rest: &[Vector3<f64>],
+    out: &mut Vec<Vector3<f64>>,
+) {
+    let k = model.body_coord[b];
+    let (rot, trans) = (data.rot_ops[k], data.frame_translation[k]);
+    out.clear();
+    out.extend(rest.iter().map(|x| rot * x + trans));
+}
+
 /// World position of a point attached to frame `k` (None: the ground).
 pub fn frame_point(data: &Data, k: Option<usize>, x_rest: &Vector3<f64>) -> Vector3<f64> {
     match k {

@@ -52,7 +52,7 @@ pub use closure::{
 pub use data::Data;
 pub use error::ModelError;
 pub use gamma::mass_matrix_gamma;
-pub use kinematics::{body_point, body_rotation, forward_kinematics, jacobians};
+pub use kinematics::{body_point, body_points, body_rotation, forward_kinematics, jacobians};
 pub use mass_matrix::{kinetic_energy, mass_matrix, mass_matrix_from_jacobians};
 pub use model::{
     Body, Closure, Coordinate, Interface, InterfaceKind, MAX_COORDINATES, Model, Parent, Parts,

@@ -14,13 +14,15 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 use serde::{Deserialize, Serialize};
 
 mod hull;
+mod surface;
 #[cfg(test)]
 mod tests;
 
 pub use hull::{
-    HULL_REL_TOL, convex_hull_triangles, polyhedron_properties_divergence,
+    HULL_REL_TOL, convex_hull_faces, convex_hull_triangles, polyhedron_properties_divergence,
     polyhedron_properties_tetrahedra,
 };
+pub use surface::{SECTOR_MIN_SEGMENTS, SECTOR_SEGMENTS_PER_TURN, Surface, sector_segments};
 
 /// Relative tolerance (w.r.t. the polygon's bounding-box diagonal) on the
 /// distance of a prism polygon vertex from the plane through its first three

@@ -26,6 +26,21 @@ pub const HULL_REL_TOL: f64 = 1e-9;
 /// Errors: fewer than 4 points, non-finite coordinates, or all points
 /// coplanar (within the tolerance).
 pub fn convex_hull_triangles(points: &[Vector3<f64>]) -> Result<Vec<[usize; 3]>, ShapeError> {
+    let mut triangles = Vec::new();
+    for poly in convex_hull_faces(points)? {
+        for w in 1..poly.len().saturating_sub(1) {
+            triangles.push([poly[0], poly[w], poly[w + 1]]);
+        }
+    }
+    Ok(triangles)
+}
+
+/// The planar faces of the 3D convex hull of `points`, each a convex polygon of indices into
+/// `points`, counter-clockwise seen from outside (so the right-hand normal points out).
+///
+/// Same merging and tolerances as [`convex_hull_triangles`] (which fan-triangulates these
+/// polygons): coplanar hull points form one face, collinear boundary points are dropped.
+pub fn convex_hull_faces(points: &[Vector3<f64>]) -> Result<Vec<Vec<usize>>, ShapeError> {
     if points.len() < 4 {
         return Err(ShapeError::TooFewPoints {
             what: "polyhedron",
@@ -103,7 +118,7 @@ pub fn convex_hull_triangles(points: &[Vector3<f64>]) -> Result<Vec<[usize; 3]>,
         return Err(ShapeError::Coplanar);
     }
 
-    let mut triangles = Vec::new();
+    let mut polygons = Vec::with_capacity(faces.len());
     for (set, normal) in &faces {
         let e1 = any_perpendicular(normal);
         let e2 = normal.cross(&e1);
@@ -112,11 +127,11 @@ pub fn convex_hull_triangles(points: &[Vector3<f64>]) -> Result<Vec<[usize; 3]>,
             .map(|&l| (l, [e1.dot(&q[l]), e2.dot(&q[l])]))
             .collect();
         let poly = convex_hull_2d(pts2, tol);
-        for w in 1..poly.len().saturating_sub(1) {
-            triangles.push([uniq[poly[0]], uniq[poly[w]], uniq[poly[w + 1]]]);
+        if poly.len() >= 3 {
+            polygons.push(poly.into_iter().map(|l| uniq[l]).collect());
         }
     }
-    Ok(triangles)
+    Ok(polygons)
 }
 
 /// Counter-clockwise 2D convex hull (Andrew's monotone chain); points within
