@@ -110,10 +110,11 @@ fn static_multipliers_in_and_out_of_plane() {
             (l - expected).abs() <= 1e-8 * expected,
             "λ_y = {l} against (t/2)/z̄ = {expected}"
         );
-        // The ring rocks on both springings' edges together, the joints stay closed.
-        assert_eq!(s.opening.len(), 2, "{:?}", s.opening);
-        assert_eq!(s.opening["springing_right.1"], side);
-        assert_eq!(s.opening["springing_left.1"], side);
+        // The ring rocks on both springings' edges together; the in-plane tilts stay seated.
+        // The folding motion has the same λ at first order and may join in (a joint's `.1`).
+        assert_eq!(s.opening["springing_right.1"], side, "{:?}", s.opening);
+        assert_eq!(s.opening["springing_left.1"], side, "{:?}", s.opening);
+        assert!(s.opening.keys().all(|k| k.ends_with(".1")), "{:?}", s.opening);
     }
 }
 
