@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _crr
 from ._errors import CrrError, FileError, InputError, SimulationError
@@ -128,9 +129,7 @@ class Model:
         frequencies (keys and units in ``docs/outputs.md``)."""
         return json.loads(self._native.check_json())
 
-    def inspect(
-        self, q: Union[None, Mapping[str, float], Sequence[float], np.ndarray] = None
-    ) -> Dict[str, Any]:
+    def inspect(self, q: Union[None, Mapping[str, float], npt.ArrayLike] = None) -> Dict[str, Any]:
         """The report of ``crr inspect --json`` at configuration ``q`` (rad): a mapping of
         coordinate names to angles (others 0, as ``--q NAME=VALUE``) or one angle per
         coordinate; default the rest configuration.
@@ -216,8 +215,8 @@ class Record:
     @classmethod
     def from_arrays(
         cls,
-        t: Sequence[float],
-        a: Sequence[float],
+        t: npt.ArrayLike,
+        a: npt.ArrayLike,
         units: str = "m/s2",
         component: str = "x",
         scale: float = 1.0,
@@ -247,7 +246,7 @@ class Record:
 
 
 GroundMotion = Union[
-    None, Record, Sequence[Record], Tuple[Sequence[float], Sequence[float]], Mapping[str, Any]
+    None, Record, Sequence[Record], Tuple[npt.ArrayLike, npt.ArrayLike], Mapping[str, Any]
 ]
 
 
@@ -531,8 +530,10 @@ def cases_frame(text: str) -> "pandas.DataFrame":
 
     # pandas < 3 reads floats exactly only with the round-trip converter; pandas 3 always does
     # (and deprecates the option).
-    exact = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
-    frame = pd.read_csv(io.StringIO(text), **exact)
+    if int(pd.__version__.split(".")[0]) >= 3:
+        frame = pd.read_csv(io.StringIO(text))
+    else:  # pragma: no cover
+        frame = pd.read_csv(io.StringIO(text), float_precision="round_trip")
     frame.attrs["cases_csv"] = text
     return frame
 

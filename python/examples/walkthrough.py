@@ -105,7 +105,7 @@ print(fraction)
 
 # %%
 fig, ax = plt.subplots(figsize=(5, 3))
-ax.plot(fraction.index, fraction.values, "o-")
+ax.plot(fraction.index.to_numpy(), fraction.to_numpy(), "o-")
 ax.set_xlabel("PGA (g)")
 ax.set_ylabel("fraction overturned")
 ax.set_ylim(-0.05, 1.05)

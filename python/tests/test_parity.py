@@ -210,7 +210,8 @@ def test_bad_inputs_raise_with_the_command_lines_message(cli, in_root, tmp_path)
         crr.simulate(model, duration=-1)
     assert str(h.value) == cli_error(p)
 
-    args = ["--record", "examples/records/synthetic.AT2", "--format", "peer-at2", "--units", "cm/s2"]
+    args = ["--record", "examples/records/synthetic.AT2", "--format", "peer-at2"]
+    args += ["--units", "cm/s2"]
     p = run_cli(cli, ["simulate", model, "--out", str(tmp_path / "o"), *args], expect=2)
     rec = crr.Record.from_file("examples/records/synthetic.AT2", format="peer-at2", units="cm/s2")
     with pytest.raises(crr.InputError) as r:
@@ -221,3 +222,28 @@ def test_bad_inputs_raise_with_the_command_lines_message(cli, in_root, tmp_path)
         crr.simulate(model, rtoll=1e-9)
     with pytest.raises(crr.InputError, match="strictly increasing"):
         crr.simulate(model, ground_motion=([0.0, 0.0, 1.0], [0.0, 1.0, 0.0]))
+
+
+def test_a_run_that_fails_part_way_raises_with_its_partial_results(cli, in_root, tmp_path):
+    d = crr.Model.from_file("examples/models/single_block.toml").to_dict()
+    d["analysis"] = dict(d.get("analysis") or {}, max_impacts=5)
+    path = tmp_path / "few_impacts.json"
+    path.write_text(json.dumps(d))
+    out = tmp_path / "cli"
+    p = run_cli(cli, ["simulate", str(path), "--out", str(out), "--quiet"], expect=1)
+    with pytest.raises(crr.SimulationError) as e:
+        crr.simulate(crr.Model.from_file(path))
+    assert isinstance(e.value, RuntimeError)
+    assert cli_error(p) == f'{e.value} (partial results written to {out}, "completed": false)'
+    partial = e.value.result
+    assert not partial.completed
+    assert_same_run(partial, out)
+
+
+def test_a_model_pickles_and_runs_the_same(in_root):
+    import pickle
+
+    model = crr.Model.from_file("examples/models/two_block_stack.toml")
+    copy = pickle.loads(pickle.dumps(model))
+    assert copy.source == model.source and copy.coordinates == model.coordinates
+    assert crr.simulate(copy).history_csv() == crr.simulate(model).history_csv()
