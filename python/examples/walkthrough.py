@@ -1,11 +1,12 @@
 # %% [markdown]
 # # crr from Python: a block, a record, and a small fragility study on a Dask cluster
 #
-# Run it as a script from the repository root (`python python/examples/walkthrough.py`; the
-# figures go to `results/python_walkthrough/`), or cell by cell (`# %%`) in VS Code, Spyder or
+# Run it as a script (`python python/examples/walkthrough.py`; the figures go to
+# `results/python_walkthrough/` of the repository, or to `$CRR_EXAMPLE_OUT`), or cell by cell (`# %%`) in VS Code, Spyder or
 # Jupyter with jupytext. Needs `pip install ./python matplotlib "dask[distributed]" pandas`.
 
 # %%
+import os
 import sys
 from pathlib import Path
 
@@ -19,7 +20,7 @@ import numpy as np
 import crr
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
-OUT = ROOT / "results" / "python_walkthrough"
+OUT = Path(os.environ.get("CRR_EXAMPLE_OUT", ROOT / "results" / "python_walkthrough"))
 OUT.mkdir(parents=True, exist_ok=True)
 
 # %% [markdown]
