@@ -547,15 +547,21 @@ def study(
     DataFrame (same columns; ``frame.attrs["cases_csv"]`` holds the file's exact text).
 
     Args:
-        study: a :class:`Study`, the path of a study file, or a mapping of its keys.
+        study: a :class:`Study`, the path of a study file, a mapping of its keys, or the text
+            of a study file (a string with a newline; read as :meth:`Study.from_toml`).
         jobs: worker threads (default one per core); the results do not depend on it.
         out: when given, the study is run into this folder exactly as
             ``crr study FILE --out OUT`` (``cases.csv``, ``study.json``; a rerun resumes).
     """
+    return _as_study(study).run(jobs=jobs, out=out)
+
+
+def _as_study(study: Union[Study, PathLike, Mapping[str, Any]]) -> Study:
+    """A :class:`Study` from a study, a mapping, TOML text (a string with a newline) or a path."""
     if isinstance(study, Study):
-        s = study
-    elif isinstance(study, Mapping):
-        s = Study.from_dict(study)
-    else:
-        s = Study.from_file(study)
-    return s.run(jobs=jobs, out=out)
+        return study
+    if isinstance(study, Mapping):
+        return Study.from_dict(study)
+    if isinstance(study, str) and "\n" in study:
+        return Study.from_toml(study)
+    return Study.from_file(study)

@@ -30,3 +30,8 @@ class SimulationError(CrrError, RuntimeError):
     def __init__(self, message: str, result: Optional[Any] = None) -> None:
         super().__init__(message)
         self.result = result
+
+
+# Shown and pickled as crr.CrrError, crr.InputError, … (the names the package exports).
+for _cls in (CrrError, InputError, FileError, SimulationError):
+    _cls.__module__ = "crr"

@@ -18,7 +18,7 @@ import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, List, Mapping, Optional, Sequence, Tuple, Union
 
-from . import Study, _load_study, cases_frame
+from . import Study, _as_study, _load_study, cases_frame
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas
@@ -50,7 +50,8 @@ def run_study(
     pandas DataFrame (``frame.attrs["cases_csv"]`` holds the exact text).
 
     Args:
-        study: a :class:`crr.Study`, the path of a study file or a mapping of its keys.
+        study: a :class:`crr.Study`, the path of a study file, a mapping of its keys or the
+            text of a study file (as :func:`crr.study`).
         client: a ``distributed.Client``.
         chunk_size: cases per task (≥ 1). Cases take from milliseconds (a pulse on a block) to
             seconds (a long record on an arch): aim for tasks of a second or more.
@@ -59,12 +60,7 @@ def run_study(
     """
     if chunk_size < 1:
         raise ValueError(f"chunk_size must be at least 1, got {chunk_size}")
-    if isinstance(study, Study):
-        s = study
-    elif isinstance(study, Mapping):
-        s = Study.from_dict(study)
-    else:
-        s = Study.from_file(study)
+    s = _as_study(study)
     ids = s.case_ids
     chunks = [ids[i : i + chunk_size] for i in range(0, len(ids), chunk_size)]
     token = uuid.uuid4().hex[:12]

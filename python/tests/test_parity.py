@@ -247,3 +247,14 @@ def test_a_model_pickles_and_runs_the_same(in_root):
     copy = pickle.loads(pickle.dumps(model))
     assert copy.source == model.source and copy.coordinates == model.coordinates
     assert crr.simulate(copy).history_csv() == crr.simulate(model).history_csv()
+
+
+def test_the_exceptions_are_the_packages_and_pickle():
+    import pickle
+
+    with pytest.raises(crr.InputError) as e:
+        crr.Model.from_toml('name = "x"\n[[body]]\nname = "b"\n')
+    assert type(e.value).__qualname__ == "InputError" and type(e.value).__module__ == "crr"
+    assert str(e.value).startswith("<string>: ")
+    copy = pickle.loads(pickle.dumps(e.value))
+    assert type(copy) is crr.InputError and str(copy) == str(e.value)

@@ -80,6 +80,8 @@ def test_a_study_as_a_dict_and_its_rows_in_chunks(cli, tmp_path):
     rows = s.run_rows(s.case_ids[3:], jobs=1) + s.run_rows(s.case_ids[:3], jobs=1)
     assert s.csv(rows) == expected
     assert crr.study(d).attrs["cases_csv"] == expected
+    # The file's text, read as if it were tmp_path/study.toml (the model path is absolute).
+    assert crr.study(path.read_text()).attrs["cases_csv"] == expected
 
 
 def test_bad_studies_raise_with_the_command_lines_message(cli, tmp_path):
