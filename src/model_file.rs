@@ -103,6 +103,14 @@ pub fn parse_model_file(path: &Path, text: &str) -> Result<ModelFile, InputError
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    parse_model_text(path, text, is_json)
+}
+
+/// Parses the text of a model (JSON when `is_json`, else TOML) that need not come from a file:
+/// `label` names it in the errors as a file path would (e.g. `<string>` for a model given as
+/// text by an embedding program).
+pub fn parse_model_text(label: &Path, text: &str, is_json: bool) -> Result<ModelFile, InputError> {
+    let path = label;
     let parsed = if is_json {
         serde_json::from_str(text).map_err(|e| e.to_string())
     } else {
@@ -200,9 +208,36 @@ pub fn load_model(path: &Path) -> Result<(ModelFile, Model), InputError> {
             source,
         })?;
     let file = parse_model_file(path, &text)?;
+    build_model(path, file)
+}
+
+/// Validates the structure of a parsed model file into a model; errors name `path` (the file,
+/// or the label of a model given as text) and the item.
+pub fn build_model(path: &Path, file: ModelFile) -> Result<(ModelFile, Model), InputError> {
     let model = Model::from_spec(&file.structure()).map_err(|source| InputError::Model {
         file: path.to_path_buf(),
         source,
     })?;
     Ok((file, model))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_model_given_as_text_reads_as_the_same_file_and_errors_name_its_label() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (from_file, _) = load_model(&path).unwrap();
+        let label = Path::new("<string>");
+        let (from_text, model) =
+            build_model(label, parse_model_text(label, &text, false).unwrap()).unwrap();
+        assert_eq!(from_file, from_text);
+        assert_eq!(model.dof(), 1);
+        let json = serde_json::to_string(&from_file).unwrap();
+        assert_eq!(parse_model_text(label, &json, true).unwrap(), from_file);
+        let err = parse_model_text(label, "name = 1", false).unwrap_err();
+        assert!(err.to_string().starts_with("<string>: "), "{err}");
+    }
 }

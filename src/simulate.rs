@@ -153,8 +153,26 @@ pub fn default_duration(ground: &GroundMotion) -> f64 {
 /// input error naming the file or item.
 pub fn prepare(path: &Path, opts: &SimulateOptions) -> Result<Prepared, InputError> {
     let (file, model) = load_model(path)?;
-    let here = |msg: String| InputError::Argument(format!("{}: {msg}", path.display()));
     let base_dir = path.parent().unwrap_or(Path::new("."));
+    let p = prepare_loaded(path, base_dir, file, model, opts, &[])?;
+    check_out_dir(&p.out, opts.force)?;
+    Ok(p)
+}
+
+/// [`prepare`] for a model already read (from a file, or given as text by an embedding program):
+/// `path` names it in the errors, `base_dir` resolves the relative record files of its
+/// `[ground_motion]`; `records` (component, record in m/s², factor) replace components after
+/// those and `opts.record`, before the default duration is taken. The output folder is not
+/// looked at (nothing is written here).
+pub fn prepare_loaded(
+    path: &Path,
+    base_dir: &Path,
+    file: ModelFile,
+    model: Model,
+    opts: &SimulateOptions,
+    records: &[(Axis, crr_dynamics::ground_motion::Record, f64)],
+) -> Result<Prepared, InputError> {
+    let here = |msg: String| InputError::Argument(format!("{}: {msg}", path.display()));
     let mut ground = match &file.ground_motion {
         Some(spec) => GroundMotion::from_spec(spec, base_dir).map_err(|e| here(e.to_string()))?,
         None => GroundMotion::none(),
@@ -165,6 +183,11 @@ pub fn prepare(path: &Path, opts: &SimulateOptions) -> Result<Prepared, InputErr
         ground = ground
             .with_record(r.component, record, r.scale)
             .map_err(|e| InputError::Argument(format!("--scale: {e}")))?;
+    }
+    for (axis, record, scale) in records {
+        ground = ground
+            .with_record(*axis, record.clone(), *scale)
+            .map_err(|e| InputError::Argument(format!("ground motion: {e}")))?;
     }
     let initial_spec = file.initial.clone().unwrap_or_default();
     let initial = solve_initial(&model, &initial_spec).map_err(|e| here(e.to_string()))?;
@@ -184,7 +207,6 @@ pub fn prepare(path: &Path, opts: &SimulateOptions) -> Result<Prepared, InputErr
         .out
         .clone()
         .unwrap_or_else(|| default_out_dir(&file.name));
-    check_out_dir(&out, opts.force)?;
     Ok(Prepared {
         file,
         model,
@@ -734,6 +756,31 @@ mod tests {
             energy_gain: true,
             seated: Vec::new(),
         }
+    }
+
+    #[test]
+    fn a_record_given_as_samples_drives_the_run_and_sets_the_default_duration() {
+        use crr_dynamics::ground_motion::Record;
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
+        let (file, model) = load_model(&path).unwrap();
+        let record = Record::from_samples(vec![0.0, 1.0, 2.0], vec![0.0, 3.0, 0.0]).unwrap();
+        let base = path.parent().unwrap();
+        let p = prepare_loaded(
+            &path,
+            base,
+            file.clone(),
+            model.clone(),
+            &SimulateOptions::default(),
+            &[(Axis::X, record, 2.0)],
+        )
+        .unwrap();
+        assert_eq!(p.ground.pga().x, 6.0);
+        assert_eq!(p.params.duration, 2.0 + 5.0);
+        // Without records it is `prepare` without the output folder check.
+        let q = prepare_loaded(&path, base, file, model, &SimulateOptions::default(), &[]).unwrap();
+        let r = prepare(&path, &SimulateOptions::default()).unwrap();
+        assert_eq!(q.params.duration, r.params.duration);
+        assert_eq!(q.initial.q, r.initial.q);
     }
 
     #[test]

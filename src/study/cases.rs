@@ -234,7 +234,14 @@ impl Study {
     /// study file and the key; a record that cannot be read is not an error here (its cases fail
     /// one by one).
     pub fn load(path: &Path) -> Result<Self, InputError> {
-        let spec = StudySpec::read(path)?;
+        Self::from_spec(StudySpec::read(path)?, path)
+    }
+
+    /// [`Study::load`] for a study already parsed (from a file, or given as text or a table by
+    /// an embedding program): `path` names it in the errors, its folder resolves the model and
+    /// record files and its stem is the default name, as for a study file at `path` (which need
+    /// not exist).
+    pub fn from_spec(spec: StudySpec, path: &Path) -> Result<Self, InputError> {
         let base = path.parent().unwrap_or(Path::new("."));
         let name = spec.name.clone().unwrap_or_else(|| {
             path.file_stem()

@@ -18,5 +18,5 @@ pub mod spec;
 pub mod zhang_makris;
 
 pub use cases::{Case, Motion, Study};
-pub use run::{Shard, StudyOptions, StudyOutcome, merge, run_study};
+pub use run::{Shard, StudyOptions, StudyOutcome, case_rows, cases_csv, merge, run_study};
 pub use spec::StudySpec;

@@ -244,6 +244,49 @@ pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> Str
     cols.join(",")
 }
 
+/// The text of `cases.csv` from its header and rows (without newlines, in any order): the rows in
+/// case-id order, as `crr study` writes the file when every case is done; a row given twice is
+/// written once.
+pub fn cases_csv<'a>(header: &str, rows: impl IntoIterator<Item = &'a str>) -> String {
+    let sorted: BTreeMap<&str, &str> = rows
+        .into_iter()
+        .map(|r| (r.split_once(',').map_or(r, |(id, _)| id), r))
+        .collect();
+    let mut text = String::with_capacity(
+        header.len() + 1 + sorted.values().map(|r| r.len() + 1).sum::<usize>(),
+    );
+    text.push_str(header);
+    text.push('\n');
+    for r in sorted.values() {
+        text.push_str(r);
+        text.push('\n');
+    }
+    text
+}
+
+/// Runs `cases` on `jobs` threads (None: one per core) and returns their rows of `cases.csv`
+/// (without newlines) in the order given, writing nothing: what an embedding program or a
+/// cluster's worker computes of a study, joined afterwards by [`cases_csv`].
+pub fn case_rows(
+    study: &Study,
+    cases: &[&Case],
+    jobs: Option<usize>,
+) -> Result<Vec<String>, InputError> {
+    if jobs == Some(0) {
+        return Err(InputError::Argument("--jobs must be at least 1".into()));
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.unwrap_or(0))
+        .build()
+        .map_err(|e| InputError::Argument(format!("--jobs: {e}")))?;
+    Ok(pool.install(|| {
+        cases
+            .par_iter()
+            .map(|case| row(study, case, &run_case(study, case)))
+            .collect()
+    }))
+}
+
 /// The ids of the complete rows of an existing `cases.csv` (a row is complete when its line ends
 /// with a newline), and the length of the file up to the last complete row. A file whose header
 /// differs is an error: it belongs to another study.
@@ -399,13 +442,7 @@ pub fn run_study(
     drop(sink);
     // Every case of the shard is done: rewrite in id order.
     let (rows, _) = done_rows(&csv, &header)?;
-    let mut text = String::with_capacity(rows.values().map(|r| r.len() + 1).sum::<usize>());
-    text.push_str(&header);
-    text.push('\n');
-    for r in rows.values() {
-        text.push_str(r);
-        text.push('\n');
-    }
+    let text = cases_csv(&header, rows.values().map(String::as_str));
     let tmp = opts.out.join("cases.csv.partial");
     std::fs::write(&tmp, &text).map_err(out_err)?;
     std::fs::rename(&tmp, &csv).map_err(out_err)?;

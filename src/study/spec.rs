@@ -222,7 +222,12 @@ impl StudySpec {
             file: path.to_path_buf(),
             source,
         })?;
-        toml::from_str(&text).map_err(|e| InputError::Parse {
+        Self::parse(path, &text)
+    }
+
+    /// Parses the TOML text of a study file; `path` names it in the errors.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, InputError> {
+        toml::from_str(text).map_err(|e| InputError::Parse {
             file: path.to_path_buf(),
             message: e.to_string(),
         })

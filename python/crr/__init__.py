@@ -1,0 +1,567 @@
+"""crr — coupled rocking rotations, from Python.
+
+The dynamics of rigid-block masonry structures (blocks, columns of drums, trilithons, arches)
+under earthquakes, computed by the Rust engine crr. The same model and study files as the
+command line, the same numbers to the last digit, and the same error messages.
+
+Units are SI throughout: lengths in m, angles in rad, rates in rad/s, times in s, accelerations
+in m/s² (records also in g or cm/s² where their units are given), energies in J, masses in kg.
+
+>>> import crr
+>>> model = crr.Model.from_file("examples/models/single_block.toml")
+>>> result = crr.simulate(model, duration=5.0)
+>>> result.q[:, 0].max()          # peak rotation of the block, rad    # doctest: +SKIP
+
+The heavy work runs in Rust with the GIL released: Python threads run simulations in parallel.
+:mod:`crr.dask` spreads a study's cases over a ``dask.distributed`` cluster.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _crr
+from ._errors import CrrError, FileError, InputError, SimulationError
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas
+
+__all__ = [
+    "CrrError",
+    "FileError",
+    "InputError",
+    "Model",
+    "Record",
+    "Result",
+    "SimulationError",
+    "Study",
+    "cases_frame",
+    "simulate",
+    "study",
+    "__version__",
+]
+
+__version__: str = _crr.__version__
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+# Columns of a history row of numbers after t, q and q̇ (history.csv).
+_ENERGIES = ("kinetic", "potential", "work_in", "dissipated")
+
+
+def _fspath(p: PathLike) -> str:
+    return os.fspath(p)
+
+
+class Model:
+    """A structure read and validated as the command line reads a model file
+    (``docs/model-format.md``): bodies, interfaces and the optional ``[ground_motion]``,
+    ``[initial]`` and ``[analysis]`` tables.
+
+    Build it with :meth:`from_file`, :meth:`from_toml` or :meth:`from_dict`.
+    """
+
+    __slots__ = ("_native",)
+
+    def __init__(self, native: _crr.Model) -> None:
+        self._native = native
+
+    @classmethod
+    def from_file(cls, path: PathLike) -> "Model":
+        """Reads a model file (TOML, or JSON when its name ends in ``.json``). Relative record
+        files of its ``[ground_motion]`` are read from the file's folder. Errors name the file,
+        the item and the problem, as ``crr`` prints them (:class:`InputError`,
+        :class:`FileError`)."""
+        return cls(_crr.Model.load(_fspath(path)))
+
+    @classmethod
+    def from_toml(
+        cls, text: str, base_dir: Optional[PathLike] = None, label: str = "<string>"
+    ) -> "Model":
+        """A model from the text of a TOML model file. ``label`` names it in error messages;
+        relative record files are read from ``base_dir`` (default: the working folder)."""
+        base = _fspath(base_dir) if base_dir is not None else "."
+        return cls(_crr.Model.parse(text, False, label, base))
+
+    @classmethod
+    def from_dict(
+        cls, d: Mapping[str, Any], base_dir: Optional[PathLike] = None, label: str = "<dict>"
+    ) -> "Model":
+        """A model from a mapping with the keys of a model file (``name``, ``body``,
+        ``interface``, ``ground_motion``, …), e.g. the output of :meth:`to_dict`."""
+        base = _fspath(base_dir) if base_dir is not None else "."
+        return cls(_crr.Model.parse(json.dumps(d), True, label, base))
+
+    @property
+    def name(self) -> str:
+        """The structure's name."""
+        return self._native.name
+
+    @property
+    def coordinates(self) -> List[str]:
+        """The names of the coordinates (hinge angles and base tilts, rad), in the order of q."""
+        return list(self._native.coordinates)
+
+    @property
+    def interfaces(self) -> List[str]:
+        """The names of the interfaces, in the order of the state columns."""
+        return list(self._native.interfaces)
+
+    @property
+    def source(self) -> str:
+        """The file the model was read from, or its label."""
+        return str(self._native.label)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The model file as a dict (every table, defaults filled in)."""
+        return json.loads(self._native.to_json())
+
+    def check(self) -> Dict[str, Any]:
+        """The mobility report of ``crr check --json``: DOF, closures, and for a one-DOF
+        mechanism the activation multiplier λ, the equivalent block, r and the free-rocking
+        frequencies (keys and units in ``docs/outputs.md``)."""
+        return json.loads(self._native.check_json())
+
+    def inspect(self, q: Union[None, Mapping[str, float], npt.ArrayLike] = None) -> Dict[str, Any]:
+        """The report of ``crr inspect --json`` at configuration ``q`` (rad): a mapping of
+        coordinate names to angles (others 0, as ``--q NAME=VALUE``) or one angle per
+        coordinate; default the rest configuration.
+
+        The keys are those of ``docs/inspect.md``; ``mass_matrix`` M(q) (kg m²),
+        ``generalized_gravity`` −∂U/∂q (N m), ``constraint_residual`` Φ(q) and
+        ``constraint_jacobian`` Φ_q (closed chains only) are numpy arrays;
+        ``potential_energy`` U (J) is a float.
+        """
+        if q is None:
+            text = self._native.inspect_json()
+        elif isinstance(q, Mapping):
+            settings = [f"{name}={float(v)!r}" for name, v in q.items()]
+            text = self._native.inspect_json(settings=settings)
+        else:
+            values = [float(v) for v in np.asarray(q, dtype=float).ravel()]
+            text = self._native.inspect_json(q=values)
+        report = json.loads(text)
+        for key in (
+            "mass_matrix",
+            "generalized_gravity",
+            "constraint_residual",
+            "constraint_jacobian",
+        ):
+            if key in report:
+                report[key] = np.asarray(report[key], dtype=float)
+        return report
+
+    def __reduce__(self) -> Tuple[Any, ...]:
+        return (_restore_model, (self._native.to_json(), self.source, str(self._native.base_dir)))
+
+    def __repr__(self) -> str:
+        return repr(self._native)
+
+
+def _restore_model(text: str, label: str, base_dir: str) -> Model:
+    return Model(_crr.Model.parse(text, True, label, base_dir))
+
+
+class Record:
+    """An accelerogram driving one ground-motion component (``x``, ``y`` or ``z``), times a
+    factor ``scale``: from a file in the command line's formats (:meth:`from_file`, as
+    ``crr simulate --record``) or from arrays (:meth:`from_arrays`)."""
+
+    __slots__ = ("path", "format", "units", "t", "a", "component", "scale")
+
+    def __init__(
+        self,
+        *,
+        component: str = "x",
+        scale: float = 1.0,
+        path: Optional[str] = None,
+        format: Optional[str] = None,
+        units: Optional[str] = None,
+        t: Optional[np.ndarray] = None,
+        a: Optional[np.ndarray] = None,
+    ) -> None:
+        self.component = component
+        self.scale = float(scale)
+        self.path = path
+        self.format = format
+        self.units = units
+        self.t = t
+        self.a = a
+
+    @classmethod
+    def from_file(
+        cls,
+        path: PathLike,
+        format: str,
+        units: Optional[str] = None,
+        component: str = "x",
+        scale: float = 1.0,
+    ) -> "Record":
+        """A record file: ``format`` ``peer-at2`` (values in g), ``csv`` or ``text`` (columns
+        time in s and acceleration in ``units``: ``g``, ``m/s2`` or ``cm/s2``), as
+        ``--record PATH --format F --units U --component C --scale S``
+        (``docs/ground-motion.md``)."""
+        return cls(
+            path=_fspath(path), format=format, units=units, component=component, scale=scale
+        )
+
+    @classmethod
+    def from_arrays(
+        cls,
+        t: npt.ArrayLike,
+        a: npt.ArrayLike,
+        units: str = "m/s2",
+        component: str = "x",
+        scale: float = 1.0,
+    ) -> "Record":
+        """Samples: times ``t`` (s, strictly increasing) and accelerations ``a`` in ``units``
+        (``m/s2``, ``g`` = 9.80665 m/s² or ``cm/s2``), linear between samples and 0 outside
+        them, as a ``csv`` record of the same numbers."""
+        return cls(
+            t=np.ascontiguousarray(t, dtype=float),
+            a=np.ascontiguousarray(a, dtype=float),
+            units=units,
+            component=component,
+            scale=scale,
+        )
+
+    def __repr__(self) -> str:
+        if self.path is not None:
+            return (
+                f"Record.from_file({self.path!r}, format={self.format!r}, units={self.units!r}, "
+                f"component={self.component!r}, scale={self.scale!r})"
+            )
+        n = 0 if self.t is None else len(self.t)
+        return (
+            f"Record.from_arrays(<{n} samples>, units={self.units!r}, "
+            f"component={self.component!r}, scale={self.scale!r})"
+        )
+
+
+GroundMotion = Union[
+    None, Record, Sequence[Record], Tuple[npt.ArrayLike, npt.ArrayLike], Mapping[str, Any]
+]
+
+
+class Result:
+    """A simulation's results: the time histories of ``history.csv`` as numpy arrays, the
+    impact log and the summary (``docs/outputs.md``).
+
+    Attributes:
+        t: sample times (s), shape (n,).
+        q: coordinates (rad), shape (n, dof), columns in the order of :attr:`coordinates`.
+        qdot: their rates (rad/s), shape (n, dof).
+        kinetic, potential, work_in, dissipated: energies T, U − U(rest), the ground motion's
+            work W and the dissipated energy D (J), shape (n,).
+        states: state of every interface per sample (``seated``, ``+``, ``-``; the slots of a
+            rocking base joined by ``/``), shape (n, interfaces), dtype str.
+        coordinates, interfaces: the column names.
+        impacts: the impact log, one dict per impact (``t`` s, ``interfaces``, ``rates_before``
+            and ``rates_after`` rad/s, ``energy_lost`` J).
+        summary: the content of ``summary.json`` (peaks, peak/α, impacts, uplift, collapse,
+            energy balance, warnings).
+    """
+
+    def __init__(self, run: _crr.Run, coordinates: List[str], interfaces: List[str]) -> None:
+        self._run = run
+        self.coordinates = coordinates
+        self.interfaces = interfaces
+        n, dof = run.samples, len(coordinates)
+        h = np.frombuffer(run.history_bytes(), dtype=np.float64).reshape(n, run.width)
+        self.t: np.ndarray = h[:, 0]
+        self.q: np.ndarray = h[:, 1 : 1 + dof]
+        self.qdot: np.ndarray = h[:, 1 + dof : 1 + 2 * dof]
+        e = 1 + 2 * dof
+        self.kinetic: np.ndarray = h[:, e]
+        self.potential: np.ndarray = h[:, e + 1]
+        self.work_in: np.ndarray = h[:, e + 2]
+        self.dissipated: np.ndarray = h[:, e + 3]
+        states = run.states()
+        self.states: np.ndarray = (
+            np.array(states, dtype=str) if n else np.empty((0, len(interfaces)), dtype=str)
+        )
+        self.impacts: List[Dict[str, Any]] = run.impacts()
+        self.summary: Dict[str, Any] = json.loads(run.summary_json)
+
+    @property
+    def completed(self) -> bool:
+        """Whether the run reached its end (or a collapse) without an error."""
+        return bool(self.summary["completed"])
+
+    @property
+    def energies(self) -> Dict[str, np.ndarray]:
+        """The energy columns by name (J)."""
+        return {k: getattr(self, k) for k in _ENERGIES}
+
+    def history_csv(self) -> str:
+        """The text of ``history.csv``, as ``crr simulate`` writes it."""
+        return self._run.history_csv()
+
+    def impacts_csv(self) -> str:
+        """The text of ``impacts.csv``, as ``crr simulate`` writes it."""
+        return self._run.impacts_csv()
+
+    def history_frame(self) -> "pandas.DataFrame":
+        """The history as a pandas DataFrame with the columns of ``history.csv``."""
+        import pandas as pd
+
+        cols: Dict[str, Any] = {"t": self.t}
+        for k, c in enumerate(self.coordinates):
+            cols[c] = self.q[:, k]
+        for k, c in enumerate(self.coordinates):
+            cols[f"{c}_rate"] = self.qdot[:, k]
+        cols.update(self.energies)
+        for k, i in enumerate(self.interfaces):
+            cols[f"{i}_state"] = self.states[:, k]
+        return pd.DataFrame(cols)
+
+    def impacts_frame(self) -> "pandas.DataFrame":
+        """The impact log as a pandas DataFrame (columns ``t``, ``interfaces``,
+        ``rates_before``, ``rates_after``, ``energy_lost``; the list-valued columns hold
+        lists)."""
+        import pandas as pd
+
+        return pd.DataFrame(
+            self.impacts,
+            columns=["t", "interfaces", "rates_before", "rates_after", "energy_lost"],
+        )
+
+    def write(self, folder: PathLike) -> None:
+        """Writes ``history.csv``, ``impacts.csv`` and ``summary.json`` into ``folder`` (created
+        if needed), the files of ``crr simulate``."""
+        d = Path(folder)
+        d.mkdir(parents=True, exist_ok=True)
+        for name, text in (
+            ("history.csv", self.history_csv()),
+            ("impacts.csv", self.impacts_csv()),
+            ("summary.json", json.dumps(self.summary, indent=2, ensure_ascii=False) + "\n"),
+        ):
+            with open(d / name, "w", newline="", encoding="utf-8") as f:
+                f.write(text)
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return (
+            f"<crr.Result {len(self.t)} samples to t = {s['end_time']} s, {s['impacts']} "
+            f"impact(s), collapsed: {s['collapse']['collapsed']}>"
+        )
+
+
+def simulate(
+    model: Union[Model, PathLike],
+    ground_motion: GroundMotion = None,
+    initial: Optional[Mapping[str, Any]] = None,
+    duration: Optional[float] = None,
+    **analysis: Any,
+) -> Result:
+    """Runs a model as ``crr simulate`` does and returns its results (nothing is written).
+
+    Args:
+        model: a :class:`Model`, or the path of a model file.
+        ground_motion: None (the model's own ``[ground_motion]``); a :class:`Record` or a list
+            of them (each replaces its component of the model's motion, as ``--record``; at
+            most one record file); a pair ``(t, a)`` of arrays (s, m/s²) driving ``x``; or a
+            mapping that replaces the whole ``[ground_motion]`` table (same keys as the model
+            file, ``docs/ground-motion.md``; record paths relative to the model's folder).
+        initial: replaces the ``[initial]`` table: ``{"angles": {name: rad}, "rates":
+            {name: rad/s}}``.
+        duration: simulated time (s), as ``--duration``; default the ``[analysis]`` duration,
+            else the ground motion's duration + 5 s, else 10 s.
+        **analysis: keys of the ``[analysis]`` table that override the model's (``rtol``,
+            ``atol``, ``method``, ``output_interval`` s, ``max_step`` s, ``friction``, …).
+
+    Raises:
+        InputError: invalid model tables, records or arguments (the command line's message).
+        FileError: a record file that cannot be read.
+        SimulationError: the run failed part-way; its ``result`` holds the partial results.
+    """
+    if not isinstance(model, Model):
+        model = Model.from_file(model)
+    native = model._native
+    gm_json: Optional[str] = None
+    record_file: Optional[Tuple[str, str, Optional[str], str, float]] = None
+    arrays: List[Tuple[str, List[float], List[float], str, float]] = []
+    if ground_motion is None:
+        pass
+    elif isinstance(ground_motion, Mapping):
+        gm_json = json.dumps(ground_motion)
+    else:
+        if isinstance(ground_motion, Record):
+            records: List[Record] = [ground_motion]
+        elif (
+            isinstance(ground_motion, tuple)
+            and len(ground_motion) == 2
+            and not isinstance(ground_motion[0], Record)
+        ):
+            records = [Record.from_arrays(ground_motion[0], ground_motion[1])]
+        else:
+            records = list(ground_motion)  # type: ignore[arg-type]
+        for r in records:
+            if not isinstance(r, Record):
+                raise TypeError(f"ground_motion: expected crr.Record items, got {type(r).__name__}")
+            if r.path is not None:
+                if record_file is not None:
+                    raise InputError("ground_motion: at most one record file per run (as --record)")
+                if r.format is None:
+                    raise InputError("--record needs --format peer-at2, csv or text")
+                record_file = (r.path, r.format, r.units, r.component, r.scale)
+            else:
+                assert r.t is not None and r.a is not None
+                arrays.append(
+                    (r.component, r.t.tolist(), r.a.tolist(), r.units or "m/s2", r.scale)
+                )
+    init_json = json.dumps(initial) if initial is not None else None
+    analysis_json: Optional[str] = None
+    if analysis:
+        table = dict(model.to_dict().get("analysis") or {})
+        table.update(analysis)
+        analysis_json = json.dumps(table)
+    run = _crr.simulate(
+        native,
+        ground_motion=gm_json,
+        initial=init_json,
+        analysis=analysis_json,
+        record_file=record_file,
+        records=arrays,
+        duration=None if duration is None else float(duration),
+    )
+    result = Result(run, model.coordinates, model.interfaces)
+    if run.error is not None:
+        raise SimulationError(f"{model.source}: the simulation failed: {run.error}", result)
+    return result
+
+
+class Study:
+    """A study (``docs/studies.md``): one model under a pulse family's amplitude × frequency
+    grid, or records scaled to intensity levels, expanded into cases with stable ids
+    (``c000000``, …). Build it with :meth:`from_file`, :meth:`from_toml` or :meth:`from_dict`.
+    """
+
+    __slots__ = ("_native", "_source")
+
+    def __init__(self, native: _crr.Study, source: Tuple[str, ...]) -> None:
+        self._native = native
+        self._source = source
+
+    @classmethod
+    def from_file(cls, path: PathLike) -> "Study":
+        """Reads a study file (TOML), its model and its records; the model and record paths are
+        relative to the file's folder."""
+        p = _fspath(path)
+        return cls(_crr.Study.load(p), ("file", p))
+
+    @classmethod
+    def from_toml(cls, text: str, base_dir: Optional[PathLike] = None) -> "Study":
+        """A study from the text of a study file, read as if it were the file
+        ``base_dir/study.toml`` (``base_dir`` default the working folder): model and record
+        paths relative to ``base_dir``, default name ``study``."""
+        label = os.path.join(_fspath(base_dir) if base_dir is not None else ".", "study.toml")
+        return cls(_crr.Study.parse(text, False, label), ("toml", text, label))
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], base_dir: Optional[PathLike] = None) -> "Study":
+        """A study from a mapping with the keys of a study file, read as :meth:`from_toml`."""
+        label = os.path.join(_fspath(base_dir) if base_dir is not None else ".", "study.toml")
+        text = json.dumps(d)
+        return cls(_crr.Study.parse(text, True, label), ("json", text, label))
+
+    @property
+    def name(self) -> str:
+        """The study's name."""
+        return self._native.name
+
+    @property
+    def case_ids(self) -> List[str]:
+        """The ids of the cases, in order."""
+        return list(self._native.case_ids)
+
+    @property
+    def columns(self) -> List[str]:
+        """The columns of ``cases.csv``."""
+        return self._native.header.split(",")
+
+    def __len__(self) -> int:
+        return len(self._native)
+
+    def run_rows(
+        self, ids: Optional[Sequence[str]] = None, jobs: Optional[int] = None
+    ) -> List[str]:
+        """Runs the cases ``ids`` (default all) on ``jobs`` threads (default one per core) and
+        returns their lines of ``cases.csv`` (without newlines), in the order of ``ids``."""
+        return self._native.run_rows(None if ids is None else list(ids), jobs)
+
+    def csv(self, rows: Sequence[str]) -> str:
+        """The text of ``cases.csv`` from rows given in any order, as ``crr study`` writes it
+        (header, then the rows in case-id order)."""
+        return self._native.csv(list(rows))
+
+    def run(self, jobs: Optional[int] = None, out: Optional[PathLike] = None) -> "pandas.DataFrame":
+        """Runs every case and returns the DataFrame of ``cases.csv``; see :func:`study`."""
+        if out is not None:
+            self._native.run_into(_fspath(out), jobs)
+            text = (Path(out) / "cases.csv").read_text()
+        else:
+            text = self.csv(self.run_rows(None, jobs))
+        return cases_frame(text)
+
+    def __repr__(self) -> str:
+        return repr(self._native)
+
+
+def _load_study(source: Tuple[str, ...]) -> Study:
+    """A study from the description :attr:`Study._source` (what a Dask worker receives)."""
+    kind = source[0]
+    if kind == "file":
+        return Study(_crr.Study.load(source[1]), source)
+    return Study(_crr.Study.parse(source[1], kind == "json", source[2]), source)
+
+
+def cases_frame(text: str) -> "pandas.DataFrame":
+    """The text of a ``cases.csv`` as a pandas DataFrame, every number read back exactly; the
+    empty cells are NaN."""
+    import pandas as pd
+
+    # pandas < 3 reads floats exactly only with the round-trip converter; pandas 3 always does
+    # (and deprecates the option).
+    if int(pd.__version__.split(".")[0]) >= 3:
+        frame = pd.read_csv(io.StringIO(text))
+    else:  # pragma: no cover
+        frame = pd.read_csv(io.StringIO(text), float_precision="round_trip")
+    frame.attrs["cases_csv"] = text
+    return frame
+
+
+def study(
+    study: Union[Study, PathLike, Mapping[str, Any]],
+    jobs: Optional[int] = None,
+    out: Optional[PathLike] = None,
+) -> "pandas.DataFrame":
+    """Runs every case of a study, as ``crr study``, and returns ``cases.csv`` as a pandas
+    DataFrame (same columns; ``frame.attrs["cases_csv"]`` holds the file's exact text).
+
+    Args:
+        study: a :class:`Study`, the path of a study file, a mapping of its keys, or the text
+            of a study file (a string with a newline; read as :meth:`Study.from_toml`).
+        jobs: worker threads (default one per core); the results do not depend on it.
+        out: when given, the study is run into this folder exactly as
+            ``crr study FILE --out OUT`` (``cases.csv``, ``study.json``; a rerun resumes).
+    """
+    return _as_study(study).run(jobs=jobs, out=out)
+
+
+def _as_study(study: Union[Study, PathLike, Mapping[str, Any]]) -> Study:
+    """A :class:`Study` from a study, a mapping, TOML text (a string with a newline) or a path."""
+    if isinstance(study, Study):
+        return study
+    if isinstance(study, Mapping):
+        return Study.from_dict(study)
+    if isinstance(study, str) and "\n" in study:
+        return Study.from_toml(study)
+    return Study.from_file(study)

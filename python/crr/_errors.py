@@ -1,0 +1,37 @@
+"""The exceptions of crr. Their messages are those the command line prints after ``crr: error:``."""
+
+from __future__ import annotations
+
+from typing import Any, Optional
+
+__all__ = ["CrrError", "InputError", "FileError", "SimulationError"]
+
+
+class CrrError(Exception):
+    """Base class of every error raised by crr."""
+
+
+class InputError(CrrError, ValueError):
+    """A model, study, record or argument that is not valid (the command line exits with 2)."""
+
+
+class FileError(CrrError, OSError):
+    """A file that cannot be read or a folder that cannot be written (the command line exits
+    with 2)."""
+
+
+class SimulationError(CrrError, RuntimeError):
+    """A run that failed part-way (the command line writes the partial results and exits with 1).
+
+    ``result`` holds what was computed until the failure (``result.summary["completed"]`` is
+    false, ``result.summary["error"]`` says why).
+    """
+
+    def __init__(self, message: str, result: Optional[Any] = None) -> None:
+        super().__init__(message)
+        self.result = result
+
+
+# Shown and pickled as crr.CrrError, crr.InputError, … (the names the package exports).
+for _cls in (CrrError, InputError, FileError, SimulationError):
+    _cls.__module__ = "crr"

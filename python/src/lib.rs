@@ -1,0 +1,553 @@
+//! `crr._crr`: the Python extension of crr (PyO3). A thin layer over the library `crr`: models
+//! read as the command line reads them, runs prepared and summarised by the same functions as
+//! `crr simulate`, study cases expanded, run and written as rows of `cases.csv` by the functions
+//! of `crr study`. The public, typed API is the pure-Python package `crr` around it
+//! (`crr/__init__.py`); this module's signatures are in `crr/_crr.pyi`.
+//!
+//! Errors are raised as the classes of `crr._errors` with the command line's messages (what
+//! `crr` prints after `crr: error: `). Simulations and studies run with the interpreter
+//! detached (`Python::detach`, the GIL released), so that Python threads run them in parallel.
+
+use std::path::{Path, PathBuf};
+
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList};
+
+use crr::dynamics::ground_motion::{Axis, Record, RecordFormat, Units};
+use crr::impact::Trajectory;
+use crr::kinematics::Model as Structure;
+use crr::model_file::{ModelFile, build_model, load_model, parse_model_text};
+use crr::simulate::{
+    RecordArg, SampleStats, SimulateOptions, history_csv, impacts_csv, prepare_loaded, summary,
+};
+use crr::study::run::header;
+use crr::study::{Case, StudyOptions, StudySpec, case_rows, cases_csv, run_study};
+use crr::{InputError, inspect};
+
+/// An exception of `crr._errors` (`kind` is the class name) carrying `message`.
+fn raise(py: Python<'_>, kind: &str, message: String) -> PyErr {
+    let made = py
+        .import("crr._errors")
+        .and_then(|m| m.getattr(kind))
+        .and_then(|cls| cls.call1((message.clone(),)));
+    match made {
+        Ok(exc) => PyErr::from_value(exc),
+        Err(e) => e,
+    }
+}
+
+/// An input error of the library as the Python exception of its kind: files that cannot be
+/// read or written are `crr.FileError` (an `OSError`), everything else `crr.InputError` (a
+/// `ValueError`).
+fn input_error(py: Python<'_>, e: InputError) -> PyErr {
+    let kind = match e {
+        InputError::Io { .. } | InputError::Output { .. } => "FileError",
+        _ => "InputError",
+    };
+    raise(py, kind, e.to_string())
+}
+
+fn argument(py: Python<'_>, message: String) -> PyErr {
+    raise(py, "InputError", message)
+}
+
+/// A model read and validated, with the name and folder its errors and relative record paths
+/// refer to.
+#[pyclass(name = "Model", module = "crr._crr", frozen)]
+struct PyModel {
+    label: PathBuf,
+    base_dir: PathBuf,
+    file: ModelFile,
+    structure: Structure,
+}
+
+#[pymethods]
+impl PyModel {
+    /// Reads a model file (TOML, or JSON when it ends in .json), as the command line does.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let (file, structure) = load_model(&path).map_err(|e| input_error(py, e))?;
+        let base_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        Ok(PyModel {
+            label: path,
+            base_dir,
+            file,
+            structure,
+        })
+    }
+
+    /// Parses a model given as text (JSON when `is_json`, else TOML); `label` names it in the
+    /// errors, `base_dir` resolves its relative record files.
+    #[staticmethod]
+    fn parse(
+        py: Python<'_>,
+        text: &str,
+        is_json: bool,
+        label: PathBuf,
+        base_dir: PathBuf,
+    ) -> PyResult<Self> {
+        let file = parse_model_text(&label, text, is_json).map_err(|e| input_error(py, e))?;
+        let (file, structure) = build_model(&label, file).map_err(|e| input_error(py, e))?;
+        Ok(PyModel {
+            label,
+            base_dir,
+            file,
+            structure,
+        })
+    }
+
+    /// The path or label naming the model in messages.
+    #[getter]
+    fn label(&self) -> PathBuf {
+        self.label.clone()
+    }
+
+    /// The folder relative record files are read from.
+    #[getter]
+    fn base_dir(&self) -> PathBuf {
+        self.base_dir.clone()
+    }
+
+    /// The structure's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.file.name.clone()
+    }
+
+    /// Coordinate names, in the order of q.
+    #[getter]
+    fn coordinates(&self) -> Vec<String> {
+        self.structure
+            .coords
+            .iter()
+            .map(|c| c.name.clone())
+            .collect()
+    }
+
+    /// Interface names, in the order of the state columns.
+    #[getter]
+    fn interfaces(&self) -> Vec<String> {
+        self.structure
+            .interfaces
+            .iter()
+            .map(|i| i.name.clone())
+            .collect()
+    }
+
+    /// The model file as JSON (every table, defaults filled in).
+    fn to_json(&self) -> String {
+        serde_json::to_string(&self.file).expect("a model file serialises")
+    }
+
+    /// `crr check --json` of this model.
+    fn check_json(&self, py: Python<'_>) -> String {
+        let report = py.detach(|| crr::check::check(&self.structure));
+        serde_json::to_string(&report).expect("the report serialises")
+    }
+
+    /// `crr inspect --json` at q: `settings` as `--q NAME=VALUE` (others 0), or every
+    /// coordinate's value in `q`.
+    #[pyo3(signature = (settings=None, q=None))]
+    fn inspect_json(
+        &self,
+        py: Python<'_>,
+        settings: Option<Vec<String>>,
+        q: Option<Vec<f64>>,
+    ) -> PyResult<String> {
+        let n = self.structure.dof();
+        let q = match q {
+            Some(v) => {
+                if v.len() != n {
+                    return Err(argument(
+                        py,
+                        format!("q has {} values, the model has {n} coordinate(s)", v.len()),
+                    ));
+                }
+                if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+                    return Err(argument(
+                        py,
+                        format!("q: {x} is not a finite number of radians"),
+                    ));
+                }
+                nalgebra::DVector::from_vec(v)
+            }
+            None => inspect::configuration(&self.structure, &settings.unwrap_or_default())
+                .map_err(|e| input_error(py, e))?,
+        };
+        let report = inspect::inspect(&self.structure, &q);
+        Ok(serde_json::to_string(&report).expect("the report serialises"))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Model(name={:?}, coordinates={:?}, source={:?})",
+            self.file.name,
+            self.coordinates(),
+            self.label.display().to_string()
+        )
+    }
+}
+
+/// A finished (or failed) run: the trajectory and its summary.
+#[pyclass(name = "Run", module = "crr._crr", frozen)]
+struct PyRun {
+    structure: Structure,
+    trajectory: Trajectory,
+    summary: String,
+    error: Option<String>,
+}
+
+#[pymethods]
+impl PyRun {
+    /// Number of samples (rows of history.csv).
+    #[getter]
+    fn samples(&self) -> usize {
+        self.trajectory.samples.len()
+    }
+
+    /// Width of a history row of numbers: t, q, q̇, T, U, W, D.
+    #[getter]
+    fn width(&self) -> usize {
+        1 + 2 * self.structure.dof() + 4
+    }
+
+    /// The numbers of history.csv (t, q, q̇, kinetic, potential, work_in, dissipated) row by row,
+    /// as native-endian f64 bytes.
+    fn history_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        let mut bytes = Vec::with_capacity(8 * self.samples() * self.width());
+        for s in &self.trajectory.samples {
+            let row = std::iter::once(s.t)
+                .chain(s.q.iter().copied())
+                .chain(s.qdot.iter().copied())
+                .chain([s.kinetic, s.potential, s.work_in, s.dissipated]);
+            for v in row {
+                bytes.extend_from_slice(&v.to_ne_bytes());
+            }
+        }
+        PyBytes::new(py, &bytes)
+    }
+
+    /// The state column of every interface per sample, as in history.csv (`seated`, `+`, `-`,
+    /// slots joined by `/`).
+    fn states(&self) -> Vec<Vec<String>> {
+        self.trajectory
+            .samples
+            .iter()
+            .map(|s| {
+                self.structure
+                    .interfaces
+                    .iter()
+                    .map(|i| {
+                        i.slots
+                            .clone()
+                            .map(|k| s.states.get(k).map_or("?", |st| st.code()))
+                            .collect::<Vec<_>>()
+                            .join("/")
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The impact log: one dict per impact (t in s, interfaces, rates before and after in
+    /// rad/s, energy lost in J).
+    fn impacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for i in &self.trajectory.impacts {
+            let d = PyDict::new(py);
+            d.set_item("t", i.t)?;
+            d.set_item("interfaces", i.interfaces.clone())?;
+            d.set_item("rates_before", i.rates_before.clone())?;
+            d.set_item("rates_after", i.rates_after.clone())?;
+            d.set_item("energy_lost", i.energy_lost)?;
+            list.append(d)?;
+        }
+        Ok(list)
+    }
+
+    /// summary.json as text.
+    #[getter]
+    fn summary_json(&self) -> String {
+        self.summary.clone()
+    }
+
+    /// Why the run stopped early, if it did.
+    #[getter]
+    fn error(&self) -> Option<String> {
+        self.error.clone()
+    }
+
+    /// The text of history.csv, as `crr simulate` writes it.
+    fn history_csv(&self) -> String {
+        history_csv(&self.structure, &self.trajectory)
+    }
+
+    /// The text of impacts.csv, as `crr simulate` writes it.
+    fn impacts_csv(&self) -> String {
+        impacts_csv(&self.trajectory)
+    }
+}
+
+/// A record array: component, times (s), accelerations, their units (`g`, `m/s2`, `cm/s2`),
+/// factor.
+type ArrayRecord = (String, Vec<f64>, Vec<f64>, String, f64);
+/// A record file as `--record FILE --format F --units U --component C --scale S`.
+type FileRecord = (PathBuf, String, Option<String>, String, f64);
+
+fn parse_axis(what: &str, axis: &str) -> Result<Axis, String> {
+    axis.parse().map_err(|e: String| format!("{what}: {e}"))
+}
+
+/// Runs `model` as `crr simulate` does, with its tables replaced by the given JSON (ground
+/// motion, initial state, analysis), a record file (as `--record`) and record arrays overriding
+/// components, and `duration` (as `--duration`).
+#[pyfunction]
+#[pyo3(signature = (model, ground_motion=None, initial=None, analysis=None, record_file=None, records=Vec::new(), duration=None))]
+fn simulate(
+    py: Python<'_>,
+    model: &PyModel,
+    ground_motion: Option<String>,
+    initial: Option<String>,
+    analysis: Option<String>,
+    record_file: Option<FileRecord>,
+    records: Vec<ArrayRecord>,
+    duration: Option<f64>,
+) -> PyResult<PyRun> {
+    let mut file = model.file.clone();
+    let table =
+        |what: &str, e: serde_json::Error| format!("{}: {what}: {e}", model.label.display());
+    if let Some(g) = ground_motion {
+        file.ground_motion =
+            Some(serde_json::from_str(&g).map_err(|e| argument(py, table("ground_motion", e)))?);
+    }
+    if let Some(i) = initial {
+        file.initial =
+            Some(serde_json::from_str(&i).map_err(|e| argument(py, table("initial", e)))?);
+    }
+    if let Some(a) = analysis {
+        file.analysis =
+            Some(serde_json::from_str(&a).map_err(|e| argument(py, table("analysis", e)))?);
+    }
+    let record = match record_file {
+        None => None,
+        Some((path, format, units, component, scale)) => {
+            let format: RecordFormat = format
+                .parse()
+                .map_err(|e| argument(py, format!("--format: {e}")))?;
+            let units: Option<Units> = units
+                .map(|u| u.parse().map_err(|e| argument(py, format!("--units: {e}"))))
+                .transpose()?;
+            let component = parse_axis("--component", &component).map_err(|e| argument(py, e))?;
+            if !scale.is_finite() {
+                return Err(argument(py, format!("--scale must be finite, got {scale}")));
+            }
+            Some(RecordArg {
+                file: path,
+                format,
+                units,
+                component,
+                scale,
+            })
+        }
+    };
+    let mut arrays = Vec::with_capacity(records.len());
+    for (component, t, a, units, scale) in records {
+        let axis =
+            parse_axis("ground motion component", &component).map_err(|e| argument(py, e))?;
+        let units: Units = units
+            .parse()
+            .map_err(|e| argument(py, format!("ground motion units: {e}")))?;
+        let a = a.into_iter().map(|x| units.to_si(x)).collect();
+        let r = Record::from_samples(t, a)
+            .map_err(|e| argument(py, format!("ground motion record: {e}")))?;
+        arrays.push((axis, r, scale));
+    }
+    let opts = SimulateOptions {
+        out: None,
+        duration,
+        record,
+        quiet: true,
+        force: false,
+    };
+    let structure = model.structure.clone();
+    let label = model.label.clone();
+    let base_dir = model.base_dir.clone();
+    let outcome = py.detach(move || -> Result<PyRun, InputError> {
+        let p = prepare_loaded(&label, &base_dir, file, structure, &opts, &arrays)?;
+        let (trajectory, error) = match crr::simulate::run(&p, false) {
+            Ok(o) => (o.trajectory, o.error.map(|e| e.to_string())),
+            Err(e) => (Trajectory::empty(&p.model), Some(e.to_string())),
+        };
+        let mut stats = SampleStats::default();
+        stats.add(&trajectory.samples);
+        let sum = summary(&label, &p, &opts, &trajectory, &stats, error.as_deref());
+        Ok(PyRun {
+            summary: serde_json::to_string(&sum).expect("the summary serialises"),
+            structure: p.model,
+            trajectory,
+            error,
+        })
+    });
+    outcome.map_err(|e| input_error(py, e))
+}
+
+/// A study expanded into its cases.
+#[pyclass(name = "Study", module = "crr._crr", frozen)]
+struct PyStudy {
+    label: PathBuf,
+    study: crr::study::Study,
+}
+
+impl PyStudy {
+    fn cases(&self, py: Python<'_>, ids: Option<Vec<String>>) -> PyResult<Vec<&Case>> {
+        match ids {
+            None => Ok(self.study.cases.iter().collect()),
+            Some(ids) => ids
+                .iter()
+                .map(|id| {
+                    case_index(id)
+                        .and_then(|k| self.study.cases.get(k))
+                        .filter(|c| &c.id == id)
+                        .ok_or_else(|| {
+                            argument(
+                                py,
+                                format!(
+                                    "{}: no case {id:?} in this study ({} case(s), c000000 …)",
+                                    self.label.display(),
+                                    self.study.cases.len()
+                                ),
+                            )
+                        })
+                })
+                .collect(),
+        }
+    }
+}
+
+fn case_index(id: &str) -> Option<usize> {
+    id.strip_prefix('c')?.parse().ok()
+}
+
+#[pymethods]
+impl PyStudy {
+    /// Reads a study file (TOML), its model and records, and lists the cases.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let study = py
+            .detach(|| crr::study::Study::load(&path))
+            .map_err(|e| input_error(py, e))?;
+        Ok(PyStudy { label: path, study })
+    }
+
+    /// A study given as text (JSON when `is_json`, else TOML), as if it were the file `label`:
+    /// its folder resolves the model and records, its stem is the default name.
+    #[staticmethod]
+    fn parse(py: Python<'_>, text: &str, is_json: bool, label: PathBuf) -> PyResult<Self> {
+        let spec = if is_json {
+            serde_json::from_str::<StudySpec>(text).map_err(|e| InputError::Parse {
+                file: label.clone(),
+                message: e.to_string(),
+            })
+        } else {
+            StudySpec::parse(&label, text)
+        }
+        .map_err(|e| input_error(py, e))?;
+        let study = py
+            .detach(|| crr::study::Study::from_spec(spec, &label))
+            .map_err(|e| input_error(py, e))?;
+        Ok(PyStudy { label, study })
+    }
+
+    /// The study's name (the output folder's default name).
+    #[getter]
+    fn name(&self) -> String {
+        self.study.name.clone()
+    }
+
+    /// The path or label naming the study in messages.
+    #[getter]
+    fn label(&self) -> PathBuf {
+        self.label.clone()
+    }
+
+    /// The case ids, in order.
+    #[getter]
+    fn case_ids(&self) -> Vec<String> {
+        self.study.cases.iter().map(|c| c.id.clone()).collect()
+    }
+
+    /// The header line of cases.csv (without its newline).
+    #[getter]
+    fn header(&self) -> String {
+        header(&self.study)
+    }
+
+    fn __len__(&self) -> usize {
+        self.study.cases.len()
+    }
+
+    /// Runs the cases `ids` (all when None) on `jobs` threads and returns their rows of
+    /// cases.csv (without newlines) in the order of `ids`.
+    #[pyo3(signature = (ids=None, jobs=None))]
+    fn run_rows(
+        &self,
+        py: Python<'_>,
+        ids: Option<Vec<String>>,
+        jobs: Option<usize>,
+    ) -> PyResult<Vec<String>> {
+        let cases = self.cases(py, ids)?;
+        py.detach(|| case_rows(&self.study, &cases, jobs))
+            .map_err(|e| input_error(py, e))
+    }
+
+    /// The text of cases.csv from rows in any order (in case-id order, as `crr study` writes it).
+    fn csv(&self, rows: Vec<String>) -> String {
+        cases_csv(&header(&self.study), rows.iter().map(String::as_str))
+    }
+
+    /// `crr study FILE --out OUT --jobs JOBS --quiet`: runs (or resumes) the study into `out`
+    /// (cases.csv, study.json) and returns (cases, skipped, ran, failed).
+    #[pyo3(signature = (out, jobs=None))]
+    fn run_into(
+        &self,
+        py: Python<'_>,
+        out: PathBuf,
+        jobs: Option<usize>,
+    ) -> PyResult<(usize, usize, usize, usize)> {
+        if jobs == Some(0) {
+            return Err(argument(py, "--jobs must be at least 1".into()));
+        }
+        let opts = StudyOptions {
+            out,
+            jobs,
+            shard: crr::study::Shard::ALL,
+            quiet: true,
+        };
+        let o = py
+            .detach(|| run_study(&self.study, &self.label, &opts))
+            .map_err(|e| input_error(py, e))?;
+        Ok((o.cases, o.skipped, o.ran, o.failed))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Study(name={:?}, cases={}, source={:?})",
+            self.study.name,
+            self.study.cases.len(),
+            self.label.display().to_string()
+        )
+    }
+}
+
+/// The crr library's version.
+const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+#[pymodule]
+fn _crr(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyModel>()?;
+    m.add_class::<PyRun>()?;
+    m.add_class::<PyStudy>()?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add("__version__", VERSION)?;
+    Ok(())
+}

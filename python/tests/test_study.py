@@ -1,0 +1,117 @@
+"""Studies from Python equal `crr study`'s cases.csv byte for byte: run locally (in memory or
+into a folder), from a file or a dict, and spread over a Dask LocalCluster of two processes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+import crr
+from conftest import ROOT, run_cli
+
+
+def small_map(folder: Path) -> Path:
+    """A 6 × 6 overturning map of Housner's block (36 cases, 4 s each)."""
+    text = (
+        'name = "small_map"\n'
+        f'model = "{(ROOT / "examples/models/single_block.toml").as_posix()}"\n'
+        "duration = 4.0\n\n[pulses]\nkind = \"one_sine_pulse\"\n"
+        "amplitude_ratios = { from = 1.5, to = 6.0, count = 6 }\n"
+        "frequency_ratios = { from = 1.0, to = 8.0, count = 6 }\n"
+    )
+    path = folder / "small_map.toml"
+    path.write_text(text)
+    return path
+
+
+def records_study() -> dict:
+    """Two synthetic records × three PGA levels on the drum column (6 cases), as a dict."""
+    return {
+        "name": "drums",
+        "model": (ROOT / "examples/models/drum_column.toml").as_posix(),
+        "duration": 6.0,
+        "records": {"synthetic": {"seeds": [1, 2]}},
+        "intensity": {"pga": [0.1, 0.25, 0.4]},
+    }
+
+
+def cli_cases(cli, study: Path, out: Path) -> str:
+    run_cli(cli, ["study", str(study), "--out", str(out), "--quiet"])
+    return (out / "cases.csv").read_text()
+
+
+def test_a_study_equals_the_command_lines_cases_csv(cli, tmp_path):
+    study = small_map(tmp_path)
+    expected = cli_cases(cli, study, tmp_path / "cli")
+    frame = crr.study(study, jobs=2)
+    assert frame.attrs["cases_csv"] == expected
+    assert list(frame.columns) == expected.splitlines()[0].split(",")
+    assert len(frame) == 36
+    assert set(frame["status"]) == {"ok"}
+    assert frame["collapse"].sum() > 0 and (frame["collapse"] == 0).sum() > 0
+    # The DataFrame holds the file's numbers exactly.
+    again = crr.cases_frame((tmp_path / "cli" / "cases.csv").read_text())
+    for column in ("amplitude_m_s2", "peak_base_rad", "dissipated_j"):
+        exact = [float(line.split(",")[again.columns.get_loc(column)]) for line in
+                 expected.splitlines()[1:]]
+        assert again[column].tolist() == exact
+    pd.testing.assert_frame_equal(frame, again, check_exact=True)
+    # Into a folder, as `crr study --out` (study.json too).
+    out = tmp_path / "py"
+    folder = crr.study(study, out=out)
+    assert (out / "cases.csv").read_text() == expected
+    assert json.loads((out / "study.json").read_text())["cases_run"] == 36
+    assert folder.attrs["cases_csv"] == expected
+
+
+def test_a_study_as_a_dict_and_its_rows_in_chunks(cli, tmp_path):
+    d = records_study()
+    path = tmp_path / "drums.toml"
+    path.write_text(
+        f'name = "drums"\nmodel = "{d["model"]}"\nduration = 6.0\n'
+        "[records]\nsynthetic = { seeds = [1, 2] }\n[intensity]\npga = [0.1, 0.25, 0.4]\n"
+    )
+    expected = cli_cases(cli, path, tmp_path / "cli")
+    s = crr.Study.from_dict(d)
+    assert len(s) == 6 and s.name == "drums"
+    rows = s.run_rows(s.case_ids[3:], jobs=1) + s.run_rows(s.case_ids[:3], jobs=1)
+    assert s.csv(rows) == expected
+    assert crr.study(d).attrs["cases_csv"] == expected
+    # The file's text, read as if it were tmp_path/study.toml (the model path is absolute).
+    assert crr.study(path.read_text()).attrs["cases_csv"] == expected
+
+
+def test_bad_studies_raise_with_the_command_lines_message(cli, tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(
+        f'model = "{(ROOT / "examples/models/single_block.toml").as_posix()}"\n'
+        "[pulses]\nkind = \"one_sine_pulse\"\namplitudes = [1.0]\nperiods = [0.0]\n"
+    )
+    p = run_cli(cli, ["study", str(bad), "--out", str(tmp_path / "o")], expect=2)
+    with pytest.raises(crr.InputError) as e:
+        crr.study(bad)
+    assert p.stderr == f"crr: error: {e.value}\n"
+    with pytest.raises(crr.InputError, match="no case"):
+        crr.Study.from_file(small_map(tmp_path)).run_rows(["c999999"])
+
+
+def test_a_dask_local_cluster_reproduces_the_study(cli, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    import crr.dask
+
+    study = small_map(tmp_path)
+    expected = cli_cases(cli, study, tmp_path / "cli")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        frame = crr.dask.run_study(study, client, chunk_size=5, out=tmp_path / "dask")
+        workers = client.run(lambda: __import__("os").getpid())
+        assert len(set(workers.values())) == 2
+        by_dict = crr.dask.run_study(records_study(), client, chunk_size=2)
+    assert frame.attrs["cases_csv"] == expected
+    assert (tmp_path / "dask" / "cases.csv").read_text() == expected
+    assert len(frame) == 36
+    assert by_dict.attrs["cases_csv"] == crr.study(records_study()).attrs["cases_csv"]
