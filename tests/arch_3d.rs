@@ -114,7 +114,11 @@ fn static_multipliers_in_and_out_of_plane() {
         // The folding motion has the same λ at first order and may join in (a joint's `.1`).
         assert_eq!(s.opening["springing_right.1"], side, "{:?}", s.opening);
         assert_eq!(s.opening["springing_left.1"], side, "{:?}", s.opening);
-        assert!(s.opening.keys().all(|k| k.ends_with(".1")), "{:?}", s.opening);
+        assert!(
+            s.opening.keys().all(|k| k.ends_with(".1")),
+            "{:?}",
+            s.opening
+        );
     }
 }
 
