@@ -318,16 +318,22 @@ pub fn to_text(r: &CheckReport) -> String {
     );
     if let Some(f) = &r.finite_mobility {
         s += &format!(
-            "DOF(2) after a {} rad step along the mechanism = {}{}\n",
-            f.step,
-            f.dof2,
-            if f.dof2 < m.dof2 {
-                " (fewer than at rest: the loops close only to first order there; \
-                 see docs/model-format.md, rocking bases in loops)"
-            } else {
-                ""
-            }
+            "DOF(2) after a {} rad step along the mechanism = {}\n",
+            f.step, f.dof2
         );
+        if f.dof2 < m.dof2 {
+            s += &format!(
+                "  the loops move only to first order at rest: {} of the {} independent motions at rest \
+                 have no finite continuation. Followed further, they would turn a \
+                 rocking base about its contact normal (a twist, which a rocking base \
+                 forbids) or pull a loop apart; the structure can only start along them. \
+                 Near rest its constrained solve is ill-conditioned. Where the order of a \
+                 rocking base's two tilts causes it, reorder its corners \
+                 (docs/model-format.md, rocking bases in loops)\n",
+                m.dof2 - f.dof2,
+                m.dof2
+            );
+        }
     }
     if let Some(note) = &r.finite_mobility_note {
         s += &format!("DOF(2) after a finite step along the mechanism: {note}\n");
