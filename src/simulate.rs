@@ -308,6 +308,7 @@ pub fn coordinate_alpha(model: &Model, coordinate: usize) -> Option<f64> {
             normal,
             e1,
             e2,
+            ..
         } => {
             let centre: Vector3<f64> = corners.iter().sum::<Vector3<f64>>() / 4.0;
             // Tilt about e₁ pivots on edges parallel to e₁: half-extent along e₂, and vice versa.

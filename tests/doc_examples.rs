@@ -252,6 +252,7 @@ fn check_facts(built: &Built) -> bool {
                 normal,
                 e1,
                 e2,
+                ..
             } = &m.interfaces[0].kind
             else {
                 panic!("{at}: a rocking base");

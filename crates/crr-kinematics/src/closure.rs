@@ -47,7 +47,9 @@ pub(crate) fn orientation_pairs(kind: &InterfaceKind) -> ([OrientationPair; 2], 
             let v2 = axis.cross(&v1);
             ([(v1, *axis), (v2, *axis)], 2)
         }
-        InterfaceKind::RockingBase { e1, e2, .. } => ([(*e1, *e2), (*e1, *e2)], 1),
+        InterfaceKind::RockingBase { e1, e2, twist, .. } => {
+            ([(*e1, *e2), (*e1, *e2)], if *twist { 0 } else { 1 })
+        }
     }
 }
 
@@ -146,6 +148,19 @@ pub fn relative_angles(kind: &InterfaceKind, rel: &Matrix3<f64>, out: &mut [f64]
                 t += 2.0 * std::f64::consts::PI;
             }
             out[0] = t;
+        }
+        InterfaceKind::RockingBase {
+            normal,
+            e1,
+            e2,
+            twist: true,
+            ..
+        } => {
+            // Γ_AᵀΓ_B n = R(e₁, θ₁)R(e₂, θ₂) n = e₁ sin θ₂ + cos θ₂ (n cos θ₁ − e₂ sin θ₁): the
+            // twist about n leaves n where it is.
+            let rn = rel * normal;
+            out[0] = (-e2.dot(&rn)).atan2(normal.dot(&rn));
+            out[1] = e1.dot(&rn).clamp(-1.0, 1.0).asin();
         }
         InterfaceKind::RockingBase { normal, e1, e2, .. } => {
             let r2 = rel * e2;

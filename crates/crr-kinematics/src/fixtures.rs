@@ -97,6 +97,7 @@ pub fn rocking_base(
         pivot_negative: None,
         rocking_base: Some(RockingBaseSpec {
             corners: corners.to_vec(),
+            twist: false,
         }),
         impact: ImpactLaw::Momentum,
     }

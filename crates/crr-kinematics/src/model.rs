@@ -103,6 +103,10 @@ pub enum InterfaceKind {
         e1: Vector3<f64>,
         /// Unit e₂ = n × e₁: axis of the second tilt.
         e2: Vector3<f64>,
+        /// The child may also twist about n on its pivot corner (loop closures only): the tilts
+        /// are then those of the child's face normal, Γ_AᵀΓ_B n = R(e₁, θ₁)R(e₂, θ₂) n, and the
+        /// closure has no orientation row.
+        twist: bool,
     },
 }
 
@@ -470,6 +474,7 @@ fn hinge_kind(
 
 fn rocking_base_kind(
     corners: &[[f64; 3]],
+    twist: bool,
     child_com: &Vector3<f64>,
     item: &str,
     size: f64,
@@ -533,6 +538,7 @@ fn rocking_base_kind(
         normal,
         e1,
         e2,
+        twist,
     })
 }
 
@@ -716,7 +722,7 @@ impl Model {
                             "a rocking_base defines its own axes and pivots: remove axis, pivot_positive and pivot_negative",
                         ));
                     }
-                    rocking_base_kind(&rb.corners, &child_com, &item, size)?
+                    rocking_base_kind(&rb.corners, rb.twist, &child_com, &item, size)?
                 }
                 None => hinge_kind(i, &child_com, &item, size)?,
             };
@@ -748,6 +754,18 @@ impl Model {
             ));
         }
 
+        if let Some(&k) = order
+            .iter()
+            .find(|&&k| matches!(ends[k].2, InterfaceKind::RockingBase { twist: true, .. }))
+        {
+            return Err(ModelError::new(
+                quoted("interface", &spec.interface[k].name),
+                "`twist = true` is allowed only on an interface that closes a loop (its child is \
+                 reached through another interface first, following the interfaces from the \
+                 ground in file order); here the child is reached through this interface, which \
+                 would need a third coordinate. List the other interface of the child first",
+            ));
+        }
         let mut coords = Vec::new();
         let mut body_coord = vec![usize::MAX; bodies.len()];
         let mut roles = vec![Role::Closure { index: 0 }; n_i];
@@ -786,7 +804,8 @@ impl Model {
             let kind = &ends[k].2;
             let rows = match kind {
                 InterfaceKind::Hinge { .. } => 5,
-                InterfaceKind::RockingBase { .. } => 4,
+                InterfaceKind::RockingBase { twist: false, .. } => 4,
+                InterfaceKind::RockingBase { twist: true, .. } => 3,
             };
             roles[k] = Role::Closure {
                 index: closures.len(),

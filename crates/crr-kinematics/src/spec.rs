@@ -96,6 +96,11 @@ pub enum PivotSpec {
 pub struct RockingBaseSpec {
     /// The four corners of the contact rectangle, in order around it (m).
     pub corners: Vec<[f64; 3]>,
+    /// The child may also turn about the contact normal (twist) on its pivot corner: the contact
+    /// keeps the corner and the face plane, not the direction of the edges. Allowed on a loop
+    /// closure only (3 rows of Φ instead of 4); default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub twist: bool,
 }
 
 /// How an impact at this interface dissipates energy (used by the impact stage).
