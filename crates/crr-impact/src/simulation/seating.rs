@@ -59,6 +59,19 @@ pub(super) fn opening_mode_in(
         return None;
     }
     let tol = 1e-9 * model.gravity / model.size;
+    // A structure with loops at rest: Gauss' principle over the seated slots' sides decides
+    // (uplift_from_rest.rs). It finds the mechanisms of several joints in hyperstatic loops (an
+    // arch that rocks out of its plane) that single releases and the active set below miss, and
+    // it costs a few factorisations instead of a solve per seated slot and side. In motion its
+    // local search over the sides picked modes that later needed tension (the 3D arch under its
+    // record), so single releases and the active set keep that case.
+    let rate_scale = (model.gravity / model.size).sqrt();
+    if model.constraint_rows > 0
+        && qdot.amax() <= 1e-12 * rate_scale
+        && let Some(mode) = opening_from_rest(model, ground, template, trial, t, q, qdot, tol)
+    {
+        return mode;
+    }
     let mut row = DVector::zeros(model.dof());
     let n = model.dof();
     // The opening acceleration of slot k in the last solve (a tree coordinate's is q̈ₖ).
@@ -196,13 +209,6 @@ pub(super) fn opening_mode_in(
     }
     if model.constraint_rows == 0 || seated.len() < 2 {
         return None;
-    }
-    // At rest, Gauss' principle over the seated slots' sides decides (uplift_from_rest.rs): it
-    // finds mechanisms of several joints in hyperstatic loops (an arch that rocks out of its
-    // plane) that the active set below can miss.
-    let rate_scale = (model.gravity / model.size).sqrt();
-    if qdot.amax() <= 1e-12 * rate_scale {
-        return opening_from_rest(model, ground, template, trial, t, q, qdot, tol);
     }
     // Active set over the seated slots released together: a slot closing on its side is tried
     // once on the other side; closing on both, it stays seated (the tilts of a loop of rocking
@@ -379,9 +385,12 @@ impl Simulation<'_> {
     /// failure located by bisection to 1e-13·max(1, t), the precision of the integrator's event
     /// location. The grid is the integrator's step cap while seated ([`SEATED_MAX_STEP`]), or
     /// the whole interval when the test cannot change inside it: after the ground motion ends,
-    /// and on open chains while the ground motion is affine in t (records between samples),
-    /// since at rest each single release's opening acceleration is linear in g_eff(t) and, once
-    /// past its threshold inside the interval, stays past it to the end. Output samples of the
+    /// and while the ground motion is affine in t (records between samples). On open chains each
+    /// single release's opening acceleration at rest is linear in g_eff(t) and, once past its
+    /// threshold inside the interval, stays past it to the end. With loops, the loads a
+    /// structure at rest carries form a convex set (static theorem: an equilibrium with
+    /// compressive contacts exists, a convex condition on the load), so a structure that holds
+    /// at both ends of a segment of g_eff holds along it. Output samples of the
     /// interval are recorded. Returns None (nothing done) unless every tree coordinate is seated.
     pub(super) fn rest_until_uplift(
         &mut self,
@@ -406,8 +415,7 @@ impl Simulation<'_> {
         let mut found = None;
         let mut t0 = self.t;
         while t0 < t_stop {
-            let whole = ground.duration() <= t0
-                || (model.constraint_rows == 0 && ground.is_affine_on(t0, t_stop));
+            let whole = ground.duration() <= t0 || ground.is_affine_on(t0, t_stop);
             let t1 = if whole {
                 t_stop
             } else {

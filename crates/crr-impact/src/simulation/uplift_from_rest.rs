@@ -1,5 +1,5 @@
-//! Uplift of a structure at rest with loops, by Gauss' principle over the pivot sides of its
-//! seated joints.
+//! Uplift of a structure with loops, by Gauss' principle over the pivot sides of its seated
+//! joints (at rest, and in motion with some joints seated).
 //!
 //! At rest (q̇ = 0) the accelerations of a structure whose seated joints may open are the
 //! admissible q̈ nearest to the free one in the kinetic metric (Gauss' principle):
@@ -45,9 +45,9 @@ impl SidesSolution {
 /// Largest number of choices of sides tried in one uplift test.
 const MAX_SIDE_CHOICES: usize = 12;
 
-/// The seated slots that open from rest, with their sides, or None when the structure holds (or
-/// the test does not apply: a singular mass matrix). `tol` is the opening threshold on σψ̈
-/// (rad/s²).
+/// The seated slots that open from rest, with their sides (`Some(Some(mode))`), `Some(None)`
+/// when the structure holds, or None when the test cannot be made (a singular mass matrix).
+/// `tol` is the opening threshold on σψ̈ (rad/s²).
 ///
 /// The sides are searched from the current ones. While the structure holds on them, the next
 /// choice is the one each slot would open on if every seated slot were free (the signs of the
@@ -64,10 +64,10 @@ pub(super) fn opening_from_rest(
     q: &DVector<f64>,
     qdot: &DVector<f64>,
     tol: f64,
-) -> Option<Vec<(usize, Side)>> {
+) -> Option<Option<Vec<(usize, Side)>>> {
     let seated = &template.seated;
     if seated.is_empty() {
-        return None;
+        return Some(None);
     }
     let key = |p: &ActivePivots| -> Vec<bool> {
         seated
@@ -139,24 +139,29 @@ pub(super) fn opening_from_rest(
         }
     }
     if !current.opens(tol) {
-        return None;
+        return Some(None);
     }
     // Every slot the mechanism moves opens, also those whose acceleration is still below the
     // threshold just above the activation (it grows in proportion to the others').
     let largest = current.opening.iter().fold(0.0_f64, |a, &o| a.max(o));
     let floor = tol.min(1e-6 * largest);
-    Some(
+    Some(Some(
         seated
             .iter()
             .zip(&current.opening)
             .filter(|&(_, &o)| o > floor)
             .map(|(&k, _)| (k, sides.sides[k]))
             .collect(),
-    )
+    ))
 }
 
-/// Gauss' principle at rest on the pivot sides `sides`: every seated slot free to open on its
-/// side or stay.
+/// Gauss' principle on the pivot sides `sides`: every seated slot free to open on its side or
+/// stay. In z = Lᵀq̈ the closures read A z = −c (A = Φ_q L⁻ᵀ, c the bias Φ̇_q q̇), so
+/// z = z_p + N y with z_p = −A⁺c; seated slot k reads ψ̈ₖ = gₖᵀz + bₖ (gₖ = L⁻¹sₖ, bₖ its bias),
+/// σₖψ̈ₖ = Gₖᵀy + hₖ. The locked motion y_p (every seated slot held: Gᵀy_p = −h, which exists
+/// whenever the seated state is one the structure can be in) shifts the cone to the origin,
+/// y = y_p + y′ with Gᵀy′ ≥ 0, and the problem is the projection of y_free − y_p onto that cone,
+/// whose dual is the non-negative least-squares problem. At rest c, b, h and y_p vanish.
 #[allow(clippy::too_many_arguments)]
 fn solve_for_sides(
     model: &Model,
@@ -178,16 +183,17 @@ fn solve_for_sides(
     let r = &trial.load - &trial.kin.velocity_product;
     let z_free = l.solve_lower_triangular(&r)?;
     // Closures in z: Φ_q L⁻ᵀ, rows normalised for the rank decision; N its null space.
-    let null = if model.constraint_rows == 0 {
-        DMatrix::identity(n, n)
+    let (null, z_p) = if model.constraint_rows == 0 {
+        (DMatrix::identity(n, n), DVector::zeros(n))
     } else {
-        let lt_inv_t = |row: DVector<f64>| l.solve_lower_triangular(&row);
         let mut a = DMatrix::zeros(model.constraint_rows, n);
+        let mut c = DVector::zeros(model.constraint_rows);
         for i in 0..model.constraint_rows {
-            let row = lt_inv_t(trial.kin.phi_q.row(i).transpose())?;
+            let row = l.solve_lower_triangular(&trial.kin.phi_q.row(i).transpose())?;
             let norm = row.norm();
             if norm > 0.0 {
                 a.row_mut(i).copy_from(&(row / norm).transpose());
+                c[i] = trial.kin.phi_bias[i] / norm;
             }
         }
         let svd = JacobiSvd::new(&a);
@@ -195,30 +201,49 @@ fn solve_for_sides(
         let cols: Vec<usize> = (0..svd.singular_values.len())
             .filter(|&j| svd.singular_values[j] <= tol)
             .collect();
-        DMatrix::from_fn(n, cols.len(), |i, c| svd.v[(i, cols[c])])
+        let null = DMatrix::from_fn(n, cols.len(), |i, k| svd.v[(i, cols[k])]);
+        let z_p = -svd.solve_with(&c, tol);
+        (null, z_p)
     };
     let d = null.ncols();
-    let y_free = null.tr_mul(&z_free);
-    // Gₖ = σₖ Nᵀ L⁻¹ sₖ: ψ̈ₖ = sₖᵀq̈ = (L⁻¹sₖ)ᵀz (no bias at rest).
+    let y_free = null.tr_mul(&(&z_free - &z_p));
     let mut row = DVector::zeros(n);
     let mut g = DMatrix::zeros(d, seated.len());
+    let mut h = DVector::zeros(seated.len());
     for (i, &k) in seated.iter().enumerate() {
-        slot_row(model, &trial.kin, k, &mut row);
+        let bias = slot_row(model, &trial.kin, k, &mut row);
         let gk = l.solve_lower_triangular(&row)?;
-        let col = null.tr_mul(&gk) * sides.sides[k].sign();
-        g.column_mut(i).copy_from(&col);
+        let sign = sides.sides[k].sign();
+        g.column_mut(i).copy_from(&(null.tr_mul(&gk) * sign));
+        h[i] = sign * (gk.dot(&z_p) + bias);
     }
-    let mu = nnls(&g, &(-&y_free));
-    let y = &y_free + &g * &mu;
-    let opening = (0..seated.len()).map(|i| g.column(i).dot(&y)).collect();
+    // The locked motion: Gᵀy_p = −h (least squares; it must be solved exactly).
+    let y_p = if h.amax() == 0.0 {
+        DVector::zeros(d)
+    } else {
+        let (y_p, _) = pinv_solve(&g.transpose(), &(-&h));
+        let residual = (g.tr_mul(&y_p) + &h).amax();
+        if residual > 1e-8 * h.amax().max(1e-12 * y_free.amax()) {
+            return None;
+        }
+        y_p
+    };
+    let target = &y_free - &y_p;
+    let mu = nnls(&g, &(-&target));
+    let y_shift = &target + &g * &mu;
+    let y = &y_p + &y_shift;
+    let opening = (0..seated.len())
+        .map(|i| g.column(i).dot(&y_shift))
+        .collect();
     let free_opening = (0..seated.len())
-        .map(|i| g.column(i).dot(&y_free))
+        .map(|i| g.column(i).dot(&y_free) + h[i])
         .collect();
     let y_load = null.tr_mul(&l.solve_lower_triangular(&trial.ground_force)?);
     let load_opening = (0..seated.len())
         .map(|i| g.column(i).dot(&y_load))
         .collect();
-    let gauss = 0.5 * (&y - &y_free).norm_squared() - 0.5 * y_free.norm_squared();
+    let z = &z_p + &null * &y;
+    let gauss = 0.5 * (&z - &z_free).norm_squared() - 0.5 * z_free.norm_squared();
     Some(SidesSolution {
         gauss,
         mu,
@@ -238,6 +263,8 @@ fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
     let mut passive = vec![false; s];
     let scale = a.norm() * b.norm();
     let w_tol = 1e-13 * scale.max(f64::MIN_POSITIVE);
+    let gram = a.tr_mul(a);
+    let atb = a.tr_mul(b);
     for _ in 0..3 * s + 3 {
         let w = a.tr_mul(&(b - a * &x));
         let Some(j) = (0..s)
@@ -249,8 +276,7 @@ fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
         passive[j] = true;
         for _ in 0..3 * s + 3 {
             let cols: Vec<usize> = (0..s).filter(|&i| passive[i]).collect();
-            let ap = DMatrix::from_fn(a.nrows(), cols.len(), |r, c| a[(r, cols[c])]);
-            let (sp, _) = pinv_solve(&ap, b);
+            let sp = passive_least_squares(a, &gram, &atb, b, &cols);
             if sp.iter().all(|&v| v > 0.0) {
                 x.fill(0.0);
                 for (c, &i) in cols.iter().enumerate() {
@@ -278,6 +304,33 @@ fn nnls(a: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
         }
     }
     x
+}
+
+/// min ‖A_P x − b‖ over the columns `cols` of A: by the Cholesky factor of their Gram matrix
+/// A_PᵀA_P (the passive columns of Lawson–Hanson are independent, and this is the cheap way),
+/// or by the minimum-norm pseudo-inverse when that matrix is singular to round-off.
+fn passive_least_squares(
+    a: &DMatrix<f64>,
+    gram: &DMatrix<f64>,
+    atb: &DVector<f64>,
+    b: &DVector<f64>,
+    cols: &[usize],
+) -> DVector<f64> {
+    let k = cols.len();
+    let sub = DMatrix::from_fn(k, k, |i, j| gram[(cols[i], cols[j])]);
+    let rhs = DVector::from_fn(k, |i, _| atb[cols[i]]);
+    let largest = (0..k).map(|i| sub[(i, i)]).fold(0.0_f64, f64::max);
+    if let Some(chol) = sub.cholesky() {
+        let l = chol.l_dirty();
+        let smallest = (0..k)
+            .map(|i| l[(i, i)] * l[(i, i)])
+            .fold(f64::INFINITY, f64::min);
+        if smallest > 1e-10 * largest {
+            return chol.solve(&rhs);
+        }
+    }
+    let ap = DMatrix::from_fn(a.nrows(), k, |r, c| a[(r, cols[c])]);
+    pinv_solve(&ap, b).0
 }
 
 #[cfg(test)]
