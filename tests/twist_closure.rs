@@ -35,15 +35,16 @@ fn twisting_text() -> String {
     out
 }
 
-/// The bundled baldachin with its three loop-closing tops allowed to twist.
-fn twisting_baldachin() -> Model {
-    let path = common::write_model("baldachin_twist_model", &twisting_text());
+/// The bundled baldachin with its three loop-closing tops allowed to twist, written to a file of
+/// its own per test (`tag`): the tests of this file run in parallel.
+fn twisting_baldachin(tag: &str) -> Model {
+    let path = common::write_model(&format!("baldachin_twist_{tag}"), &twisting_text());
     crr::load_model(&path).unwrap().1
 }
 
 #[test]
 fn the_tilts_of_a_twisting_base_are_those_of_its_face_normal() {
-    let m = twisting_baldachin();
+    let m = twisting_baldachin("angles");
     let k = m.interfaces.iter().position(|i| i.name == "top_2").unwrap();
     let kind = &m.interfaces[k].kind;
     let InterfaceKind::RockingBase {
@@ -82,7 +83,7 @@ fn the_tilts_of_a_twisting_base_are_those_of_its_face_normal() {
 /// second difference).
 #[test]
 fn slot_rows_are_the_derivatives_of_the_twisting_tilts() {
-    let m = twisting_baldachin();
+    let m = twisting_baldachin("rows");
     let n = m.dof();
     let ground = GroundMotion::none();
     let mut rng = 0x2545F4914F6CDD1Du64;
@@ -180,14 +181,14 @@ fn a_tree_interface_cannot_twist() {
 /// constraints, angles and slot rows inside the whole simulation.
 #[test]
 fn the_twisting_baldachin_moves_as_the_rigid_one() {
-    let m = twisting_baldachin();
+    let m = twisting_baldachin("finite");
     let zero = DVector::zeros(m.dof());
     let rest = mobility(&m, &zero, &ActivePivots::uniform(&m, Side::Positive));
     let finite = mobility_after_step(&m, 0.01).unwrap();
     assert_eq!((rest.dof2, finite.dof2), (2, 2));
     let rigid_text = common::bundled_text("baldachin");
     let (_, rigid) = common::run_model_text("baldachin_rigid", &rigid_text, None);
-    let twist_path = common::write_model("baldachin_twist", &twisting_text());
+    let twist_path = common::write_model("baldachin_twist_run", &twisting_text());
     let opts = crr::simulate::SimulateOptions::default();
     let p = crr::simulate::prepare(&twist_path, &opts).unwrap();
     let twisting = crr::simulate::run(&p, false).unwrap().trajectory;

@@ -404,17 +404,8 @@ pub fn slot_row(model: &Model, kin: &Data, slot: usize, row: &mut DVector<f64>) 
         model.frame_of(iface.parent),
         Some(model.body_coord[iface.child]),
     );
-    let rot = |k: Option<usize>| k.map_or_else(nalgebra::Matrix3::identity, |k| kin.rot_ops[k]);
-    let ang = |k: Option<usize>, part: usize| -> Vector3<f64> {
-        k.map_or_else(Vector3::zeros, |k| {
-            let v = if part == 0 {
-                &kin.spatial_velocity[k]
-            } else {
-                &kin.bias_acceleration[k]
-            };
-            Vector3::new(v[0], v[1], v[2])
-        })
-    };
+    let rot = |k: Option<usize>| frame_rotation(kin, k);
+    let ang = |k: Option<usize>, part: usize| frame_angular(kin, k, part);
     if let crr_kinematics::InterfaceKind::RockingBase {
         normal,
         e1,
@@ -448,6 +439,24 @@ pub fn slot_row(model: &Model, kin: &Data, slot: usize, row: &mut DVector<f64>) 
     w.dot(&(ang(b, 1) - ang(a, 1))) + (wb - wa).dot(&w_dot)
 }
 
+/// The rotation Γ of frame `k` (the identity for the ground, `None`).
+fn frame_rotation(kin: &Data, k: Option<usize>) -> nalgebra::Matrix3<f64> {
+    k.map_or_else(nalgebra::Matrix3::identity, |k| kin.rot_ops[k])
+}
+
+/// The angular part of frame `k`'s spatial velocity (`part` 0) or bias acceleration (`part` 1),
+/// world axes; zero for the ground (`None`).
+fn frame_angular(kin: &Data, k: Option<usize>, part: usize) -> Vector3<f64> {
+    k.map_or_else(Vector3::zeros, |k| {
+        let v = if part == 0 {
+            &kin.spatial_velocity[k]
+        } else {
+            &kin.bias_acceleration[k]
+        };
+        Vector3::new(v[0], v[1], v[2])
+    })
+}
+
 /// [`slot_row`] of a closure tilt of a rocking base that may twist: the tilts are those of the
 /// child's face normal m = Γ_B n seen from the parent, θ₁ = atan2(u, v) with u = −(Γ_A e₂)·m,
 /// v = (Γ_A n)·m, and θ₂ = asin((Γ_A e₁)·m). With Ω = ω_B − ω_A (world), ṁ = ω_B × m and the
@@ -462,17 +471,8 @@ fn twisting_tilt_row(
     component: usize,
     row: &mut DVector<f64>,
 ) -> f64 {
-    let rot = |k: Option<usize>| k.map_or_else(nalgebra::Matrix3::identity, |k| kin.rot_ops[k]);
-    let ang = |k: Option<usize>, part: usize| -> Vector3<f64> {
-        k.map_or_else(Vector3::zeros, |k| {
-            let v = if part == 0 {
-                &kin.spatial_velocity[k]
-            } else {
-                &kin.bias_acceleration[k]
-            };
-            Vector3::new(v[0], v[1], v[2])
-        })
-    };
+    let rot = |k: Option<usize>| frame_rotation(kin, k);
+    let ang = |k: Option<usize>, part: usize| frame_angular(kin, k, part);
     let (ra, rb) = (rot(a), rot(b));
     let (wa, wb) = (ang(a, 0), ang(b, 0));
     let m = rb * normal;
