@@ -16,6 +16,9 @@ use crr::synthetic;
 fn main() -> std::io::Result<()> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(synthetic::FILE);
     synthetic::write_at2(&path)?;
+    let path_y = Path::new(env!("CARGO_MANIFEST_DIR")).join(synthetic::FILE_Y);
+    synthetic::write_at2_with_seed(&path_y, synthetic::SEED_Y)?;
+    println!("wrote {} (seed {:#X})", path_y.display(), synthetic::SEED_Y);
     let a = synthetic::accelerogram();
     let g = crr::dynamics::ground_motion::STANDARD_GRAVITY;
     let v_end: f64 = a

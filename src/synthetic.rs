@@ -48,6 +48,11 @@ pub const SMOOTHING_WIDTH: usize = 5;
 pub const SMOOTHING_PASSES: usize = 4;
 /// Path of the bundled file, relative to the repository root.
 pub const FILE: &str = "examples/records/synthetic.AT2";
+/// The seed of the second horizontal component, [`FILE_Y`] (the temple's y component): the same
+/// procedure as [`FILE`], another white noise.
+pub const SEED_Y: u64 = 0x0C22_5EED_2026;
+/// The second horizontal component written by `cargo run --example make_record`.
+pub const FILE_Y: &str = "examples/records/synthetic_y.AT2";
 
 /// The envelope e(t): linear rise to 1 at 2 s, 1 until 10 s, exponential decay after.
 pub fn envelope(t: f64) -> f64 {
@@ -145,10 +150,16 @@ pub fn fortran_e(v: f64) -> String {
 
 /// The complete `.AT2` text of the bundled record (4 header lines, then 5 values per line).
 pub fn at2_text() -> String {
-    let a = accelerogram();
+    at2_text_with_seed(SEED)
+}
+
+/// The `.AT2` text of the record of `seed` ([`accelerogram_with_seed`]): [`at2_text`] for
+/// [`SEED`], the second component [`FILE_Y`] for [`SEED_Y`].
+pub fn at2_text_with_seed(seed: u64) -> String {
+    let a = accelerogram_with_seed(seed);
     let mut out = String::new();
     out.push_str(&format!(
-        "SYNTHETIC ACCELEROGRAM, NOT A REAL RECORD: crr::synthetic, SEED {SEED:#X}, \
+        "SYNTHETIC ACCELEROGRAM, NOT A REAL RECORD: crr::synthetic, SEED {seed:#X}, \
          cargo run --example make_record\n"
     ));
     out.push_str(&format!(
@@ -173,8 +184,13 @@ pub fn at2_text() -> String {
 
 /// Writes [`at2_text`] to `path`, creating its folder.
 pub fn write_at2(path: &std::path::Path) -> std::io::Result<()> {
+    write_at2_with_seed(path, SEED)
+}
+
+/// Writes [`at2_text_with_seed`] to `path`, creating its folder.
+pub fn write_at2_with_seed(path: &std::path::Path, seed: u64) -> std::io::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    std::fs::write(path, at2_text())
+    std::fs::write(path, at2_text_with_seed(seed))
 }

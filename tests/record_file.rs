@@ -58,3 +58,30 @@ fn band_limit_and_envelope_are_as_documented() {
     assert_eq!(synthetic::fortran_e(0.25), "  .2500000E+00");
     assert_eq!(synthetic::fortran_e(0.0), "  .0000000E+00");
 }
+
+/// The second horizontal component (`synthetic_y.AT2`, the temple's y): the same procedure with
+/// another seed, byte-identical to what `cargo run --example make_record` writes, PGA 0.25 g,
+/// and another signal than the first component.
+#[test]
+fn the_second_component_regenerates_and_differs() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(synthetic::FILE_Y);
+    let committed = std::fs::read_to_string(&path).expect("the second component exists");
+    assert!(
+        committed == synthetic::at2_text_with_seed(synthetic::SEED_Y),
+        "{} differs; regenerate with `cargo run --example make_record`",
+        synthetic::FILE_Y
+    );
+    let a = synthetic::accelerogram_with_seed(synthetic::SEED_Y);
+    let peak = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!((peak - synthetic::PGA_G).abs() < 1e-15);
+    let b = synthetic::accelerogram();
+    let diff = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        diff > 0.1 * synthetic::PGA_G,
+        "the components differ by {diff} g at most"
+    );
+}

@@ -199,7 +199,7 @@ struct RowSelection {
 
 /// Number of seated sets whose row selections [`Dynamics`] keeps: the integration's set, and
 /// the uplift test's single releases (two per seated slot, one per side) and active sets.
-const SELECTION_CACHE: usize = 32;
+const SELECTION_CACHE: usize = 256;
 
 /// Largest ‖R_D‖_F/‖B‖_F accepted by the solve on selected rows, R_D the part of the rows not
 /// selected outside the span of the selected ones. Redundant closures that are exactly closed

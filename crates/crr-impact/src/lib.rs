@@ -41,6 +41,7 @@
 
 pub mod laws;
 pub mod monitor;
+pub mod nnls;
 pub mod simulation;
 
 pub use simulation::{

@@ -9,12 +9,13 @@
 //! with two pivot lines n ∝ u × (P⁻ − P⁺); for a rocking base its normal), rotated with the parent.
 //! Plain hinges (one pivot line) are joints that can hold tension and are not monitored.
 
-use nalgebra::{DVector, Vector3, Vector6};
+use nalgebra::{DMatrix, DVector, Vector3, Vector6};
 use serde::Serialize;
 
 use crr_dynamics::DynamicsError;
-use crr_dynamics::eom::{Dynamics, effective_gravity};
+use crr_dynamics::eom::{Dynamics, effective_gravity, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
+use crr_dynamics::linalg::JacobiSvd;
 use crr_kinematics::{InterfaceKind, Model, Role};
 
 /// The force a contact transmits to its child side.
@@ -116,15 +117,42 @@ pub fn contact_forces(
             (a_c - g_eff) * body.mass
         })
         .collect();
-    // Closure point forces: λ on the parent side, −λ on the child side.
+    Ok(interface_forces(model, kin, &body_force, &dynamics.lambda)
+        .into_iter()
+        .map(|f| {
+            f.map(|(force, normal)| {
+                let nf = force.dot(&normal);
+                ContactForce {
+                    force: force.into(),
+                    normal: nf,
+                    tangential: (force - normal * nf).norm(),
+                }
+            })
+        })
+        .collect())
+}
+
+/// The force each monitored interface transmits to its child side, with its contact normal
+/// (world axes), from the bodies' net forces beyond their loads (`body_force`) and the closure
+/// multipliers `lambda` (the point force λ of a closure acts on its parent side, −λ on its
+/// child side); None for plain hinges.
+fn interface_forces(
+    model: &Model,
+    kin: &crr_kinematics::Data,
+    body_force: &[Vector3<f64>],
+    lambda: &DVector<f64>,
+) -> Vec<Option<(Vector3<f64>, Vector3<f64>)>> {
+    let point_force = |first_row: usize| {
+        Vector3::new(
+            lambda[first_row],
+            lambda[first_row + 1],
+            lambda[first_row + 2],
+        )
+    };
     let mut closure_on: Vec<(Option<usize>, Vector3<f64>)> = Vec::new();
     for cl in &model.closures {
         let iface = &model.interfaces[cl.interface];
-        let lam = Vector3::new(
-            dynamics.lambda[cl.first_row],
-            dynamics.lambda[cl.first_row + 1],
-            dynamics.lambda[cl.first_row + 2],
-        );
+        let lam = point_force(cl.first_row);
         closure_on.push((model.frame_of(iface.parent), lam));
         closure_on.push((Some(model.body_coord[iface.child]), -lam));
     }
@@ -138,7 +166,7 @@ pub fn contact_forces(
         }
         false
     };
-    let out = model
+    model
         .interfaces
         .iter()
         .map(|iface| {
@@ -162,24 +190,68 @@ pub fn contact_forces(
                     }
                     f
                 }
-                Role::Closure { index } => {
-                    let cl = &model.closures[index];
-                    -Vector3::new(
-                        dynamics.lambda[cl.first_row],
-                        dynamics.lambda[cl.first_row + 1],
-                        dynamics.lambda[cl.first_row + 2],
-                    )
-                }
+                Role::Closure { index } => -point_force(model.closures[index].first_row),
             };
-            let nf = force.dot(&normal);
-            Some(ContactForce {
-                force: force.into(),
-                normal: nf,
-                tangential: (force - normal * nf).norm(),
-            })
+            Some((force, normal))
         })
-        .collect();
-    Ok(out)
+        .collect()
+}
+
+/// How the monitored interfaces' normal forces change along the self-stress states of a
+/// hyperstatic structure (None when it has none, or no loops): column j holds the change of
+/// every normal force (rows in interface order, 0 for plain hinges) under the j-th state.
+///
+/// A structure whose loops and seated joints hold it more times than its motion needs (a bay of
+/// columns under one entablature, an arch at rest) has multipliers λ that the motion does not
+/// determine: any λ + K ν with Bᵀ K = 0, B the rows of the closures and the seated slots, gives
+/// the same accelerations. The solver returns the least-norm λ, one distribution among them; a
+/// tension in it is no flight if another distribution is compressive ([`check`]).
+pub fn self_stress_normals(model: &Model, dynamics: &Dynamics) -> Option<DMatrix<f64>> {
+    if model.constraint_rows == 0 {
+        return None;
+    }
+    let kin = &dynamics.kin;
+    let n = model.dof();
+    let rows = model.constraint_rows + dynamics.seated.len();
+    // Rows normalised for the rank decision (B' = S B); λ = S λ' maps the null space back.
+    let mut bt = DMatrix::zeros(n, rows);
+    let mut scale = vec![0.0; rows];
+    let mut row = DVector::zeros(n);
+    for i in 0..rows {
+        if i < model.constraint_rows {
+            row.copy_from(&kin.phi_q.row(i).transpose());
+        } else {
+            slot_row(
+                model,
+                kin,
+                dynamics.seated[i - model.constraint_rows],
+                &mut row,
+            );
+        }
+        let norm = row.norm();
+        if norm > 0.0 {
+            scale[i] = 1.0 / norm;
+            bt.column_mut(i).copy_from(&(&row * scale[i]));
+        }
+    }
+    let states = JacobiSvd::new(&bt).null_space();
+    if states.ncols() == 0 {
+        return None;
+    }
+    let zero = vec![Vector3::zeros(); model.bodies.len()];
+    let mut d = DMatrix::zeros(model.interfaces.len(), states.ncols());
+    for j in 0..states.ncols() {
+        let lambda = DVector::from_fn(model.constraint_rows, |i, _| states[(i, j)] * scale[i]);
+        for (i, f) in interface_forces(model, kin, &zero, &lambda)
+            .into_iter()
+            .enumerate()
+        {
+            if let Some((force, normal)) = f {
+                d[(i, j)] = force.dot(&normal);
+            }
+        }
+    }
+    Some(d)
 }
 
 /// A pivot's normal force counts as tension (flight) below −TENSION_TOLERANCE W, W the
@@ -191,13 +263,48 @@ pub const TENSION_TOLERANCE: f64 = 1e-3;
 
 /// The first violation among the given contact forces at time t (tension first, then sliding
 /// when μ is given). A tension smaller than `tolerance` (N) is round-off, not flight.
+///
+/// With `self_stress` ([`self_stress_normals`]) a tension counts only if no distribution of the
+/// hyperstatic forces is compressive: the nearest change ν of the least-norm one with every
+/// normal force N + Dν ≥ −tolerance/2 is sought by least-distance programming, and when it
+/// exists the normal forces are those of N + Dν (the tangential ones are kept).
 pub fn check(
     model: &Model,
     forces: &[Option<ContactForce>],
+    self_stress: Option<&DMatrix<f64>>,
     t: f64,
     friction: Option<f64>,
     tolerance: f64,
 ) -> Option<Violation> {
+    let tension = forces
+        .iter()
+        .any(|f| f.is_some_and(|f| f.normal < -tolerance));
+    let adjusted;
+    let forces = match self_stress {
+        Some(d) if tension => {
+            let monitored: Vec<usize> =
+                (0..forces.len()).filter(|&i| forces[i].is_some()).collect();
+            let g = DMatrix::from_fn(monitored.len(), d.ncols(), |r, c| d[(monitored[r], c)]);
+            let h = DVector::from_fn(monitored.len(), |r, _| {
+                -0.5 * tolerance - forces[monitored[r]].map_or(0.0, |f| f.normal)
+            });
+            match crate::nnls::least_distance(&g, &h) {
+                Some(nu) => {
+                    let dn = &g * nu;
+                    let mut out = forces.to_vec();
+                    for (r, &i) in monitored.iter().enumerate() {
+                        if let Some(f) = &mut out[i] {
+                            f.normal += dn[r];
+                        }
+                    }
+                    adjusted = out;
+                    &adjusted[..]
+                }
+                None => forces,
+            }
+        }
+        _ => forces,
+    };
     for (i, f) in forces.iter().enumerate() {
         let Some(f) = f else { continue };
         if f.normal < -tolerance {

@@ -281,11 +281,15 @@ impl Simulation<'_> {
         let n = model.dof();
         self.y[..n].copy_from_slice(q_new.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
-        let post = self.sample_at(t, &self.y.clone());
-        self.record_sample(post);
         self.impacts.push(record);
         self.reset_solver();
-        self.release_if_opening()?;
+        // The joints that open right after the impact open before the post-impact sample, so
+        // that its contact forces are those of the motion that follows (with the impact's
+        // mode alone, a joint that must open at once shows a spurious tension).
+        let released = self.release_if_opening();
+        let post = self.sample_at(t, &self.y.clone());
+        self.record_sample(post);
+        released?;
         Ok(self.impacts.len() - 1)
     }
 }
