@@ -263,3 +263,129 @@ fn self_stress_moves_forces_between_columns_only() {
         }
     }
 }
+
+/// `[x, y, z]` in TOML.
+fn pt(x: f64, y: f64, z: f64) -> String {
+    format!("[{x:?}, {y:?}, {z:?}]")
+}
+
+/// A rectangle [x0, x1] × [y0, y1] at height z, its first edge along +y (`y_first`) or +x.
+fn rect(x0: f64, x1: f64, y0: f64, y1: f64, z: f64, y_first: bool) -> String {
+    let c = if y_first {
+        [(x0, y0), (x0, y1), (x1, y1), (x1, y0)]
+    } else {
+        [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    };
+    let c: Vec<String> = c.iter().map(|&(x, y)| pt(x, y, z)).collect();
+    format!("[{}]", c.join(", "))
+}
+
+/// The columns of the bundled temple under separate architraves instead of the entablature:
+/// along x, one per span and row (axis to axis, 2.6 × 1.1 × 0.7 m) resting on half of each
+/// abacus it meets; along y, one at each end (0.55 × 3.7 × 0.7 m) on the outer halves of the
+/// corner capitals. The second seat of each closes a loop (6 loops) and may twist.
+fn temple_with_architraves() -> String {
+    let text = common::bundled_text("temple");
+    let head = &text[..text.find("[ground_motion]").unwrap()];
+    let mut blocks: Vec<String> = head
+        .split("\n\n")
+        .filter(|b| !b.contains("name = \"entablature"))
+        .map(str::to_string)
+        .collect();
+    let (xs, ys) = ([-2.6, 0.0, 2.6], [-1.3, 1.3]);
+    let (h, z, height) = (0.55, 4.35, 0.7);
+    let mut seats = Vec::new();
+    for (i, &y) in ys.iter().enumerate() {
+        for k in 0..2 {
+            let name = format!("architrave_{}{}", i + 1, k + 1);
+            let (x0, x1) = (xs[k], xs[k + 1]);
+            blocks.push(format!(
+                "[[body]]\nname = \"{name}\"\ndensity = 2500.0\nbox = {{ center = {}, size = [{:?}, 1.1, 0.7] }}",
+                pt((x0 + x1) / 2.0, y, z + height / 2.0),
+                x1 - x0
+            ));
+            for (j, second) in [(k, false), (k + 1, true)] {
+                let (lo, hi) = (x0.max(xs[j] - h), x1.min(xs[j] + h));
+                seats.push(format!(
+                    "[[interface]]\nname = \"{name}_on_c{}{}\"\nparent = \"c{}{}_capital\"\nchild = \"{name}\"\nrocking_base = {{ corners = {}{} }}",
+                    i + 1, j + 1, i + 1, j + 1,
+                    rect(lo, hi, y - h, y + h, z, true),
+                    if second { ", twist = true" } else { "" }
+                ));
+            }
+        }
+    }
+    for j in [0, 2] {
+        let name = format!("end_architrave_{}", j + 1);
+        let (x0, x1) = if j == 0 {
+            (xs[j] - h, xs[j])
+        } else {
+            (xs[j], xs[j] + h)
+        };
+        blocks.push(format!(
+            "[[body]]\nname = \"{name}\"\ndensity = 2500.0\nbox = {{ center = {}, size = [{h:?}, 3.7, 0.7] }}",
+            pt((x0 + x1) / 2.0, 0.0, z + height / 2.0)
+        ));
+        for (i, &y) in ys.iter().enumerate() {
+            seats.push(format!(
+                "[[interface]]\nname = \"{name}_on_c{}{}\"\nparent = \"c{}{}_capital\"\nchild = \"{name}\"\nrocking_base = {{ corners = {}{} }}",
+                i + 1, j + 1, i + 1, j + 1,
+                rect(x0, x1, y - h, y + h, z, false),
+                if i == 1 { ", twist = true" } else { "" }
+            ));
+        }
+    }
+    blocks.extend(seats);
+    blocks.join("\n\n") + "\n"
+}
+
+/// With separate architraves the bay has a mechanism below the frame rule along ±y: each row
+/// (three columns and its two architraves) rocks as one wall about its base edges, the end
+/// architraves translating on the walls' tops and pivoting on the corner capitals' −y edges
+/// (the side that rises when a capital tips towards +y). Kinematic theorem, the walls turning by
+/// δθ about the line y = y_row + b: every wall mass m at height z does λ m g z δθ and rises by
+/// b δθ; the end architraves (mass m_e) move with their seats, 4.35 δθ across and (b + 0.55) δθ
+/// up: λ = (b Σm + (b + 0.55) m_e) / (Σ m z + 4.35 m_e). Along +y and −y alike (the bay is
+/// symmetric about y = 0): the local search from the current sides alone found it along −y
+/// only (0.116 and 0.163), the search from three starts finds it along both.
+#[test]
+fn separate_architraves_rock_as_walls_along_y() {
+    let path = common::write_model("temple_architraves", &temple_with_architraves());
+    let (_, model) = crr::load_model(&path).unwrap();
+    assert_eq!(model.closures.len(), 6);
+    let b = R / 2f64.sqrt();
+    let rho = 2500.0;
+    let drum = rho * 0.5 * 16.0 * R * R * (2.0 * std::f64::consts::PI / 16.0).sin() * H_DRUM;
+    let capital = rho * 1.1 * 1.1 * 0.45;
+    let architrave = rho * 2.6 * 1.1 * 0.7;
+    let end = rho * 0.55 * 3.7 * 0.7;
+    // Two walls: 9 drums, 3 capitals, 2 architraves each.
+    let m_walls = 2.0 * (9.0 * drum + 3.0 * capital + 2.0 * architrave);
+    let mz_walls =
+        2.0 * (3.0 * drum * (0.65 + 1.95 + 3.25) + 3.0 * capital * 4.125 + 2.0 * architrave * 4.7);
+    let m_e = 2.0 * end;
+    let expected = (b * m_walls + (b + 0.55) * m_e) / (mz_walls + 4.35 * m_e);
+    for d in [nalgebra::Vector3::y(), -nalgebra::Vector3::y()] {
+        let s = crr::static_multiplier::static_multiplier(&model, d).unwrap();
+        let l = s.lambda.expect("it opens");
+        assert!(
+            (l - expected).abs() <= 1e-8 * expected,
+            "d = {d:?}: λ = {l} against {expected}, opening {:?}",
+            s.opening
+        );
+        for r in 1..=2 {
+            for c in 1..=3 {
+                assert!(
+                    s.opening.contains_key(&format!("c{r}{c}_bed_1.1")),
+                    "{:?}",
+                    s.opening
+                );
+            }
+        }
+        assert!(
+            !s.opening.keys().any(|k| k.contains("neck")),
+            "{:?}",
+            s.opening
+        );
+    }
+}

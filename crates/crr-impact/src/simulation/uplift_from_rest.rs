@@ -48,18 +48,20 @@ impl SidesSolution {
 /// solve, not motion (the threshold is 1e-9 g/L; round-off is some 1e-14 g/L).
 const ROUND_OFF_OPENING: f64 = 1e-2;
 
-/// Largest number of choices of sides tried in one uplift test.
+/// Largest number of choices of sides tried from one start of the search.
 const MAX_SIDE_CHOICES: usize = 12;
 
 /// The seated slots that open from rest, with their sides (`Some(Some(mode))`), `Some(None)`
 /// when the structure holds, or None when the test cannot be made (a singular mass matrix).
 /// `tol` is the opening threshold on σψ̈ (rad/s²).
 ///
-/// The sides are searched from the current ones. While the structure holds on them, the next
-/// choice is the one each slot would open on if every seated slot were free (the signs of the
-/// unconstrained accelerations), then the slots that push on their seat (μₖ > 0) flipped one at
-/// a time and all together; the first choice on which it opens is kept, and improved by the same
-/// flips while the Gauss function decreases. At most [`MAX_SIDE_CHOICES`] choices are solved.
+/// The sides are searched locally from three starts in turn: the current sides, every seated
+/// slot on its positive side, every one on its negative side. From a start, while the structure
+/// holds, the next choice is the one each slot would open on if every seated slot were free (the
+/// signs of the unconstrained accelerations), then the slots that push on their seat (μₖ > 0)
+/// flipped one at a time and all together; the first choice on which it opens is kept, and
+/// improved by the same flips while the Gauss function decreases. At most [`MAX_SIDE_CHOICES`]
+/// choices are solved from each start; the first start on which the structure opens decides.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn opening_from_rest(
     model: &Model,
@@ -81,9 +83,90 @@ pub(super) fn opening_from_rest(
             .map(|&k| p.sides[k] == Side::Positive)
             .collect()
     };
-    let mut sides = template.pivots.clone();
+    // Starts of the local search: the current sides, then every seated slot on its positive
+    // side, then on its negative one (a structure that is symmetric in fact need not be in its
+    // coordinates, and the search from one start can miss the mirror image of a mechanism that it
+    // finds from another). The first start on which the structure opens is kept.
+    let mut starts = vec![template.pivots.clone()];
+    for side in [Side::Positive, Side::Negative] {
+        let mut p = template.pivots.clone();
+        for &k in seated {
+            p.sides[k] = side;
+        }
+        starts.push(p);
+    }
+    let mut visited: Vec<Vec<bool>> = Vec::new();
+    let mut best: Option<(ActivePivots, SidesSolution)> = None;
+    for start in starts {
+        if visited.contains(&key(&start)) {
+            continue;
+        }
+        let Some(found) = local_search(
+            model,
+            ground,
+            trial,
+            t,
+            q,
+            qdot,
+            tol,
+            seated,
+            start,
+            &mut visited,
+        ) else {
+            continue;
+        };
+        let opens = found.1.opens(tol);
+        best = Some(found);
+        if opens {
+            break;
+        }
+    }
+    let (sides, current) = best?;
+    if !current.opens(tol) {
+        return Some(None);
+    }
+    // Every slot the mechanism moves opens, also those whose acceleration is still below the
+    // threshold just above the activation (it grows in proportion to the others'), but not
+    // those at the round-off of the solve: at the located uplift instant the mechanism's
+    // accelerations are about `tol` and the slots it does not move show some 1e-14 g/L (a
+    // temple's drum beds), which must not open them.
+    let largest = current.opening.iter().fold(0.0_f64, |a, &o| a.max(o));
+    let floor = (ROUND_OFF_OPENING * tol).max(tol.min(1e-6 * largest));
+    Some(Some(
+        seated
+            .iter()
+            .zip(&current.opening)
+            .filter(|&(_, &o)| o > floor)
+            .map(|(&k, _)| (k, sides.sides[k]))
+            .collect(),
+    ))
+}
+
+/// The local search of [`opening_from_rest`] from the sides `start`: returns the last choice
+/// reached with its solution (None if its first solve fails). `visited` holds the choices
+/// solved so far, over every start.
+#[allow(clippy::too_many_arguments)]
+fn local_search(
+    model: &Model,
+    ground: &GroundMotion,
+    trial: &mut Dynamics,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    tol: f64,
+    seated: &[usize],
+    start: ActivePivots,
+    visited: &mut Vec<Vec<bool>>,
+) -> Option<(ActivePivots, SidesSolution)> {
+    let key = |p: &ActivePivots| -> Vec<bool> {
+        seated
+            .iter()
+            .map(|&k| p.sides[k] == Side::Positive)
+            .collect()
+    };
+    let mut sides = start;
     let mut current = solve_for_sides(model, ground, trial, &sides, seated, t, q, qdot)?;
-    let mut visited = vec![key(&sides)];
+    visited.push(key(&sides));
     let mut solved = 1;
     while solved < MAX_SIDE_CHOICES {
         let opens = current.opens(tol);
@@ -144,24 +227,7 @@ pub(super) fn opening_from_rest(
             break;
         }
     }
-    if !current.opens(tol) {
-        return Some(None);
-    }
-    // Every slot the mechanism moves opens, also those whose acceleration is still below the
-    // threshold just above the activation (it grows in proportion to the others'), but not
-    // those at the round-off of the solve: at the located uplift instant the mechanism's
-    // accelerations are about `tol` and the slots it does not move show some 1e-14 g/L (a
-    // temple's drum beds), which must not open them.
-    let largest = current.opening.iter().fold(0.0_f64, |a, &o| a.max(o));
-    let floor = (ROUND_OFF_OPENING * tol).max(tol.min(1e-6 * largest));
-    Some(Some(
-        seated
-            .iter()
-            .zip(&current.opening)
-            .filter(|&(_, &o)| o > floor)
-            .map(|(&k, _)| (k, sides.sides[k]))
-            .collect(),
-    ))
+    Some((sides, current))
 }
 
 /// Gauss' principle on the pivot sides `sides`: every seated slot free to open on its side or
