@@ -169,3 +169,49 @@ fn trilithon_reactions_balance_the_weight() {
             .all(|i| normal(i) > 0.0)
     );
 }
+
+/// The hyperstatic rule of `monitor::check`: a tension in the given (least-norm) forces is a
+/// violation only if no self-stress state makes every normal force ≥ −tolerance/2. On the
+/// trilithon's four monitored joints (two column bases, two lintel seats), one synthetic
+/// self-stress state moving force from the first joint to the second: N = (−3, 5, 10, 10) kN is
+/// made compressive by moving 3 to 5 kN (no violation), N = (−10, 5, 10, 10) kN is not (moving
+/// 10 would leave −5: the tension is reported on the first joint, with its least-norm N).
+#[test]
+fn hyperstatic_tension_needs_no_compressive_distribution() {
+    use crr_impact::monitor::{ContactForce, check};
+    use nalgebra::DMatrix;
+    let model = Model::from_spec(&crr_kinematics::fixtures::trilithon(
+        0.25, 1.5, 2.0, 0.5, 1.0,
+    ))
+    .unwrap();
+    let monitored = model.interfaces.len();
+    assert_eq!(monitored, 4);
+    let forces = |n: [f64; 4]| -> Vec<Option<ContactForce>> {
+        n.iter()
+            .map(|&normal| {
+                Some(ContactForce {
+                    force: [0.0, 0.0, normal],
+                    normal,
+                    tangential: 0.0,
+                })
+            })
+            .collect()
+    };
+    let mut d = DMatrix::zeros(monitored, 1);
+    d[(0, 0)] = 1.0;
+    d[(1, 0)] = -1.0;
+    let tol = 1.0;
+    let fixable = forces([-3e3, 5e3, 1e4, 1e4]);
+    assert!(check(&model, &fixable, None, 0.0, None, tol).is_some());
+    assert_eq!(check(&model, &fixable, Some(&d), 0.0, None, tol), None);
+    let hopeless = forces([-1e4, 5e3, 1e4, 1e4]);
+    let v = check(&model, &hopeless, Some(&d), 0.0, None, tol).expect("tension");
+    assert_eq!(
+        (v.kind.as_str(), v.interface.as_str()),
+        ("tension", model.interfaces[0].name.as_str())
+    );
+    assert_eq!(v.normal, -1e4);
+    // A state that moves no force at all changes nothing.
+    let none = DMatrix::zeros(monitored, 1);
+    assert!(check(&model, &fixable, Some(&none), 0.0, None, tol).is_some());
+}

@@ -288,7 +288,10 @@ fn releases_that_may_open(
 ) -> Option<Vec<bool>> {
     let n = model.dof();
     let seated = &template.seated;
-    if model.constraint_rows != 0 || seated.iter().any(|&k| k >= n) {
+    if model.constraint_rows != 0 {
+        return loop_releases_that_may_open(model, ground, template, trial, t, q, qdot);
+    }
+    if seated.iter().any(|&k| k >= n) {
         return None;
     }
     // Seated coordinates sit at q = 0, q̇ = 0 up to round-off (the projections leave ~1e-16):
@@ -332,6 +335,42 @@ fn releases_that_may_open(
         let arm = (pivot - trial.kin.pivot[k]).cross(&trial.kin.axis[k]);
         let r_other = r + arm.dot(&f.fixed_rows::<3>(3));
         may_open[index(other)] = -other.sign() * r_other > 0.0;
+    }
+    Some(may_open)
+}
+
+/// [`releases_that_may_open`] on a structure with loops, for the releases on the current sides
+/// (those on the other sides are all solved).
+///
+/// With every seated slot held, the seated rows and the closure rows B carry multipliers with
+/// M q̈ = Q + Bᵀλ. Releasing seated slot k alone removes its row bₖ. If bₖ is in the span of the
+/// other rows the motion does not change and the release cannot open. Otherwise every λ that
+/// solves the locked problem has the same component λₖ (a self-stress state ν, Bᵀν = 0, has
+/// νₖ = 0, or bₖ would be a combination of the others), and the release changes q̈ along the
+/// one new direction d of the admissible accelerations, d the part of M⁻¹bₖ M-orthogonal to the
+/// other rows' span, so that the released slot's acceleration is bₖ·Δq̈ = −λₖ (bₖ·d) with
+/// bₖ·d > 0: it opens on its side σ only if −σλₖ > 0, whichever solution of the locked problem
+/// gave λ. Reactions within 1e-9 of the largest of the closing sign are solved all the same
+/// (round-off of a near-dependent row), so no release that opens is skipped.
+fn loop_releases_that_may_open(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<Vec<bool>> {
+    let seated = &template.seated;
+    trial.pivots.clone_from(&template.pivots);
+    trial.seated.clone_from(seated);
+    trial.accelerations(model, ground, t, q, qdot).ok()?;
+    let margin = 1e-9 * trial.seat_reactions.amax();
+    let mut may_open = vec![true; 2 * seated.len()];
+    for (i, &k) in seated.iter().enumerate() {
+        let side = template.pivots.sides[k];
+        let r = trial.seat_reactions[i];
+        may_open[2 * i + usize::from(side == Side::Negative)] = -side.sign() * r > -margin;
     }
     Some(may_open)
 }
