@@ -267,7 +267,9 @@ pub const TENSION_TOLERANCE: f64 = 1e-3;
 /// With `self_stress` ([`self_stress_normals`]) a tension counts only if no distribution of the
 /// hyperstatic forces is compressive: the nearest change ν of the least-norm one with every
 /// normal force N + Dν ≥ −tolerance/2 is sought by least-distance programming, and when it
-/// exists the normal forces are those of N + Dν (the tangential ones are kept).
+/// exists the tests read the normal forces of N + Dν; the sliding test keeps the given tangential
+/// forces (the self-stress states' tangential parts are not sought: their friction demand is an
+/// estimate, only made when the least-norm forces show a tension).
 pub fn check(
     model: &Model,
     forces: &[Option<ContactForce>],
@@ -279,51 +281,40 @@ pub fn check(
     let tension = forces
         .iter()
         .any(|f| f.is_some_and(|f| f.normal < -tolerance));
-    let adjusted;
-    let forces = match self_stress {
-        Some(d) if tension => {
-            let monitored: Vec<usize> =
-                (0..forces.len()).filter(|&i| forces[i].is_some()).collect();
-            let g = DMatrix::from_fn(monitored.len(), d.ncols(), |r, c| d[(monitored[r], c)]);
-            let h = DVector::from_fn(monitored.len(), |r, _| {
-                -0.5 * tolerance - forces[monitored[r]].map_or(0.0, |f| f.normal)
-            });
-            match crate::nnls::least_distance(&g, &h) {
-                Some(nu) => {
-                    let dn = &g * nu;
-                    let mut out = forces.to_vec();
-                    for (r, &i) in monitored.iter().enumerate() {
-                        if let Some(f) = &mut out[i] {
-                            f.normal += dn[r];
-                        }
-                    }
-                    adjusted = out;
-                    &adjusted[..]
-                }
-                None => forces,
+    // The normal forces of the compressive distribution, when one is needed and exists.
+    let mut normals: Vec<f64> = forces.iter().map(|f| f.map_or(0.0, |f| f.normal)).collect();
+    if let (Some(d), true) = (self_stress, tension) {
+        let monitored: Vec<usize> = (0..forces.len()).filter(|&i| forces[i].is_some()).collect();
+        let g = DMatrix::from_fn(monitored.len(), d.ncols(), |r, c| d[(monitored[r], c)]);
+        let h = DVector::from_fn(monitored.len(), |r, _| {
+            -0.5 * tolerance - normals[monitored[r]]
+        });
+        if let Some(nu) = crate::nnls::least_distance(&g, &h) {
+            let dn = &g * nu;
+            for (r, &i) in monitored.iter().enumerate() {
+                normals[i] += dn[r];
             }
         }
-        _ => forces,
-    };
+    }
     for (i, f) in forces.iter().enumerate() {
         let Some(f) = f else { continue };
-        if f.normal < -tolerance {
+        if normals[i] < -tolerance {
             return Some(Violation {
                 t,
                 interface: model.interfaces[i].name.clone(),
                 kind: "tension".into(),
-                normal: f.normal,
+                normal: normals[i],
                 friction_demand: f.friction_demand(),
             });
         }
         if let Some(mu) = friction
-            && f.tangential > mu * f.normal.max(0.0) + tolerance
+            && f.tangential > mu * normals[i].max(0.0) + tolerance
         {
             return Some(Violation {
                 t,
                 interface: model.interfaces[i].name.clone(),
                 kind: "sliding".into(),
-                normal: f.normal,
+                normal: normals[i],
                 friction_demand: f.friction_demand(),
             });
         }

@@ -516,16 +516,22 @@ impl<'a> Simulation<'a> {
                 let tol = crate::monitor::TENSION_TOLERANCE
                     * self.model.total_mass()
                     * self.model.gravity;
-                let friction = self.params.friction;
-                self.violation = crate::monitor::check(self.model, &forces, None, t, friction, tol);
                 // A tension in a hyperstatic structure: is there a compressive distribution?
                 // (The self-stress states cost a decomposition, made only then.)
-                if self.violation.as_ref().is_some_and(|v| v.kind == "tension")
-                    && let Some(states) = crate::monitor::self_stress_normals(self.model, d)
-                {
-                    self.violation =
-                        crate::monitor::check(self.model, &forces, Some(&states), t, friction, tol);
-                }
+                let tension = forces.iter().any(|f| f.is_some_and(|f| f.normal < -tol));
+                let states = if tension {
+                    crate::monitor::self_stress_normals(self.model, d)
+                } else {
+                    None
+                };
+                self.violation = crate::monitor::check(
+                    self.model,
+                    &forces,
+                    states.as_ref(),
+                    t,
+                    self.params.friction,
+                    tol,
+                );
             }
         }
         forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
