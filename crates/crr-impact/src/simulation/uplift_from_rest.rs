@@ -77,12 +77,7 @@ pub(super) fn opening_from_rest(
     if seated.is_empty() {
         return Some(None);
     }
-    let key = |p: &ActivePivots| -> Vec<bool> {
-        seated
-            .iter()
-            .map(|&k| p.sides[k] == Side::Positive)
-            .collect()
-    };
+    let key = |p: &ActivePivots| sides_key(seated, p);
     // Starts of the local search: the current sides, then every seated slot on its positive
     // side, then on its negative one (a structure that is symmetric in fact need not be in its
     // coordinates, and the search from one start can miss the mirror image of a mechanism that it
@@ -142,6 +137,14 @@ pub(super) fn opening_from_rest(
     ))
 }
 
+/// A choice of sides as the seated slots' sides (true: positive), to recognise it when seen again.
+fn sides_key(seated: &[usize], p: &ActivePivots) -> Vec<bool> {
+    seated
+        .iter()
+        .map(|&k| p.sides[k] == Side::Positive)
+        .collect()
+}
+
 /// The local search of [`opening_from_rest`] from the sides `start`: returns the last choice
 /// reached with its solution (None if its first solve fails). `visited` holds the choices
 /// solved so far, over every start.
@@ -158,12 +161,7 @@ fn local_search(
     start: ActivePivots,
     visited: &mut Vec<Vec<bool>>,
 ) -> Option<(ActivePivots, SidesSolution)> {
-    let key = |p: &ActivePivots| -> Vec<bool> {
-        seated
-            .iter()
-            .map(|&k| p.sides[k] == Side::Positive)
-            .collect()
-    };
+    let key = |p: &ActivePivots| sides_key(seated, p);
     let mut sides = start;
     let mut current = solve_for_sides(model, ground, trial, &sides, seated, t, q, qdot)?;
     visited.push(key(&sides));
