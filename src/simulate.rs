@@ -779,16 +779,26 @@ mod tests {
         assert_eq!(p.params.duration, 2.0 + 5.0);
         // Without records it is `prepare` without the output folder check.
         let q = prepare_loaded(&path, base, file, model, &SimulateOptions::default(), &[]).unwrap();
-        let r = prepare(&path, &SimulateOptions::default()).unwrap();
+        let r = prepare(&path, &unit_test_options()).unwrap();
         assert_eq!(q.params.duration, r.params.duration);
         assert_eq!(q.initial.q, r.initial.q);
+    }
+
+    /// Default options with an output folder that holds no results: the default
+    /// `results/single_block` may hold those of the README's command, which `prepare` refuses to
+    /// replace.
+    fn unit_test_options() -> SimulateOptions {
+        SimulateOptions {
+            out: Some(std::env::temp_dir().join("crr-simulate-unit-tests-no-results")),
+            ..Default::default()
+        }
     }
 
     #[test]
     fn an_energy_gain_is_a_warning_naming_the_worst_impact() {
         // No law of crr raises T for r ≤ 1, so the case is built by hand.
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
-        let p = prepare(&path, &SimulateOptions::default()).unwrap();
+        let p = prepare(&path, &unit_test_options()).unwrap();
         let t = Trajectory::empty(&p.model);
         let stats = SampleStats::default();
         assert!(warnings(&p, &t, &stats, &[]).is_empty());
