@@ -611,6 +611,7 @@ fn every_bundled_model_with_every_law_loses_energy_at_every_impact() {
             let path = common::write_model(&format!("every_law_{tag}"), &model_text);
             let opts = SimulateOptions {
                 duration: Some(2.0),
+                out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
                 ..Default::default()
             };
             let prepared = prepare(&path, &opts).unwrap();

@@ -11,6 +11,7 @@ fn a_streamed_run_holds_bounded_chunks_and_agrees_with_the_in_memory_run() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
     let opts = SimulateOptions {
         duration: Some(200.0),
+        out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
         ..Default::default()
     };
     let p = prepare(&path, &opts).unwrap();
@@ -53,6 +54,7 @@ fn a_sink_that_fails_stops_the_run_with_an_error_and_keeps_the_results() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
     let opts = SimulateOptions {
         duration: Some(100.0),
+        out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
         ..Default::default()
     };
     let p = prepare(&path, &opts).unwrap();

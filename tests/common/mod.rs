@@ -68,6 +68,7 @@ pub fn run_model_text(
     let path = write_model(tag, text);
     let opts = crr::simulate::SimulateOptions {
         duration,
+        out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
         ..Default::default()
     };
     let p = crr::simulate::prepare(&path, &opts).unwrap_or_else(|e| panic!("{tag}: {e}"));
