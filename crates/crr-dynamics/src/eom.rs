@@ -32,6 +32,7 @@ use crate::linalg::{
     JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, cholesky_solve,
     forward_substitute, pivot_columns,
 };
+use crate::single_coordinate;
 
 /// A failure of the equations of motion at some state.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -148,6 +149,9 @@ pub struct Dynamics {
     mass_current: bool,
     /// The last [`Self::accelerations_with`] used the articulated-body algorithm.
     used_articulated: bool,
+    /// The last [`Self::accelerations_with`] used the one-coordinate closed form
+    /// ([`crate::single_coordinate`]).
+    used_single_coordinate: bool,
 }
 
 /// Open chains with at least this many coordinates (DOF(1)) are solved by the articulated-body
@@ -542,6 +546,7 @@ impl Dynamics {
             g_eff: Vector3::zeros(),
             mass_current: false,
             used_articulated: false,
+            used_single_coordinate: false,
             locked: vec![false; n],
             free: (0..n).collect(),
             residual: DVector::zeros(n),
@@ -661,6 +666,12 @@ impl Dynamics {
         self.used_articulated
     }
 
+    /// True when the last [`Self::accelerations_with`] used the one-coordinate closed form
+    /// I_p θ̈ = Q + τ ([`crate::single_coordinate`]).
+    pub fn used_single_coordinate(&self) -> bool {
+        self.used_single_coordinate
+    }
+
     /// The spatial force fₖ = Iᴬₖaₖ + pᴬₖ = [n₀; f] (N m about the world origin; N) that the
     /// parent side transmits across coordinate k's joint to the bodies beyond it, gravity and
     /// inertia included, from the last solve when it was the articulated-body algorithm (None
@@ -740,8 +751,23 @@ impl Dynamics {
         qdot: &DVector<f64>,
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
-        self.used_articulated = true;
         self.add_extra_force(model, t, q, qdot, extra);
+        if self.solver == ForwardSolver::Auto
+            && self.seated.is_empty()
+            && single_coordinate::applies(model)
+        {
+            // One coordinate about a fixed line: I_p θ̈ = Q + τ, no 6 × 6 algebra.
+            self.used_articulated = false;
+            self.used_single_coordinate = true;
+            let force = self.load[0] + self.extra_force[0];
+            self.qddot[0] = single_coordinate::solve(model, &mut self.kin, qdot[0], force)
+                .ok_or_else(|| DynamicsError::SingularMassMatrix {
+                    coordinate: model.coords[0].name.clone(),
+                })?;
+            return self.check_finite(t);
+        }
+        self.used_articulated = true;
+        self.used_single_coordinate = false;
         if self.seat_reactions.len() != self.seated.len() {
             self.seat_reactions = DVector::zeros(self.seated.len());
         }
@@ -778,6 +804,7 @@ impl Dynamics {
             return self.solve_articulated(model, t, q, qdot, extra);
         }
         self.used_articulated = false;
+        self.used_single_coordinate = false;
         self.used_selected = false;
         self.factorise(model)?;
         self.add_extra_force(model, t, q, qdot, extra);

@@ -19,6 +19,7 @@ pub mod integrator;
 pub mod linalg;
 pub mod mechanism;
 pub mod run;
+pub mod single_coordinate;
 pub mod system;
 
 pub use analysis::{AnalysisSpec, MethodName};
