@@ -152,6 +152,8 @@ pub struct Dynamics {
     /// The last [`Self::accelerations_with`] used the one-coordinate closed form
     /// ([`crate::single_coordinate`]).
     used_single_coordinate: bool,
+    /// The one-coordinate kernel of the last active pivot ([`Self::integration_accelerations`]).
+    kernel: Option<single_coordinate::Kernel>,
 }
 
 /// Open chains with at least this many coordinates (DOF(1)) are solved by the articulated-body
@@ -547,6 +549,7 @@ impl Dynamics {
             mass_current: false,
             used_articulated: false,
             used_single_coordinate: false,
+            kernel: None,
             locked: vec![false; n],
             free: (0..n).collect(),
             residual: DVector::zeros(n),
@@ -649,6 +652,50 @@ impl Dynamics {
         }
         self.evaluate(model, ground, t, q, qdot);
         self.solve_evaluated(model, t, q, qdot, extra)
+    }
+
+    /// What the integrator's right-hand side reads, q̈, Q, Q_g and the extra force, at
+    /// (t, q, q̇): [`Self::accelerations_with`], except on a structure of one coordinate with
+    /// nothing seated, no extra force and [`ForwardSolver::Auto`], where the
+    /// [`single_coordinate::Kernel`] of the active pivot gives them from sin θ and cos θ alone.
+    /// `kin` (frames, V, M) is then left as it was: code that reads the kinematics of the state
+    /// calls [`Self::accelerations_with`].
+    pub fn integration_accelerations(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) -> Result<(), DynamicsError> {
+        if extra.is_none()
+            && self.solver == ForwardSolver::Auto
+            && self.seated.is_empty()
+            && single_coordinate::applies(model)
+        {
+            if !self
+                .kernel
+                .as_ref()
+                .is_some_and(|k| k.is_for(model, &self.pivots))
+            {
+                self.kernel = single_coordinate::Kernel::new(model, &self.pivots);
+            }
+            if let Some(kernel) = &self.kernel {
+                let a = ground.acceleration(t);
+                self.g_eff = gravity_with_ground(model, &a);
+                let (sin, cos) = q[0].sin_cos();
+                self.load[0] = kernel.load(&self.g_eff, sin, cos);
+                self.ground_force[0] = kernel.load(&(-a), sin, cos);
+                self.extra_force[0] = 0.0;
+                self.qddot[0] = self.load[0] / kernel.inertia();
+                self.used_articulated = false;
+                self.used_single_coordinate = true;
+                self.mass_current = false;
+                return self.check_finite(t);
+            }
+        }
+        self.accelerations_with(model, ground, t, q, qdot, extra)
     }
 
     /// Makes `kin.mass_matrix` hold M(q) of the last evaluation: the articulated-body path does

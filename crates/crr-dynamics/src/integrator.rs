@@ -340,17 +340,28 @@ fn dense_eval(coef: &[f64], dim: usize, t0: f64, h: f64, t: f64, out: &mut [f64]
     }
 }
 
-/// `out = y + h Σ_j a_j k_j`.
+/// `out = Σ_j a_j k_j` over the stages `k` (rows of `dim`), skipping the zero coefficients of
+/// the tableau. The sum runs stage by stage over contiguous slices: the same order of additions
+/// for every component as a component-by-component loop, so the same result to the last bit.
 #[inline]
-fn stage_input(y: &[f64], k: &[f64], dim: usize, h: f64, a: &[f64], out: &mut [f64]) {
-    for i in 0..dim {
-        let mut s = 0.0;
-        for (j, &aj) in a.iter().enumerate() {
-            if aj != 0.0 {
-                s += aj * k[j * dim + i];
+fn stage_sum(k: &[f64], dim: usize, a: &[f64], out: &mut [f64]) {
+    let out = &mut out[..dim];
+    out.fill(0.0);
+    for (kj, &aj) in k.chunks_exact(dim).zip(a) {
+        if aj != 0.0 {
+            for (o, &x) in out.iter_mut().zip(kj) {
+                *o += aj * x;
             }
         }
-        out[i] = y[i] + h * s;
+    }
+}
+
+/// `out = y + h Σ_j a_j k_j` ([`stage_sum`]).
+#[inline]
+fn stage_input(y: &[f64], k: &[f64], dim: usize, h: f64, a: &[f64], out: &mut [f64]) {
+    stage_sum(k, dim, a, out);
+    for (o, &yi) in out[..dim].iter_mut().zip(&y[..dim]) {
+        *o = yi + h * *o;
     }
 }
 
@@ -1128,15 +1139,9 @@ impl Solver {
         match *method {
             Method::Dop853 => {
                 for (r, row) in DOP853_D.iter().enumerate() {
-                    for i in 0..d {
-                        let mut s = 0.0;
-                        for (j, &dj) in row.iter().enumerate() {
-                            if dj != 0.0 {
-                                s += dj * k[j * d + i];
-                            }
-                        }
-                        dense[(4 + r) * d + i] = h * s;
-                    }
+                    let out = &mut dense[(4 + r) * d..(5 + r) * d];
+                    stage_sum(k, d, row, out);
+                    out.iter_mut().for_each(|x| *x *= h);
                 }
             }
             Method::Dopri5 => {

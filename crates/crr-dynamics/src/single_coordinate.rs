@@ -18,11 +18,23 @@
 //! cost: the whole right-hand side of a free-rocking block is then the forward kinematics of one
 //! rotation. `tests/single_coordinate.rs` checks it against the articulated-body algorithm and
 //! against M by composite rigid bodies on random 3D bodies.
+//!
+//! **The integrator's kernel** ([`Kernel`]). With the parent the ground, the axis u and the pivot
+//! p₀ are the rest ones and every centre moves as cₙ = p₀ + R(θ)(cₙ⁰ − p₀), R = I + sin θ [u]× +
+//! (1 − cos θ)[u]×² (Rodrigues, as [`crr_kinematics::rotation::axis_angle`]). With
+//! r₀ = Σₙ mₙ(cₙ⁰ − p₀) the first moment about the pivot at rest, the load of a field f is
+//!
+//! Q_f(θ) = f · (u × R r₀) = f·a₁ + sin θ f·a₂ + (1 − cos θ) f·a₃,
+//! a₁ = u × r₀, a₂ = u × a₁, a₃ = u × a₂,
+//!
+//! so that θ̈ = Q_{g_eff}(θ)/I_p and the ground force Q_{−a_g}(θ) cost one sin/cos and a few
+//! products once a₁, a₂, a₃ and I_p are known for the active pivot, without the kinematics
+//! workspace.
 
-use nalgebra::Vector6;
+use nalgebra::{Vector3, Vector6};
 
 use crr_kinematics::mass_matrix::spatial_axis;
-use crr_kinematics::{Data, Model};
+use crr_kinematics::{ActivePivots, Data, Model};
 
 /// Whether [`solve`] applies: one coordinate, no closure rows.
 pub fn applies(model: &Model) -> bool {
@@ -50,4 +62,67 @@ pub fn solve(model: &Model, data: &mut Data, theta_dot: f64, force: f64) -> Opti
     data.spatial_velocity[0] = spatial_axis(data, 0) * theta_dot;
     data.bias_acceleration[0] = Vector6::zeros();
     Some(force / inertia)
+}
+
+/// The one-coordinate equation of motion for one active pivot, as a function of θ alone (see the
+/// module docs): θ̈ = (Q_{g_eff}(θ) + τ)/I_p.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Kernel {
+    /// The rest pivot p₀ it was built for (m).
+    pivot: Vector3<f64>,
+    /// I_p (kg m²).
+    inertia: f64,
+    /// a₁ = u × r₀, a₂ = u × a₁, a₃ = u × a₂ (kg m).
+    a: [Vector3<f64>; 3],
+}
+
+impl Kernel {
+    /// The kernel of `model`'s one coordinate on the active pivot of `pivots`. None when
+    /// [`applies`] does not hold or I_p is not positive and finite.
+    pub fn new(model: &Model, pivots: &ActivePivots) -> Option<Self> {
+        if !applies(model) || model.coords[0].parent.is_some() {
+            return None;
+        }
+        let coord = &model.coords[0];
+        let iface = &model.interfaces[coord.interface];
+        let pivot = iface.kind.pivot(&pivots.sides[iface.slots.clone()]);
+        let u = coord.axis;
+        let (mut inertia, mut r0) = (0.0, Vector3::zeros());
+        for (b, body) in model.bodies.iter().enumerate() {
+            if model.body_coord[b] != 0 {
+                continue;
+            }
+            let arm = body.com - pivot;
+            inertia += body.mass * u.cross(&arm).norm_squared() + u.dot(&(body.inertia * u));
+            r0 += arm * body.mass;
+        }
+        if !(inertia > 0.0 && inertia.is_finite()) {
+            return None;
+        }
+        let a1 = u.cross(&r0);
+        let a2 = u.cross(&a1);
+        let a3 = u.cross(&a2);
+        Some(Self {
+            pivot,
+            inertia,
+            a: [a1, a2, a3],
+        })
+    }
+
+    /// Whether this kernel was built for the active pivot of `pivots`.
+    pub fn is_for(&self, model: &Model, pivots: &ActivePivots) -> bool {
+        let iface = &model.interfaces[model.coords[0].interface];
+        iface.kind.pivot(&pivots.sides[iface.slots.clone()]) == self.pivot
+    }
+
+    /// I_p (kg m²).
+    pub fn inertia(&self) -> f64 {
+        self.inertia
+    }
+
+    /// The generalized force of a uniform field `field` (m/s², on every body's mass) at θ, from
+    /// sin θ and cos θ: Q_f = f·a₁ + sin θ f·a₂ + (1 − cos θ) f·a₃ (N m).
+    pub fn load(&self, field: &Vector3<f64>, sin: f64, cos: f64) -> f64 {
+        field.dot(&self.a[0]) + sin * field.dot(&self.a[1]) + (1.0 - cos) * field.dot(&self.a[2])
+    }
 }

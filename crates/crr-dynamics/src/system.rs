@@ -71,7 +71,7 @@ impl OdeSystem for ConstrainedSystem<'_> {
             None => None,
         };
         self.dynamics
-            .accelerations_with(self.model, self.ground, t, &self.q, &self.qdot, extra)
+            .integration_accelerations(self.model, self.ground, t, &self.q, &self.qdot, extra)
             .map_err(|e| RhsError(e.to_string()))?;
         dydt[..n].copy_from_slice(&y[n..2 * n]);
         dydt[n..2 * n].copy_from_slice(self.dynamics.qddot.as_slice());

@@ -87,25 +87,55 @@ pub fn contact_forces(
     q: &DVector<f64>,
     qdot: &DVector<f64>,
 ) -> Result<Vec<Option<ContactForce>>, DynamicsError> {
+    let mut work = ForceWork::default();
+    contact_forces_into(model, dynamics, ground, t, q, qdot, &mut work)?;
+    Ok(work.forces)
+}
+
+/// Buffers of [`contact_forces_into`], reused from call to call (a simulation samples the contact
+/// forces at every output sample).
+#[derive(Clone, Debug, Default)]
+pub struct ForceWork {
+    /// Total spatial acceleration of every coordinate's frame.
+    acc: Vec<Vector6<f64>>,
+    /// Net force of every body beyond its load, m (a_c − g_eff).
+    body_force: Vec<Vector3<f64>>,
+    /// Point forces of the closures on their two sides: (frame, force on it).
+    closure_on: Vec<(Option<usize>, Vector3<f64>)>,
+    /// Force and contact normal of every interface (None for plain hinges).
+    transmitted: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
+    /// The contact forces of the last call, in interface order.
+    pub forces: Vec<Option<ContactForce>>,
+}
+
+/// [`contact_forces`] into reused buffers: the forces are left in `work.forces`.
+pub fn contact_forces_into(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    ground: &GroundMotion,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    work: &mut ForceWork,
+) -> Result<(), DynamicsError> {
     dynamics.accelerations(model, ground, t, q, qdot)?;
     let kin = &dynamics.kin;
     let n = model.dof();
     // Total spatial accelerations A = A_bias + Σ sⱼ q̈ⱼ along each path.
-    let mut acc = vec![Vector6::zeros(); n];
+    let acc = &mut work.acc;
+    acc.clear();
     for k in 0..n {
         let s = crr_kinematics::mass_matrix::spatial_axis(kin, k) * dynamics.qddot[k];
         let parent = model.coords[k]
             .parent
             .map_or(Vector6::zeros(), |p| acc[p] - kin.bias_acceleration[p]);
-        acc[k] = kin.bias_acceleration[k] + parent + s;
+        acc.push(kin.bias_acceleration[k] + parent + s);
     }
     let g_eff = effective_gravity(model, ground, t);
     // Net force on each body beyond its load: m (a_c − g_eff).
-    let body_force: Vec<Vector3<f64>> = model
-        .bodies
-        .iter()
-        .enumerate()
-        .map(|(b, body)| {
+    work.body_force.clear();
+    work.body_force
+        .extend(model.bodies.iter().enumerate().map(|(b, body)| {
             let k = model.body_coord[b];
             let (w, v0) = (
                 top(&kin.spatial_velocity[k]),
@@ -115,33 +145,41 @@ pub fn contact_forces(
             let c = kin.com[b];
             let a_c = a0 + al.cross(&c) + w.cross(&(v0 + w.cross(&c)));
             (a_c - g_eff) * body.mass
+        }));
+    interface_forces(
+        model,
+        kin,
+        &work.body_force,
+        &dynamics.lambda,
+        &mut work.closure_on,
+        &mut work.transmitted,
+    );
+    work.forces.clear();
+    work.forces.extend(work.transmitted.iter().map(|f| {
+        f.map(|(force, normal)| {
+            let nf = force.dot(&normal);
+            ContactForce {
+                force: force.into(),
+                normal: nf,
+                tangential: (force - normal * nf).norm(),
+            }
         })
-        .collect();
-    Ok(interface_forces(model, kin, &body_force, &dynamics.lambda)
-        .into_iter()
-        .map(|f| {
-            f.map(|(force, normal)| {
-                let nf = force.dot(&normal);
-                ContactForce {
-                    force: force.into(),
-                    normal: nf,
-                    tangential: (force - normal * nf).norm(),
-                }
-            })
-        })
-        .collect())
+    }));
+    Ok(())
 }
 
 /// The force each monitored interface transmits to its child side, with its contact normal
 /// (world axes), from the bodies' net forces beyond their loads (`body_force`) and the closure
 /// multipliers `lambda` (the point force λ of a closure acts on its parent side, −λ on its
-/// child side); None for plain hinges.
+/// child side); None for plain hinges. Written to `out`; `closure_on` is a buffer.
 fn interface_forces(
     model: &Model,
     kin: &crr_kinematics::Data,
     body_force: &[Vector3<f64>],
     lambda: &DVector<f64>,
-) -> Vec<Option<(Vector3<f64>, Vector3<f64>)>> {
+    closure_on: &mut Vec<(Option<usize>, Vector3<f64>)>,
+    out: &mut Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
+) {
     let point_force = |first_row: usize| {
         Vector3::new(
             lambda[first_row],
@@ -149,7 +187,7 @@ fn interface_forces(
             lambda[first_row + 2],
         )
     };
-    let mut closure_on: Vec<(Option<usize>, Vector3<f64>)> = Vec::new();
+    closure_on.clear();
     for cl in &model.closures {
         let iface = &model.interfaces[cl.interface];
         let lam = point_force(cl.first_row);
@@ -166,35 +204,32 @@ fn interface_forces(
         }
         false
     };
-    model
-        .interfaces
-        .iter()
-        .map(|iface| {
-            let n_rest = rest_normal(&iface.kind, model.size)?;
-            let parent_rot = model
-                .frame_of(iface.parent)
-                .map_or_else(nalgebra::Matrix3::identity, |k| kin.rot_ops[k]);
-            let normal = parent_rot * n_rest;
-            let force = match iface.role {
-                Role::Tree { first_coord } => {
-                    let mut f = Vector3::zeros();
-                    for (b, fb) in body_force.iter().enumerate() {
-                        if in_subtree(Some(model.body_coord[b]), first_coord) {
-                            f += fb;
-                        }
+    out.clear();
+    out.extend(model.interfaces.iter().map(|iface| {
+        let n_rest = rest_normal(&iface.kind, model.size)?;
+        let parent_rot = model
+            .frame_of(iface.parent)
+            .map_or_else(nalgebra::Matrix3::identity, |k| kin.rot_ops[k]);
+        let normal = parent_rot * n_rest;
+        let force = match iface.role {
+            Role::Tree { first_coord } => {
+                let mut f = Vector3::zeros();
+                for (b, fb) in body_force.iter().enumerate() {
+                    if in_subtree(Some(model.body_coord[b]), first_coord) {
+                        f += fb;
                     }
-                    for (frame, fc) in &closure_on {
-                        if in_subtree(*frame, first_coord) {
-                            f -= fc;
-                        }
-                    }
-                    f
                 }
-                Role::Closure { index } => -point_force(model.closures[index].first_row),
-            };
-            Some((force, normal))
-        })
-        .collect()
+                for (frame, fc) in closure_on.iter() {
+                    if in_subtree(*frame, first_coord) {
+                        f -= fc;
+                    }
+                }
+                f
+            }
+            Role::Closure { index } => -point_force(model.closures[index].first_row),
+        };
+        Some((force, normal))
+    }));
 }
 
 /// How the monitored interfaces' normal forces change along the self-stress states of a
@@ -239,15 +274,21 @@ pub fn self_stress_normals(model: &Model, dynamics: &Dynamics) -> Option<DMatrix
         return None;
     }
     let zero = vec![Vector3::zeros(); model.bodies.len()];
+    let (mut closure_on, mut transmitted) = (Vec::new(), Vec::new());
     let mut d = DMatrix::zeros(model.interfaces.len(), states.ncols());
     for j in 0..states.ncols() {
         let lambda = DVector::from_fn(model.constraint_rows, |i, _| states[(i, j)] * scale[i]);
-        for (i, f) in interface_forces(model, kin, &zero, &lambda)
-            .into_iter()
-            .enumerate()
-        {
+        interface_forces(
+            model,
+            kin,
+            &zero,
+            &lambda,
+            &mut closure_on,
+            &mut transmitted,
+        );
+        for (i, f) in transmitted.iter().enumerate() {
             if let Some((force, normal)) = f {
-                d[(i, j)] = force.dot(&normal);
+                d[(i, j)] = force.dot(normal);
             }
         }
     }
@@ -281,8 +322,12 @@ pub fn check(
     let tension = forces
         .iter()
         .any(|f| f.is_some_and(|f| f.normal < -tolerance));
-    // The normal forces of the compressive distribution, when one is needed and exists.
-    let mut normals: Vec<f64> = forces.iter().map(|f| f.map_or(0.0, |f| f.normal)).collect();
+    // The normal forces of the compressive distribution, when one is needed and exists (no
+    // buffer when there is no tension: the forces' own normals are read).
+    let mut normals: Vec<f64> = Vec::new();
+    if tension {
+        normals.extend(forces.iter().map(|f| f.map_or(0.0, |f| f.normal)));
+    }
     if let (Some(d), true) = (self_stress, tension) {
         let monitored: Vec<usize> = (0..forces.len()).filter(|&i| forces[i].is_some()).collect();
         let g = DMatrix::from_fn(monitored.len(), d.ncols(), |r, c| d[(monitored[r], c)]);
@@ -296,25 +341,27 @@ pub fn check(
             }
         }
     }
+    let normal_of = |i: usize, f: &ContactForce| normals.get(i).copied().unwrap_or(f.normal);
     for (i, f) in forces.iter().enumerate() {
         let Some(f) = f else { continue };
-        if normals[i] < -tolerance {
+        let normal = normal_of(i, f);
+        if normal < -tolerance {
             return Some(Violation {
                 t,
                 interface: model.interfaces[i].name.clone(),
                 kind: "tension".into(),
-                normal: normals[i],
+                normal,
                 friction_demand: f.friction_demand(),
             });
         }
         if let Some(mu) = friction
-            && f.tangential > mu * normals[i].max(0.0) + tolerance
+            && f.tangential > mu * normal.max(0.0) + tolerance
         {
             return Some(Violation {
                 t,
                 interface: model.interfaces[i].name.clone(),
                 kind: "sliding".into(),
-                normal: normals[i],
+                normal,
                 friction_demand: f.friction_demand(),
             });
         }

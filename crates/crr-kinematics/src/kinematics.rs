@@ -16,13 +16,20 @@ pub fn forward_kinematics(model: &Model, data: &mut Data, q: &DVector<f64>, pivo
     for (k, c) in model.coords.iter().enumerate() {
         let iface = &model.interfaces[c.interface];
         let p_rest = iface.kind.pivot(&pivots.sides[iface.slots.clone()]);
-        let (parent_rot, parent_trans) = match c.parent {
-            Some(p) => (data.rot_ops[p], data.frame_translation[p]),
-            None => (Matrix3::identity(), Vector3::zeros()),
+        let own = axis_angle(&c.axis, q[k]);
+        // A root coordinate's parent frame is the world: no products with the identity.
+        let (rot, pivot, axis) = match c.parent {
+            Some(p) => {
+                let parent_rot = data.rot_ops[p];
+                (
+                    parent_rot * own,
+                    parent_rot * p_rest + data.frame_translation[p],
+                    parent_rot * c.axis,
+                )
+            }
+            None => (own, p_rest, c.axis),
         };
-        let rot = parent_rot * axis_angle(&c.axis, q[k]);
-        let pivot = parent_rot * p_rest + parent_trans;
-        data.axis[k] = parent_rot * c.axis;
+        data.axis[k] = axis;
         data.pivot_rest[k] = p_rest;
         data.pivot[k] = pivot;
         data.rot_ops[k] = rot;

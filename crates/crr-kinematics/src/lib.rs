@@ -64,4 +64,4 @@ pub use spec::{
     BodySpec, ImpactLaw, InterfaceSpec, PivotSpec, RockingBaseSpec, StructureSpec,
     SymmetryRelation, SymmetrySpec,
 };
-pub use velocity::{constraint_bias, velocities, velocity_product};
+pub use velocity::{body_kinetic_energy, constraint_bias, velocities, velocity_product};

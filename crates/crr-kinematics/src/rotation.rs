@@ -10,9 +10,23 @@ pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
 /// Rotation by `angle` (rad, right-handed) about the unit vector `axis` (Rodrigues' formula):
 /// `R = I + sin θ [u]× + (1 − cos θ) [u]×²`.
 pub fn axis_angle(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
-    let k = skew(axis);
+    // I + s[u]× + (1 − c)[u]×², with [u]×² = uuᵀ − |u|²I written out (no 3 × 3 product).
     let (s, c) = angle.sin_cos();
-    Matrix3::identity() + k * s + k * k * (1.0 - c)
+    let d = 1.0 - c;
+    let u = axis;
+    let diag = 1.0 - d * u.norm_squared();
+    let (xy, xz, yz) = (d * u.x * u.y, d * u.x * u.z, d * u.y * u.z);
+    Matrix3::new(
+        diag + d * u.x * u.x,
+        xy - s * u.z,
+        xz + s * u.y,
+        xy + s * u.z,
+        diag + d * u.y * u.y,
+        yz - s * u.x,
+        xz - s * u.y,
+        yz + s * u.x,
+        diag + d * u.z * u.z,
+    )
 }
 
 /// dR/dθ of [`axis_angle`]: `[u]× R(u, θ)`.

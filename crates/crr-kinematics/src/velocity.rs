@@ -37,6 +37,24 @@ pub fn cross_force(a: &Vector6<f64>, b: &Vector6<f64>) -> Vector6<f64> {
     join(w.cross(&n) + v.cross(&f), w.cross(&f))
 }
 
+/// Kinetic energy from the bodies' velocities (J): T = Σₙ ½ mₙ|v_c|² + ½ ωᵀIₙω with
+/// v_c = v₀ + ω × cₙ from the spatial velocity [ω; v₀] of the body's frame. The same T as
+/// ½ q̇ᵀ M q̇ ([`crate::kinetic_energy`]) without forming M: O(bodies). Requires
+/// `data.spatial_velocity` of these rates ([`velocities`], or a forward-dynamics solve).
+pub fn body_kinetic_energy(model: &Model, data: &Data) -> f64 {
+    let mut t = 0.0;
+    for (b, body) in model.bodies.iter().enumerate() {
+        let k = model.body_coord[b];
+        let v = &data.spatial_velocity[k];
+        let (w, v0) = (top(v), bottom(v));
+        let vc = v0 + w.cross(&data.com[b]);
+        // ωᵀ(Γ I Γᵀ)ω = uᵀ I u with u = Γᵀω, the angular velocity in body axes.
+        let u = data.rot_ops[k].tr_mul(&w);
+        t += 0.5 * (body.mass * vc.norm_squared() + u.dot(&(body.inertia * u)));
+    }
+    t
+}
+
 /// Fills `data.spatial_velocity` and `data.bias_acceleration` for rates q̇.
 /// Requires [`crate::forward_kinematics`].
 pub fn velocities(model: &Model, data: &mut Data, qdot: &DVector<f64>) {

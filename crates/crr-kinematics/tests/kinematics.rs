@@ -49,6 +49,23 @@ proptest! {
         prop_assert!(rel_diff(&data.mass_matrix, &m_jac) < 1e-12);
     }
 
+    /// T from the bodies' velocities (Σ ½ m|v_c|² + ½ ωᵀIω, `body_kinetic_energy`) equals
+    /// ½ q̇ᵀ M q̇ with M from the γ inner products (Eq 2), an independent derivation, to
+    /// round-off of the sums (1e-12 relative).
+    #[test]
+    fn kinetic_energy_from_body_velocities_matches_the_mass_matrix(seed in any::<u64>(), n in 1usize..7) {
+        let (model, mut data, q, pivots) = setup(seed, n, 0);
+        let mut rng = SplitMix(seed ^ 0x7E57);
+        let qdot = DVector::from_fn(model.dof(), |_, _| rng.uniform(-2.0, 2.0));
+        forward_kinematics(&model, &mut data, &q, &pivots);
+        velocities(&model, &mut data, &qdot);
+        let t_bodies = body_kinetic_energy(&model, &data);
+        let m_gamma = mass_matrix_gamma(&model, &q, &pivots);
+        let t_gamma = 0.5 * qdot.dot(&(&m_gamma * &qdot));
+        prop_assert!(t_gamma > 0.0);
+        prop_assert!((t_bodies - t_gamma).abs() <= 1e-12 * t_gamma, "{t_bodies} against {t_gamma}");
+    }
+
     /// M is symmetric positive definite; every Γ is a rotation (ΓᵀΓ = I, det Γ = 1).
     #[test]
     fn mass_matrix_spd_and_rot_ops_orthonormal(seed in any::<u64>(), n in 1usize..7) {

@@ -128,6 +128,13 @@ impl EventFunctions for SegmentEvents<'_> {
 
     /// One function alone: root location on an impact does not solve the uplift problem.
     fn eval_one(&mut self, i: usize, t: f64, y: &[f64], _g: &mut [f64]) -> f64 {
+        // A tree slot's angle is its coordinate: no kinematics (root location on an impact
+        // evaluates this function alone, a dozen times).
+        if let Some(&(s, side)) = self.rocking.get(i)
+            && s < self.model.dof()
+        {
+            return side.sign() * y[s] + ROCKING_EVENT_MARGIN;
+        }
         self.load_state(y);
         if i < self.rocking.len() {
             let (s, side) = self.rocking[i];

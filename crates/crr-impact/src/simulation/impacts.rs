@@ -32,10 +32,12 @@ impl GeneralizedForce for Regularised {
 /// The plastic impulse that stops the given slots (and keeps the loops closed):
 /// q̇⁺ = q̇ − M⁻¹Cᵀ(C M⁻¹ Cᵀ)⁺ C q̇ with C the closure rows and the slots' rate rows, i.e. the
 /// impulse along those constraints only, with the smallest kinetic-energy loss. Rank-revealing:
-/// dependent rows (slots locked together in a loop) are harmless. Returns q̇⁺ and T⁺.
+/// dependent rows (slots locked together in a loop) are harmless. Returns q̇⁺ and T⁺. `work` is a
+/// workspace for `model` (its pivots and seated slots are overwritten).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn plastic_projection(
     model: &Model,
-    template: &Dynamics,
+    work: &mut Dynamics,
     ground: &GroundMotion,
     t: f64,
     q: &DVector<f64>,
@@ -43,13 +45,13 @@ pub(super) fn plastic_projection(
     pivots: &ActivePivots,
     slots: &[usize],
 ) -> (DVector<f64>, f64) {
-    let mut d = template.clone();
-    d.pivots = pivots.clone();
+    let d = work;
+    d.pivots.clone_from(pivots);
     d.seated.clear();
     d.evaluate(model, ground, t, q, qdot);
     let n = model.dof();
-    let m = d.kin.mass_matrix.clone();
-    let kinetic = |v: &DVector<f64>| 0.5 * v.dot(&(&m * v));
+    let m = &d.kin.mass_matrix;
+    let kinetic = |v: &DVector<f64>| 0.5 * v.dot(&(m * v));
     if slots.is_empty() {
         return (qdot.clone(), kinetic(qdot));
     }
@@ -123,7 +125,13 @@ impl Simulation<'_> {
         let model = self.model;
         let (t, q, qdot) = (self.t, self.q(), self.qdot());
         let before = self.dynamics.pivots.clone();
-        let mut kin = Data::new(model);
+        // Workspaces of the run (given back below; an error return only costs a reallocation).
+        let mut kin = self
+            .spare
+            .events_kin
+            .take()
+            .unwrap_or_else(|| Data::new(model));
+        let mut work = self.take_trial();
         let mut angles = vec![0.0; model.slot_count];
         slot_angles(model, &mut kin, &q, &before, &mut angles);
         crr_kinematics::velocities(model, &mut kin, &qdot);
@@ -162,7 +170,7 @@ impl Simulation<'_> {
             // (booked as dissipation), as "all other hinges persisting".
             let (qd, k) = plastic_projection(
                 model,
-                &self.dynamics,
+                &mut work,
                 self.ground,
                 t,
                 &q,
@@ -212,7 +220,7 @@ impl Simulation<'_> {
             let all: Vec<usize> = held.iter().chain(&to_seat).copied().collect();
             (qdot_after, kinetic_after) = plastic_projection(
                 model,
-                &self.dynamics,
+                &mut work,
                 self.ground,
                 t,
                 &q_new,
@@ -277,6 +285,8 @@ impl Simulation<'_> {
             forward_kinematics(model, &mut kin, &q_new, &self.dynamics.pivots);
             u0 - potential_energy(model, &kin)
         };
+        self.spare.events_kin = Some(kin);
+        self.spare.trial = Some(work);
         self.dissipated_at_impacts += lost + u_snap;
         let n = model.dof();
         self.y[..n].copy_from_slice(q_new.as_slice());

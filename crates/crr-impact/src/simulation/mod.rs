@@ -31,7 +31,7 @@ use crr_dynamics::{ConstrainedSystem, InitialState};
 use crr_kinematics::spec::ImpactLaw;
 use crr_kinematics::{
     ActivePivots, Data, InterfaceKind, Model, Side, closure_angles, forward_kinematics,
-    mass_matrix, potential_energy,
+    potential_energy,
 };
 
 use crate::laws::{ImpactError, dirac_law, dirac_regularised_force, momentum_law, restitution_law};
@@ -318,6 +318,13 @@ struct Workspaces {
     events_kin: Option<Data>,
     trial: Option<Dynamics>,
     monitor: Dynamics,
+    /// q and q̇ of the sample being taken.
+    sample_q: DVector<f64>,
+    sample_qdot: DVector<f64>,
+    /// The output samples a segment's steps pass, [t, y…] each, taken after the segment.
+    pending: Vec<f64>,
+    /// Buffers of the monitor's contact forces.
+    forces: crate::monitor::ForceWork,
 }
 
 impl<'a> Simulation<'a> {
@@ -395,6 +402,10 @@ impl<'a> Simulation<'a> {
                 events_kin: Some(Data::new(model)),
                 trial: Some(trial),
                 monitor: Dynamics::new(model, initial.pivots.clone()),
+                sample_q: DVector::zeros(n),
+                sample_qdot: DVector::zeros(n),
+                pending: Vec::new(),
+                forces: Default::default(),
             },
             parts: model.parts(),
             y,
@@ -497,8 +508,12 @@ impl<'a> Simulation<'a> {
 
     fn sample_at(&mut self, t: f64, y: &[f64]) -> Sample {
         let n = self.model.dof();
-        let mut q = DVector::from_column_slice(&y[..n]);
-        let mut qdot = DVector::from_column_slice(&y[n..2 * n]);
+        let (mut q, mut qdot) = (
+            std::mem::take(&mut self.spare.sample_q),
+            std::mem::take(&mut self.spare.sample_qdot),
+        );
+        q.copy_from_slice(&y[..n]);
+        qdot.copy_from_slice(&y[n..2 * n]);
         // A seated coordinate is held at 0 (the dense output between projections carries round-off).
         for k in 0..n {
             if self.seated[k] {
@@ -506,13 +521,19 @@ impl<'a> Simulation<'a> {
                 qdot[k] = 0.0;
             }
         }
+        // The monitor's solve leaves the kinematics of this state in its workspace: the energies
+        // read them when it ran (the same q and pivots), else the output workspace's.
+        let mut monitor_kin = false;
         if self.violation.is_none() {
             let d = &mut self.spare.monitor;
             d.pivots.clone_from(&self.dynamics.pivots);
             d.seated.clone_from(&self.dynamics.seated);
-            if let Ok(forces) =
-                crate::monitor::contact_forces(self.model, d, self.ground, t, &q, &qdot)
+            let work = &mut self.spare.forces;
+            if crate::monitor::contact_forces_into(self.model, d, self.ground, t, &q, &qdot, work)
+                .is_ok()
             {
+                let forces = &work.forces;
+                monitor_kin = true;
                 let tol = crate::monitor::TENSION_TOLERANCE
                     * self.model.total_mass()
                     * self.model.gravity;
@@ -526,7 +547,7 @@ impl<'a> Simulation<'a> {
                 };
                 self.violation = crate::monitor::check(
                     self.model,
-                    &forces,
+                    forces,
                     states.as_ref(),
                     t,
                     self.params.friction,
@@ -534,18 +555,27 @@ impl<'a> Simulation<'a> {
                 );
             }
         }
-        forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
-        mass_matrix(self.model, &mut self.out_kin);
-        Sample {
+        // T from the bodies' velocities (no M): the monitor's solve filled them.
+        let kin = if monitor_kin {
+            &self.spare.monitor.kin
+        } else {
+            forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
+            crr_kinematics::velocities(self.model, &mut self.out_kin, &qdot);
+            &self.out_kin
+        };
+        let kinetic = crr_kinematics::body_kinetic_energy(self.model, kin);
+        let sample = Sample {
             t,
-            kinetic: 0.5 * qdot.dot(&(&self.out_kin.mass_matrix * &qdot)),
-            potential: potential_energy(self.model, &self.out_kin) - self.u_rest,
+            kinetic,
+            potential: potential_energy(self.model, kin) - self.u_rest,
             work_in: y[2 * n],
             dissipated: self.dissipated_at_impacts + y[2 * n + 1],
-            q: q.iter().copied().collect(),
-            qdot: qdot.iter().copied().collect(),
+            q: q.as_slice().to_vec(),
+            qdot: qdot.as_slice().to_vec(),
             states: self.states(),
-        }
+        };
+        (self.spare.sample_q, self.spare.sample_qdot) = (q, qdot);
+        sample
     }
 
     fn reset_solver(&mut self) {
@@ -625,7 +655,9 @@ impl<'a> Simulation<'a> {
         // dynamics.
         let dt = self.params.output_interval;
         let mut next_sample = self.next_sample;
-        let mut pending: Vec<(f64, Vec<f64>)> = Vec::new();
+        let mut pending = std::mem::take(&mut self.spare.pending);
+        pending.clear();
+        let stride = 2 * n + 3;
         let mut peaks: Vec<Peak> = Vec::new();
         let rocking_coords: Vec<usize> = (0..n).filter(|&k| !self.seated[k]).collect();
         let mut buf = vec![0.0; 2 * n + 2];
@@ -635,7 +667,8 @@ impl<'a> Simulation<'a> {
             {
                 let ts = (next_sample as f64 * dt).min(step.t1());
                 step.eval(ts, &mut buf);
-                pending.push((next_sample as f64 * dt, buf.clone()));
+                pending.push(next_sample as f64 * dt);
+                pending.extend_from_slice(&buf);
                 next_sample += 1;
             }
             for &k in &rocking_coords {
@@ -644,10 +677,13 @@ impl<'a> Simulation<'a> {
                     step.eval_component(step.t1(), n + k),
                 );
                 if a != 0.0 && b != 0.0 && a.signum() != b.signum() {
-                    // Bisection on q̇ₖ(t) of the dense output.
+                    // Bisection on q̇ₖ(t) of the dense output, to adjacent doubles.
                     let (mut lo, mut hi) = (step.t0(), step.t1());
                     for _ in 0..60 {
                         let mid = 0.5 * (lo + hi);
+                        if mid <= lo || mid >= hi {
+                            break;
+                        }
                         if step.eval_component(mid, n + k).signum() == a.signum() {
                             lo = mid;
                         } else {
@@ -715,10 +751,11 @@ impl<'a> Simulation<'a> {
         self.spare.trial = Some(trial);
         self.next_sample = next_sample;
         self.peaks.extend(peaks);
-        for (t, y) in pending {
-            let s = self.sample_at(t, &y);
+        for sample in pending.chunks_exact(stride) {
+            let s = self.sample_at(sample[0], &sample[1..]);
             self.record_sample(s);
         }
+        self.spare.pending = pending;
         let stop = stop?;
         self.t = self.solver.t();
         self.y.copy_from_slice(self.solver.y());

@@ -508,18 +508,38 @@ impl Simulation<'_> {
     /// points into their closed side (they cannot open on that side; left alone they would slip
     /// through the contact without a crossing to detect). They may then uplift on the other side.
     pub(super) fn settle_resting_joints(&mut self) -> Result<Option<f64>, SimulationError> {
+        // The run's workspaces (given back whatever the outcome).
+        let mut kin = self
+            .spare
+            .events_kin
+            .take()
+            .unwrap_or_else(|| Data::new(self.model));
+        let mut d = self.take_trial();
+        let result = self.settle_resting_joints_in(&mut d, &mut kin);
+        self.spare.events_kin = Some(kin);
+        self.spare.trial = Some(d);
+        result
+    }
+
+    /// [`Self::settle_resting_joints`] with the workspaces `d` (its pivots and seated slots are
+    /// set here) and `kin`.
+    fn settle_resting_joints_in(
+        &mut self,
+        d: &mut Dynamics,
+        kin: &mut Data,
+    ) -> Result<Option<f64>, SimulationError> {
         let model = self.model;
         let (q, qdot) = (self.q(), self.qdot());
         let mut angles = vec![0.0; model.slot_count];
-        let mut kin = Data::new(model);
-        slot_angles(model, &mut kin, &q, &self.dynamics.pivots, &mut angles);
+        slot_angles(model, kin, &q, &self.dynamics.pivots, &mut angles);
         let candidates: Vec<usize> = (0..model.slot_count)
             .filter(|&s| !self.seated[s] && angles[s].abs() <= self.params.simultaneity)
             .collect();
         if candidates.is_empty() {
             return Ok(None);
         }
-        let mut d = self.dynamics.clone();
+        d.pivots.clone_from(&self.dynamics.pivots);
+        d.seated.clone_from(&self.dynamics.seated);
         d.accelerations(model, self.ground, self.t, &q, &qdot)
             .map_err(|e| SimulationError::Dynamics {
                 t: self.t,
@@ -557,9 +577,10 @@ impl Simulation<'_> {
         let held: Vec<usize> = (0..model.slot_count)
             .filter(|&s| self.seated[s] || closing.contains(&s))
             .collect();
+        // Seating is rare: its projection gets a workspace of its own.
         let (qd, kinetic) = plastic_projection(
             model,
-            &self.dynamics,
+            &mut self.dynamics.clone(),
             self.ground,
             self.t,
             &q,
@@ -580,8 +601,8 @@ impl Simulation<'_> {
         // their residual angle (below `simultaneity`): both are booked as dissipated.
         let u_after = {
             let q_new = self.q();
-            forward_kinematics(model, &mut kin, &q_new, &self.dynamics.pivots);
-            potential_energy(model, &kin)
+            forward_kinematics(model, kin, &q_new, &self.dynamics.pivots);
+            potential_energy(model, kin)
         };
         self.dissipated_at_impacts += before - kinetic + u_before - u_after;
         let n = model.dof();
