@@ -25,6 +25,8 @@ pub(super) struct SegmentEvents<'b> {
     pub(super) uplift: Option<Dynamics>,
     /// Workspace of the uplift test (a copy of the dynamics, reused at every evaluation).
     pub(super) trial: Dynamics,
+    /// The uplift test's factorisations at rest.
+    pub(super) rest: RestCache,
     /// The part of each slot ([`crr_kinematics::Parts::of_slot`]).
     pub(super) slot_part: Vec<usize>,
     /// q and q̇ of the state evaluated.
@@ -86,6 +88,7 @@ impl SegmentEvents<'_> {
             self.ground,
             template,
             &mut self.trial,
+            &mut self.rest,
             &self.slot_part,
             t,
             &self.q,

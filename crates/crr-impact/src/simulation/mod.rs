@@ -48,7 +48,7 @@ pub use seating::opening_mode;
 use seating::opening_mode_in;
 pub use slots::check_initial_state;
 use slots::*;
-use uplift_from_rest::opening_from_rest;
+use uplift_from_rest::{RestCache, opening_from_rest};
 
 /// Largest step while joints are seated and the ground moves (s): the time resolution of the
 /// uplift test (exact location then by bisection on the release test).
@@ -325,6 +325,8 @@ struct Workspaces {
     pending: Vec<f64>,
     /// Buffers of the monitor's contact forces.
     forces: crate::monitor::ForceWork,
+    /// The uplift test's factorisations at rest ([`RestCache`]).
+    rest: RestCache,
 }
 
 impl<'a> Simulation<'a> {
@@ -406,6 +408,7 @@ impl<'a> Simulation<'a> {
                 sample_qdot: DVector::zeros(n),
                 pending: Vec::new(),
                 forces: Default::default(),
+                rest: RestCache::default(),
             },
             parts: model.parts(),
             y,
@@ -633,6 +636,7 @@ impl<'a> Simulation<'a> {
             angles: vec![0.0; model.slot_count],
             uplift: (!self.dynamics.seated.is_empty()).then(|| self.dynamics.clone()),
             trial: self.take_trial(),
+            rest: std::mem::take(&mut self.spare.rest),
             slot_part: self.parts.of_slot.clone(),
             q: DVector::zeros(n),
             qdot: DVector::zeros(n),
@@ -744,11 +748,13 @@ impl<'a> Simulation<'a> {
         let SegmentEvents {
             kin: events_kin,
             trial,
+            rest,
             rocking,
             ..
         } = events;
         self.spare.events_kin = Some(events_kin);
         self.spare.trial = Some(trial);
+        self.spare.rest = rest;
         self.next_sample = next_sample;
         self.peaks.extend(peaks);
         for sample in pending.chunks_exact(stride) {

@@ -24,6 +24,7 @@ pub fn opening_mode(
         ground,
         template,
         &mut trial,
+        &mut RestCache::default(),
         &parts.of_slot,
         t,
         q,
@@ -33,7 +34,8 @@ pub fn opening_mode(
 
 /// [`opening_mode`] with a workspace: `trial` is any [`Dynamics`] of the same model (its pivots
 /// and seated slots are overwritten), so that the uplift test at every step allocates no
-/// workspace of the dynamics; `slot_part` is [`crr_kinematics::Parts::of_slot`] of the model.
+/// workspace of the dynamics; `rest` keeps the factorisations of the test at rest from one
+/// instant to the next; `slot_part` is [`crr_kinematics::Parts::of_slot`] of the model.
 ///
 /// On open chains the single releases are batched over the model's connected parts: the
 /// accelerations of one part do not depend on another part's pivots or seated slots (M is
@@ -49,6 +51,7 @@ pub(super) fn opening_mode_in(
     ground: &GroundMotion,
     template: &Dynamics,
     trial: &mut Dynamics,
+    rest: &mut RestCache,
     slot_part: &[usize],
     t: f64,
     q: &DVector<f64>,
@@ -68,7 +71,7 @@ pub(super) fn opening_mode_in(
     let rate_scale = (model.gravity / model.size).sqrt();
     if model.constraint_rows > 0
         && qdot.amax() <= 1e-12 * rate_scale
-        && let Some(mode) = opening_from_rest(model, ground, template, trial, t, q, qdot, tol)
+        && let Some(mode) = opening_from_rest(model, ground, template, trial, rest, t, q, qdot, tol)
     {
         return mode;
     }
@@ -398,6 +401,7 @@ impl Simulation<'_> {
             self.ground,
             &self.dynamics,
             &mut trial,
+            &mut self.spare.rest,
             &self.parts.of_slot,
             self.t,
             &q,
@@ -447,9 +451,13 @@ impl Simulation<'_> {
         }
         let (q, qdot) = (self.q(), self.qdot());
         let mut trial = self.take_trial();
+        let mut rest = std::mem::take(&mut self.spare.rest);
         let (ground, template, parts) = (self.ground, &self.dynamics, &self.parts.of_slot);
         let mut opens = |t: f64| {
-            opening_mode_in(model, ground, template, &mut trial, parts, t, &q, &qdot).is_some()
+            opening_mode_in(
+                model, ground, template, &mut trial, &mut rest, parts, t, &q, &qdot,
+            )
+            .is_some()
         };
         let mut found = None;
         let mut t0 = self.t;
@@ -476,6 +484,7 @@ impl Simulation<'_> {
             t0 = t1;
         }
         self.spare.trial = Some(trial);
+        self.spare.rest = rest;
         let t_end = found.unwrap_or(t_stop);
         let dt = self.params.output_interval;
         let y = self.y.clone();

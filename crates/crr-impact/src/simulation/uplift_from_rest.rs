@@ -24,6 +24,59 @@ use crr_dynamics::linalg::{JacobiSvd, RANK_TOLERANCE, pinv_solve};
 use crate::nnls::nnls;
 use crr_kinematics::{ActivePivots, Model, Side};
 
+/// The closures' null space N and particular solution z_p of [`solve_for_sides`] for the states
+/// and pivot sides solved before. At rest they depend on q, q̇ and the sides only, not on the
+/// time (the ground motion changes Q alone), and the uplift test at rest runs on a time grid and
+/// by bisection at one state: their SVD is made once per choice of sides instead of at every
+/// instant.
+#[derive(Clone, Debug, Default)]
+pub(super) struct RestCache {
+    entries: Vec<RestEntry>,
+}
+
+#[derive(Clone, Debug)]
+struct RestEntry {
+    sides: Vec<Side>,
+    state: Vec<u64>,
+    null: DMatrix<f64>,
+    z_p: DVector<f64>,
+}
+
+/// Most entries of a [`RestCache`] (the oldest is dropped beyond).
+const REST_CACHE: usize = 64;
+
+impl RestCache {
+    /// The exact state (q, q̇) as bits, the second half of an entry's key.
+    fn state_key(q: &DVector<f64>, qdot: &DVector<f64>) -> Vec<u64> {
+        q.iter().chain(qdot.iter()).map(|x| x.to_bits()).collect()
+    }
+
+    fn get(&self, sides: &ActivePivots, state: &[u64]) -> Option<(&DMatrix<f64>, &DVector<f64>)> {
+        self.entries
+            .iter()
+            .find(|e| e.sides == sides.sides && e.state == state)
+            .map(|e| (&e.null, &e.z_p))
+    }
+
+    fn insert(
+        &mut self,
+        sides: &ActivePivots,
+        state: Vec<u64>,
+        null: DMatrix<f64>,
+        z_p: DVector<f64>,
+    ) {
+        if self.entries.len() >= REST_CACHE {
+            self.entries.remove(0);
+        }
+        self.entries.push(RestEntry {
+            sides: sides.sides.clone(),
+            state,
+            null,
+            z_p,
+        });
+    }
+}
+
 /// The opening mode at rest for one choice of pivot sides.
 struct SidesSolution {
     /// The Gauss function relative to staying at rest, ½‖y − y_free‖² − ½‖y_free‖² (≤ 0).
@@ -68,6 +121,7 @@ pub(super) fn opening_from_rest(
     ground: &GroundMotion,
     template: &Dynamics,
     trial: &mut Dynamics,
+    cache: &mut RestCache,
     t: f64,
     q: &DVector<f64>,
     qdot: &DVector<f64>,
@@ -100,6 +154,7 @@ pub(super) fn opening_from_rest(
             model,
             ground,
             trial,
+            cache,
             t,
             q,
             qdot,
@@ -153,6 +208,7 @@ fn local_search(
     model: &Model,
     ground: &GroundMotion,
     trial: &mut Dynamics,
+    cache: &mut RestCache,
     t: f64,
     q: &DVector<f64>,
     qdot: &DVector<f64>,
@@ -163,7 +219,7 @@ fn local_search(
 ) -> Option<(ActivePivots, SidesSolution)> {
     let key = |p: &ActivePivots| sides_key(seated, p);
     let mut sides = start;
-    let mut current = solve_for_sides(model, ground, trial, &sides, seated, t, q, qdot)?;
+    let mut current = solve_for_sides(model, ground, trial, cache, &sides, seated, t, q, qdot)?;
     visited.push(key(&sides));
     let mut solved = 1;
     while solved < MAX_SIDE_CHOICES {
@@ -203,7 +259,8 @@ fn local_search(
             }
             visited.push(next_key);
             solved += 1;
-            let Some(next) = solve_for_sides(model, ground, trial, &next_sides, seated, t, q, qdot)
+            let Some(next) =
+                solve_for_sides(model, ground, trial, cache, &next_sides, seated, t, q, qdot)
             else {
                 continue;
             };
@@ -240,6 +297,7 @@ fn solve_for_sides(
     model: &Model,
     ground: &GroundMotion,
     trial: &mut Dynamics,
+    cache: &mut RestCache,
     sides: &ActivePivots,
     seated: &[usize],
     t: f64,
@@ -256,8 +314,11 @@ fn solve_for_sides(
     let r = &trial.load - &trial.kin.velocity_product;
     let z_free = l.solve_lower_triangular(&r)?;
     // Closures in z: Φ_q L⁻ᵀ, rows normalised for the rank decision; N its null space.
+    let state = RestCache::state_key(q, qdot);
     let (null, z_p) = if model.constraint_rows == 0 {
         (DMatrix::identity(n, n), DVector::zeros(n))
+    } else if let Some((null, z_p)) = cache.get(sides, &state) {
+        (null.clone(), z_p.clone())
     } else {
         let mut a = DMatrix::zeros(model.constraint_rows, n);
         let mut c = DVector::zeros(model.constraint_rows);
@@ -276,6 +337,7 @@ fn solve_for_sides(
             .collect();
         let null = DMatrix::from_fn(n, cols.len(), |i, k| svd.v[(i, cols[k])]);
         let z_p = -svd.solve_with(&c, tol);
+        cache.insert(sides, state, null.clone(), z_p.clone());
         (null, z_p)
     };
     let d = null.ncols();
