@@ -20,8 +20,8 @@
 //! against M by composite rigid bodies on random 3D bodies.
 //!
 //! **The integrator's kernel** ([`Kernel`]). With the parent the ground, the axis u and the pivot
-//! p₀ are the rest ones and every centre moves as cₙ = p₀ + R(θ)(cₙ⁰ − p₀), R = I + sin θ [u]× +
-//! (1 − cos θ)[u]×² (Rodrigues, as [`crr_kinematics::rotation::axis_angle`]). With
+//! p₀ are the rest ones and every centre moves as cₙ = p₀ + R(θ)(cₙ⁰ − p₀), R = I + sin θ \[u\]× +
+//! (1 − cos θ)\[u\]×² (Rodrigues, as [`crr_kinematics::rotation::axis_angle`]). With
 //! r₀ = Σₙ mₙ(cₙ⁰ − p₀) the first moment about the pivot at rest, the load of a field f is
 //!
 //! Q_f(θ) = f · (u × R r₀) = f·a₁ + sin θ f·a₂ + (1 − cos θ) f·a₃,
