@@ -4,39 +4,16 @@
 //! rocking bases, random states, ground accelerations, extra forces and locked (seated)
 //! coordinates; and the seat reactions against closed forms.
 
-use crr_dynamics::eom::{ARTICULATED_BODY_MIN_DOF, GeneralizedForce};
-use crr_dynamics::ground_motion::{Axis, GroundMotion, Record};
+use crr_dynamics::eom::ARTICULATED_BODY_MIN_DOF;
+use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::{Dynamics, ForwardSolver, effective_gravity};
 use crr_kinematics::fixtures::{SplitMix, random_chain, serial_chain, single_block};
-use crr_kinematics::{ActivePivots, Data, Model, Side, StructureSpec, jacobians};
+use crr_kinematics::{ActivePivots, Model, Side, StructureSpec, jacobians};
 use nalgebra::{DMatrix, DVector, Vector3};
 use proptest::prelude::*;
 
-/// A constant extra generalized force τ.
-struct Tau(DVector<f64>);
-
-impl GeneralizedForce for Tau {
-    fn add(
-        &mut self,
-        _model: &Model,
-        _kin: &Data,
-        _t: f64,
-        _q: &DVector<f64>,
-        _qdot: &DVector<f64>,
-        out: &mut DVector<f64>,
-    ) {
-        *out += &self.0;
-    }
-}
-
-/// A ground motion of constant acceleration `a` (m/s²) around t = 0.
-fn constant_ground(a: Vector3<f64>) -> GroundMotion {
-    let rec = |v: f64| Record::uniform(1.0, vec![v, v, v]).expect("valid record");
-    GroundMotion::from_record(Axis::X, rec(a.x), 1.0)
-        .and_then(|g| g.with_record(Axis::Y, rec(a.y), 1.0))
-        .and_then(|g| g.with_record(Axis::Z, rec(a.z), 1.0))
-        .expect("valid ground motion")
-}
+mod common;
+use common::{Tau, constant_ground};
 
 /// A random state of `model`: q, q̇, τ, the ground acceleration and the locked coordinates (each
 /// with probability `p_lock`).

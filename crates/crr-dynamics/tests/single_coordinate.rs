@@ -7,37 +7,14 @@
 //! θ̈ = −p² sin(α sgn θ − θ), p² = 3g/(4R), for a rectangular block.
 
 use crr_dynamics::eom::GeneralizedForce;
-use crr_dynamics::ground_motion::{Axis, GroundMotion, Record};
+use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::{Dynamics, ForwardSolver};
 use crr_kinematics::fixtures::{SplitMix, random_chain, single_block};
-use crr_kinematics::{ActivePivots, Data, Model, Side};
+use crr_kinematics::{ActivePivots, Model, Side};
 use nalgebra::{DVector, Vector3};
 
-/// A constant extra generalized force τ.
-struct Tau(f64);
-
-impl GeneralizedForce for Tau {
-    fn add(
-        &mut self,
-        _model: &Model,
-        _kin: &Data,
-        _t: f64,
-        _q: &DVector<f64>,
-        _qdot: &DVector<f64>,
-        out: &mut DVector<f64>,
-    ) {
-        out[0] += self.0;
-    }
-}
-
-/// A ground motion of constant acceleration `a` (m/s²) around t = 0.
-fn constant_ground(a: Vector3<f64>) -> GroundMotion {
-    let rec = |v: f64| Record::uniform(1.0, vec![v, v, v]).expect("valid record");
-    GroundMotion::from_record(Axis::X, rec(a.x), 1.0)
-        .and_then(|g| g.with_record(Axis::Y, rec(a.y), 1.0))
-        .and_then(|g| g.with_record(Axis::Z, rec(a.z), 1.0))
-        .expect("valid ground motion")
-}
+mod common;
+use common::{Tau, constant_ground};
 
 /// Solves at (θ, θ̇) under `ground` with `solver` (and τ when given).
 fn solve(
@@ -54,7 +31,7 @@ fn solve(
     pivots.follow_coordinates(&q);
     let mut d = Dynamics::new(model, pivots);
     d.solver = solver;
-    let mut force = tau.map(Tau);
+    let mut force = tau.map(|t| Tau(DVector::from_element(1, t)));
     d.accelerations_with(
         model,
         ground,
