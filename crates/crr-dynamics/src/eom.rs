@@ -700,7 +700,9 @@ impl Dynamics {
 
     /// Makes `kin.mass_matrix` hold M(q) of the last evaluation: the articulated-body path does
     /// not form M, so readers of M after [`Self::accelerations`] call this first (O(DOF(1) ×
-    /// depth), nothing done when M is already current).
+    /// depth), nothing done when M is already current). Not after
+    /// [`Self::integration_accelerations`] on its one-coordinate kernel, which leaves the
+    /// kinematics of an earlier state in `kin`.
     pub fn ensure_mass_matrix(&mut self, model: &Model) {
         if !self.mass_current {
             mass_matrix(model, &mut self.kin);

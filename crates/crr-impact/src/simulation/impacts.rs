@@ -167,17 +167,22 @@ impl Simulation<'_> {
             let result = apply_law(model, &mut kin, &q, &qdot, &before, &after, &impacting)
                 .map_err(|source| SimulationError::Impact { t, source })?;
             // Joints that were seated stay seated through the impact: a plastic impulse on them
-            // (booked as dissipation), as "all other hinges persisting".
-            let (qd, k) = plastic_projection(
-                model,
-                &mut work,
-                self.ground,
-                t,
-                &q,
-                &result.qdot,
-                &after,
-                &held,
-            );
+            // (booked as dissipation), as "all other hinges persisting". With none, the law's
+            // q̇⁺ and T⁺ = ½q̇⁺ᵀM⁺q̇⁺ (the same M⁺, at the same q) stand.
+            let (qd, k) = if held.is_empty() {
+                (result.qdot.clone(), result.kinetic_after)
+            } else {
+                plastic_projection(
+                    model,
+                    &mut work,
+                    self.ground,
+                    t,
+                    &q,
+                    &result.qdot,
+                    &after,
+                    &held,
+                )
+            };
             forward_kinematics(model, &mut kin, &q, &after);
             crr_kinematics::velocities(model, &mut kin, &qd);
             slot_rates(model, &kin, &qd, &mut rates);
