@@ -692,6 +692,7 @@ impl Dynamics {
                 self.used_articulated = false;
                 self.used_single_coordinate = true;
                 self.mass_current = false;
+                self.seat_reactions = DVector::zeros(0);
                 return self.check_finite(t);
             }
         }
@@ -727,7 +728,8 @@ impl Dynamics {
     /// after a solve on M). Its component along the joint's spatial axis is sₖᵀfₖ = τₖ + rₖ (rₖ = 0
     /// for a free coordinate); along any other axis through any other point it is the moment the
     /// joint would have to carry about that axis with the same motion, e.g. the reaction of a
-    /// seated joint about the pivot on its other side.
+    /// seated joint about the pivot on its other side. None also after the one-coordinate closed
+    /// form ([`Self::used_single_coordinate`]), taken only when nothing is seated.
     pub fn joint_force(&self, k: usize) -> Option<Vector6<f64>> {
         self.used_articulated.then(|| {
             self.articulated.inertia[k] * self.articulated.acceleration[k]
@@ -808,6 +810,8 @@ impl Dynamics {
             // One coordinate about a fixed line: I_p θ̈ = Q + τ, no 6 × 6 algebra.
             self.used_articulated = false;
             self.used_single_coordinate = true;
+            // Nothing is seated: no reactions (not those of an earlier seated solve).
+            self.seat_reactions = DVector::zeros(0);
             let force = self.load[0] + self.extra_force[0];
             self.qddot[0] = single_coordinate::solve(model, &mut self.kin, qdot[0], force)
                 .ok_or_else(|| DynamicsError::SingularMassMatrix {

@@ -345,6 +345,9 @@ fn dense_eval(coef: &[f64], dim: usize, t0: f64, h: f64, t: f64, out: &mut [f64]
 /// for every component as a component-by-component loop, so the same result to the last bit.
 #[inline]
 fn stage_sum(k: &[f64], dim: usize, a: &[f64], out: &mut [f64]) {
+    if dim == 0 {
+        return;
+    }
     let out = &mut out[..dim];
     out.fill(0.0);
     for (kj, &aj) in k.chunks_exact(dim).zip(a) {

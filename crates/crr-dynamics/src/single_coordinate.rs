@@ -1,6 +1,8 @@
-//! Forward dynamics of a structure with one coordinate (DOF(1) = 1): every body turns with θ
-//! about one world axis w through the active pivot p, both fixed in the world (the coordinate's
-//! parent is the ground). Housner's block, a block on a hinge, a rigid group rocking as one.
+//! Forward dynamics of a structure with one coordinate (DOF(1) = 1): its body turns with θ about
+//! one world axis w through the active pivot p, both fixed in the world (the coordinate's parent
+//! is the ground). Housner's block, a block on a hinge. (Every body is the child of one tree
+//! interface that adds at least one coordinate, so DOF(1) = 1 without closures means one body on
+//! a hinge to the ground; the sums below run over the bodies all the same.)
 //!
 //! The kinetic energy is T = ½ I_p θ̇² with the moment of inertia about the pivot line
 //!
@@ -88,10 +90,7 @@ impl Kernel {
         let pivot = iface.kind.pivot(&pivots.sides[iface.slots.clone()]);
         let u = coord.axis;
         let (mut inertia, mut r0) = (0.0, Vector3::zeros());
-        for (b, body) in model.bodies.iter().enumerate() {
-            if model.body_coord[b] != 0 {
-                continue;
-            }
+        for body in &model.bodies {
             let arm = body.com - pivot;
             inertia += body.mass * u.cross(&arm).norm_squared() + u.dot(&(body.inertia * u));
             r0 += arm * body.mass;

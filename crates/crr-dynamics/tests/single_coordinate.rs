@@ -156,6 +156,17 @@ fn seated_block_takes_the_articulated_path() {
         "reaction {} against m g b = {weight_moment}",
         d.seat_reactions[0]
     );
+    // Released, the same workspace takes the closed form and reports no reaction (none of the
+    // seated solve's), and no joint force.
+    d.seated.clear();
+    d.accelerations(&model, &GroundMotion::none(), 0.0, &zero, &zero)
+        .expect("regular");
+    assert!(d.used_single_coordinate());
+    assert!(d.seat_reactions.is_empty());
+    assert!(d.joint_force(0).is_none());
+    d.integration_accelerations(&model, &GroundMotion::none(), 0.0, &zero, &zero, None)
+        .expect("regular");
+    assert!(d.seat_reactions.is_empty());
 }
 
 /// The integrator's kernel (`Dynamics::integration_accelerations`: θ̈, Q and Q_g from sin θ,
