@@ -80,7 +80,8 @@ fn the_tilts_of_a_twisting_base_are_those_of_its_face_normal() {
 /// ψ(t) along q(t) = q₀ + t q̇ + ½t² q̈: (ψ(h) − ψ(−h))/2h = row·q̇ and
 /// (ψ(h) − 2ψ(0) + ψ(−h))/h² = row·q̈ + bias, to the differences' truncation (h² ψ‴/6, h² ψ⁗/12
 /// with derivatives of order 1 here: 1e-8 at h = 1e-4) plus round-off (1e-16/h² = 1e-8 for the
-/// second difference).
+/// second difference). The largest errors over these cases are 5.9e-9 (rate) and 3.1e-8
+/// (acceleration); the tolerances are 2e-8 and 1e-7, about three times those.
 #[test]
 fn slot_rows_are_the_derivatives_of_the_twisting_tilts() {
     let m = twisting_baldachin("rows");
@@ -142,12 +143,12 @@ fn slot_rows_are_the_derivatives_of_the_twisting_tilts() {
             let rate = (ap[i] - am[i]) / (2.0 * h);
             let accel = (ap[i] - 2.0 * a0[i] + am[i]) / (h * h);
             assert!(
-                (row.dot(&qd) - rate).abs() < 1e-7,
+                (row.dot(&qd) - rate).abs() < 2e-8,
                 "slot {s}: rate {} against {rate}",
                 row.dot(&qd)
             );
             assert!(
-                (row.dot(&qdd) + bias - accel).abs() < 1e-5,
+                (row.dot(&qdd) + bias - accel).abs() < 1e-7,
                 "slot {s}: acceleration {} against {accel}",
                 row.dot(&qdd) + bias
             );
