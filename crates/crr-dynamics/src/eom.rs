@@ -669,11 +669,7 @@ impl Dynamics {
         qdot: &DVector<f64>,
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
-        if extra.is_none()
-            && self.solver == ForwardSolver::Auto
-            && self.seated.is_empty()
-            && single_coordinate::applies(model)
-        {
+        if extra.is_none() && self.single_coordinate_applies(model) {
             if !self
                 .kernel
                 .as_ref()
@@ -689,14 +685,30 @@ impl Dynamics {
                 self.ground_force[0] = kernel.load(&(-a), sin, cos);
                 self.extra_force[0] = 0.0;
                 self.qddot[0] = self.load[0] / kernel.inertia();
-                self.used_articulated = false;
-                self.used_single_coordinate = true;
                 self.mass_current = false;
-                self.seat_reactions = DVector::zeros(0);
+                self.mark_single_coordinate();
                 return self.check_finite(t);
             }
         }
         self.accelerations_with(model, ground, t, q, qdot, extra)
+    }
+
+    /// Whether a solve takes the one-coordinate closed form ([`crate::single_coordinate`]):
+    /// DOF(1) = 1, no closures, nothing seated, [`ForwardSolver::Auto`].
+    fn single_coordinate_applies(&self, model: &Model) -> bool {
+        self.solver == ForwardSolver::Auto
+            && self.seated.is_empty()
+            && single_coordinate::applies(model)
+    }
+
+    /// Records a solve by the one-coordinate closed form: nothing is seated, so no seat
+    /// reactions (not those of an earlier seated solve) and no joint force.
+    fn mark_single_coordinate(&mut self) {
+        self.used_articulated = false;
+        self.used_single_coordinate = true;
+        if !self.seat_reactions.is_empty() {
+            self.seat_reactions = DVector::zeros(0);
+        }
     }
 
     /// Makes `kin.mass_matrix` hold M(q) of the last evaluation: the articulated-body path does
@@ -803,15 +815,9 @@ impl Dynamics {
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
         self.add_extra_force(model, t, q, qdot, extra);
-        if self.solver == ForwardSolver::Auto
-            && self.seated.is_empty()
-            && single_coordinate::applies(model)
-        {
+        if self.single_coordinate_applies(model) {
             // One coordinate about a fixed line: I_p θ̈ = Q + τ, no 6 × 6 algebra.
-            self.used_articulated = false;
-            self.used_single_coordinate = true;
-            // Nothing is seated: no reactions (not those of an earlier seated solve).
-            self.seat_reactions = DVector::zeros(0);
+            self.mark_single_coordinate();
             let force = self.load[0] + self.extra_force[0];
             self.qddot[0] = single_coordinate::solve(model, &mut self.kin, qdot[0], force)
                 .ok_or_else(|| DynamicsError::SingularMassMatrix {
