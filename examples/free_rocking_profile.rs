@@ -8,6 +8,9 @@
 //! valgrind --tool=callgrind target/release/examples/free_rocking_profile 20
 //! ```
 //!
+//! A second argument sets the output interval (s, 0.01 unless given), e.g. `20 15` for no samples
+//! but the first and the last.
+//!
 //! The instructions reported divided by N are the cost of one run (the model's set-up is a few
 //! thousandths of them); docs/performance.md quotes them.
 
@@ -27,6 +30,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map_err(|e| format!("the number of runs {s:?}: {e}"))?,
         None => 20,
     };
+    // The output interval (s), 0.01 s as in the bench unless given: the cost of the output
+    // samples is the difference between two counts.
+    let output_interval: f64 = match std::env::args().nth(2) {
+        Some(s) => s
+            .parse()
+            .map_err(|e| format!("the output interval {s:?}: {e}"))?,
+        None => 0.01,
+    };
     let (b, h) = (0.2, 1.0);
     let alpha = f64::atan(b / h);
     let model = Model::from_spec(&single_block(b, h, 2500.0))?;
@@ -45,6 +56,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             atol: 1e-12,
             ..Options::default()
         },
+        output_interval,
         ..Parameters::default()
     };
     let start = Instant::now();

@@ -204,7 +204,7 @@ pub fn run_section(
         let result = sim.step();
         let samples = sim.drain_samples();
         if settings.kind == SectionKind::Stroboscopic {
-            for s in samples {
+            for s in &samples {
                 // Only the samples at exactly (k as f64)·T: the impact and collapse samples
                 // fall elsewhere (an impact exactly at kT gives its pre-impact sample first).
                 if s.t == next_k as f64 * period {
@@ -212,9 +212,9 @@ pub fn run_section(
                         section.points.push(SectionPoint {
                             k: next_k,
                             t: s.t,
-                            q: s.q,
-                            qdot: s.qdot,
-                            states: s.states,
+                            q: s.q.to_vec(),
+                            qdot: s.qdot.to_vec(),
+                            states: s.states.to_vec(),
                         });
                     }
                     next_k += 1;

@@ -10,7 +10,7 @@ use serde_json::{Value, json};
 use crr_dynamics::ground_motion::{Axis, GroundMotion, RecordFormat, Units, read_record};
 use crr_dynamics::{AnalysisSpec, InitialState, solve_initial};
 use crr_impact::simulation::{
-    ImpactRecord, Parameters, Sample, Simulation, SimulationError, StopReason, Trajectory,
+    ImpactRecord, Parameters, Sample, Samples, Simulation, SimulationError, StopReason, Trajectory,
     check_initial_state,
 };
 use crr_kinematics::{InterfaceKind, Model};
@@ -238,7 +238,7 @@ pub fn run(p: &Prepared, progress: bool) -> Result<Outcome, SimulationError> {
 pub fn run_with_sink(
     p: &Prepared,
     progress: bool,
-    mut sink: impl FnMut(&[Sample]) -> std::io::Result<()>,
+    mut sink: impl FnMut(&Samples) -> std::io::Result<()>,
     stream: bool,
 ) -> Result<Outcome, SimulationError> {
     let mut sim = Simulation::new(&p.model, &p.ground, &p.initial, p.params.clone())?;
@@ -354,7 +354,7 @@ pub fn history_row(model: &Model, x: &Sample) -> String {
 
 /// Appends one line of `history.csv` to `s`, formatting in place (no string per value: writing
 /// the history was a quarter of a short run's time).
-pub fn push_history_row(s: &mut String, model: &Model, x: &Sample) {
+pub fn push_history_row(s: &mut String, model: &Model, x: &Sample<'_>) {
     use std::fmt::Write;
     // Writing to a String cannot fail.
     let _ = write!(s, "{:e}", x.t);
@@ -380,7 +380,7 @@ pub fn push_history_row(s: &mut String, model: &Model, x: &Sample) {
 pub fn history_csv(model: &Model, t: &Trajectory) -> String {
     let mut s = history_header(model);
     for x in &t.samples {
-        push_history_row(&mut s, model, x);
+        push_history_row(&mut s, model, &x);
     }
     s
 }
@@ -397,7 +397,7 @@ pub struct SampleStats {
 
 impl SampleStats {
     /// Counts `samples` in.
-    pub fn add(&mut self, samples: &[Sample]) {
+    pub fn add(&mut self, samples: &Samples) {
         self.rows += samples.len();
         for s in samples {
             let e = s
@@ -707,11 +707,11 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
         .map_err(output_error)?;
     let mut stats = SampleStats::default();
     let mut rows = String::new();
-    let sink = |samples: &[Sample]| -> std::io::Result<()> {
+    let sink = |samples: &Samples| -> std::io::Result<()> {
         stats.add(samples);
         rows.clear();
         for x in samples {
-            push_history_row(&mut rows, &p.model, x);
+            push_history_row(&mut rows, &p.model, &x);
         }
         history.write_all(rows.as_bytes())
     };

@@ -165,8 +165,8 @@ fn out_of_plane_uplift_at_the_static_multiplier() {
 }
 
 /// The regular output samples (t a multiple of 0.01 s, the first row of each time).
-fn regular(traj: &Trajectory) -> Vec<&crr::impact::simulation::Sample> {
-    let mut out: Vec<&crr::impact::simulation::Sample> = Vec::new();
+fn regular(traj: &Trajectory) -> Vec<crr::impact::simulation::Sample<'_>> {
+    let mut out: Vec<crr::impact::simulation::Sample<'_>> = Vec::new();
     for s in &traj.samples {
         let k = (s.t / 0.01).round();
         if (s.t - k * 0.01).abs() < 1e-9 && out.last().is_none_or(|l| l.t != s.t) {

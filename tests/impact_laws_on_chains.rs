@@ -296,13 +296,16 @@ fn with_law(name: &str, law: &str, tail: &str) -> String {
 }
 
 /// The pre- and post-impact samples of each impact (pushed at the impact's time).
-fn impact_samples<'a>(traj: &'a Trajectory, imp: &ImpactRecord) -> (&'a Sample, &'a Sample) {
-    let i = traj
-        .samples
+fn impact_samples<'a>(traj: &'a Trajectory, imp: &ImpactRecord) -> (Sample<'a>, Sample<'a>) {
+    let t = traj.samples.times();
+    let i = t
         .windows(2)
-        .position(|w| w[0].t == imp.t && w[1].t == imp.t)
+        .position(|w| w[0] == imp.t && w[1] == imp.t)
         .expect("samples before and after the impact");
-    (&traj.samples[i], &traj.samples[i + 1])
+    (
+        traj.samples.get(i).unwrap(),
+        traj.samples.get(i + 1).unwrap(),
+    )
 }
 
 fn pivots_of(states: &[SlotState]) -> (ActivePivots, Vec<bool>) {
@@ -324,13 +327,13 @@ fn check_run(model: &Model, traj: &Trajectory, tag: &str) -> f64 {
     let mut worst: f64 = 0.0;
     for imp in &traj.impacts {
         let (pre, post) = impact_samples(traj, imp);
-        let (before, seated_before) = pivots_of(&pre.states);
-        let (after, seated_after) = pivots_of(&post.states);
+        let (before, seated_before) = pivots_of(pre.states);
+        let (after, seated_after) = pivots_of(post.states);
         // The laws act at φ = 0: the located angles (within the event tolerance, or within
         // `simultaneity` for joints impacting together) snapped to 0, as in the post sample.
-        let q = DVector::from_column_slice(&post.q);
-        let m_minus = motion(model, &q, &DVector::from_column_slice(&pre.qdot), &before);
-        let m_plus = motion(model, &q, &DVector::from_column_slice(&post.qdot), &after);
+        let q = DVector::from_column_slice(post.q);
+        let m_minus = motion(model, &q, &DVector::from_column_slice(pre.qdot), &before);
+        let m_plus = motion(model, &q, &DVector::from_column_slice(post.qdot), &after);
         let (h_minus, h_plus) = (
             hinge_momenta(model, &m_minus),
             hinge_momenta(model, &m_plus),
@@ -428,10 +431,10 @@ fn energy_ratios(model: &Model, traj: &Trajectory) -> Vec<(f64, Vec<f64>)> {
         .filter(|imp| imp.seated.is_empty())
         .map(|imp| {
             let (pre, post) = impact_samples(traj, imp);
-            let (before, _) = pivots_of(&pre.states);
-            let (after, _) = pivots_of(&post.states);
-            let t_minus = kinetic(model, &motion(model, &v(&post.q), &v(&pre.qdot), &before));
-            let t_plus = kinetic(model, &motion(model, &v(&post.q), &v(&post.qdot), &after));
+            let (before, _) = pivots_of(pre.states);
+            let (after, _) = pivots_of(post.states);
+            let t_minus = kinetic(model, &motion(model, &v(post.q), &v(pre.qdot), &before));
+            let t_plus = kinetic(model, &motion(model, &v(post.q), &v(post.qdot), &after));
             let rates = imp
                 .rates_after
                 .iter()

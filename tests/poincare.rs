@@ -71,9 +71,9 @@ fn reference_samples(
     let mut next = 0usize;
     loop {
         let stop = sim.step().unwrap();
-        for s in sim.drain_samples() {
+        for s in &sim.drain_samples() {
             if s.t == next as f64 * dt {
-                out.push((s.t, s.q, s.qdot));
+                out.push((s.t, s.q.to_vec(), s.qdot.to_vec()));
                 next += 1;
             }
         }

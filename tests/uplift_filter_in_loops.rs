@@ -78,8 +78,8 @@ fn compare(name: &str, duration: f64) -> usize {
         }
         let mut template = Dynamics::new(model, pivots);
         template.seated = seated;
-        let q = DVector::from_column_slice(&s.q);
-        let qdot = DVector::from_column_slice(&s.qdot);
+        let q = DVector::from_column_slice(s.q);
+        let qdot = DVector::from_column_slice(s.qdot);
         let expected = reference(model, &p.ground, &template, s.t, &q, &qdot);
         let got = opening_mode(model, &p.ground, &template, s.t, &q, &qdot);
         match expected {

@@ -108,20 +108,19 @@ pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
     let variant = &study.variants[case.variant];
     let mut sim = Simulation::new(&variant.model, &ground, &variant.initial, params)
         .map_err(|e| e.to_string())?;
+    // The last sample's largest |q| (the residual tilt) and dissipated energy.
     let mut last = None;
     loop {
         let stop = sim.step().map_err(|e| e.to_string())?;
-        if let Some(s) = sim.drain_samples().pop() {
-            last = Some(s);
+        if let Some(s) = sim.drain_samples().last() {
+            last = Some((s.q.iter().fold(0.0f64, |m, q| m.max(q.abs())), s.dissipated));
         }
         if matches!(stop, StopReason::End(_) | StopReason::Collapse(_)) {
             break;
         }
     }
     let t = sim.into_trajectory();
-    let (residual, dissipated) = last.map_or((0.0, 0.0), |s| {
-        (s.q.iter().fold(0.0f64, |m, q| m.max(q.abs())), s.dissipated)
-    });
+    let (residual, dissipated) = last.unwrap_or((0.0, 0.0));
     Ok(Measures {
         peak: t.peak_abs.clone(),
         collapse: t.collapse.as_ref().map(|c| c.t),

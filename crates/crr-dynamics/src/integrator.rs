@@ -317,26 +317,39 @@ impl DenseStep<'_> {
     }
 }
 
-/// Evaluates `r1 + s(r2 + (1-s)(r3 + s(r4 + (1-s)(...))))`.
+/// Evaluates `r1 + s(r2 + (1-s)(r3 + s(r4 + (1-s)(...))))`: row j (0-based) is multiplied by s
+/// when j is even, by 1 − s when odd (a table lookup, no branch).
 #[inline]
 fn nested(ncoef: usize, s: f64, r: impl Fn(usize) -> f64) -> f64 {
-    let s1 = 1.0 - s;
+    let m = [s, 1.0 - s];
     let mut acc = r(ncoef - 1);
     for j in (0..ncoef - 1).rev() {
-        let m = if (j + 1) % 2 == 1 { s } else { s1 };
-        acc = r(j) + m * acc;
+        acc = r(j) + m[j & 1] * acc;
     }
     acc
 }
 
+/// [`nested`] for every component, row by row over contiguous slices of `coef` (`ncoef × dim`):
+/// the same operations in the same order for each component, so the same result to the last bit.
 fn dense_eval(coef: &[f64], dim: usize, t0: f64, h: f64, t: f64, out: &mut [f64]) {
     if dim == 0 {
         return;
     }
     let ncoef = coef.len() / dim;
     let s = (t - t0) / h;
-    for (i, o) in out.iter_mut().enumerate().take(dim) {
-        *o = nested(ncoef, s, |j| coef[j * dim + i]);
+    let m = [s, 1.0 - s];
+    let out = &mut out[..dim];
+    let mut rows = coef[..ncoef * dim].chunks_exact(dim).enumerate().rev();
+    if let Some((_, last)) = rows.next() {
+        for (o, &c) in out.iter_mut().zip(last) {
+            *o = c;
+        }
+    }
+    for (j, row) in rows {
+        let mj = m[j & 1];
+        for (o, &c) in out.iter_mut().zip(row) {
+            *o = c + mj * *o;
+        }
     }
 }
 

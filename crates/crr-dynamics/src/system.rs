@@ -64,8 +64,8 @@ impl OdeSystem for ConstrainedSystem<'_> {
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
         let n = self.model.dof();
-        self.q.as_mut_slice().copy_from_slice(&y[..n]);
-        self.qdot.as_mut_slice().copy_from_slice(&y[n..2 * n]);
+        copy_short(self.q.as_mut_slice(), &y[..n]);
+        copy_short(self.qdot.as_mut_slice(), &y[n..2 * n]);
         let extra: Option<&mut dyn GeneralizedForce> = match &mut self.extra {
             Some(f) => Some(&mut **f),
             None => None,
@@ -73,8 +73,8 @@ impl OdeSystem for ConstrainedSystem<'_> {
         self.dynamics
             .integration_accelerations(self.model, self.ground, t, &self.q, &self.qdot, extra)
             .map_err(|e| RhsError(e.to_string()))?;
-        dydt[..n].copy_from_slice(&y[n..2 * n]);
-        dydt[n..2 * n].copy_from_slice(self.dynamics.qddot.as_slice());
+        copy_short(&mut dydt[..n], &y[n..2 * n]);
+        copy_short(&mut dydt[n..2 * n], self.dynamics.qddot.as_slice());
         dydt[2 * n] = self.dynamics.ground_force.dot(&self.qdot);
         dydt[2 * n + 1] = -self.dynamics.extra_force.dot(&self.qdot);
         Ok(())
@@ -243,5 +243,16 @@ impl OdeSystem for ReducedSystem<'_> {
         dydt[k..2 * k].copy_from_slice(&zdd);
         dydt[2 * k] = d.ground_force.dot(&self.qdot);
         Ok(())
+    }
+}
+
+/// `dst.copy_from_slice(src)`, with one coordinate copied without a call to `memcpy` (a
+/// right-hand side of a single block makes four such copies).
+#[inline]
+fn copy_short(dst: &mut [f64], src: &[f64]) {
+    if let ([d], [s]) = (&mut *dst, src) {
+        *d = *s;
+    } else {
+        dst.copy_from_slice(src);
     }
 }

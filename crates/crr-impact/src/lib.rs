@@ -45,5 +45,6 @@ pub mod nnls;
 pub mod simulation;
 
 pub use simulation::{
-    Interrupted, Parameters, Simulation, SimulationError, SlotState, StopReason, Trajectory,
+    Interrupted, Parameters, Sample, Samples, Simulation, SimulationError, SlotState, StopReason,
+    Trajectory,
 };

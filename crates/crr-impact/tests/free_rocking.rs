@@ -118,7 +118,7 @@ fn the_block_comes_to_rest_with_a_bounded_number_of_impacts() {
     let t_rest = traj.impacts.last().unwrap().t;
     assert!(t_rest < 80.0);
     // Energy: everything the block had above rest was dissipated at the impacts.
-    let e0 = traj.samples[0].potential;
+    let e0 = traj.samples.first().unwrap().potential;
     assert!(
         (last.dissipated - e0).abs() < 1e-8 * e0,
         "dissipated {} vs initial {e0}",

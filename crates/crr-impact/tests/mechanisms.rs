@@ -110,7 +110,8 @@ fn arch_switches_to_the_mirrored_mechanism_and_loses_energy() {
         assert_eq!(after.states[s], expected, "slot {s}");
     }
     // Energy is lost, never gained, at every impact; T + U falls accordingly.
-    let mut previous = traj.samples[0].kinetic + traj.samples[0].potential;
+    let mut previous =
+        traj.samples.first().unwrap().kinetic + traj.samples.first().unwrap().potential;
     for imp in &traj.impacts {
         assert!(imp.energy_lost > 0.0 && !imp.energy_gain, "{imp:?}");
         let post = traj.samples.iter().rev().find(|s| s.t == imp.t).unwrap();
@@ -148,7 +149,7 @@ fn arch_switches_to_the_mirrored_mechanism_and_loses_energy() {
             .iter()
             .all(|s| *s == SlotState::Seated)
     );
-    let e0 = traj.samples[0].potential;
+    let e0 = traj.samples.first().unwrap().potential;
     assert!(
         traj.energy_balance_error < 1e-7 * e0,
         "balance {:e} of {e0}",

@@ -49,7 +49,7 @@ proptest! {
             Err(interrupted) => interrupted.partial,
         };
         let scale = model.total_mass() * model.gravity * model.size;
-        prop_assert!(traj.samples.iter().all(|s| s.q.iter().chain(&s.qdot).all(|x| x.is_finite())));
+        prop_assert!(traj.samples.iter().all(|s| s.q.iter().chain(s.qdot).all(|x| x.is_finite())));
         // The energy balance closes to the integration tolerance: 1e-6 of m g L, on open chains
         // and loops alike (loops lost energy outside the impacts before the projection's rank
         // threshold was fixed: tests/projection_round_off.rs).

@@ -74,7 +74,7 @@ fn squat_block_rests_without_false_collapse() {
     assert!(traj.collapse.is_none(), "{:?}", traj.collapse);
     assert_no_penetration(&traj);
     assert_eq!(traj.samples.last().unwrap().states[0], SlotState::Seated);
-    let e0 = traj.samples[0].potential;
+    let e0 = traj.samples.first().unwrap().potential;
     assert!(
         traj.energy_balance_error < 1e-7 * e0,
         "{:e}",
@@ -124,7 +124,7 @@ fn two_drums_keep_the_seated_joint_closed_and_the_energy_balanced() {
             traj.collapse
         );
         assert_no_penetration(&traj);
-        let e0 = traj.samples[0].potential;
+        let e0 = traj.samples.first().unwrap().potential;
         assert!(
             traj.energy_balance_error < 1e-7 * e0,
             "start {start}: {:e}",

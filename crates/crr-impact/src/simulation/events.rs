@@ -18,17 +18,17 @@ pub(super) struct SegmentEvents<'b> {
     pub(super) ground: &'b GroundMotion,
     /// Rocking slots watched for a zero crossing, with their sides.
     pub(super) rocking: Vec<(usize, Side)>,
-    pub(super) kin: Data,
+    pub(super) kin: Box<Data>,
     pub(super) pivots: ActivePivots,
     pub(super) angles: Vec<f64>,
     /// Present when some slot is seated: the dynamics to test releases with.
     pub(super) uplift: Option<Dynamics>,
     /// Workspace of the uplift test (a copy of the dynamics, reused at every evaluation).
-    pub(super) trial: Dynamics,
+    pub(super) trial: Box<Dynamics>,
     /// The uplift test's factorisations at rest.
     pub(super) rest: RestCache,
     /// The part of each slot ([`crr_kinematics::Parts::of_slot`]).
-    pub(super) slot_part: Vec<usize>,
+    pub(super) slot_part: &'b [usize],
     /// q and q̇ of the state evaluated.
     pub(super) q: DVector<f64>,
     pub(super) qdot: DVector<f64>,
@@ -89,7 +89,7 @@ impl SegmentEvents<'_> {
             template,
             &mut self.trial,
             &mut self.rest,
-            &self.slot_part,
+            self.slot_part,
             t,
             &self.q,
             &self.qdot,

@@ -130,7 +130,7 @@ impl Simulation<'_> {
             .spare
             .events_kin
             .take()
-            .unwrap_or_else(|| Data::new(model));
+            .unwrap_or_else(|| Box::new(Data::new(model)));
         let mut work = self.take_trial();
         let mut angles = vec![0.0; model.slot_count];
         slot_angles(model, &mut kin, &q, &before, &mut angles);
@@ -273,7 +273,9 @@ impl Simulation<'_> {
             seated: to_seat.clone(),
         };
         // Sample just before the impact, then switch.
-        let pre = self.sample_at(t, &self.y.clone());
+        let y = std::mem::take(&mut self.y);
+        let pre = self.sample_at(t, &y);
+        self.y = y;
         self.record_sample(pre);
         for &s in &impacting {
             self.last_impact[s] = t;
@@ -302,7 +304,9 @@ impl Simulation<'_> {
         // that its contact forces are those of the motion that follows (with the impact's
         // mode alone, a joint that must open at once shows a spurious tension).
         let released = self.release_if_opening();
-        let post = self.sample_at(t, &self.y.clone());
+        let y = std::mem::take(&mut self.y);
+        let post = self.sample_at(t, &y);
+        self.y = y;
         self.record_sample(post);
         released?;
         Ok(self.impacts.len() - 1)

@@ -38,12 +38,14 @@ use crate::laws::{ImpactError, dirac_law, dirac_regularised_force, momentum_law,
 
 mod events;
 mod impacts;
+mod samples;
 mod seating;
 mod slots;
 mod uplift_from_rest;
 
 use events::*;
 use impacts::*;
+pub use samples::{Iter as SampleIter, Sample, Samples};
 pub use seating::opening_mode;
 use seating::opening_mode_in;
 pub use slots::check_initial_state;
@@ -145,27 +147,6 @@ impl SlotState {
             SlotState::Negative => "-",
         }
     }
-}
-
-/// One output sample.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Sample {
-    /// Time (s).
-    pub t: f64,
-    /// q (rad).
-    pub q: Vec<f64>,
-    /// q̇ (rad/s).
-    pub qdot: Vec<f64>,
-    /// Kinetic energy T (J).
-    pub kinetic: f64,
-    /// U − U(rest) (J).
-    pub potential: f64,
-    /// Work done by the ground motion since the start (J).
-    pub work_in: f64,
-    /// Energy dissipated since the start, at impacts and by regularised laws (J).
-    pub dissipated: f64,
-    /// State of every angle slot.
-    pub states: Vec<SlotState>,
 }
 
 /// One impact.
@@ -297,7 +278,7 @@ pub struct Simulation<'a> {
     last_sample_t: f64,
     /// Output samples at the output interval, plus the instants just before and after impacts,
     /// since the last [`Simulation::drain_samples`].
-    pub samples: Vec<Sample>,
+    pub samples: Samples,
     /// Every impact, in time order.
     pub impacts: Vec<ImpactRecord>,
     /// Local extrema of the rocking coordinates.
@@ -311,16 +292,60 @@ pub struct Simulation<'a> {
     pub violation: Option<crate::monitor::Violation>,
 }
 
+/// The scalars of a sample being taken ([`Simulation::sample_at`]); its q, q̇ and slot states
+/// wait in the workspace.
+#[derive(Clone, Copy, Debug)]
+struct Taken {
+    t: f64,
+    kinetic: f64,
+    potential: f64,
+    work_in: f64,
+    dissipated: f64,
+}
+
+/// The buffers of one integration segment ([`Simulation::step`]): the events' state and pivots,
+/// the watched slots and the output's scratch.
+#[derive(Clone, Debug)]
+struct SegmentBuffers {
+    rocking: Vec<(usize, Side)>,
+    rocking_coords: Vec<usize>,
+    pivots: ActivePivots,
+    angles: Vec<f64>,
+    q: DVector<f64>,
+    qdot: DVector<f64>,
+    y: Vec<f64>,
+    peaks: Vec<Peak>,
+}
+
+impl Default for SegmentBuffers {
+    fn default() -> Self {
+        Self {
+            rocking: Vec::new(),
+            rocking_coords: Vec::new(),
+            pivots: ActivePivots { sides: Vec::new() },
+            angles: Vec::new(),
+            q: DVector::zeros(0),
+            qdot: DVector::zeros(0),
+            y: Vec::new(),
+            peaks: Vec::new(),
+        }
+    }
+}
+
 /// Workspaces of a simulation reused from segment to segment (taken by a segment's events and
 /// given back after it).
 #[derive(Clone, Debug)]
 struct Workspaces {
-    events_kin: Option<Data>,
-    trial: Option<Dynamics>,
+    /// Boxed, so that taking and giving back a workspace moves a pointer, not the structure.
+    events_kin: Option<Box<Data>>,
+    trial: Option<Box<Dynamics>>,
+    /// The buffers of a segment's events and output, taken by each segment and given back.
+    segment: SegmentBuffers,
     monitor: Dynamics,
-    /// q and q̇ of the sample being taken.
+    /// q, q̇ and the slot states of the sample being taken.
     sample_q: DVector<f64>,
     sample_qdot: DVector<f64>,
+    sample_states: Vec<SlotState>,
     /// The output samples a segment's steps pass, [t, y…] each, taken after the segment.
     pending: Vec<f64>,
     /// Buffers of the monitor's contact forces.
@@ -401,11 +426,13 @@ impl<'a> Simulation<'a> {
             regularised,
             out_kin: Data::new(model),
             spare: Workspaces {
-                events_kin: Some(Data::new(model)),
-                trial: Some(trial),
+                events_kin: Some(Box::new(Data::new(model))),
+                trial: Some(Box::new(trial)),
+                segment: SegmentBuffers::default(),
                 monitor: Dynamics::new(model, initial.pivots.clone()),
                 sample_q: DVector::zeros(n),
                 sample_qdot: DVector::zeros(n),
+                sample_states: Vec::with_capacity(model.slot_count),
                 pending: Vec::new(),
                 forces: Default::default(),
                 rest: RestCache::default(),
@@ -423,14 +450,16 @@ impl<'a> Simulation<'a> {
             peak_abs: vec![0.0; n],
             balance_error: 0.0,
             last_sample_t: f64::NEG_INFINITY,
-            samples: Vec::new(),
+            samples: Samples::new(n, model.slot_count),
             impacts: Vec::new(),
             peaks: Vec::new(),
             uplift_time: None,
             collapse: None,
             violation: None,
         };
-        let first = sim.sample_at(0.0, &sim.y.clone());
+        let y = std::mem::take(&mut sim.y);
+        let first = sim.sample_at(0.0, &y);
+        sim.y = y;
         sim.energy_start = first.kinetic + first.potential;
         // Released beyond the point of no return (its potential energy already below the rest
         // level by the collapse margin, e.g. a block tilted past 2α): collapsed at t = 0. The
@@ -469,16 +498,19 @@ impl<'a> Simulation<'a> {
     /// Current state of every slot.
     pub fn states(&self) -> Vec<SlotState> {
         (0..self.model.slot_count)
-            .map(|s| {
-                if self.seated[s] {
-                    SlotState::Seated
-                } else if self.dynamics.pivots.sides[s] == Side::Positive {
-                    SlotState::Positive
-                } else {
-                    SlotState::Negative
-                }
-            })
+            .map(|s| self.slot_state(s))
             .collect()
+    }
+
+    /// The state of slot `s`.
+    fn slot_state(&self, s: usize) -> SlotState {
+        if self.seated[s] {
+            SlotState::Seated
+        } else if self.dynamics.pivots.sides[s] == Side::Positive {
+            SlotState::Positive
+        } else {
+            SlotState::Negative
+        }
     }
 
     /// The current dynamic chain.
@@ -492,24 +524,40 @@ impl<'a> Simulation<'a> {
     }
 
     /// Keeps a sample and updates the running peaks and energy balance.
-    fn record_sample(&mut self, s: Sample) {
-        for (p, q) in self.peak_abs.iter_mut().zip(&s.q) {
+    /// Records the sample [`Self::sample_at`] has just taken: its scalars `s`, its q, q̇ and
+    /// slot states from the workspace.
+    fn record_sample(&mut self, s: Taken) {
+        let q = self.spare.sample_q.as_slice();
+        for (p, q) in self.peak_abs.iter_mut().zip(q) {
             *p = p.max(q.abs());
         }
         let balance =
             (s.kinetic + s.potential - s.work_in + s.dissipated - self.energy_start).abs();
         self.balance_error = self.balance_error.max(balance);
         self.last_sample_t = s.t;
-        self.samples.push(s);
+        self.samples.push(Sample {
+            t: s.t,
+            q,
+            qdot: self.spare.sample_qdot.as_slice(),
+            kinetic: s.kinetic,
+            potential: s.potential,
+            work_in: s.work_in,
+            dissipated: s.dissipated,
+            states: &self.spare.sample_states,
+        });
     }
 
     /// Takes the samples recorded since the last call, so that a long run can stream them to a
     /// file and keep its memory flat; the peaks and the energy balance still cover every sample.
-    pub fn drain_samples(&mut self) -> Vec<Sample> {
-        std::mem::take(&mut self.samples)
+    pub fn drain_samples(&mut self) -> Samples {
+        let empty = Samples::new(self.model.dof(), self.model.slot_count);
+        std::mem::replace(&mut self.samples, empty)
     }
 
-    fn sample_at(&mut self, t: f64, y: &[f64]) -> Sample {
+    /// Takes the sample of state `y` = [q, q̇, W, D] at `t`: checks the contact hypotheses on it
+    /// (the monitor), leaves its q, q̇ and slot states in the workspace and returns its scalars,
+    /// for [`Self::record_sample`].
+    fn sample_at(&mut self, t: f64, y: &[f64]) -> Taken {
         let n = self.model.dof();
         let (mut q, mut qdot) = (
             std::mem::take(&mut self.spare.sample_q),
@@ -566,19 +614,19 @@ impl<'a> Simulation<'a> {
             crr_kinematics::velocities(self.model, &mut self.out_kin, &qdot);
             &self.out_kin
         };
-        let kinetic = crr_kinematics::body_kinetic_energy(self.model, kin);
-        let sample = Sample {
+        let taken = Taken {
             t,
-            kinetic,
+            kinetic: crr_kinematics::body_kinetic_energy(self.model, kin),
             potential: potential_energy(self.model, kin) - self.u_rest,
             work_in: y[2 * n],
             dissipated: self.dissipated_at_impacts + y[2 * n + 1],
-            q: q.as_slice().to_vec(),
-            qdot: qdot.as_slice().to_vec(),
-            states: self.states(),
         };
         (self.spare.sample_q, self.spare.sample_qdot) = (q, qdot);
-        sample
+        let mut states = std::mem::take(&mut self.spare.sample_states);
+        states.clear();
+        states.extend((0..self.model.slot_count).map(|s| self.slot_state(s)));
+        self.spare.sample_states = states;
+        taken
     }
 
     fn reset_solver(&mut self) {
@@ -619,27 +667,37 @@ impl<'a> Simulation<'a> {
         {
             return Ok(stop);
         }
-        let rocking: Vec<(usize, Side)> = (0..model.slot_count)
-            .filter(|&s| !self.seated[s])
-            .map(|s| (s, self.dynamics.pivots.sides[s]))
-            .collect();
+        let mut seg = std::mem::take(&mut self.spare.segment);
+        seg.rocking.clear();
+        seg.rocking.extend(
+            (0..model.slot_count)
+                .filter(|&s| !self.seated[s])
+                .map(|s| (s, self.dynamics.pivots.sides[s])),
+        );
+        seg.pivots.clone_from(&self.dynamics.pivots);
+        seg.angles.clear();
+        seg.angles.resize(model.slot_count, 0.0);
+        if seg.q.len() != n {
+            seg.q = DVector::zeros(n);
+            seg.qdot = DVector::zeros(n);
+        }
         let mut events = SegmentEvents {
             model,
             ground: self.ground,
-            rocking,
+            rocking: std::mem::take(&mut seg.rocking),
             kin: self
                 .spare
                 .events_kin
                 .take()
-                .unwrap_or_else(|| Data::new(model)),
-            pivots: self.dynamics.pivots.clone(),
-            angles: vec![0.0; model.slot_count],
+                .unwrap_or_else(|| Box::new(Data::new(model))),
+            pivots: std::mem::replace(&mut seg.pivots, ActivePivots { sides: Vec::new() }),
+            angles: std::mem::take(&mut seg.angles),
             uplift: (!self.dynamics.seated.is_empty()).then(|| self.dynamics.clone()),
             trial: self.take_trial(),
             rest: std::mem::take(&mut self.spare.rest),
-            slot_part: self.parts.of_slot.clone(),
-            q: DVector::zeros(n),
-            qdot: DVector::zeros(n),
+            slot_part: &self.parts.of_slot,
+            q: std::mem::take(&mut seg.q),
+            qdot: std::mem::take(&mut seg.qdot),
             u_rest: self.u_rest,
             energy_scale: model.total_mass() * model.gravity * model.size,
             collapse_drop: self.params.collapse_drop,
@@ -662,9 +720,14 @@ impl<'a> Simulation<'a> {
         let mut pending = std::mem::take(&mut self.spare.pending);
         pending.clear();
         let stride = 2 * n + 3;
-        let mut peaks: Vec<Peak> = Vec::new();
-        let rocking_coords: Vec<usize> = (0..n).filter(|&k| !self.seated[k]).collect();
-        let mut buf = vec![0.0; 2 * n + 2];
+        let mut peaks = std::mem::take(&mut seg.peaks);
+        peaks.clear();
+        let mut rocking_coords = std::mem::take(&mut seg.rocking_coords);
+        rocking_coords.clear();
+        rocking_coords.extend((0..n).filter(|&k| !self.seated[k]));
+        let mut buf = std::mem::take(&mut seg.y);
+        buf.clear();
+        buf.resize(2 * n + 2, 0.0);
         let mut on_step = |step: &DenseStep| {
             while (next_sample as f64) * dt <= step.t1() + 1e-12 * dt
                 && (next_sample as f64) * dt <= self.params.duration + 1e-12 * dt
@@ -745,18 +808,30 @@ impl<'a> Simulation<'a> {
         drop(sys);
         let (collapse_index, first_zone_index) =
             (events.collapse_index(), events.first_zone_index());
+        let rocking_len = events.rocking.len();
+        let event_slot = match &stop {
+            Ok(Stop::Event { index, .. }) => events.rocking.get(*index).map(|r| r.0),
+            _ => None,
+        };
         let SegmentEvents {
             kin: events_kin,
             trial,
             rest,
             rocking,
+            pivots,
+            angles,
+            q,
+            qdot,
             ..
         } = events;
         self.spare.events_kin = Some(events_kin);
         self.spare.trial = Some(trial);
         self.spare.rest = rest;
         self.next_sample = next_sample;
-        self.peaks.extend(peaks);
+        self.peaks.extend_from_slice(&peaks);
+        (seg.rocking, seg.pivots, seg.angles, seg.q, seg.qdot) = (rocking, pivots, angles, q, qdot);
+        (seg.peaks, seg.rocking_coords, seg.y) = (peaks, rocking_coords, buf);
+        self.spare.segment = seg;
         for sample in pending.chunks_exact(stride) {
             let s = self.sample_at(sample[0], &sample[1..]);
             self.record_sample(s);
@@ -770,7 +845,9 @@ impl<'a> Simulation<'a> {
                 if self.t >= self.params.duration {
                     self.finished = true;
                     if self.last_sample_t < self.t {
-                        let s = self.sample_at(self.t, &self.y.clone());
+                        let y = std::mem::take(&mut self.y);
+                        let s = self.sample_at(self.t, &y);
+                        self.y = y;
                         self.record_sample(s);
                     }
                     return Ok(StopReason::End(self.t));
@@ -778,8 +855,8 @@ impl<'a> Simulation<'a> {
                 Ok(StopReason::Breakpoint(self.t))
             }
             Stop::Event { index, .. } => {
-                if index < rocking.len() {
-                    let slot = rocking[index].0;
+                if let Some(slot) = event_slot {
+                    debug_assert!(index < rocking_len);
                     self.impact(slot).map(StopReason::Impact)
                 } else if index == collapse_index {
                     let (q, qdot) = (self.q(), self.qdot());
@@ -787,7 +864,9 @@ impl<'a> Simulation<'a> {
                         let c = self.collapse_record();
                         self.collapse = Some(c.clone());
                         self.finished = true;
-                        let s = self.sample_at(self.t, &self.y.clone());
+                        let y = std::mem::take(&mut self.y);
+                        let s = self.sample_at(self.t, &y);
+                        self.y = y;
                         self.record_sample(s);
                         Ok(StopReason::Collapse(c))
                     } else {
@@ -879,7 +958,7 @@ pub struct Trajectory {
     /// Coordinate names in the order of q.
     pub coordinates: Vec<String>,
     /// Output samples (and the instants just before and after each impact).
-    pub samples: Vec<Sample>,
+    pub samples: Samples,
     /// Impact log.
     pub impacts: Vec<ImpactRecord>,
     /// Local extrema of the rocking coordinates.
@@ -905,7 +984,7 @@ impl Trajectory {
     pub fn empty(model: &Model) -> Self {
         Trajectory {
             coordinates: model.coords.iter().map(|c| c.name.clone()).collect(),
-            samples: Vec::new(),
+            samples: Samples::new(model.dof(), model.slot_count),
             impacts: Vec::new(),
             peaks: Vec::new(),
             peak_abs: vec![0.0; model.dof()],

@@ -380,11 +380,11 @@ fn loop_releases_that_may_open(
 
 impl Simulation<'_> {
     /// The uplift test's workspace (give it back to `spare.trial` after use).
-    pub(super) fn take_trial(&mut self) -> Dynamics {
+    pub(super) fn take_trial(&mut self) -> Box<Dynamics> {
         self.spare
             .trial
             .take()
-            .unwrap_or_else(|| self.dynamics.clone())
+            .unwrap_or_else(|| Box::new(self.dynamics.clone()))
     }
 
     /// Releases seated slots if the seated state cannot hold now.
@@ -522,7 +522,7 @@ impl Simulation<'_> {
             .spare
             .events_kin
             .take()
-            .unwrap_or_else(|| Data::new(self.model));
+            .unwrap_or_else(|| Box::new(Data::new(self.model)));
         let mut d = self.take_trial();
         let result = self.settle_resting_joints_in(&mut d, &mut kin);
         self.spare.events_kin = Some(kin);
