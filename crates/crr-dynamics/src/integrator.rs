@@ -315,6 +315,43 @@ impl DenseStep<'_> {
         let col = |j: usize| self.coef[j * self.dim + i];
         nested(ncoef, s, col)
     }
+
+    /// Component `i` of the interpolant with its coefficients gathered once, for repeated
+    /// evaluations (a bisection): [`DenseComponent::eval`] equals [`Self::eval_component`] to
+    /// the last bit.
+    pub fn component(&self, i: usize) -> DenseComponent {
+        let ncoef = self.coef.len() / self.dim;
+        let mut coef = [0.0; MAX_DENSE_COEF];
+        for (j, c) in coef.iter_mut().enumerate().take(ncoef) {
+            *c = self.coef[j * self.dim + i];
+        }
+        DenseComponent {
+            t0: self.t0,
+            h: self.h,
+            ncoef,
+            coef,
+        }
+    }
+}
+
+/// Most coefficients of a dense output per component (DOP853's 8).
+const MAX_DENSE_COEF: usize = 8;
+
+/// One component of a step's dense output ([`DenseStep::component`]).
+#[derive(Debug, Clone, Copy)]
+pub struct DenseComponent {
+    t0: f64,
+    h: f64,
+    ncoef: usize,
+    coef: [f64; MAX_DENSE_COEF],
+}
+
+impl DenseComponent {
+    /// The component at `t` (in the step; outside it the polynomial extrapolates).
+    pub fn eval(&self, t: f64) -> f64 {
+        let s = (t - self.t0) / self.h;
+        nested(self.ncoef, s, |j| self.coef[j])
+    }
 }
 
 /// Evaluates `r1 + s(r2 + (1-s)(r3 + s(r4 + (1-s)(...))))`: row j (0-based) is multiplied by s
@@ -322,6 +359,18 @@ impl DenseStep<'_> {
 #[inline]
 fn nested(ncoef: usize, s: f64, r: impl Fn(usize) -> f64) -> f64 {
     let m = [s, 1.0 - s];
+    if ncoef == 8 {
+        // DOP853's eight rows written out (the loop below, unrolled: the same operations).
+        let s1 = m[1];
+        let mut acc = r(7);
+        acc = r(6) + s * acc;
+        acc = r(5) + s1 * acc;
+        acc = r(4) + s * acc;
+        acc = r(3) + s1 * acc;
+        acc = r(2) + s * acc;
+        acc = r(1) + s1 * acc;
+        return r(0) + s * acc;
+    }
     let mut acc = r(ncoef - 1);
     for j in (0..ncoef - 1).rev() {
         acc = r(j) + m[j & 1] * acc;

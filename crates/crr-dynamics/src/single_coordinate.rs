@@ -36,7 +36,7 @@
 use nalgebra::{Vector3, Vector6};
 
 use crr_kinematics::mass_matrix::spatial_axis;
-use crr_kinematics::{ActivePivots, Data, Model};
+use crr_kinematics::{ActivePivots, Data, Model, Side};
 
 /// Whether [`solve`] applies: one coordinate, no closure rows.
 pub fn applies(model: &Model) -> bool {
@@ -70,7 +70,9 @@ pub fn solve(model: &Model, data: &mut Data, theta_dot: f64, force: f64) -> Opti
 /// module docs): θ̈ = (Q_{g_eff}(θ) + τ)/I_p.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Kernel {
-    /// The rest pivot p₀ it was built for (m).
+    /// The sides of the pivot's interface it was built for (they set the pivot).
+    sides: Vec<Side>,
+    /// The rest pivot p₀ (m).
     pivot: Vector3<f64>,
     /// I_p (kg m²).
     inertia: f64,
@@ -87,7 +89,8 @@ impl Kernel {
         }
         let coord = &model.coords[0];
         let iface = &model.interfaces[coord.interface];
-        let pivot = iface.kind.pivot(&pivots.sides[iface.slots.clone()]);
+        let sides = pivots.sides[iface.slots.clone()].to_vec();
+        let pivot = iface.kind.pivot(&sides);
         let u = coord.axis;
         let (mut inertia, mut r0) = (0.0, Vector3::zeros());
         for body in &model.bodies {
@@ -102,16 +105,18 @@ impl Kernel {
         let a2 = u.cross(&a1);
         let a3 = u.cross(&a2);
         Some(Self {
+            sides,
             pivot,
             inertia,
             a: [a1, a2, a3],
         })
     }
 
-    /// Whether this kernel was built for the active pivot of `pivots`.
+    /// Whether this kernel was built for the active pivot of `pivots` (the same sides of its
+    /// interface: the pivot is a function of them).
     pub fn is_for(&self, model: &Model, pivots: &ActivePivots) -> bool {
         let iface = &model.interfaces[model.coords[0].interface];
-        iface.kind.pivot(&pivots.sides[iface.slots.clone()]) == self.pivot
+        pivots.sides.get(iface.slots.clone()) == Some(&self.sides[..])
     }
 
     /// I_p (kg m²).

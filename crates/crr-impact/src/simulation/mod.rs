@@ -739,10 +739,8 @@ impl<'a> Simulation<'a> {
                 next_sample += 1;
             }
             for &k in &rocking_coords {
-                let (a, b) = (
-                    step.eval_component(step.t0(), n + k),
-                    step.eval_component(step.t1(), n + k),
-                );
+                let rate = step.component(n + k);
+                let (a, b) = (rate.eval(step.t0()), rate.eval(step.t1()));
                 if a != 0.0 && b != 0.0 && a.signum() != b.signum() {
                     // Bisection on q̇ₖ(t) of the dense output, to adjacent doubles.
                     let (mut lo, mut hi) = (step.t0(), step.t1());
@@ -751,7 +749,7 @@ impl<'a> Simulation<'a> {
                         if mid <= lo || mid >= hi {
                             break;
                         }
-                        if step.eval_component(mid, n + k).signum() == a.signum() {
+                        if rate.eval(mid).signum() == a.signum() {
                             lo = mid;
                         } else {
                             hi = mid;
