@@ -7,10 +7,24 @@ use crate::model::{Model, Side};
 /// The active pivot of every angle slot (the paper's "dynamic chain"): slot k < DOF(1) is
 /// coordinate k; the slots after them are the angles of the loop closures
 /// ([`crate::Interface::slots`]). Part of the state: an angle at exactly 0 keeps its side.
-#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct ActivePivots {
     /// One side per slot.
     pub sides: Vec<Side>,
+}
+
+// By hand for `clone_from`: the derived one would allocate a new vector, and workspaces copy the
+// run's pivots in at every output sample and uplift test.
+impl Clone for ActivePivots {
+    fn clone(&self) -> Self {
+        Self {
+            sides: self.sides.clone(),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.sides.clone_from(&source.sides);
+    }
 }
 
 impl ActivePivots {

@@ -332,6 +332,17 @@ impl Default for SegmentBuffers {
     }
 }
 
+/// The buffers of the test for joints coming to rest: q, q̇, the slot angles and rates, the
+/// slots near φ = 0.
+#[derive(Clone, Debug, Default)]
+struct SettleBuffers {
+    q: DVector<f64>,
+    qdot: DVector<f64>,
+    angles: Vec<f64>,
+    rates: Vec<f64>,
+    candidates: Vec<usize>,
+}
+
 /// Workspaces of a simulation reused from segment to segment (taken by a segment's events and
 /// given back after it).
 #[derive(Clone, Debug)]
@@ -341,6 +352,8 @@ struct Workspaces {
     trial: Option<Box<Dynamics>>,
     /// The buffers of a segment's events and output, taken by each segment and given back.
     segment: SegmentBuffers,
+    /// The buffers of the test for joints coming to rest ([`Simulation::step`]'s first task).
+    settle: SettleBuffers,
     monitor: Dynamics,
     /// q, q̇ and the slot states of the sample being taken.
     sample_q: DVector<f64>,
@@ -429,6 +442,7 @@ impl<'a> Simulation<'a> {
                 events_kin: Some(Box::new(Data::new(model))),
                 trial: Some(Box::new(trial)),
                 segment: SegmentBuffers::default(),
+                settle: SettleBuffers::default(),
                 monitor: Dynamics::new(model, initial.pivots.clone()),
                 sample_q: DVector::zeros(n),
                 sample_qdot: DVector::zeros(n),

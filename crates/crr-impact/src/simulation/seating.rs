@@ -524,43 +524,64 @@ impl Simulation<'_> {
             .take()
             .unwrap_or_else(|| Box::new(Data::new(self.model)));
         let mut d = self.take_trial();
-        let result = self.settle_resting_joints_in(&mut d, &mut kin);
+        let mut buffers = std::mem::take(&mut self.spare.settle);
+        let result = self.settle_resting_joints_in(&mut d, &mut kin, &mut buffers);
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(d);
+        self.spare.settle = buffers;
         result
     }
 
     /// [`Self::settle_resting_joints`] with the workspaces `d` (its pivots and seated slots are
-    /// set here) and `kin`.
+    /// set here), `kin` and `buffers`.
     fn settle_resting_joints_in(
         &mut self,
         d: &mut Dynamics,
         kin: &mut Data,
+        buffers: &mut SettleBuffers,
     ) -> Result<Option<f64>, SimulationError> {
         let model = self.model;
-        let (q, qdot) = (self.q(), self.qdot());
-        let mut angles = vec![0.0; model.slot_count];
-        slot_angles(model, kin, &q, &self.dynamics.pivots, &mut angles);
-        let candidates: Vec<usize> = (0..model.slot_count)
-            .filter(|&s| !self.seated[s] && angles[s].abs() <= self.params.simultaneity)
-            .collect();
+        let n = model.dof();
+        let SettleBuffers {
+            q,
+            qdot,
+            angles,
+            rates,
+            candidates,
+        } = buffers;
+        if q.len() != n {
+            *q = DVector::zeros(n);
+            *qdot = DVector::zeros(n);
+        }
+        q.copy_from_slice(&self.y[..n]);
+        qdot.copy_from_slice(&self.y[n..2 * n]);
+        let (q, qdot) = (&*q, &*qdot);
+        angles.clear();
+        angles.resize(model.slot_count, 0.0);
+        slot_angles(model, kin, q, &self.dynamics.pivots, angles);
+        candidates.clear();
+        candidates.extend(
+            (0..model.slot_count)
+                .filter(|&s| !self.seated[s] && angles[s].abs() <= self.params.simultaneity),
+        );
         if candidates.is_empty() {
             return Ok(None);
         }
         d.pivots.clone_from(&self.dynamics.pivots);
         d.seated.clone_from(&self.dynamics.seated);
-        d.accelerations(model, self.ground, self.t, &q, &qdot)
+        d.accelerations(model, self.ground, self.t, q, qdot)
             .map_err(|e| SimulationError::Dynamics {
                 t: self.t,
                 source: e,
             })?;
-        let mut rates = vec![0.0; model.slot_count];
-        slot_rates(model, &d.kin, &qdot, &mut rates);
+        rates.clear();
+        rates.resize(model.slot_count, 0.0);
+        slot_rates(model, &d.kin, qdot, rates);
         let mut row = DVector::zeros(model.dof());
         // A joint leaving φ = 0 against its acceleration returns after τ = 2|φ̇|/|φ̈|: the
         // segment is capped at τ/2 (the turning point) so the return is a plain sign change.
         let mut cap: Option<f64> = None;
-        for &s in &candidates {
+        for &s in candidates.iter() {
             let bias = slot_row(model, &d.kin, s, &mut row);
             let acc = row.dot(&d.qddot) + bias;
             let side = self.dynamics.pivots.sides[s].sign();
@@ -570,7 +591,8 @@ impl Simulation<'_> {
             }
         }
         let closing: Vec<usize> = candidates
-            .into_iter()
+            .iter()
+            .copied()
             .filter(|&s| {
                 let bias = slot_row(model, &d.kin, s, &mut row);
                 let acc = row.dot(&d.qddot) + bias;
@@ -592,13 +614,13 @@ impl Simulation<'_> {
             &mut self.dynamics.clone(),
             self.ground,
             self.t,
-            &q,
-            &qdot,
+            q,
+            qdot,
             &self.dynamics.pivots,
             &held,
         );
         d.ensure_mass_matrix(model);
-        let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * &qdot));
+        let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * qdot));
         let u_before = potential_energy(model, &d.kin);
         for &s in &closing {
             self.seated[s] = true;

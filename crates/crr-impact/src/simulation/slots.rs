@@ -59,10 +59,16 @@ pub(super) fn slot_angles(
 
 /// Rate ψ̇ = aᵀq̇ of every slot. Needs kinematics and velocities in `kin`.
 pub(super) fn slot_rates(model: &Model, kin: &Data, qdot: &DVector<f64>, out: &mut [f64]) {
-    let mut row = DVector::zeros(model.dof());
+    let n = model.dof();
+    let mut row = DVector::zeros(if out.len() > n { n } else { 0 });
     for (s, o) in out.iter_mut().enumerate() {
-        slot_row(model, kin, s, &mut row);
-        *o = row.dot(qdot);
+        if s < n {
+            // A tree slot's row is eₛ: its rate is q̇ₛ (0 + q̇ₛ, the +0 of eₛᵀq̇ when q̇ₛ = −0).
+            *o = 0.0 + qdot[s];
+        } else {
+            slot_row(model, kin, s, &mut row);
+            *o = row.dot(qdot);
+        }
     }
 }
 
