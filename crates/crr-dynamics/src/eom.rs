@@ -669,28 +669,56 @@ impl Dynamics {
         qdot: &DVector<f64>,
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
-        if extra.is_none() && self.single_coordinate_applies(model) {
-            if !self
-                .kernel
-                .as_ref()
-                .is_some_and(|k| k.is_for(model, &self.pivots))
-            {
-                self.kernel = single_coordinate::Kernel::new(model, &self.pivots);
-            }
-            if let Some(kernel) = &self.kernel {
-                let a = ground.acceleration(t);
-                self.g_eff = gravity_with_ground(model, &a);
-                let (sin, cos) = q[0].sin_cos();
-                self.load[0] = kernel.load(&self.g_eff, sin, cos);
-                self.ground_force[0] = kernel.load(&(-a), sin, cos);
-                self.extra_force[0] = 0.0;
-                self.qddot[0] = self.load[0] / kernel.inertia();
-                self.mass_current = false;
-                self.mark_single_coordinate();
-                return self.check_finite(t);
-            }
+        if extra.is_none()
+            && let Some(rates) = self.single_coordinate_rates(model, ground, t, q[0])
+        {
+            return rates.map(|_| ());
         }
         self.accelerations_with(model, ground, t, q, qdot, extra)
+    }
+
+    /// [`Self::integration_accelerations`]' one-coordinate kernel alone, at (t, θ) with no extra
+    /// force: returns (θ̈, Q_g) and sets q̈, Q, Q_g and the extra force (0) as it does; None when
+    /// the kernel does not apply (more coordinates, something seated, another solver, a massless
+    /// coordinate). The integrator's right-hand side of a single block calls it directly.
+    pub fn single_coordinate_rates(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        theta: f64,
+    ) -> Option<Result<(f64, f64), DynamicsError>> {
+        if !self.single_coordinate_applies(model) {
+            return None;
+        }
+        if !self
+            .kernel
+            .as_ref()
+            .is_some_and(|k| k.is_for(model, &self.pivots))
+        {
+            self.kernel = single_coordinate::Kernel::new(model, &self.pivots);
+        }
+        let kernel = self.kernel.as_ref()?;
+        let a = ground.acceleration(t);
+        self.g_eff = gravity_with_ground(model, &a);
+        let (sin, cos) = theta.sin_cos();
+        let load = kernel.load(&self.g_eff, sin, cos);
+        let ground_force = kernel.load(&(-a), sin, cos);
+        let qddot = load / kernel.inertia();
+        self.load[0] = load;
+        self.ground_force[0] = ground_force;
+        self.extra_force[0] = 0.0;
+        self.qddot[0] = qddot;
+        self.mass_current = false;
+        self.mark_single_coordinate();
+        Some(if qddot.is_finite() {
+            Ok((qddot, ground_force))
+        } else {
+            Err(DynamicsError::NonFinite {
+                what: "acceleration",
+                t,
+            })
+        })
     }
 
     /// Whether a solve takes the one-coordinate closed form ([`crate::single_coordinate`]):

@@ -64,6 +64,22 @@ impl OdeSystem for ConstrainedSystem<'_> {
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
         let n = self.model.dof();
+        // One coordinate: the kernel straight from y (no copies into q and q̇).
+        if n == 1
+            && self.extra.is_none()
+            && let Some(rates) =
+                self.dynamics
+                    .single_coordinate_rates(self.model, self.ground, t, y[0])
+        {
+            let (qddot, ground_force) = rates.map_err(|e| RhsError(e.to_string()))?;
+            let rate = y[1];
+            dydt[0] = rate;
+            dydt[1] = qddot;
+            // Q_g·q̇ and −τ·q̇ (τ = 0) summed as the one-term dot products below sum them.
+            dydt[2] = 0.0 + ground_force * rate;
+            dydt[3] = -(0.0 + 0.0 * rate);
+            return Ok(());
+        }
         copy_short(self.q.as_mut_slice(), &y[..n]);
         copy_short(self.qdot.as_mut_slice(), &y[n..2 * n]);
         let extra: Option<&mut dyn GeneralizedForce> = match &mut self.extra {
