@@ -670,6 +670,7 @@ impl Dynamics {
         extra: Option<&mut dyn GeneralizedForce>,
     ) -> Result<(), DynamicsError> {
         if extra.is_none()
+            && q.len() == 1
             && let Some(rates) = self.single_coordinate_rates(model, ground, t, q[0])
         {
             return rates.map(|_| ());

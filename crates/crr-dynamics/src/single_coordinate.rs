@@ -112,8 +112,9 @@ impl Kernel {
         })
     }
 
-    /// Whether this kernel was built for the active pivot of `pivots` (the same sides of its
-    /// interface: the pivot is a function of them).
+    /// Whether this kernel, built for `model`, is the one of the active pivot of `pivots`: the
+    /// same sides of its interface (the pivot is a function of them). A kernel belongs to one
+    /// model (as the [`crate::Dynamics`] holding it does): the geometry is not compared.
     pub fn is_for(&self, model: &Model, pivots: &ActivePivots) -> bool {
         let iface = &model.interfaces[model.coords[0].interface];
         pivots.sides.get(iface.slots.clone()) == Some(&self.sides[..])

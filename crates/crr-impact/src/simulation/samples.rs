@@ -30,7 +30,7 @@ pub struct Sample<'a> {
 }
 
 /// Output samples in time order, by columns (see the module documentation).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Samples {
     dof: usize,
     slots: usize,
@@ -50,7 +50,14 @@ impl Samples {
         Self {
             dof,
             slots,
-            ..Self::default()
+            t: Vec::new(),
+            q: Vec::new(),
+            qdot: Vec::new(),
+            kinetic: Vec::new(),
+            potential: Vec::new(),
+            work_in: Vec::new(),
+            dissipated: Vec::new(),
+            states: Vec::new(),
         }
     }
 
@@ -158,8 +165,9 @@ impl Samples {
     pub fn push(&mut self, s: Sample<'_>) {
         assert!(
             s.q.len() == self.dof && s.qdot.len() == self.dof && s.states.len() == self.slots,
-            "a sample of {} coordinates and {} slots pushed to samples of {} and {}",
+            "a sample of {} coordinates, {} rates and {} slots pushed to samples of {} and {}",
             s.q.len(),
+            s.qdot.len(),
             s.states.len(),
             self.dof,
             self.slots
@@ -172,6 +180,30 @@ impl Samples {
         self.work_in.push(s.work_in);
         self.dissipated.push(s.dissipated);
         self.states.extend_from_slice(s.states);
+    }
+
+    /// Appends every sample of `other` (e.g. the batches [`super::Simulation::drain_samples`]
+    /// hands over, joined again).
+    ///
+    /// # Panics
+    /// If `other`'s dimensions differ.
+    pub fn append(&mut self, other: &Samples) {
+        assert!(
+            other.dof == self.dof && other.slots == self.slots,
+            "samples of {} coordinates and {} slots appended to samples of {} and {}",
+            other.dof,
+            other.slots,
+            self.dof,
+            self.slots
+        );
+        self.t.extend_from_slice(&other.t);
+        self.q.extend_from_slice(&other.q);
+        self.qdot.extend_from_slice(&other.qdot);
+        self.kinetic.extend_from_slice(&other.kinetic);
+        self.potential.extend_from_slice(&other.potential);
+        self.work_in.extend_from_slice(&other.work_in);
+        self.dissipated.extend_from_slice(&other.dissipated);
+        self.states.extend_from_slice(&other.states);
     }
 
     /// Removes every sample, keeping the dimensions and the allocated capacity.
@@ -288,7 +320,7 @@ mod tests {
     }
 
     #[test]
-    #[should_panic(expected = "a sample of 1 coordinates")]
+    #[should_panic(expected = "a sample of 1 coordinates, 1 rates and 0 slots")]
     fn a_row_of_the_wrong_width_is_refused() {
         let mut s = Samples::new(2, 0);
         s.push(Sample {
