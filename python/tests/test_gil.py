@@ -10,8 +10,12 @@ best of five attempts is taken for the same reason.
 
 A wall-clock ratio says nothing on a machine whose second core is busy with other processes, and
 the load average cannot tell (it counts this test's own work and the builds just before it). So
-(2) has a control without a GIL: the same two runs in two processes. When they do not run in
-parallel either (their ratio is above 1.4 too), the machine has no free core: the thread ratio is
+(2) has a control without a GIL: the same two runs in two processes, measured when the threads
+take 1.6 × or more. On a partly busy machine both ratios rise together: the threads then pass
+when they take at most 0.3 × more than the processes (a held GIL would take 2 ×, above the
+processes' ratio by far more, and the threads' ratio must stay below 1.9 in any case; a CI run
+measured 1.62 for the threads against 1.40 for the processes). When the processes do not run
+in parallel at all (their ratio is above 1.6), the machine has no free core: the thread ratio is
 skipped, with both values in the reason; (1) still holds.
 """
 
@@ -93,12 +97,14 @@ def _assert_parallel(target, what: str) -> None:
     if best >= 1.6:
         control = _process_ratio()
         print(f"control: two processes / one = {control:.2f}")
-        if control > 1.4:
+        if control > 1.6:
             pytest.skip(
                 f"no free core: two runs in two processes take {control:.2f} × one, in two "
                 f"threads {best:.2f} ×"
             )
-    assert best < 1.6
+        assert best < min(1.9, control + 0.3), (
+            f"two threads take {best:.2f} × one run, two processes {control:.2f} ×"
+        )
 
 
 def _threads(n: int, target) -> float:
