@@ -5,10 +5,7 @@
 
 mod common;
 
-use std::collections::BTreeMap;
-
 use crr_dynamics::ground_motion::GroundMotion;
-use crr_dynamics::{InitialSpec, solve_initial};
 use crr_impact::{Parameters, Simulation, SlotState};
 use crr_kinematics::Model;
 use crr_kinematics::fixtures::single_block;
@@ -16,14 +13,7 @@ use crr_kinematics::fixtures::single_block;
 fn free_run(b: f64, h: f64, duration: f64) -> (crr_impact::Trajectory, f64, f64) {
     let model = Model::from_spec(&single_block(b, h, 2500.0)).unwrap();
     let alpha = (b / h).atan();
-    let init = solve_initial(
-        &model,
-        &InitialSpec {
-            angles: BTreeMap::from([("base".into(), alpha / 2.0)]),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let init = common::released_at(&model, "base", alpha / 2.0);
     let ground = GroundMotion::none();
     let params = Parameters {
         duration,

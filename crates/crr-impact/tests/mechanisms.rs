@@ -4,10 +4,7 @@
 
 mod common;
 
-use std::collections::BTreeMap;
-
 use crr_dynamics::ground_motion::GroundMotion;
-use crr_dynamics::{InitialSpec, solve_initial};
 use crr_impact::{Parameters, Simulation, SlotState};
 use crr_kinematics::Model;
 use crr_kinematics::fixtures::{four_hinge_arch, trilithon};
@@ -32,14 +29,7 @@ fn trilithon_is_its_equivalent_block_through_impacts() {
     let (alpha, rr) = ((b / h).atan(), (b * b + h * h).sqrt());
     for gamma in [0.5, 1.0, 2.0] {
         let model = Model::from_spec(&trilithon(b, h, 2.0, 0.5, gamma)).unwrap();
-        let init = solve_initial(
-            &model,
-            &InitialSpec {
-                angles: BTreeMap::from([("base_left".into(), alpha / 2.0)]),
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let init = common::released_at(&model, "base_left", alpha / 2.0);
         let traj = Simulation::new(&model, &GroundMotion::none(), &init, tight(8.0))
             .unwrap()
             .run()
@@ -78,14 +68,7 @@ fn trilithon_is_its_equivalent_block_through_impacts() {
 #[test]
 fn arch_switches_to_the_mirrored_mechanism_and_loses_energy() {
     let model = Model::from_spec(&four_hinge_arch(4.0, 4.6, 1.0, true)).unwrap();
-    let init = solve_initial(
-        &model,
-        &InitialSpec {
-            angles: BTreeMap::from([("springing_right".into(), 0.01)]),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let init = common::released_at(&model, "springing_right", 0.01);
     let sides0 = init.pivots.sides.clone();
     let traj = Simulation::new(&model, &GroundMotion::none(), &init, tight(6.0))
         .unwrap()

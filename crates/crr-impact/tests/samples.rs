@@ -2,10 +2,9 @@
 //! `Simulation::drain_samples` receives, batch after batch, is the run's samples, and the rows and
 //! the columns read the same numbers.
 
-use std::collections::BTreeMap;
+mod common;
 
 use crr_dynamics::ground_motion::GroundMotion;
-use crr_dynamics::{InitialSpec, solve_initial};
 use crr_impact::{Parameters, Samples, Simulation, SlotState, StopReason};
 use crr_kinematics::Model;
 use crr_kinematics::fixtures::single_block;
@@ -14,14 +13,7 @@ use crr_kinematics::fixtures::single_block;
 fn setup() -> (Model, crr_dynamics::InitialState, Parameters) {
     let model = Model::from_spec(&single_block(0.2, 1.0, 2500.0)).unwrap();
     let alpha = (0.2f64).atan();
-    let init = solve_initial(
-        &model,
-        &InitialSpec {
-            angles: BTreeMap::from([("base".into(), alpha / 2.0)]),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let init = common::released_at(&model, "base", alpha / 2.0);
     let params = Parameters {
         duration: 6.0,
         ..Parameters::default()

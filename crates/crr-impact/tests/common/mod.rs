@@ -1,5 +1,25 @@
 //! Shared references for the simulation tests: the exact free-rocking quarter period by
-//! Gauss–Legendre quadrature of the energy integral.
+//! Gauss–Legendre quadrature of the energy integral, and a structure released from rest.
+// Each test binary uses part of it.
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+
+use crr_dynamics::{InitialSpec, InitialState, solve_initial};
+use crr_kinematics::Model;
+
+/// The consistent initial state of `model` released from rest with coordinate `name` at
+/// `angle` (rad), the loops closed by [`solve_initial`].
+pub fn released_at(model: &Model, name: &str, angle: f64) -> InitialState {
+    solve_initial(
+        model,
+        &InitialSpec {
+            angles: BTreeMap::from([(name.into(), angle)]),
+            ..Default::default()
+        },
+    )
+    .unwrap()
+}
 
 /// Gauss–Legendre nodes and weights on [0, 1] (Newton on Pₙ).
 pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
