@@ -456,7 +456,7 @@ fn many_bodies(c: &mut Criterion) {
             b.iter(|| black_box(run(&model, &ground, black_box(&init), params.clone())));
         });
     }
-    for n in [5, 10, 20] {
+    for n in [5, 10, 20, 100] {
         let model = Model::from_spec(&block_field(n)).expect("valid blocks");
         let params = Parameters {
             duration: 1.0,

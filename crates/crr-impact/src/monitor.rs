@@ -16,7 +16,7 @@ use crr_dynamics::DynamicsError;
 use crr_dynamics::eom::{Dynamics, effective_gravity, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::linalg::JacobiSvd;
-use crr_kinematics::{InterfaceKind, Model, Role};
+use crr_kinematics::{InterfaceKind, Model, Role, forward_kinematics, velocities};
 
 /// The force a contact transmits to its child side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -118,7 +118,23 @@ pub fn contact_forces_into(
     qdot: &DVector<f64>,
     work: &mut ForceWork,
 ) -> Result<(), DynamicsError> {
-    dynamics.accelerations(model, ground, t, q, qdot)?;
+    // One coordinate: θ̈ from the integrator's own closed form (Dynamics::single_coordinate_rates,
+    // a sin/cos and a few products, the θ̈ the run integrates), and the frames and velocities of
+    // the state, which the forces below read, from the kinematics alone (M is not needed).
+    // Otherwise the general solve, which leaves them too.
+    match q
+        .as_slice()
+        .first()
+        .filter(|_| q.len() == 1)
+        .and_then(|&theta| dynamics.single_coordinate_rates(model, ground, t, theta))
+    {
+        Some(rates) => {
+            rates?;
+            forward_kinematics(model, &mut dynamics.kin, q, &dynamics.pivots);
+            velocities(model, &mut dynamics.kin, qdot);
+        }
+        None => dynamics.accelerations(model, ground, t, q, qdot)?,
+    }
     let kin = &dynamics.kin;
     let n = model.dof();
     // Total spatial accelerations A = A_bias + Σ sⱼ q̈ⱼ along each path.
