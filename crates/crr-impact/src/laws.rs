@@ -147,8 +147,9 @@ pub fn slot_rate_direction(model: &Model, kin: &Data, slot: usize) -> DVector<f6
 struct Chain {
     /// M(q) of this chain.
     mass: DMatrix<f64>,
-    /// Orthonormal basis of ker Φ_q (n × DOF(2)); the identity for an open chain.
-    null: DMatrix<f64>,
+    /// Orthonormal basis of ker Φ_q (n × DOF(2)); None for an open chain, where it is the
+    /// identity.
+    null: Option<DMatrix<f64>>,
 }
 
 /// Evaluates the kinematics of the chain `pivots` into `kin` (forward kinematics, Jacobians, M,
@@ -157,14 +158,11 @@ fn evaluate_chain(model: &Model, kin: &mut Data, q: &DVector<f64>, pivots: &Acti
     forward_kinematics(model, kin, q, pivots);
     jacobians(model, kin);
     mass_matrix(model, kin);
-    let n = model.dof();
-    let null = if model.constraint_rows == 0 {
-        DMatrix::identity(n, n)
-    } else {
+    let null = (model.constraint_rows > 0).then(|| {
         constraint_jacobian(model, kin, pivots);
         let scale = constraint_row_scale(model);
         null_space(&kin.phi_q, &scale)
-    };
+    });
     Chain {
         mass: kin.mass_matrix.clone(),
         null,
@@ -390,14 +388,22 @@ pub fn dirac_law(
 
 /// The kinetic metric of one chain on its mechanism's velocities: q̇ = N z, T = ½ zᵀ(NᵀMN)z
 /// = ½|w|² with w = Lᵀz, L the Cholesky factor of NᵀMN.
+///
+/// On an open chain N = I and z = q̇: the products with N are skipped (each entry of a product
+/// with I is one entry times 1 plus zeros, so the results are the same to the last bit; for n
+/// coordinates this saves the O(n³) products NᵀMN and NᵀA at every impact).
 struct Metric {
-    null: DMatrix<f64>,
+    /// N, None for the identity (an open chain).
+    null: Option<DMatrix<f64>>,
     chol: DMatrix<f64>,
 }
 
 impl Metric {
     fn new(law: &'static str, chain: &Chain) -> Result<Self, ImpactError> {
-        let mut chol = chain.null.transpose() * &chain.mass * &chain.null;
+        let mut chol = match &chain.null {
+            Some(null) => null.transpose() * &chain.mass * null,
+            None => chain.mass.clone(),
+        };
         let d = chol.nrows();
         cholesky_in_place(&mut chol).map_err(|col| ImpactError::Singular {
             law,
@@ -415,13 +421,19 @@ impl Metric {
 
     /// w = Lᵀ Nᵀ q̇ for a velocity q̇ of this chain (Φ_q q̇ = 0).
     fn w_of_qdot(&self, qdot: &DVector<f64>) -> DVector<f64> {
-        self.chol.tr_mul(&self.null.tr_mul(qdot))
+        match &self.null {
+            Some(null) => self.chol.tr_mul(&null.tr_mul(qdot)),
+            None => self.chol.tr_mul(qdot),
+        }
     }
 
     /// w = L⁻¹ Nᵀ p for a generalized momentum p (the momentum's components along the
     /// mechanism's motions, in the energy-normalised coordinates).
     fn w_of_momentum(&self, p: &DVector<f64>) -> DVector<f64> {
-        let mut w = self.null.tr_mul(p);
+        let mut w = match &self.null {
+            Some(null) => null.tr_mul(p),
+            None => p.clone(),
+        };
         forward_substitute(&self.chol, w.as_mut_slice());
         w
     }
@@ -430,12 +442,18 @@ impl Metric {
     fn qdot_of_w(&self, w: &DVector<f64>) -> DVector<f64> {
         let mut z = w.clone();
         back_substitute_transposed(&self.chol, z.as_mut_slice());
-        &self.null * z
+        match &self.null {
+            Some(null) => null * z,
+            None => z,
+        }
     }
 
     /// C = L⁻¹ Nᵀ A, so that the slot rates are ψ̇ = Aᵀq̇ = Cᵀw.
     fn slot_map(&self, a: &DMatrix<f64>) -> DMatrix<f64> {
-        let mut c = self.null.tr_mul(a);
+        let mut c = match &self.null {
+            Some(null) => null.tr_mul(a),
+            None => a.clone(),
+        };
         for mut col in c.column_iter_mut() {
             let mut v = col.clone_owned();
             forward_substitute(&self.chol, v.as_mut_slice());
