@@ -11,8 +11,8 @@ use crr_dynamics::ground_motion::{Axis, ComponentSpec, ConstantSpec, GroundMotio
 use crr_dynamics::{InitialSpec, solve_initial};
 use crr_impact::monitor::contact_forces;
 use crr_impact::{Parameters, Simulation};
-use crr_kinematics::fixtures::{box_body, hinge, single_block, transformed};
-use crr_kinematics::{ActivePivots, Model, Side, StructureSpec};
+use crr_kinematics::fixtures::{box_body, single_block, transformed};
+use crr_kinematics::{ActivePivots, Model, Side};
 use nalgebra::{DVector, Matrix3, Rotation3, Vector3};
 
 const G: f64 = 9.81;
@@ -228,25 +228,15 @@ fn hyperstatic_tension_needs_no_compressive_distribution() {
 #[test]
 fn one_coordinate_forces_match_the_general_solve() {
     let (b, h) = (0.25, 0.9);
-    let spec = StructureSpec {
-        name: "offset_block".into(),
-        gravity: G,
-        body: vec![box_body(
-            "block",
-            2500.0,
-            [0.06, 0.11, h],
-            [2.0 * b + 0.12, 0.5, 2.0 * h],
-        )],
-        interface: vec![hinge(
-            "base",
-            "ground",
-            "block",
-            [0.0, 1.0, 0.0],
-            [b, 0.0, 0.0],
-            [-b, 0.0, 0.0],
-        )],
-        symmetry: Vec::new(),
-    };
+    // Housner's block on its hinge, with the body moved off the hinge's mid-plane (x) and off
+    // its symmetry plane (y), and wider than the base.
+    let mut spec = single_block(b, h, 2500.0);
+    spec.body[0] = box_body(
+        "block",
+        2500.0,
+        [0.06, 0.11, h],
+        [2.0 * b + 0.12, 0.5, 2.0 * h],
+    );
     let turn: Matrix3<f64> = *Rotation3::from_axis_angle(&Vector3::z_axis(), 0.7).matrix();
     let model =
         Model::from_spec(&transformed(&spec, &turn, &Vector3::new(1.0, -2.0, 0.0))).unwrap();
