@@ -387,6 +387,12 @@ fn dense_eval(coef: &[f64], dim: usize, t0: f64, h: f64, t: f64, out: &mut [f64]
     let ncoef = coef.len() / dim;
     let s = (t - t0) / h;
     let m = [s, 1.0 - s];
+    match dim {
+        4 => return dense_eval_fixed::<4>(&coef[..ncoef * 4], m, out),
+        6 => return dense_eval_fixed::<6>(&coef[..ncoef * 6], m, out),
+        8 => return dense_eval_fixed::<8>(&coef[..ncoef * 8], m, out),
+        _ => {}
+    }
     let out = &mut out[..dim];
     let mut rows = coef[..ncoef * dim].chunks_exact(dim).enumerate().rev();
     if let Some((_, last)) = rows.next() {
@@ -402,13 +408,37 @@ fn dense_eval(coef: &[f64], dim: usize, t0: f64, h: f64, t: f64, out: &mut [f64]
     }
 }
 
+/// [`dense_eval`] for a dimension known at compile time (the small systems: one to three
+/// coordinates): the partial sums stay in registers from row to row, where the general loop
+/// stores and reloads them, a store-to-load round trip on the critical path at every row. The
+/// same operations in the same order, so the same result to the last bit.
+#[inline]
+fn dense_eval_fixed<const D: usize>(coef: &[f64], m: [f64; 2], out: &mut [f64]) {
+    let mut rows = coef.chunks_exact(D).enumerate().rev();
+    let mut acc = [0.0; D];
+    if let Some((_, last)) = rows.next() {
+        acc.copy_from_slice(last);
+    }
+    for (j, row) in rows {
+        let mj = m[j & 1];
+        for (a, &c) in acc.iter_mut().zip(row) {
+            *a = c + mj * *a;
+        }
+    }
+    out[..D].copy_from_slice(&acc);
+}
+
 /// `out = Σ_j a_j k_j` over the stages `k` (rows of `dim`), skipping the zero coefficients of
 /// the tableau. The sum runs stage by stage over contiguous slices: the same order of additions
 /// for every component as a component-by-component loop, so the same result to the last bit.
 #[inline]
 fn stage_sum(k: &[f64], dim: usize, a: &[f64], out: &mut [f64]) {
-    if dim == 0 {
-        return;
+    match dim {
+        0 => return,
+        4 => return stage_sum_fixed::<4>(k, a, out),
+        6 => return stage_sum_fixed::<6>(k, a, out),
+        8 => return stage_sum_fixed::<8>(k, a, out),
+        _ => {}
     }
     let out = &mut out[..dim];
     out.fill(0.0);
@@ -419,6 +449,21 @@ fn stage_sum(k: &[f64], dim: usize, a: &[f64], out: &mut [f64]) {
             }
         }
     }
+}
+
+/// [`stage_sum`] for a dimension known at compile time, with the sums in registers (see
+/// [`dense_eval_fixed`]): 0 + a₁k₁ + a₂k₂ + … in the same order, the same result to the last bit.
+#[inline]
+fn stage_sum_fixed<const D: usize>(k: &[f64], a: &[f64], out: &mut [f64]) {
+    let mut acc = [0.0; D];
+    for (kj, &aj) in k.chunks_exact(D).zip(a) {
+        if aj != 0.0 {
+            for (s, &x) in acc.iter_mut().zip(kj) {
+                *s += aj * x;
+            }
+        }
+    }
+    out[..D].copy_from_slice(&acc);
 }
 
 /// `out = y + h Σ_j a_j k_j` ([`stage_sum`]).
