@@ -266,11 +266,10 @@ fn small_dimensions_agree_with_the_general_code_to_the_last_bit() {
         let (method, opts) = method_fixed(m, 0.1);
         for n in 2..=5 {
             let y0: Vec<f64> = starts[..n].iter().flat_map(|&x| [x, 0.0]).collect();
-            let (together, readings) = run(&omegas[..n], &y0, method, opts.clone());
+            let (together, readings) = run(&omegas[..n], &y0, method, opts);
             assert_eq!(readings.len(), 4 * 20, "{m}, {n} pendulums: 20 steps");
             for k in 0..n {
-                let (alone, alone_readings) =
-                    run(&omegas[k..=k], &[starts[k], 0.0], method, opts.clone());
+                let (alone, alone_readings) = run(&omegas[k..=k], &[starts[k], 0.0], method, opts);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                 assert_eq!(
                     bits(&together[2 * k..2 * k + 2]),
