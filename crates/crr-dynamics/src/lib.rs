@@ -19,6 +19,7 @@ pub mod integrator;
 pub mod linalg;
 pub mod mechanism;
 pub mod run;
+pub mod short_copy;
 pub mod single_coordinate;
 pub mod system;
 

@@ -17,6 +17,7 @@ use crate::eom::{Dynamics, GeneralizedForce};
 use crate::ground_motion::GroundMotion;
 use crate::integrator::{OdeSystem, RhsError};
 use crate::linalg::{cholesky_in_place, cholesky_solve, pseudo_inverse};
+use crate::short_copy::copy_short;
 
 /// The multi-DOF constrained form: y = [q, q̇, W, D] with W the work of the ground motion and D
 /// the energy dissipated by the extra force (if any), Ḋ = −F_extraᵀq̇.
@@ -259,16 +260,5 @@ impl OdeSystem for ReducedSystem<'_> {
         dydt[k..2 * k].copy_from_slice(&zdd);
         dydt[2 * k] = d.ground_force.dot(&self.qdot);
         Ok(())
-    }
-}
-
-/// `dst.copy_from_slice(src)`, with one coordinate copied without a call to `memcpy` (a
-/// right-hand side of a single block makes four such copies).
-#[inline]
-fn copy_short(dst: &mut [f64], src: &[f64]) {
-    if let ([d], [s]) = (&mut *dst, src) {
-        *d = *s;
-    } else {
-        dst.copy_from_slice(src);
     }
 }

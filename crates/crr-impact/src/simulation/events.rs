@@ -56,8 +56,8 @@ impl SegmentEvents<'_> {
     /// Loads q (and q̇) from y and the slot angles of q.
     fn load_state(&mut self, y: &[f64]) {
         let n = self.model.dof();
-        self.q.as_mut_slice().copy_from_slice(&y[..n]);
-        self.qdot.as_mut_slice().copy_from_slice(&y[n..2 * n]);
+        copy_short(self.q.as_mut_slice(), &y[..n]);
+        copy_short(self.qdot.as_mut_slice(), &y[n..2 * n]);
         slot_angles(
             self.model,
             &mut self.kin,

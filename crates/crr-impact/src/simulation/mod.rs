@@ -27,6 +27,7 @@ use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::integrator::{
     DenseStep, Direction, EventFunctions, Method, Options, SolveError, Solver, Stop,
 };
+use crr_dynamics::short_copy::{copy_short, extend_short};
 use crr_dynamics::{ConstrainedSystem, InitialState};
 use crr_kinematics::spec::ImpactLaw;
 use crr_kinematics::{
@@ -577,8 +578,8 @@ impl<'a> Simulation<'a> {
             std::mem::take(&mut self.spare.sample_q),
             std::mem::take(&mut self.spare.sample_qdot),
         );
-        q.copy_from_slice(&y[..n]);
-        qdot.copy_from_slice(&y[n..2 * n]);
+        copy_short(q.as_mut_slice(), &y[..n]);
+        copy_short(qdot.as_mut_slice(), &y[n..2 * n]);
         // A seated coordinate is held at 0 (the dense output between projections carries round-off).
         for k in 0..n {
             if self.seated[k] {
@@ -749,7 +750,7 @@ impl<'a> Simulation<'a> {
                 let ts = (next_sample as f64 * dt).min(step.t1());
                 step.eval(ts, &mut buf);
                 pending.push(next_sample as f64 * dt);
-                pending.extend_from_slice(&buf);
+                extend_short(&mut pending, &buf);
                 next_sample += 1;
             }
             for &k in &rocking_coords {

@@ -7,6 +7,7 @@
 use serde::Serialize;
 
 use super::SlotState;
+use crr_dynamics::short_copy::extend_short;
 
 /// One output sample: a view of one row of [`Samples`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -173,13 +174,13 @@ impl Samples {
             self.slots
         );
         self.t.push(s.t);
-        self.q.extend_from_slice(s.q);
-        self.qdot.extend_from_slice(s.qdot);
+        extend_short(&mut self.q, s.q);
+        extend_short(&mut self.qdot, s.qdot);
         self.kinetic.push(s.kinetic);
         self.potential.push(s.potential);
         self.work_in.push(s.work_in);
         self.dissipated.push(s.dissipated);
-        self.states.extend_from_slice(s.states);
+        extend_short(&mut self.states, s.states);
     }
 
     /// Appends every sample of `other` (e.g. the batches [`super::Simulation::drain_samples`]
