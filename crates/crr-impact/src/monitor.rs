@@ -16,7 +16,7 @@ use crr_dynamics::DynamicsError;
 use crr_dynamics::eom::{Dynamics, effective_gravity, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::linalg::JacobiSvd;
-use crr_kinematics::{InterfaceKind, Model, Role, forward_kinematics, velocities};
+use crr_kinematics::{InterfaceKind, Model, Role, forward_kinematics};
 
 /// The force a contact transmits to its child side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -119,22 +119,18 @@ pub fn contact_forces_into(
     work: &mut ForceWork,
 ) -> Result<(), DynamicsError> {
     // One coordinate: θ̈ from the integrator's own closed form (Dynamics::single_coordinate_rates,
-    // a sin/cos and a few products, the θ̈ the run integrates), and the frames and velocities of
-    // the state, which the forces below read, from the kinematics alone (M is not needed).
-    // Otherwise the general solve, which leaves them too.
-    match q
-        .as_slice()
-        .first()
-        .filter(|_| q.len() == 1)
-        .and_then(|&theta| dynamics.single_coordinate_rates(model, ground, t, theta))
+    // a sin/cos and a few products, the θ̈ the run integrates), the frames of the state from the
+    // kinematics alone (M is not needed), and the force in closed form.
+    if let [theta] = q.as_slice()
+        && let ([_], [_]) = (&model.bodies[..], &model.interfaces[..])
+        && let Some(rates) = dynamics.single_coordinate_rates(model, ground, t, *theta)
     {
-        Some(rates) => {
-            rates?;
-            forward_kinematics(model, &mut dynamics.kin, q, &dynamics.pivots);
-            velocities(model, &mut dynamics.kin, qdot);
-        }
-        None => dynamics.accelerations(model, ground, t, q, qdot)?,
+        rates?;
+        forward_kinematics(model, &mut dynamics.kin, q, &dynamics.pivots);
+        one_body_force(model, dynamics, ground, t, qdot[0], work);
+        return Ok(());
     }
+    dynamics.accelerations(model, ground, t, q, qdot)?;
     let kin = &dynamics.kin;
     let n = model.dof();
     // Total spatial accelerations A = A_bias + Σ sⱼ q̈ⱼ along each path.
@@ -182,6 +178,39 @@ pub fn contact_forces_into(
         })
     }));
     Ok(())
+}
+
+/// [`contact_forces_into`] for a structure of one coordinate with θ̈ solved and the frames of
+/// the state in `dynamics.kin`: one body on one interface to the ground (every interface adds a
+/// coordinate and there is no closure), turning with ω = θ̇w, α = θ̈w about the pivot line (w, p)
+/// fixed in the world. The ground transmits the body's net force beyond its load,
+/// F = m (a_c − g_eff) with a_c = α × r + ω × (ω × r), r = c − p: the general assembly's spatial
+/// algebra for one body, without its buffers. Also sets the body's spatial velocity
+/// V = [w; p × w] θ̇ (as [`crr_kinematics::velocities`] does), which the energies of a sample read.
+fn one_body_force(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    ground: &GroundMotion,
+    t: f64,
+    theta_dot: f64,
+    work: &mut ForceWork,
+) {
+    let kin = &mut dynamics.kin;
+    kin.spatial_velocity[0] = crr_kinematics::mass_matrix::spatial_axis(kin, 0) * theta_dot;
+    let (body, iface) = (&model.bodies[0], &model.interfaces[0]);
+    let (w, r) = (kin.axis[0], kin.com[0] - kin.pivot[0]);
+    let a_c = w.cross(&r) * dynamics.qddot[0] + w.cross(&w.cross(&r)) * (theta_dot * theta_dot);
+    let force = (a_c - effective_gravity(model, ground, t)) * body.mass;
+    work.forces.clear();
+    work.forces
+        .push(rest_normal(&iface.kind, model.size).map(|normal| {
+            let nf = force.dot(&normal);
+            ContactForce {
+                force: force.into(),
+                normal: nf,
+                tangential: (force - normal * nf).norm(),
+            }
+        }));
 }
 
 /// The force each monitored interface transmits to its child side, with its contact normal
