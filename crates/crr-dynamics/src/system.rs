@@ -48,6 +48,34 @@ impl<'a> ConstrainedSystem<'a> {
         }
     }
 
+    /// [`Self::new`] on the q and q̇ buffers of an earlier system ([`Self::into_buffers`]),
+    /// resized to the model when needed: a simulation builds a system for every segment between
+    /// events, and this one does not allocate.
+    pub fn with_buffers(
+        model: &'a Model,
+        ground: &'a GroundMotion,
+        dynamics: &'a mut Dynamics,
+        (mut q, mut qdot): (DVector<f64>, DVector<f64>),
+    ) -> Self {
+        let n = model.dof();
+        if q.len() != n || qdot.len() != n {
+            (q, qdot) = (DVector::zeros(n), DVector::zeros(n));
+        }
+        Self {
+            model,
+            ground,
+            dynamics,
+            extra: None,
+            q,
+            qdot,
+        }
+    }
+
+    /// The q and q̇ buffers, for [`Self::with_buffers`].
+    pub fn into_buffers(self) -> (DVector<f64>, DVector<f64>) {
+        (self.q, self.qdot)
+    }
+
     /// State vector [q, q̇, W, D].
     pub fn pack(q: &DVector<f64>, qdot: &DVector<f64>, work: f64, dissipated: f64) -> Vec<f64> {
         q.iter()

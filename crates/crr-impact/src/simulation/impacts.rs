@@ -116,6 +116,18 @@ pub(super) fn apply_law(
     restitution_law(model, kin, q, qdot, before, after, &factors)
 }
 
+/// Scratch of [`Simulation::impact`], kept by the run: the slot angles and rates, and the lists
+/// of held, wrongly moving, seating candidate and newly seated slots.
+#[derive(Clone, Debug, Default)]
+pub(super) struct ImpactBuffers {
+    angles: Vec<f64>,
+    rates: Vec<f64>,
+    held: Vec<usize>,
+    wrong: Vec<usize>,
+    candidates: Vec<usize>,
+    pending: Vec<usize>,
+}
+
 impl Simulation<'_> {
     /// Handles an impact fired by `slot` at the current time.
     pub(super) fn impact(&mut self, slot: usize) -> Result<usize, SimulationError> {
@@ -132,10 +144,21 @@ impl Simulation<'_> {
             .take()
             .unwrap_or_else(|| Box::new(Data::new(model)));
         let mut work = self.take_trial();
-        let mut angles = vec![0.0; model.slot_count];
+        // Scratch of the run (given back below, or reallocated after an error return).
+        let ImpactBuffers {
+            mut angles,
+            mut rates,
+            mut held,
+            mut wrong,
+            mut candidates,
+            mut pending,
+        } = std::mem::take(&mut self.spare.impact);
+        angles.clear();
+        angles.resize(model.slot_count, 0.0);
         slot_angles(model, &mut kin, &q, &before, &mut angles);
         crr_kinematics::velocities(model, &mut kin, &qdot);
-        let mut rates = vec![0.0; model.slot_count];
+        rates.clear();
+        rates.resize(model.slot_count, 0.0);
         slot_rates(model, &kin, &qdot, &mut rates);
         let mut impacting: Vec<usize> = (0..model.slot_count)
             .filter(|&s| {
@@ -145,7 +168,8 @@ impl Simulation<'_> {
                         && rates[s] * before.sides[s].sign() < 0.0)
             })
             .collect();
-        let held: Vec<usize> = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        held.clear();
+        held.extend((0..model.slot_count).filter(|&s| self.seated[s]));
         // A rocking joint at φ ≈ 0 that the impact sends into its closed side impacts too (its
         // pivot switches): enlarge the impacting set until no joint penetrates.
         let (after, q_new, result, mut qdot_after, mut kinetic_after) = loop {
@@ -164,13 +188,13 @@ impl Simulation<'_> {
                 }
             }
             let q = q_at;
-            let result = apply_law(model, &mut kin, &q, &qdot, &before, &after, &impacting)
+            let mut result = apply_law(model, &mut kin, &q, &qdot, &before, &after, &impacting)
                 .map_err(|source| SimulationError::Impact { t, source })?;
             // Joints that were seated stay seated through the impact: a plastic impulse on them
             // (booked as dissipation), as "all other hinges persisting". With none, the law's
             // q̇⁺ and T⁺ = ½q̇⁺ᵀM⁺q̇⁺ (the same M⁺, at the same q) stand.
             let (qd, k) = if held.is_empty() {
-                (result.qdot.clone(), result.kinetic_after)
+                (std::mem::take(&mut result.qdot), result.kinetic_after)
             } else {
                 plastic_projection(
                     model,
@@ -186,30 +210,28 @@ impl Simulation<'_> {
             forward_kinematics(model, &mut kin, &q, &after);
             crr_kinematics::velocities(model, &mut kin, &qd);
             slot_rates(model, &kin, &qd, &mut rates);
-            let wrong: Vec<usize> = (0..model.slot_count)
-                .filter(|&s| {
-                    !self.seated[s]
-                        && !impacting.contains(&s)
-                        && angles[s].abs() <= self.params.simultaneity
-                        && after.sides[s].sign() * rates[s] < -1e-12
-                })
-                .collect();
+            wrong.clear();
+            wrong.extend((0..model.slot_count).filter(|&s| {
+                !self.seated[s]
+                    && !impacting.contains(&s)
+                    && angles[s].abs() <= self.params.simultaneity
+                    && after.sides[s].sign() * rates[s] < -1e-12
+            }));
             if wrong.is_empty() {
                 break (after, q, result, qd, k);
             }
-            impacting.extend(wrong);
+            impacting.extend_from_slice(&wrong);
         };
         let rates_after: Vec<f64> = impacting.iter().map(|&s| rates[s]).collect();
         // Seating of the impacting interfaces that come to rest. Seating one joint of a loop can
         // lock the others: seat, recompute the rates, and seat every impacting slot brought below
         // the threshold, until nothing changes.
         // Candidates: the impacting slots, and rocking slots resting at φ ≈ 0 with a negligible rate.
-        let candidates: Vec<usize> = (0..model.slot_count)
-            .filter(|&s| {
-                impacting.contains(&s)
-                    || (!self.seated[s] && angles[s].abs() <= self.params.simultaneity)
-            })
-            .collect();
+        candidates.clear();
+        candidates.extend((0..model.slot_count).filter(|&s| {
+            impacting.contains(&s)
+                || (!self.seated[s] && angles[s].abs() <= self.params.simultaneity)
+        }));
         let mut to_seat: Vec<usize> = candidates
             .iter()
             .copied()
@@ -220,7 +242,7 @@ impl Simulation<'_> {
                     || after.sides[s].sign() * rates[s] < 0.0
             })
             .collect();
-        let mut pending = to_seat.clone();
+        pending.clone_from(&to_seat);
         while !pending.is_empty() {
             let all: Vec<usize> = held.iter().chain(&to_seat).copied().collect();
             (qdot_after, kinetic_after) = plastic_projection(
@@ -236,23 +258,19 @@ impl Simulation<'_> {
             forward_kinematics(model, &mut kin, &q_new, &after);
             crr_kinematics::velocities(model, &mut kin, &qdot_after);
             slot_rates(model, &kin, &qdot_after, &mut rates);
-            pending = candidates
-                .iter()
-                .copied()
-                .filter(|&s| {
-                    !to_seat.contains(&s)
-                        && (rates[s].abs() < self.params.seat_rate
-                            || after.sides[s].sign() * rates[s] < 0.0)
-                })
-                .collect();
-            to_seat.extend(pending.iter().copied());
+            pending.clear();
+            pending.extend(candidates.iter().copied().filter(|&s| {
+                !to_seat.contains(&s)
+                    && (rates[s].abs() < self.params.seat_rate
+                        || after.sides[s].sign() * rates[s] < 0.0)
+            }));
+            to_seat.extend_from_slice(&pending);
         }
         let before_rates: Vec<f64> = {
             forward_kinematics(model, &mut kin, &q, &before);
             crr_kinematics::velocities(model, &mut kin, &qdot);
-            let mut r = vec![0.0; model.slot_count];
-            slot_rates(model, &kin, &qdot, &mut r);
-            impacting.iter().map(|&s| r[s]).collect()
+            slot_rates(model, &kin, &qdot, &mut rates);
+            impacting.iter().map(|&s| rates[s]).collect()
         };
         let lost = result.kinetic_before - kinetic_after;
         let record = ImpactRecord {
@@ -265,26 +283,29 @@ impl Simulation<'_> {
                 names.dedup();
                 names
             },
-            slots: impacting.clone(),
+            slots: impacting,
             rates_before: before_rates,
             rates_after,
             energy_lost: lost,
             energy_gain: result.kinetic_after > result.kinetic_before * (1.0 + 1e-9) + 1e-12,
-            seated: to_seat.clone(),
+            seated: to_seat,
         };
         // Sample just before the impact, then switch.
         let y = std::mem::take(&mut self.y);
         let pre = self.sample_at(t, &y);
         self.y = y;
         self.record_sample(pre);
-        for &s in &impacting {
+        for &s in &record.slots {
             self.last_impact[s] = t;
         }
-        for &s in &to_seat {
+        for &s in &record.seated {
             self.seated[s] = true;
         }
         self.dynamics.pivots = after;
-        self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        self.dynamics.seated.clear();
+        self.dynamics
+            .seated
+            .extend((0..model.slot_count).filter(|&s| self.seated[s]));
         // The snap of the impacting angles to exactly 0 changes U by round-off: booked too.
         let u_snap = {
             forward_kinematics(model, &mut kin, &q, &before);
@@ -294,6 +315,14 @@ impl Simulation<'_> {
         };
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(work);
+        self.spare.impact = ImpactBuffers {
+            angles,
+            rates,
+            held,
+            wrong,
+            candidates,
+            pending,
+        };
         self.dissipated_at_impacts += lost + u_snap;
         let n = model.dof();
         self.y[..n].copy_from_slice(q_new.as_slice());

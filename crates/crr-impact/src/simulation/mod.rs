@@ -364,8 +364,12 @@ struct Workspaces {
     pending: Vec<f64>,
     /// Buffers of the monitor's contact forces.
     forces: crate::monitor::ForceWork,
+    /// The q and q̇ buffers of the segments' right-hand sides ([`ConstrainedSystem::with_buffers`]).
+    system: (DVector<f64>, DVector<f64>),
     /// The uplift test's factorisations at rest ([`RestCache`]).
     rest: RestCache,
+    /// Scratch of the impacts.
+    impact: ImpactBuffers,
 }
 
 impl<'a> Simulation<'a> {
@@ -451,6 +455,8 @@ impl<'a> Simulation<'a> {
                 pending: Vec::new(),
                 forces: Default::default(),
                 rest: RestCache::default(),
+                system: Default::default(),
+                impact: ImpactBuffers::default(),
             },
             parts: model.parts(),
             y,
@@ -811,14 +817,16 @@ impl<'a> Simulation<'a> {
             }
         }
         self.solver.set_h_max(h_max);
-        let mut sys = ConstrainedSystem::new(model, self.ground, &mut self.dynamics);
+        let buffers = std::mem::take(&mut self.spare.system);
+        let mut sys =
+            ConstrainedSystem::with_buffers(model, self.ground, &mut self.dynamics, buffers);
         if let Some(r) = self.regularised.as_mut() {
             sys.extra = Some(r);
         }
         let stop = self
             .solver
             .advance(&mut sys, t_stop, &mut events, &mut on_step);
-        drop(sys);
+        self.spare.system = sys.into_buffers();
         let (collapse_index, first_zone_index) =
             (events.collapse_index(), events.first_zone_index());
         let rocking_len = events.rocking.len();
