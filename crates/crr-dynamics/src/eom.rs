@@ -689,21 +689,13 @@ impl Dynamics {
         t: f64,
         theta: f64,
     ) -> Option<Result<(f64, f64), DynamicsError>> {
-        if !self.single_coordinate_applies(model) {
-            return None;
-        }
-        if !self
-            .kernel
-            .as_ref()
-            .is_some_and(|k| k.is_for(model, &self.pivots))
-        {
-            self.kernel = single_coordinate::Kernel::new(model, &self.pivots);
-        }
-        let kernel = self.kernel.as_ref()?;
+        self.single_coordinate_kernel(model)?;
         let a = ground.acceleration(t);
-        self.g_eff = gravity_with_ground(model, &a);
+        let g_eff = gravity_with_ground(model, &a);
+        self.g_eff = g_eff;
+        let kernel = self.kernel.as_ref()?;
         let (sin, cos) = theta.sin_cos();
-        let load = kernel.load(&self.g_eff, sin, cos);
+        let load = kernel.load(&g_eff, sin, cos);
         let ground_force = kernel.load(&(-a), sin, cos);
         let qddot = load / kernel.inertia();
         self.load[0] = load;
@@ -720,6 +712,65 @@ impl Dynamics {
                 t,
             })
         })
+    }
+
+    /// [`Self::accelerations`] of a structure of one coordinate where the kernel applies, from
+    /// the forward kinematics of the state (left in `kin`, as the general solve leaves it)
+    /// instead of the kernel's own sin/cos: Q_f = f · (w × Σₙ mₙ(cₙ − p)) for
+    /// f = g_eff and −a_g, θ̈ = Q/I_p with the kernel's I_p. For code that needs the kinematics
+    /// of the state anyway (the monitor of the output samples), it saves one sin/cos. None when
+    /// the kernel does not apply. The velocities in `kin` are not set.
+    pub fn single_coordinate_accelerations(
+        &mut self,
+        model: &Model,
+        ground: &GroundMotion,
+        t: f64,
+        q: &DVector<f64>,
+    ) -> Option<Result<(), DynamicsError>> {
+        let inertia = self.single_coordinate_kernel(model)?.inertia();
+        forward_kinematics(model, &mut self.kin, q, &self.pivots);
+        let a = ground.acceleration(t);
+        let g_eff = gravity_with_ground(model, &a);
+        self.g_eff = g_eff;
+        let (w, p) = (self.kin.axis[0], self.kin.pivot[0]);
+        let mut moment = Vector3::zeros();
+        for (c, body) in self.kin.com.iter().zip(&model.bodies) {
+            moment += (c - p) * body.mass;
+        }
+        let arm = w.cross(&moment);
+        self.load[0] = g_eff.dot(&arm);
+        self.ground_force[0] = -a.dot(&arm);
+        self.extra_force[0] = 0.0;
+        self.qddot[0] = self.load[0] / inertia;
+        self.mass_current = false;
+        self.mark_single_coordinate();
+        Some(self.check_finite(t))
+    }
+
+    /// g_eff = g + (−a_g) of the last solve (m/s², world axes): the field whose generalized
+    /// force is the load Q.
+    pub fn effective_gravity(&self) -> Vector3<f64> {
+        self.g_eff
+    }
+
+    /// The [`single_coordinate::Kernel`] of the active pivot (built on the first call after a
+    /// pivot switch), when [`Self::single_coordinate_rates`] applies; its I_p is what a reader of
+    /// the kinematics of a one-coordinate state needs to solve for θ̈ without the sin/cos.
+    pub fn single_coordinate_kernel(
+        &mut self,
+        model: &Model,
+    ) -> Option<&single_coordinate::Kernel> {
+        if !self.single_coordinate_applies(model) {
+            return None;
+        }
+        if !self
+            .kernel
+            .as_ref()
+            .is_some_and(|k| k.is_for(model, &self.pivots))
+        {
+            self.kernel = single_coordinate::Kernel::new(model, &self.pivots);
+        }
+        self.kernel.as_ref()
     }
 
     /// Whether a solve takes the one-coordinate closed form ([`crate::single_coordinate`]):

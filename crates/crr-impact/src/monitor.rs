@@ -16,7 +16,7 @@ use crr_dynamics::DynamicsError;
 use crr_dynamics::eom::{Dynamics, effective_gravity, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::linalg::JacobiSvd;
-use crr_kinematics::{InterfaceKind, Model, Role, forward_kinematics};
+use crr_kinematics::{InterfaceKind, Model, Role};
 
 /// The force a contact transmits to its child side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -118,16 +118,14 @@ pub fn contact_forces_into(
     qdot: &DVector<f64>,
     work: &mut ForceWork,
 ) -> Result<(), DynamicsError> {
-    // One coordinate: θ̈ from the integrator's own closed form (Dynamics::single_coordinate_rates,
-    // a sin/cos and a few products, the θ̈ the run integrates), the frames of the state from the
-    // kinematics alone (M is not needed), and the force in closed form.
-    if let [theta] = q.as_slice()
+    // One body on one coordinate: θ̈ = Q/I_p from the kinematics of the state and the
+    // one-coordinate kernel's I_p (M is not needed), and the force in closed form.
+    if let [_] = q.as_slice()
         && let ([_], [_]) = (&model.bodies[..], &model.interfaces[..])
-        && let Some(rates) = dynamics.single_coordinate_rates(model, ground, t, *theta)
+        && let Some(solved) = dynamics.single_coordinate_accelerations(model, ground, t, q)
     {
-        rates?;
-        forward_kinematics(model, &mut dynamics.kin, q, &dynamics.pivots);
-        one_body_force(model, dynamics, ground, t, qdot[0], work);
+        solved?;
+        one_body_force(model, dynamics, qdot[0], work);
         return Ok(());
     }
     dynamics.accelerations(model, ground, t, q, qdot)?;
@@ -187,20 +185,14 @@ pub fn contact_forces_into(
 /// F = m (a_c − g_eff) with a_c = α × r + ω × (ω × r), r = c − p: the general assembly's spatial
 /// algebra for one body, without its buffers. Also sets the body's spatial velocity
 /// V = [w; p × w] θ̇ (as [`crr_kinematics::velocities`] does), which the energies of a sample read.
-fn one_body_force(
-    model: &Model,
-    dynamics: &mut Dynamics,
-    ground: &GroundMotion,
-    t: f64,
-    theta_dot: f64,
-    work: &mut ForceWork,
-) {
+fn one_body_force(model: &Model, dynamics: &mut Dynamics, theta_dot: f64, work: &mut ForceWork) {
+    let g_eff = dynamics.effective_gravity();
     let kin = &mut dynamics.kin;
     kin.spatial_velocity[0] = crr_kinematics::mass_matrix::spatial_axis(kin, 0) * theta_dot;
     let (body, iface) = (&model.bodies[0], &model.interfaces[0]);
     let (w, r) = (kin.axis[0], kin.com[0] - kin.pivot[0]);
     let a_c = w.cross(&r) * dynamics.qddot[0] + w.cross(&w.cross(&r)) * (theta_dot * theta_dot);
-    let force = (a_c - effective_gravity(model, ground, t)) * body.mass;
+    let force = (a_c - g_eff) * body.mass;
     work.forces.clear();
     work.forces
         .push(rest_normal(&iface.kind, model.size).map(|normal| {
