@@ -173,7 +173,9 @@ fn seated_block_takes_the_articulated_path() {
 /// cos θ and the moments a₁, a₂, a₃ of the rest pivot) against the full evaluation on the
 /// kinematics (forward kinematics, generalized loads from subtree sums, Cholesky on M), on random
 /// bodies, states and ground accelerations, on both pivots in turn with one workspace (the kernel
-/// follows the active pivot): θ̈, Q and Q_g agree to 1e-12 of their scale.
+/// follows the active pivot): θ̈, Q and Q_g agree to 1e-12 of their scale. So do those of
+/// `Dynamics::single_coordinate_accelerations` (from the forward kinematics of the state and the
+/// kernel's I_p).
 #[test]
 fn integration_kernel_agrees_with_the_full_evaluation() {
     let mut checked = 0;
@@ -210,21 +212,25 @@ fn integration_kernel_agrees_with_the_full_evaluation() {
                 None,
                 ForwardSolver::Cholesky,
             );
+            // The same from the forward kinematics of the state and the kernel's I_p.
+            let mut from_kin = Dynamics::new(&model, kernel.pivots.clone());
+            from_kin
+                .single_coordinate_accelerations(&model, &ground, 0.0, &q)
+                .expect("the kernel applies")
+                .expect("regular");
+            assert!(from_kin.used_single_coordinate());
             let force_scale = model.total_mass() * (model.gravity + 10.0) * model.size;
-            for (name, a, b, scale) in [
-                ("θ̈", kernel.qddot[0], full.qddot[0], full.qddot[0].abs()),
-                ("Q", kernel.load[0], full.load[0], force_scale),
-                (
-                    "Q_g",
-                    kernel.ground_force[0],
-                    full.ground_force[0],
-                    force_scale,
-                ),
-            ] {
-                assert!(
-                    (a - b).abs() <= 1e-12 * scale.max(1e-300),
-                    "seed {seed}, θ = {theta}: {name} {a} against {b}"
-                );
+            for d in [&kernel, &from_kin] {
+                for (name, a, b, scale) in [
+                    ("θ̈", d.qddot[0], full.qddot[0], full.qddot[0].abs()),
+                    ("Q", d.load[0], full.load[0], force_scale),
+                    ("Q_g", d.ground_force[0], full.ground_force[0], force_scale),
+                ] {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale.max(1e-300),
+                        "seed {seed}, θ = {theta}: {name} {a} against {b}"
+                    );
+                }
             }
             checked += 1;
         }
