@@ -56,6 +56,8 @@ mod tableau;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crr_kinematics::short_copy::copy_short;
+
 use tableau::*;
 
 /// Error returned by a right-hand side evaluation; the message is shown by
@@ -1026,7 +1028,7 @@ impl Solver {
             Method::Rk4 { .. } => 4,
         };
         let d = self.dim;
-        self.f.copy_from_slice(&self.k[fsal * d..(fsal + 1) * d]);
+        copy_short(&mut self.f, &self.k[fsal * d..(fsal + 1) * d]);
         std::mem::swap(&mut self.y, &mut self.y_new);
         self.t = t1;
         self.f_valid = true;
@@ -1157,7 +1159,7 @@ impl Solver {
             ..
         } = self;
         let (d, t) = (*dim, *t);
-        k[..d].copy_from_slice(f);
+        copy_short(&mut k[..d], f);
         let stage_t = |c: f64| if c == 1.0 { t1 } else { t + c * h };
         match *method {
             Method::Dop853 => {
@@ -1200,7 +1202,7 @@ impl Solver {
                     call_rhs(sys, stats, stage_t(DOPRI5_C[s]), y_tmp, &mut ks[..d])?;
                 }
                 // The last stage input is the 5th-order solution (FSAL).
-                y_new.copy_from_slice(y_tmp);
+                copy_short(y_new, y_tmp);
                 let mut err = 0.0;
                 for i in 0..d {
                     let sk = opts.atol + opts.rtol * y[i].abs().max(y_new[i].abs());

@@ -19,7 +19,6 @@ pub mod integrator;
 pub mod linalg;
 pub mod mechanism;
 pub mod run;
-pub mod short_copy;
 pub mod single_coordinate;
 pub mod system;
 

@@ -17,7 +17,7 @@ use crate::eom::{Dynamics, GeneralizedForce};
 use crate::ground_motion::GroundMotion;
 use crate::integrator::{OdeSystem, RhsError};
 use crate::linalg::{cholesky_in_place, cholesky_solve, pseudo_inverse};
-use crate::short_copy::copy_short;
+use crr_kinematics::short_copy::copy_short;
 
 /// The multi-DOF constrained form: y = [q, q̇, W, D] with W the work of the ground motion and D
 /// the energy dissipated by the extra force (if any), Ḋ = −F_extraᵀq̇.

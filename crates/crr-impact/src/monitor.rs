@@ -13,10 +13,10 @@ use nalgebra::{DMatrix, DVector, Vector3, Vector6};
 use serde::Serialize;
 
 use crr_dynamics::DynamicsError;
-use crr_dynamics::eom::{Dynamics, effective_gravity, slot_row};
+use crr_dynamics::eom::{Dynamics, ForwardSolver, effective_gravity, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::linalg::JacobiSvd;
-use crr_kinematics::{InterfaceKind, Model, Role};
+use crr_kinematics::{InterfaceKind, Model, Role, forward_kinematics};
 
 /// The force a contact transmits to its child side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -118,15 +118,25 @@ pub fn contact_forces_into(
     qdot: &DVector<f64>,
     work: &mut ForceWork,
 ) -> Result<(), DynamicsError> {
-    // One body on one coordinate: θ̈ = Q/I_p from the kinematics of the state and the
-    // one-coordinate kernel's I_p (M is not needed), and the force in closed form.
+    // One body on one coordinate: the force in closed form, with θ̈ = Q/I_p from the kinematics
+    // of the state and the one-coordinate kernel's I_p (M is not needed), or θ̈ = 0 when its
+    // joint is seated (held).
     if let [_] = q.as_slice()
         && let ([_], [_]) = (&model.bodies[..], &model.interfaces[..])
-        && let Some(solved) = dynamics.single_coordinate_accelerations(model, ground, t, q)
     {
-        solved?;
-        one_body_force(model, dynamics, qdot[0], work);
-        return Ok(());
+        if let Some(solved) = dynamics.single_coordinate_accelerations(model, ground, t, q) {
+            solved?;
+            let (g_eff, qddot) = (dynamics.effective_gravity(), dynamics.qddot[0]);
+            one_body_force(model, &mut dynamics.kin, g_eff, qddot, qdot[0], work);
+            return Ok(());
+        }
+        if dynamics.solver == ForwardSolver::Auto && dynamics.seated.len() == model.slot_count {
+            forward_kinematics(model, &mut dynamics.kin, q, &dynamics.pivots);
+            dynamics.qddot[0] = 0.0;
+            let g_eff = effective_gravity(model, ground, t);
+            one_body_force(model, &mut dynamics.kin, g_eff, 0.0, qdot[0], work);
+            return Ok(());
+        }
     }
     dynamics.accelerations(model, ground, t, q, qdot)?;
     let kin = &dynamics.kin;
@@ -179,19 +189,24 @@ pub fn contact_forces_into(
 }
 
 /// [`contact_forces_into`] for a structure of one coordinate with θ̈ solved and the frames of
-/// the state in `dynamics.kin`: one body on one interface to the ground (every interface adds a
+/// the state in `kin`: one body on one interface to the ground (every interface adds a
 /// coordinate and there is no closure), turning with ω = θ̇w, α = θ̈w about the pivot line (w, p)
 /// fixed in the world. The ground transmits the body's net force beyond its load,
 /// F = m (a_c − g_eff) with a_c = α × r + ω × (ω × r), r = c − p: the general assembly's spatial
 /// algebra for one body, without its buffers. Also sets the body's spatial velocity
 /// V = [w; p × w] θ̇ (as [`crr_kinematics::velocities`] does), which the energies of a sample read.
-fn one_body_force(model: &Model, dynamics: &mut Dynamics, theta_dot: f64, work: &mut ForceWork) {
-    let g_eff = dynamics.effective_gravity();
-    let kin = &mut dynamics.kin;
+fn one_body_force(
+    model: &Model,
+    kin: &mut crr_kinematics::Data,
+    g_eff: Vector3<f64>,
+    theta_ddot: f64,
+    theta_dot: f64,
+    work: &mut ForceWork,
+) {
     kin.spatial_velocity[0] = crr_kinematics::mass_matrix::spatial_axis(kin, 0) * theta_dot;
     let (body, iface) = (&model.bodies[0], &model.interfaces[0]);
     let (w, r) = (kin.axis[0], kin.com[0] - kin.pivot[0]);
-    let a_c = w.cross(&r) * dynamics.qddot[0] + w.cross(&w.cross(&r)) * (theta_dot * theta_dot);
+    let a_c = w.cross(&r) * theta_ddot + w.cross(&w.cross(&r)) * (theta_dot * theta_dot);
     let force = (a_c - g_eff) * body.mass;
     work.forces.clear();
     work.forces

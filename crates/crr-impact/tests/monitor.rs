@@ -217,14 +217,16 @@ fn hyperstatic_tension_needs_no_compressive_distribution() {
     assert!(check(&model, &fixable, Some(&none), 0.0, None, tol).is_some());
 }
 
-/// On one coordinate the monitor takes θ̈ from the integrator's closed form
-/// (`Dynamics::single_coordinate_rates`) and the kinematics alone; with `ForwardSolver::Cholesky`
-/// it solves M(q) q̈ = Q − h in general. Both are exact, so the contact forces agree to round-off:
-/// here on a block whose centre is off the hinge's mid-plane and off its symmetry plane, turned
-/// 0.7 rad about z (its inertia is full in world axes and the force has a component along the
-/// hinge axis), under a constant ground acceleration with three components, on both pivots, at
-/// tilts on either side and rates up to flight. The forces are of order mg and a few hundred
-/// roundings apart: 1e-12 mg.
+/// On one body with one coordinate the monitor takes the contact force in closed form, with θ̈
+/// from the kinematics and the one-coordinate kernel's I_p (`Dynamics::
+/// single_coordinate_accelerations`), or θ̈ = 0 when the joint is seated; with
+/// `ForwardSolver::Cholesky` it solves M(q) q̈ = Q − h (with the seated row held) and assembles
+/// the forces along the tree in general. Both are exact, so the contact forces agree to
+/// round-off: here on a block whose centre is off the hinge's mid-plane and off its symmetry
+/// plane, turned 0.7 rad about z (its inertia is full in world axes and the force has a component
+/// along the hinge axis), under a constant ground acceleration with three components, on both
+/// pivots, at tilts on either side and rates up to flight, and seated (at rest, and with a rate
+/// the seat holds). The forces are of order mg and a few hundred roundings apart: 1e-12 mg.
 #[test]
 fn one_coordinate_forces_match_the_general_solve() {
     let (b, h) = (0.25, 0.9);
@@ -257,10 +259,20 @@ fn one_coordinate_forces_match_the_general_solve() {
     }
     let mut compared = 0;
     for side in [Side::Positive, Side::Negative] {
-        for (theta, rate) in [(0.0, 0.0), (0.12, -1.3), (-0.2, 2.4), (0.35, 4.0)] {
+        for (theta, rate, seated) in [
+            (0.0, 0.0, false),
+            (0.12, -1.3, false),
+            (-0.2, 2.4, false),
+            (0.35, 4.0, false),
+            (0.0, 0.0, true),
+            (0.0, 1.5, true),
+        ] {
             let forces = |solver| {
                 let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, side));
                 d.solver = solver;
+                if seated {
+                    d.seated = vec![0];
+                }
                 let f = contact_forces(
                     &model,
                     &mut d,
@@ -276,13 +288,13 @@ fn one_coordinate_forces_match_the_general_solve() {
             let ((closed, kernel_used), (general, general_kernel)) =
                 (forces(ForwardSolver::Auto), forces(ForwardSolver::Cholesky));
             assert!(
-                kernel_used && !general_kernel,
+                (kernel_used || seated) && !general_kernel,
                 "the two paths were not taken"
             );
             for i in 0..3 {
                 assert!(
                     (closed.force[i] - general.force[i]).abs() < 1e-12 * scale,
-                    "{side:?} θ = {theta}, θ̇ = {rate}: F[{i}] {} against {}",
+                    "{side:?} θ = {theta}, θ̇ = {rate}, seated {seated}: F[{i}] {} against {}",
                     closed.force[i],
                     general.force[i]
                 );

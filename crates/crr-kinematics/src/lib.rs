@@ -43,6 +43,7 @@ pub mod pivots;
 pub mod potential;
 pub mod rotation;
 pub mod shapes;
+pub mod short_copy;
 pub mod spec;
 pub mod velocity;
 

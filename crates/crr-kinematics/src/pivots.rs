@@ -3,6 +3,7 @@
 use nalgebra::DVector;
 
 use crate::model::{Model, Side};
+use crate::short_copy::copy_short;
 
 /// The active pivot of every angle slot (the paper's "dynamic chain"): slot k < DOF(1) is
 /// coordinate k; the slots after them are the angles of the loop closures
@@ -23,7 +24,11 @@ impl Clone for ActivePivots {
     }
 
     fn clone_from(&mut self, source: &Self) {
-        self.sides.clone_from(&source.sides);
+        if self.sides.len() == source.sides.len() {
+            copy_short(&mut self.sides, &source.sides);
+        } else {
+            self.sides.clone_from(&source.sides);
+        }
     }
 }
 

@@ -27,8 +27,8 @@ use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::integrator::{
     DenseStep, Direction, EventFunctions, Method, Options, SolveError, Solver, Stop,
 };
-use crr_dynamics::short_copy::{copy_short, extend_short};
 use crr_dynamics::{ConstrainedSystem, InitialState};
+use crr_kinematics::short_copy::{copy_short, extend_short};
 use crr_kinematics::spec::ImpactLaw;
 use crr_kinematics::{
     ActivePivots, Data, InterfaceKind, Model, Side, closure_angles, forward_kinematics,
@@ -860,7 +860,7 @@ impl<'a> Simulation<'a> {
         self.spare.pending = pending;
         let stop = stop?;
         self.t = self.solver.t();
-        self.y.copy_from_slice(self.solver.y());
+        copy_short(&mut self.y, self.solver.y());
         match stop {
             Stop::Reached => {
                 if self.t >= self.params.duration {

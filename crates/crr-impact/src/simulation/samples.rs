@@ -7,7 +7,7 @@
 use serde::Serialize;
 
 use super::SlotState;
-use crr_dynamics::short_copy::extend_short;
+use crr_kinematics::short_copy::extend_short;
 
 /// One output sample: a view of one row of [`Samples`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

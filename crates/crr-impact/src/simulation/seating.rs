@@ -553,8 +553,8 @@ impl Simulation<'_> {
             *q = DVector::zeros(n);
             *qdot = DVector::zeros(n);
         }
-        q.copy_from_slice(&self.y[..n]);
-        qdot.copy_from_slice(&self.y[n..2 * n]);
+        copy_short(q.as_mut_slice(), &self.y[..n]);
+        copy_short(qdot.as_mut_slice(), &self.y[n..2 * n]);
         let (q, qdot) = (&*q, &*qdot);
         angles.clear();
         angles.resize(model.slot_count, 0.0);
