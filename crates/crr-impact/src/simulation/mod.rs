@@ -39,6 +39,7 @@ use crate::laws::{ImpactError, dirac_law, dirac_regularised_force, momentum_law,
 
 mod events;
 mod impacts;
+mod output;
 mod samples;
 mod seating;
 mod slots;
@@ -293,17 +294,6 @@ pub struct Simulation<'a> {
     pub violation: Option<crate::monitor::Violation>,
 }
 
-/// The scalars of a sample being taken ([`Simulation::sample_at`]); its q, q̇ and slot states
-/// wait in the workspace.
-#[derive(Clone, Copy, Debug)]
-struct Taken {
-    t: f64,
-    kinetic: f64,
-    potential: f64,
-    work_in: f64,
-    dissipated: f64,
-}
-
 /// The buffers of one integration segment ([`Simulation::step`]): the events' state and pivots,
 /// the watched slots and the output's scratch.
 #[derive(Clone, Debug)]
@@ -544,110 +534,11 @@ impl<'a> Simulation<'a> {
         self.balance_error
     }
 
-    /// Keeps a sample and updates the running peaks and energy balance.
-    /// Records the sample [`Self::sample_at`] has just taken: its scalars `s`, its q, q̇ and
-    /// slot states from the workspace.
-    fn record_sample(&mut self, s: Taken) {
-        let q = self.spare.sample_q.as_slice();
-        for (p, q) in self.peak_abs.iter_mut().zip(q) {
-            *p = p.max(q.abs());
-        }
-        let balance =
-            (s.kinetic + s.potential - s.work_in + s.dissipated - self.energy_start).abs();
-        self.balance_error = self.balance_error.max(balance);
-        self.last_sample_t = s.t;
-        self.samples.push(Sample {
-            t: s.t,
-            q,
-            qdot: self.spare.sample_qdot.as_slice(),
-            kinetic: s.kinetic,
-            potential: s.potential,
-            work_in: s.work_in,
-            dissipated: s.dissipated,
-            states: &self.spare.sample_states,
-        });
-    }
-
     /// Takes the samples recorded since the last call, so that a long run can stream them to a
     /// file and keep its memory flat; the peaks and the energy balance still cover every sample.
     pub fn drain_samples(&mut self) -> Samples {
         let empty = Samples::new(self.model.dof(), self.model.slot_count);
         std::mem::replace(&mut self.samples, empty)
-    }
-
-    /// Takes the sample of state `y` = [q, q̇, W, D] at `t`: checks the contact hypotheses on it
-    /// (the monitor), leaves its q, q̇ and slot states in the workspace and returns its scalars,
-    /// for [`Self::record_sample`].
-    fn sample_at(&mut self, t: f64, y: &[f64]) -> Taken {
-        let n = self.model.dof();
-        let (mut q, mut qdot) = (
-            std::mem::take(&mut self.spare.sample_q),
-            std::mem::take(&mut self.spare.sample_qdot),
-        );
-        copy_short(q.as_mut_slice(), &y[..n]);
-        copy_short(qdot.as_mut_slice(), &y[n..2 * n]);
-        // A seated coordinate is held at 0 (the dense output between projections carries round-off).
-        for k in 0..n {
-            if self.seated[k] {
-                q[k] = 0.0;
-                qdot[k] = 0.0;
-            }
-        }
-        // The monitor's solve leaves the kinematics of this state in its workspace: the energies
-        // read them when it ran (the same q and pivots), else the output workspace's.
-        let mut monitor_kin = false;
-        if self.violation.is_none() {
-            let d = &mut self.spare.monitor;
-            d.pivots.clone_from(&self.dynamics.pivots);
-            d.seated.clone_from(&self.dynamics.seated);
-            let work = &mut self.spare.forces;
-            if crate::monitor::contact_forces_into(self.model, d, self.ground, t, &q, &qdot, work)
-                .is_ok()
-            {
-                let forces = &work.forces;
-                monitor_kin = true;
-                let tol = crate::monitor::TENSION_TOLERANCE
-                    * self.model.total_mass()
-                    * self.model.gravity;
-                // A tension in a hyperstatic structure: is there a compressive distribution?
-                // (The self-stress states cost a decomposition, made only then.)
-                let tension = forces.iter().any(|f| f.is_some_and(|f| f.normal < -tol));
-                let states = if tension {
-                    crate::monitor::self_stress_normals(self.model, d)
-                } else {
-                    None
-                };
-                self.violation = crate::monitor::check(
-                    self.model,
-                    forces,
-                    states.as_ref(),
-                    t,
-                    self.params.friction,
-                    tol,
-                );
-            }
-        }
-        // T from the bodies' velocities (no M): the monitor's solve filled them.
-        let kin = if monitor_kin {
-            &self.spare.monitor.kin
-        } else {
-            forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
-            crr_kinematics::velocities(self.model, &mut self.out_kin, &qdot);
-            &self.out_kin
-        };
-        let taken = Taken {
-            t,
-            kinetic: crr_kinematics::body_kinetic_energy(self.model, kin),
-            potential: potential_energy(self.model, kin) - self.u_rest,
-            work_in: y[2 * n],
-            dissipated: self.dissipated_at_impacts + y[2 * n + 1],
-        };
-        (self.spare.sample_q, self.spare.sample_qdot) = (q, qdot);
-        let mut states = std::mem::take(&mut self.spare.sample_states);
-        states.clear();
-        states.extend((0..self.model.slot_count).map(|s| self.slot_state(s)));
-        self.spare.sample_states = states;
-        taken
     }
 
     fn reset_solver(&mut self) {
