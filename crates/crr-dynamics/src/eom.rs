@@ -756,6 +756,7 @@ impl Dynamics {
     /// The [`single_coordinate::Kernel`] of the active pivot (built on the first call after a
     /// pivot switch), when [`Self::single_coordinate_rates`] applies; its I_p is what a reader of
     /// the kinematics of a one-coordinate state needs to solve for θ̈ without the sin/cos.
+    #[inline(always)]
     pub fn single_coordinate_kernel(
         &mut self,
         model: &Model,

@@ -115,9 +115,13 @@ impl Kernel {
     /// Whether this kernel, built for `model`, is the one of the active pivot of `pivots`: the
     /// same sides of its interface (the pivot is a function of them). A kernel belongs to one
     /// model (as the [`crate::Dynamics`] holding it does): the geometry is not compared.
+    #[inline]
     pub fn is_for(&self, model: &Model, pivots: &ActivePivots) -> bool {
         let iface = &model.interfaces[model.coords[0].interface];
-        pivots.sides.get(iface.slots.clone()) == Some(&self.sides[..])
+        // Compared side by side: one or two sides, read on every right-hand side.
+        pivots.sides.get(iface.slots.clone()).is_some_and(|s| {
+            s.len() == self.sides.len() && s.iter().zip(&self.sides).all(|(a, b)| a == b)
+        })
     }
 
     /// I_p (kg m²).

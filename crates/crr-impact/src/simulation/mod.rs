@@ -425,6 +425,9 @@ impl<'a> Simulation<'a> {
         solver.reset(0.0, &y);
         let u_rest = crr_dynamics::energy::rest_potential(model);
         let trial = dynamics.clone();
+        // Room for the regular samples of the whole run, up to one step's worth (a longer run
+        // grows by doubling, or is drained by a caller streaming it).
+        let regular_samples = (params.duration / params.output_interval) as usize + 2;
         let mut sim = Self {
             model,
             ground,
@@ -461,7 +464,11 @@ impl<'a> Simulation<'a> {
             peak_abs: vec![0.0; n],
             balance_error: 0.0,
             last_sample_t: f64::NEG_INFINITY,
-            samples: Samples::new(n, model.slot_count),
+            samples: Samples::with_capacity(
+                n,
+                model.slot_count,
+                regular_samples.min(MAX_SAMPLES_PER_STEP),
+            ),
             impacts: Vec::new(),
             peaks: Vec::new(),
             uplift_time: None,

@@ -62,6 +62,23 @@ impl Samples {
         }
     }
 
+    /// [`Self::new`] with room for `capacity` samples, so that pushing that many does not
+    /// reallocate.
+    pub fn with_capacity(dof: usize, slots: usize, capacity: usize) -> Self {
+        Self {
+            dof,
+            slots,
+            t: Vec::with_capacity(capacity),
+            q: Vec::with_capacity(capacity * dof),
+            qdot: Vec::with_capacity(capacity * dof),
+            kinetic: Vec::with_capacity(capacity),
+            potential: Vec::with_capacity(capacity),
+            work_in: Vec::with_capacity(capacity),
+            dissipated: Vec::with_capacity(capacity),
+            states: Vec::with_capacity(capacity * slots),
+        }
+    }
+
     /// Number of coordinates of each sample's q and q̇.
     pub fn dof(&self) -> usize {
         self.dof
