@@ -154,6 +154,8 @@ pub struct Dynamics {
     used_single_coordinate: bool,
     /// The one-coordinate kernel of the last active pivot ([`Self::integration_accelerations`]).
     kernel: Option<single_coordinate::Kernel>,
+    /// The kernel of the pivot before: a rocking block alternates between two.
+    previous_kernel: Option<single_coordinate::Kernel>,
 }
 
 /// Open chains with at least this many coordinates (DOF(1)) are solved by the articulated-body
@@ -550,6 +552,7 @@ impl Dynamics {
             used_articulated: false,
             used_single_coordinate: false,
             kernel: None,
+            previous_kernel: None,
             locked: vec![false; n],
             free: (0..n).collect(),
             residual: DVector::zeros(n),
@@ -753,9 +756,11 @@ impl Dynamics {
         self.g_eff
     }
 
-    /// The [`single_coordinate::Kernel`] of the active pivot (built on the first call after a
-    /// pivot switch), when [`Self::single_coordinate_rates`] applies; its I_p is what a reader of
-    /// the kinematics of a one-coordinate state needs to solve for θ̈ without the sin/cos.
+    /// The [`single_coordinate::Kernel`] of the active pivot, when [`Self::single_coordinate_rates`]
+    /// applies; its I_p is what a reader of the kinematics of a one-coordinate state needs to
+    /// solve for θ̈ without the sin/cos. Built on the first call after a switch to a new pivot;
+    /// the kernel of the pivot before is kept, so that a block rocking between its two edges
+    /// builds two in all.
     #[inline(always)]
     pub fn single_coordinate_kernel(
         &mut self,
@@ -764,12 +769,14 @@ impl Dynamics {
         if !self.single_coordinate_applies(model) {
             return None;
         }
-        if !self
-            .kernel
-            .as_ref()
-            .is_some_and(|k| k.is_for(model, &self.pivots))
-        {
-            self.kernel = single_coordinate::Kernel::new(model, &self.pivots);
+        let is_current = |k: &Option<single_coordinate::Kernel>, pivots: &ActivePivots| {
+            k.as_ref().is_some_and(|k| k.is_for(model, pivots))
+        };
+        if !is_current(&self.kernel, &self.pivots) {
+            std::mem::swap(&mut self.kernel, &mut self.previous_kernel);
+            if !is_current(&self.kernel, &self.pivots) {
+                self.kernel = single_coordinate::Kernel::new(model, &self.pivots);
+            }
         }
         self.kernel.as_ref()
     }
