@@ -9,7 +9,7 @@ use crr_dynamics::ForwardSolver;
 use crr_dynamics::eom::Dynamics;
 use crr_dynamics::ground_motion::{Axis, ComponentSpec, ConstantSpec, GroundMotion, SignalSpec};
 use crr_dynamics::{InitialSpec, solve_initial};
-use crr_impact::monitor::contact_forces;
+use crr_impact::monitor::{ContactForce, contact_forces};
 use crr_impact::{Parameters, Simulation};
 use crr_kinematics::fixtures::{box_body, single_block, transformed};
 use crr_kinematics::{ActivePivots, Model, Side};
@@ -17,30 +17,64 @@ use nalgebra::{DVector, Matrix3, Rotation3, Vector3};
 
 const G: f64 = 9.81;
 
+/// A constant ground acceleration with the given components (m/s²).
+fn constant_ground(components: &[(Axis, f64)]) -> GroundMotion {
+    components
+        .iter()
+        .fold(GroundMotion::none(), |ground, &(axis, value)| {
+            ground
+                .with_component(
+                    axis,
+                    &ComponentSpec::new(SignalSpec::Constant(ConstantSpec { value })),
+                    Path::new("."),
+                )
+                .unwrap()
+        })
+}
+
+/// The contact force of the one interface of a one-coordinate model at (θ, θ̇), on the pivots of
+/// `side`, seated or not, with `solver`; and whether the one-coordinate closed form solved it.
+fn one_force(
+    model: &Model,
+    ground: &GroundMotion,
+    side: Side,
+    seated: bool,
+    solver: ForwardSolver,
+    (theta, rate): (f64, f64),
+) -> (ContactForce, bool) {
+    let mut d = Dynamics::new(model, ActivePivots::uniform(model, side));
+    d.solver = solver;
+    if seated {
+        d.seated = vec![0];
+    }
+    let q = DVector::from_element(1, theta);
+    let f = contact_forces(
+        model,
+        &mut d,
+        ground,
+        0.0,
+        &q,
+        &DVector::from_element(1, rate),
+    )
+    .unwrap()[0]
+        .unwrap();
+    (f, d.used_single_coordinate())
+}
+
 #[test]
 fn seated_block_force_and_sliding_demand() {
     let model = Model::from_spec(&single_block(0.2, 1.0, 2500.0)).unwrap();
     let m = model.total_mass();
     let ax = 0.15 * G;
-    let ground = GroundMotion::none()
-        .with_component(
-            Axis::X,
-            &ComponentSpec::new(SignalSpec::Constant(ConstantSpec { value: ax })),
-            Path::new("."),
-        )
-        .unwrap();
-    let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
-    d.seated = vec![0];
-    let f = contact_forces(
+    let ground = constant_ground(&[(Axis::X, ax)]);
+    let (f, _) = one_force(
         &model,
-        &mut d,
         &ground,
-        0.0,
-        &DVector::zeros(1),
-        &DVector::zeros(1),
-    )
-    .unwrap()[0]
-        .unwrap();
+        Side::Positive,
+        true,
+        ForwardSolver::Auto,
+        (0.0, 0.0),
+    );
     // The ground holds the weight and pushes the block with the ground: F = m (a_x, 0, g).
     assert!((f.normal - m * G).abs() < 1e-9 * m * G, "N = {}", f.normal);
     assert!(
@@ -85,17 +119,14 @@ fn rocking_block_contact_force_and_flight() {
     let p2 = 3.0 * G / (4.0 * r);
     let ground = GroundMotion::none();
     for rate in [0.5, 2.5, 3.5] {
-        let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
-        let f = contact_forces(
+        let (f, _) = one_force(
             &model,
-            &mut d,
             &ground,
-            0.0,
-            &DVector::zeros(1),
-            &DVector::from_element(1, rate),
-        )
-        .unwrap()[0]
-            .unwrap();
+            Side::Positive,
+            false,
+            ForwardSolver::Auto,
+            (0.0, rate),
+        );
         let theta_dd = -p2 * alpha.sin();
         let z_dd = r * alpha.sin() * theta_dd - r * alpha.cos() * rate * rate;
         let x_dd = r * alpha.cos() * theta_dd + r * alpha.sin() * rate * rate;
@@ -243,20 +274,11 @@ fn one_coordinate_forces_match_the_general_solve() {
     let model =
         Model::from_spec(&transformed(&spec, &turn, &Vector3::new(1.0, -2.0, 0.0))).unwrap();
     let scale = model.total_mass() * G;
-    let mut ground = GroundMotion::none();
-    for (axis, value) in [
+    let ground = constant_ground(&[
         (Axis::X, 0.21 * G),
         (Axis::Y, -0.13 * G),
         (Axis::Z, 0.08 * G),
-    ] {
-        ground = ground
-            .with_component(
-                axis,
-                &ComponentSpec::new(SignalSpec::Constant(ConstantSpec { value })),
-                Path::new("."),
-            )
-            .unwrap();
-    }
+    ]);
     let mut compared = 0;
     for side in [Side::Positive, Side::Negative] {
         for (theta, rate, seated) in [
@@ -267,24 +289,7 @@ fn one_coordinate_forces_match_the_general_solve() {
             (0.0, 0.0, true),
             (0.0, 1.5, true),
         ] {
-            let forces = |solver| {
-                let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, side));
-                d.solver = solver;
-                if seated {
-                    d.seated = vec![0];
-                }
-                let f = contact_forces(
-                    &model,
-                    &mut d,
-                    &ground,
-                    0.0,
-                    &DVector::from_element(1, theta),
-                    &DVector::from_element(1, rate),
-                )
-                .unwrap()[0]
-                    .unwrap();
-                (f, d.used_single_coordinate())
-            };
+            let forces = |solver| one_force(&model, &ground, side, seated, solver, (theta, rate));
             let ((closed, kernel_used), (general, general_kernel)) =
                 (forces(ForwardSolver::Auto), forces(ForwardSolver::Cholesky));
             assert!(
