@@ -717,12 +717,16 @@ impl Dynamics {
         })
     }
 
-    /// [`Self::accelerations`] of a structure of one coordinate where the kernel applies, from
-    /// the forward kinematics of the state (left in `kin`, as the general solve leaves it)
-    /// instead of the kernel's own sin/cos: Q_f = f · (w × Σₙ mₙ(cₙ − p)) for
-    /// f = g_eff and −a_g, θ̈ = Q/I_p with the kernel's I_p. For code that needs the kinematics
-    /// of the state anyway (the monitor of the output samples), it saves one sin/cos. None when
-    /// the kernel does not apply. The velocities in `kin` are not set.
+    /// [`Self::accelerations`] of a structure of one coordinate ([`ForwardSolver::Auto`], no
+    /// closures), from the forward kinematics of the state (left in `kin`, as the general solve
+    /// leaves it): Q_f = f · (w × Σₙ mₙ(cₙ − p)) for f = g_eff and −a_g, and
+    ///
+    /// * free: θ̈ = Q/I_p with the kernel's I_p (no sin/cos beyond the kinematics', which code
+    ///   that needs the kinematics of the state anyway, the monitor of the output samples, saves);
+    /// * seated: θ̈ = 0 (held), and the seat's reaction is the residual of the one row,
+    ///   M θ̈ + h − Q = −Q (h = 0: I_p does not depend on θ), as the general solve reports it.
+    ///
+    /// None when neither applies. The velocities in `kin` are not set; M is not formed.
     pub fn single_coordinate_accelerations(
         &mut self,
         model: &Model,
@@ -730,7 +734,14 @@ impl Dynamics {
         t: f64,
         q: &DVector<f64>,
     ) -> Option<Result<(), DynamicsError>> {
-        let inertia = self.single_coordinate_kernel(model)?.inertia();
+        let held = self.solver == ForwardSolver::Auto
+            && single_coordinate::applies(model)
+            && self.seated == [0];
+        let inertia = if held {
+            None
+        } else {
+            Some(self.single_coordinate_kernel(model)?.inertia())
+        };
         forward_kinematics(model, &mut self.kin, q, &self.pivots);
         let a = ground.acceleration(t);
         let g_eff = gravity_with_ground(model, &a);
@@ -744,9 +755,21 @@ impl Dynamics {
         self.load[0] = g_eff.dot(&arm);
         self.ground_force[0] = -a.dot(&arm);
         self.extra_force[0] = 0.0;
-        self.qddot[0] = self.load[0] / inertia;
         self.mass_current = false;
-        self.mark_single_coordinate();
+        match inertia {
+            Some(inertia) => {
+                self.qddot[0] = self.load[0] / inertia;
+                self.mark_single_coordinate();
+            }
+            None => {
+                self.qddot[0] = 0.0;
+                (self.used_articulated, self.used_single_coordinate) = (false, false);
+                if self.seat_reactions.len() != 1 {
+                    self.seat_reactions = DVector::zeros(1);
+                }
+                self.seat_reactions[0] = -self.load[0];
+            }
+        }
         Some(self.check_finite(t))
     }
 

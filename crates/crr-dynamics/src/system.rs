@@ -38,14 +38,12 @@ impl<'a> ConstrainedSystem<'a> {
     /// Wraps the model, ground motion and workspace.
     pub fn new(model: &'a Model, ground: &'a GroundMotion, dynamics: &'a mut Dynamics) -> Self {
         let n = model.dof();
-        Self {
+        Self::with_buffers(
             model,
             ground,
             dynamics,
-            extra: None,
-            q: DVector::zeros(n),
-            qdot: DVector::zeros(n),
-        }
+            (DVector::zeros(n), DVector::zeros(n)),
+        )
     }
 
     /// [`Self::new`] on the q and q̇ buffers of an earlier system ([`Self::into_buffers`]),

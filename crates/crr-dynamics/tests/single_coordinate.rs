@@ -169,6 +169,65 @@ fn seated_block_takes_the_articulated_path() {
     assert!(d.seat_reactions.is_empty());
 }
 
+/// `Dynamics::single_coordinate_accelerations` on a seated coordinate (held, θ̈ = 0, the seat's
+/// reaction −Q) against the general solve with the coordinate eliminated (Cholesky on M, the
+/// reaction the residual of its row, with h from the velocity product), on random bodies under
+/// random ground accelerations, at θ = 0 and with a rate the seat holds: θ̈ exactly 0, Q, Q_g
+/// and the reaction to 1e-12 of the force scale. For Housner's block the reaction is also
+/// checked against m g b (`seated_block_takes_the_articulated_path`).
+#[test]
+fn seated_closed_form_agrees_with_the_general_solve() {
+    let mut checked = 0;
+    for seed in 0u64..100 {
+        let model = Model::from_spec(&random_chain(seed, 1, 0)).expect("valid random body");
+        if model.dof() != 1 {
+            continue;
+        }
+        let mut rng = SplitMix(seed ^ 0x5EA7_ED00);
+        let ground = constant_ground(Vector3::new(
+            rng.uniform(-6.0, 6.0),
+            rng.uniform(-6.0, 6.0),
+            rng.uniform(-3.0, 3.0),
+        ));
+        let force_scale = model.total_mass() * (model.gravity + 10.0) * model.size;
+        for theta_dot in [0.0, rng.uniform(-2.0, 2.0)] {
+            let (q, qdot) = (DVector::zeros(1), DVector::from_element(1, theta_dot));
+            let held = |solver| {
+                let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+                d.solver = solver;
+                d.seated = vec![0];
+                d
+            };
+            let mut closed = held(ForwardSolver::Auto);
+            closed
+                .single_coordinate_accelerations(&model, &ground, 0.0, &q)
+                .expect("a seated coordinate is held")
+                .expect("regular");
+            let mut general = held(ForwardSolver::Cholesky);
+            general
+                .accelerations(&model, &ground, 0.0, &q, &qdot)
+                .expect("regular");
+            assert_eq!((closed.qddot[0], general.qddot[0]), (0.0, 0.0));
+            for (name, a, b) in [
+                ("Q", closed.load[0], general.load[0]),
+                ("Q_g", closed.ground_force[0], general.ground_force[0]),
+                (
+                    "reaction",
+                    closed.seat_reactions[0],
+                    general.seat_reactions[0],
+                ),
+            ] {
+                assert!(
+                    (a - b).abs() <= 1e-12 * force_scale,
+                    "seed {seed}, θ̇ = {theta_dot}: {name} {a} against {b}"
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "only {checked} states");
+}
+
 /// The integrator's kernel (`Dynamics::integration_accelerations`: θ̈, Q and Q_g from sin θ,
 /// cos θ and the moments a₁, a₂, a₃ of the rest pivot) against the full evaluation on the
 /// kinematics (forward kinematics, generalized loads from subtree sums, Cholesky on M), on random

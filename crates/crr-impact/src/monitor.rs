@@ -13,10 +13,10 @@ use nalgebra::{DMatrix, DVector, Vector3, Vector6};
 use serde::Serialize;
 
 use crr_dynamics::DynamicsError;
-use crr_dynamics::eom::{Dynamics, ForwardSolver, effective_gravity, slot_row};
+use crr_dynamics::eom::{Dynamics, effective_gravity, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::linalg::JacobiSvd;
-use crr_kinematics::{InterfaceKind, Model, Role, forward_kinematics};
+use crr_kinematics::{InterfaceKind, Model, Role};
 
 /// The force a contact transmits to its child side.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -30,6 +30,16 @@ pub struct ContactForce {
 }
 
 impl ContactForce {
+    /// The force `force` on the child side split along the unit contact normal `normal`.
+    fn new(force: Vector3<f64>, normal: Vector3<f64>) -> Self {
+        let nf = force.dot(&normal);
+        Self {
+            force: force.into(),
+            normal: nf,
+            tangential: (force - normal * nf).norm(),
+        }
+    }
+
     /// |F_t|/N (infinite when N ≤ 0).
     pub fn friction_demand(&self) -> f64 {
         if self.normal > 0.0 {
@@ -118,25 +128,16 @@ pub fn contact_forces_into(
     qdot: &DVector<f64>,
     work: &mut ForceWork,
 ) -> Result<(), DynamicsError> {
-    // One body on one coordinate: the force in closed form, with θ̈ = Q/I_p from the kinematics
-    // of the state and the one-coordinate kernel's I_p (M is not needed), or θ̈ = 0 when its
-    // joint is seated (held).
+    // One body on one coordinate: the force in closed form, with θ̈ from the kinematics of the
+    // state (Q/I_p, or 0 when the joint is seated; M is not needed).
     if let [_] = q.as_slice()
         && let ([_], [_]) = (&model.bodies[..], &model.interfaces[..])
+        && let Some(solved) = dynamics.single_coordinate_accelerations(model, ground, t, q)
     {
-        if let Some(solved) = dynamics.single_coordinate_accelerations(model, ground, t, q) {
-            solved?;
-            let (g_eff, qddot) = (dynamics.effective_gravity(), dynamics.qddot[0]);
-            one_body_force(model, &mut dynamics.kin, g_eff, qddot, qdot[0], work);
-            return Ok(());
-        }
-        if dynamics.solver == ForwardSolver::Auto && dynamics.seated.len() == model.slot_count {
-            forward_kinematics(model, &mut dynamics.kin, q, &dynamics.pivots);
-            dynamics.qddot[0] = 0.0;
-            let g_eff = effective_gravity(model, ground, t);
-            one_body_force(model, &mut dynamics.kin, g_eff, 0.0, qdot[0], work);
-            return Ok(());
-        }
+        solved?;
+        let (g_eff, qddot) = (dynamics.effective_gravity(), dynamics.qddot[0]);
+        one_body_force(model, &mut dynamics.kin, g_eff, qddot, qdot[0], work);
+        return Ok(());
     }
     dynamics.accelerations(model, ground, t, q, qdot)?;
     let kin = &dynamics.kin;
@@ -175,16 +176,11 @@ pub fn contact_forces_into(
         &mut work.transmitted,
     );
     work.forces.clear();
-    work.forces.extend(work.transmitted.iter().map(|f| {
-        f.map(|(force, normal)| {
-            let nf = force.dot(&normal);
-            ContactForce {
-                force: force.into(),
-                normal: nf,
-                tangential: (force - normal * nf).norm(),
-            }
-        })
-    }));
+    work.forces.extend(
+        work.transmitted
+            .iter()
+            .map(|f| f.map(|(force, normal)| ContactForce::new(force, normal))),
+    );
     Ok(())
 }
 
@@ -210,14 +206,7 @@ fn one_body_force(
     let force = (a_c - g_eff) * body.mass;
     work.forces.clear();
     work.forces
-        .push(rest_normal(&iface.kind, model.size).map(|normal| {
-            let nf = force.dot(&normal);
-            ContactForce {
-                force: force.into(),
-                normal: nf,
-                tangential: (force - normal * nf).norm(),
-            }
-        }));
+        .push(rest_normal(&iface.kind, model.size).map(|normal| ContactForce::new(force, normal)));
 }
 
 /// The force each monitored interface transmits to its child side, with its contact normal

@@ -48,18 +48,7 @@ pub struct Samples {
 impl Samples {
     /// No samples, of a model with `dof` coordinates and `slots` angle slots.
     pub fn new(dof: usize, slots: usize) -> Self {
-        Self {
-            dof,
-            slots,
-            t: Vec::new(),
-            q: Vec::new(),
-            qdot: Vec::new(),
-            kinetic: Vec::new(),
-            potential: Vec::new(),
-            work_in: Vec::new(),
-            dissipated: Vec::new(),
-            states: Vec::new(),
-        }
+        Self::with_capacity(dof, slots, 0)
     }
 
     /// [`Self::new`] with room for `capacity` samples, so that pushing that many does not
