@@ -144,6 +144,7 @@ pub fn slot_rate_direction(model: &Model, kin: &Data, slot: usize) -> DVector<f6
 }
 
 /// Everything an impact law needs of one dynamic chain at the impact configuration.
+#[derive(Clone, Debug)]
 struct Chain {
     /// M(q) of this chain.
     mass: DMatrix<f64>,
@@ -152,21 +153,82 @@ struct Chain {
     null: Option<DMatrix<f64>>,
 }
 
+impl Default for Chain {
+    fn default() -> Self {
+        Self {
+            mass: DMatrix::zeros(0, 0),
+            null: None,
+        }
+    }
+}
+
 /// Evaluates the kinematics of the chain `pivots` into `kin` (forward kinematics, Jacobians, M,
-/// Φ_q) and returns M and the null space of the row-scaled Φ_q.
-fn evaluate_chain(model: &Model, kin: &mut Data, q: &DVector<f64>, pivots: &ActivePivots) -> Chain {
+/// Φ_q) and leaves M and the null space of the row-scaled Φ_q in `chain`.
+fn evaluate_chain(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+    chain: &mut Chain,
+) {
     forward_kinematics(model, kin, q, pivots);
     jacobians(model, kin);
     mass_matrix(model, kin);
-    let null = (model.constraint_rows > 0).then(|| {
+    chain.null = (model.constraint_rows > 0).then(|| {
         constraint_jacobian(model, kin, pivots);
         let scale = constraint_row_scale(model);
         null_space(&kin.phi_q, &scale)
     });
-    Chain {
-        mass: kin.mass_matrix.clone(),
-        null,
+    copy_matrix(&mut chain.mass, &kin.mass_matrix);
+}
+
+/// `dst` = `src`, reusing `dst`'s storage when the shapes agree.
+fn copy_matrix(dst: &mut DMatrix<f64>, src: &DMatrix<f64>) {
+    if dst.shape() == src.shape() {
+        dst.copy_from(src);
+    } else {
+        *dst = src.clone();
     }
+}
+
+/// `dst` = `src`, reusing `dst`'s storage when the lengths agree.
+fn copy_vector(dst: &mut DVector<f64>, src: &DVector<f64>) {
+    if dst.len() == src.len() {
+        dst.copy_from(src);
+    } else {
+        *dst = src.clone();
+    }
+}
+
+/// `v` with `len` entries (their values are to be overwritten), reusing its storage if it has.
+fn with_len(v: &mut DVector<f64>, len: usize) {
+    if v.len() != len {
+        *v = DVector::zeros(len);
+    }
+}
+
+/// Buffers the impact laws reuse from one impact to the next (a simulation keeps one, so that
+/// an impact on a chain allocates only its result): both chains' M, the bodies' momenta and the
+/// metric's factor. The products written into them are the ones the allocating forms make:
+/// nalgebra's `mul_to` / `tr_mul_to` run the same gemm / dot loops as `*` / `tr_mul`.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LawWorkspace {
+    /// The `before` chain.
+    minus: Chain,
+    /// The `after` chain.
+    plus: Chain,
+    /// J_c⁻ q̇⁻, then the linear momenta m ċ (3 per body).
+    linear: DVector<f64>,
+    /// J_ω⁻ q̇⁻, then the angular momenta I ω (3 per body).
+    angular: DVector<f64>,
+    /// (J⁺)ᵀ 𝕄 J⁻ q̇⁻, the generalized momentum on the `after` chain.
+    momentum: DVector<f64>,
+    /// J_ω⁺ᵀ I ω, the angular part of `momentum`; then M q̇ for the kinetic energies.
+    part: DVector<f64>,
+    /// The metric of the `after` chain.
+    metric: Metric,
+    /// w of the momentum.
+    w: DVector<f64>,
 }
 
 /// Orthonormal basis of the null space of diag(scale) Φ (rank-revealing Jacobi SVD, the relative
@@ -230,7 +292,15 @@ fn check_slot(model: &Model, slot: usize) -> Result<(), ImpactError> {
 }
 
 fn kinetic(m: &DMatrix<f64>, v: &DVector<f64>) -> f64 {
-    0.5 * v.dot(&(m * v))
+    let mut mv = DVector::zeros(v.len());
+    kinetic_with(m, v, &mut mv)
+}
+
+/// ½ vᵀ M v, with M v written into `mv`.
+fn kinetic_with(m: &DMatrix<f64>, v: &DVector<f64>, mv: &mut DVector<f64>) -> f64 {
+    with_len(mv, m.nrows());
+    m.mul_to(v, mv);
+    0.5 * v.dot(mv)
 }
 
 /// The slot directions as the columns of A (n × slots).
@@ -255,20 +325,36 @@ pub fn momentum_law(
     before: &ActivePivots,
     after: &ActivePivots,
 ) -> Result<ImpactResult, ImpactError> {
+    let mut ws = LawWorkspace::default();
+    momentum_law_with(model, kin, &mut ws, q, qdot_minus, before, after)
+}
+
+/// [`momentum_law`] with the buffers `ws` (the same results to the last bit).
+pub(crate) fn momentum_law_with(
+    model: &Model,
+    kin: &mut Data,
+    ws: &mut LawWorkspace,
+    q: &DVector<f64>,
+    qdot_minus: &DVector<f64>,
+    before: &ActivePivots,
+    after: &ActivePivots,
+) -> Result<ImpactResult, ImpactError> {
     check_inputs(model, q, qdot_minus, before, after)?;
-    let (minus, plus, momentum) = pre_impact_momentum(model, kin, q, qdot_minus, before, after);
-    let metric = Metric::new("momentum law", &plus)?;
-    let qdot = metric.qdot_of_w(&metric.w_of_momentum(&momentum));
+    pre_impact_momentum(model, kin, q, qdot_minus, before, after, ws);
+    ws.metric.refactor("momentum law", &ws.plus)?;
+    ws.metric.w_of_momentum_into(&ws.momentum, &mut ws.w);
+    let qdot = ws.metric.qdot_of_w(&ws.w);
     Ok(ImpactResult {
-        kinetic_before: kinetic(&minus.mass, qdot_minus),
-        kinetic_after: kinetic(&plus.mass, &qdot),
+        kinetic_before: kinetic_with(&ws.minus.mass, qdot_minus, &mut ws.part),
+        kinetic_after: kinetic_with(&ws.plus.mass, &qdot, &mut ws.part),
         qdot,
     })
 }
 
 /// The momentum of the bodies' real motion before the impact, V⁻ = J⁻q̇⁻ (linear m ċ, angular
-/// I ω), as a generalized momentum of the `after` chain: (J⁺)ᵀ 𝕄 J⁻ q̇⁻. Evaluates both chains;
-/// `kin` is left evaluated for the `after` chain.
+/// I ω), as a generalized momentum of the `after` chain: (J⁺)ᵀ 𝕄 J⁻ q̇⁻. Evaluates both chains
+/// into `ws.minus` and `ws.plus` and the momentum into `ws.momentum`; `kin` is left evaluated
+/// for the `after` chain.
 fn pre_impact_momentum(
     model: &Model,
     kin: &mut Data,
@@ -276,23 +362,30 @@ fn pre_impact_momentum(
     qdot_minus: &DVector<f64>,
     before: &ActivePivots,
     after: &ActivePivots,
-) -> (Chain, Chain, DVector<f64>) {
-    let minus = evaluate_chain(model, kin, q, before);
-    let vc = &kin.com_jacobian * qdot_minus;
-    let wv = &kin.angular_jacobian * qdot_minus;
-    let plus = evaluate_chain(model, kin, q, after);
-    let mut lin = DVector::zeros(vc.len());
-    let mut ang = DVector::zeros(wv.len());
+    ws: &mut LawWorkspace,
+) {
+    evaluate_chain(model, kin, q, before, &mut ws.minus);
+    let (vc, wv) = (&mut ws.linear, &mut ws.angular);
+    with_len(vc, kin.com_jacobian.nrows());
+    with_len(wv, kin.angular_jacobian.nrows());
+    kin.com_jacobian.mul_to(qdot_minus, vc);
+    kin.angular_jacobian.mul_to(qdot_minus, wv);
+    evaluate_chain(model, kin, q, after, &mut ws.plus);
+    // In place: body bi's entries are read before they are overwritten.
     for (bi, body) in model.bodies.iter().enumerate() {
         let i_w = world_inertia(body, &kin.rot_ops[model.body_coord[bi]]);
         let w = i_w * Vector3::new(wv[3 * bi], wv[3 * bi + 1], wv[3 * bi + 2]);
         for r in 0..3 {
-            lin[3 * bi + r] = body.mass * vc[3 * bi + r];
-            ang[3 * bi + r] = w[r];
+            vc[3 * bi + r] *= body.mass;
+            wv[3 * bi + r] = w[r];
         }
     }
-    let momentum = kin.com_jacobian.tr_mul(&lin) + kin.angular_jacobian.tr_mul(&ang);
-    (minus, plus, momentum)
+    let n = kin.com_jacobian.ncols();
+    with_len(&mut ws.momentum, n);
+    with_len(&mut ws.part, n);
+    kin.com_jacobian.tr_mul_to(vc, &mut ws.momentum);
+    kin.angular_jacobian.tr_mul_to(wv, &mut ws.part);
+    ws.momentum += &ws.part;
 }
 
 /// Classical restitution on a chain: each impacting slot s with coefficient r_s has its rate
@@ -392,31 +485,47 @@ pub fn dirac_law(
 /// On an open chain N = I and z = q̇: the products with N are skipped (each entry of a product
 /// with I is one entry times 1 plus zeros, so the results are the same to the last bit; for n
 /// coordinates this saves the O(n³) products NᵀMN and NᵀA at every impact).
+#[derive(Clone, Debug)]
 struct Metric {
     /// N, None for the identity (an open chain).
     null: Option<DMatrix<f64>>,
     chol: DMatrix<f64>,
 }
 
+impl Default for Metric {
+    fn default() -> Self {
+        Self {
+            null: None,
+            chol: DMatrix::zeros(0, 0),
+        }
+    }
+}
+
 impl Metric {
     fn new(law: &'static str, chain: &Chain) -> Result<Self, ImpactError> {
-        let mut chol = match &chain.null {
-            Some(null) => null.transpose() * &chain.mass * null,
-            None => chain.mass.clone(),
-        };
-        let d = chol.nrows();
-        cholesky_in_place(&mut chol).map_err(|col| ImpactError::Singular {
+        let mut metric = Self::default();
+        metric.refactor(law, chain)?;
+        Ok(metric)
+    }
+
+    /// Makes this the metric of `chain`, reusing the factor's storage (an open chain's metric
+    /// allocates nothing once the sizes are set).
+    fn refactor(&mut self, law: &'static str, chain: &Chain) -> Result<(), ImpactError> {
+        match &chain.null {
+            Some(null) => self.chol = null.transpose() * &chain.mass * null,
+            None => copy_matrix(&mut self.chol, &chain.mass),
+        }
+        let d = self.chol.nrows();
+        cholesky_in_place(&mut self.chol).map_err(|col| ImpactError::Singular {
             law,
             rank: col,
             needed: d,
             hint: "the mass matrix is not positive definite on the mechanism's velocities",
         })?;
         // cholesky_in_place leaves scratch in the strict upper triangle: clear it, Lᵀ is used.
-        chol.fill_upper_triangle(0.0, 1);
-        Ok(Self {
-            null: chain.null.clone(),
-            chol,
-        })
+        self.chol.fill_upper_triangle(0.0, 1);
+        self.null.clone_from(&chain.null);
+        Ok(())
     }
 
     /// w = Lᵀ Nᵀ q̇ for a velocity q̇ of this chain (Φ_q q̇ = 0).
@@ -430,12 +539,18 @@ impl Metric {
     /// w = L⁻¹ Nᵀ p for a generalized momentum p (the momentum's components along the
     /// mechanism's motions, in the energy-normalised coordinates).
     fn w_of_momentum(&self, p: &DVector<f64>) -> DVector<f64> {
-        let mut w = match &self.null {
-            Some(null) => null.tr_mul(p),
-            None => p.clone(),
-        };
-        forward_substitute(&self.chol, w.as_mut_slice());
+        let mut w = DVector::zeros(0);
+        self.w_of_momentum_into(p, &mut w);
         w
+    }
+
+    /// [`Self::w_of_momentum`] written into `w` (its storage reused on an open chain).
+    fn w_of_momentum_into(&self, p: &DVector<f64>, w: &mut DVector<f64>) {
+        match &self.null {
+            Some(null) => *w = null.tr_mul(p),
+            None => copy_vector(w, p),
+        }
+        forward_substitute(&self.chol, w.as_mut_slice());
     }
 
     /// q̇ = N L⁻ᵀ w.
@@ -504,7 +619,9 @@ fn rate_law(
     after: &ActivePivots,
     slots: &[(usize, f64)],
 ) -> Result<ImpactResult, ImpactError> {
-    let (minus, plus, momentum) = pre_impact_momentum(model, kin, q, qdot_minus, before, after);
+    let mut ws = LawWorkspace::default();
+    pre_impact_momentum(model, kin, q, qdot_minus, before, after, &mut ws);
+    let (minus, plus, momentum) = (&ws.minus, &ws.plus, &ws.momentum);
     // The slot directions do not depend on the pivots (only on the Γ's).
     let a = directions(model, kin, slots.iter().map(|x| x.0));
     let rates = a.tr_mul(qdot_minus);
@@ -515,7 +632,7 @@ fn rate_law(
     let f_max = slots.iter().map(|s| s.1).fold(0.0, f64::max);
 
     // Before: the impact mode's energy E⁻ and the energy of the target rates.
-    let metric_minus = Metric::new(law, &minus)?;
+    let metric_minus = Metric::new(law, minus)?;
     let c_minus = metric_minus.slot_map(&a);
     let q_minus = range_basis(&c_minus);
     let mode_energy = 0.5
@@ -526,7 +643,7 @@ fn rate_law(
         .min(f_max * f_max * mode_energy);
 
     // After: keep the momentum along ker Cᵀ, set the impact mode.
-    let metric_plus = Metric::new(law, &plus)?;
+    let metric_plus = Metric::new(law, plus)?;
     let c_plus = metric_plus.slot_map(&a);
     let q_plus = range_basis(&c_plus);
     if q_plus.ncols() < q_minus.ncols() {
@@ -537,7 +654,7 @@ fn rate_law(
             hint: "an impacting slot's rate is locked by the closures of the new chain",
         });
     }
-    let w_momentum = metric_plus.w_of_momentum(&momentum);
+    let w_momentum = metric_plus.w_of_momentum(momentum);
     let y = mode_coordinates(&c_plus, &q_plus, &targets);
     let y_energy = 0.5 * y.norm_squared();
     let scale = if y_energy > 0.0 {
@@ -661,4 +778,43 @@ fn mechanism_inverse(model: &Model, kin: &Data) -> Option<DMatrix<f64>> {
         col.copy_from(&v);
     }
     Some(&null * inv_nt)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crr_kinematics::Side;
+    use crr_kinematics::fixtures::{random_chain, single_block, trilithon};
+
+    /// One workspace reused across chains of different sizes, open and closed, gives the
+    /// momentum law's results to the last bit of a fresh evaluation: the buffers are resized
+    /// when the chain changes and nothing of one impact leaks into the next.
+    #[test]
+    fn a_reused_workspace_gives_the_fresh_results_to_the_last_bit() {
+        // Consecutive chains of one size reuse the storage, the others resize it.
+        let specs = [
+            single_block(0.2, 1.0, 2500.0),
+            single_block(0.3, 1.2, 2400.0),
+            random_chain(3, 4, 0),
+            trilithon(0.3, 2.0, 2.0, 0.5, 0.4),
+            trilithon(0.25, 1.5, 1.8, 0.4, 0.2),
+            random_chain(11, 6, 0),
+        ];
+        let mut ws = LawWorkspace::default();
+        for spec in &specs {
+            let model = Model::from_spec(spec).expect("valid fixture");
+            let n = model.dof();
+            let before = ActivePivots::uniform(&model, Side::Positive);
+            let after = ActivePivots {
+                sides: before.sides.iter().map(|s| s.flipped()).collect(),
+            };
+            let q = DVector::zeros(n);
+            let qd = DVector::from_fn(n, |i, _| 0.3 - 0.17 * i as f64);
+            let (mut k1, mut k2) = (Data::new(&model), Data::new(&model));
+            let fresh = momentum_law(&model, &mut k1, &q, &qd, &before, &after);
+            assert!(fresh.is_ok(), "{n} coordinates: {fresh:?}");
+            let reused = momentum_law_with(&model, &mut k2, &mut ws, &q, &qd, &before, &after);
+            assert_eq!(fresh, reused, "{n} coordinates");
+        }
+    }
 }

@@ -77,9 +77,11 @@ pub(super) fn plastic_projection(
 /// uses it; otherwise one rate law ([`restitution_law`]) with a factor per slot: r for
 /// restitution, r^C for the exact Dirac law, and 1 for a regularised Dirac law (an elastic pivot
 /// switch: its force does the dissipation on either side of the switch).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn apply_law(
     model: &Model,
     kin: &mut Data,
+    ws: &mut LawWorkspace,
     q: &DVector<f64>,
     qdot: &DVector<f64>,
     before: &ActivePivots,
@@ -91,7 +93,7 @@ pub(super) fn apply_law(
         .map(|&s| model.interfaces[slot_interface(model, s)].impact)
         .collect();
     if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
-        return momentum_law(model, kin, q, qdot, before, after);
+        return momentum_law_with(model, kin, ws, q, qdot, before, after);
     }
     if let Some(dirac) = laws
         .iter()
@@ -116,11 +118,13 @@ pub(super) fn apply_law(
     restitution_law(model, kin, q, qdot, before, after, &factors)
 }
 
-/// Scratch of [`Simulation::impact`], kept by the run: the slot angles and rates, and the lists
-/// of held, wrongly moving, seating candidate and newly seated slots.
+/// Scratch of [`Simulation::impact`], kept by the run: the slot angles and rates (before the
+/// impact, and of the trial velocities after it), and the lists of held, wrongly moving,
+/// seating candidate and newly seated slots.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ImpactBuffers {
     angles: Vec<f64>,
+    rates_before: Vec<f64>,
     rates: Vec<f64>,
     held: Vec<usize>,
     wrong: Vec<usize>,
@@ -145,8 +149,10 @@ impl Simulation<'_> {
             .unwrap_or_else(|| Box::new(Data::new(model)));
         let mut work = self.take_trial();
         // Scratch of the run (given back below, or reallocated after an error return).
+        let mut laws = std::mem::take(&mut self.spare.laws);
         let ImpactBuffers {
             mut angles,
+            mut rates_before,
             mut rates,
             mut held,
             mut wrong,
@@ -156,16 +162,19 @@ impl Simulation<'_> {
         angles.clear();
         angles.resize(model.slot_count, 0.0);
         slot_angles(model, &mut kin, &q, &before, &mut angles);
+        // U at the located state, for the snap of the impacting angles to 0 (booked below).
+        let u_located = potential_energy(model, &kin);
         crr_kinematics::velocities(model, &mut kin, &qdot);
-        rates.clear();
-        rates.resize(model.slot_count, 0.0);
-        slot_rates(model, &kin, &qdot, &mut rates);
+        rates_before.clear();
+        rates_before.resize(model.slot_count, 0.0);
+        slot_rates(model, &kin, &qdot, &mut rates_before);
+        rates.clone_from(&rates_before);
         let mut impacting: Vec<usize> = (0..model.slot_count)
             .filter(|&s| {
                 s == slot
                     || (!self.seated[s]
                         && angles[s].abs() <= self.params.simultaneity
-                        && rates[s] * before.sides[s].sign() < 0.0)
+                        && rates_before[s] * before.sides[s].sign() < 0.0)
             })
             .collect();
         held.clear();
@@ -188,8 +197,10 @@ impl Simulation<'_> {
                 }
             }
             let q = q_at;
-            let mut result = apply_law(model, &mut kin, &q, &qdot, &before, &after, &impacting)
-                .map_err(|source| SimulationError::Impact { t, source })?;
+            let mut result = apply_law(
+                model, &mut kin, &mut laws, &q, &qdot, &before, &after, &impacting,
+            )
+            .map_err(|source| SimulationError::Impact { t, source })?;
             // Joints that were seated stay seated through the impact: a plastic impulse on them
             // (booked as dissipation), as "all other hinges persisting". With none, the law's
             // q̇⁺ and T⁺ = ½q̇⁺ᵀM⁺q̇⁺ (the same M⁺, at the same q) stand.
@@ -266,12 +277,9 @@ impl Simulation<'_> {
             }));
             to_seat.extend_from_slice(&pending);
         }
-        let before_rates: Vec<f64> = {
-            forward_kinematics(model, &mut kin, &q, &before);
-            crr_kinematics::velocities(model, &mut kin, &qdot);
-            slot_rates(model, &kin, &qdot, &mut rates);
-            impacting.iter().map(|&s| rates[s]).collect()
-        };
+        // `kin` holds the kinematics of q_new on the `after` chain (the last evaluation above).
+        let u_snapped = potential_energy(model, &kin);
+        let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;
         let record = ImpactRecord {
             t,
@@ -307,16 +315,13 @@ impl Simulation<'_> {
             .seated
             .extend((0..model.slot_count).filter(|&s| self.seated[s]));
         // The snap of the impacting angles to exactly 0 changes U by round-off: booked too.
-        let u_snap = {
-            forward_kinematics(model, &mut kin, &q, &before);
-            let u0 = potential_energy(model, &kin);
-            forward_kinematics(model, &mut kin, &q_new, &self.dynamics.pivots);
-            u0 - potential_energy(model, &kin)
-        };
+        let u_snap = u_located - u_snapped;
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(work);
+        self.spare.laws = laws;
         self.spare.impact = ImpactBuffers {
             angles,
+            rates_before,
             rates,
             held,
             wrong,

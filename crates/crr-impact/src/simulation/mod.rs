@@ -35,7 +35,10 @@ use crr_kinematics::{
     potential_energy,
 };
 
-use crate::laws::{ImpactError, dirac_law, dirac_regularised_force, momentum_law, restitution_law};
+use crate::laws::{
+    ImpactError, LawWorkspace, dirac_law, dirac_regularised_force, momentum_law_with,
+    restitution_law,
+};
 
 mod events;
 mod impacts;
@@ -249,6 +252,9 @@ pub struct Interrupted {
 /// The most output samples one [`Simulation::step`] produces.
 const MAX_SAMPLES_PER_STEP: usize = 4096;
 
+/// Impact records a run has room for from the start (a rocking run has tens to hundreds).
+const INITIAL_IMPACT_ROOM: usize = 256;
+
 /// An event-driven simulation of one structure under one ground motion.
 pub struct Simulation<'a> {
     model: &'a Model,
@@ -360,6 +366,8 @@ struct Workspaces {
     rest: RestCache,
     /// Scratch of the impacts.
     impact: ImpactBuffers,
+    /// The impact laws' buffers.
+    laws: crate::laws::LawWorkspace,
 }
 
 impl<'a> Simulation<'a> {
@@ -426,8 +434,11 @@ impl<'a> Simulation<'a> {
         let u_rest = crr_dynamics::energy::rest_potential(model);
         let trial = dynamics.clone();
         // Room for the regular samples of the whole run, up to one step's worth (a longer run
-        // grows by doubling, or is drained by a caller streaming it).
+        // grows by doubling, or is drained by a caller streaming it), and for the two samples
+        // of an impact every eighth output interval (more impacts grow the vectors once).
         let regular_samples = (params.duration / params.output_interval) as usize + 2;
+        let sample_room = regular_samples + regular_samples / 4;
+        let impact_room = params.max_impacts.min(INITIAL_IMPACT_ROOM);
         let mut sim = Self {
             model,
             ground,
@@ -450,6 +461,7 @@ impl<'a> Simulation<'a> {
                 rest: RestCache::default(),
                 system: Default::default(),
                 impact: ImpactBuffers::default(),
+                laws: Default::default(),
             },
             parts: model.parts(),
             y,
@@ -467,9 +479,9 @@ impl<'a> Simulation<'a> {
             samples: Samples::with_capacity(
                 n,
                 model.slot_count,
-                regular_samples.min(MAX_SAMPLES_PER_STEP),
+                sample_room.min(MAX_SAMPLES_PER_STEP),
             ),
-            impacts: Vec::new(),
+            impacts: Vec::with_capacity(impact_room),
             peaks: Vec::new(),
             uplift_time: None,
             collapse: None,
