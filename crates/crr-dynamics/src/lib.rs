@@ -18,6 +18,7 @@ pub mod input;
 pub mod integrator;
 pub mod linalg;
 pub mod mechanism;
+pub mod roots;
 pub mod run;
 pub mod single_coordinate;
 pub mod system;

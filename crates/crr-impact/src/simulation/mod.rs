@@ -27,6 +27,7 @@ use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::integrator::{
     DenseStep, Direction, EventFunctions, Method, Options, SolveError, Solver, Stop,
 };
+use crr_dynamics::roots::sign_change;
 use crr_dynamics::{ConstrainedSystem, InitialState};
 use crr_kinematics::short_copy::{copy_short, extend_short};
 use crr_kinematics::spec::ImpactLaw;
@@ -673,19 +674,8 @@ impl<'a> Simulation<'a> {
                 let rate = step.component(n + k);
                 let (a, b) = (rate.eval(step.t0()), rate.eval(step.t1()));
                 if a != 0.0 && b != 0.0 && a.signum() != b.signum() {
-                    // Bisection on q̇ₖ(t) of the dense output, to adjacent doubles.
-                    let (mut lo, mut hi) = (step.t0(), step.t1());
-                    for _ in 0..60 {
-                        let mid = 0.5 * (lo + hi);
-                        if mid <= lo || mid >= hi {
-                            break;
-                        }
-                        if rate.eval(mid).signum() == a.signum() {
-                            lo = mid;
-                        } else {
-                            hi = mid;
-                        }
-                    }
+                    // The sign change of q̇ₖ(t) of the dense output, to adjacent doubles.
+                    let (lo, hi) = sign_change(|t| rate.eval(t), step.t0(), a, step.t1(), b);
                     let tp = 0.5 * (lo + hi);
                     peaks.push(Peak {
                         t: tp,
