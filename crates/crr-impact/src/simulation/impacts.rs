@@ -88,17 +88,16 @@ pub(super) fn apply_law(
     after: &ActivePivots,
     impacting: &[usize],
 ) -> Result<crate::laws::ImpactResult, ImpactError> {
-    let laws: Vec<ImpactLaw> = impacting
+    let law = |s: usize| model.interfaces[slot_interface(model, s)].impact;
+    if impacting
         .iter()
-        .map(|&s| model.interfaces[slot_interface(model, s)].impact)
-        .collect();
-    if laws.iter().any(|l| matches!(l, ImpactLaw::Momentum)) {
+        .any(|&s| matches!(law(s), ImpactLaw::Momentum))
+    {
         return momentum_law_with(model, kin, ws, q, qdot, before, after);
     }
-    if let Some(dirac) = laws
+    if let Some(dirac) = impacting
         .iter()
-        .zip(impacting)
-        .map(|(l, &s)| match *l {
+        .map(|&s| match law(s) {
             ImpactLaw::Dirac { r, c } => Some((s, r, c)),
             _ => None,
         })
@@ -106,10 +105,9 @@ pub(super) fn apply_law(
     {
         return dirac_law(model, kin, q, qdot, before, after, &dirac);
     }
-    let factors: Vec<(usize, f64)> = laws
+    let factors: Vec<(usize, f64)> = impacting
         .iter()
-        .zip(impacting)
-        .map(|(l, &s)| match *l {
+        .map(|&s| match law(s) {
             ImpactLaw::Restitution(r) => (s, r),
             ImpactLaw::Dirac { r, c } => (s, r.powf(c)),
             _ => (s, 1.0),
@@ -118,11 +116,17 @@ pub(super) fn apply_law(
     restitution_law(model, kin, q, qdot, before, after, &factors)
 }
 
-/// Scratch of [`Simulation::impact`], kept by the run: the slot angles and rates (before the
-/// impact, and of the trial velocities after it), and the lists of held, wrongly moving,
-/// seating candidate and newly seated slots.
-#[derive(Clone, Debug, Default)]
+/// Scratch of [`Simulation::impact`], kept by the run: the state before the impact (q, q̇) and
+/// at φ = 0 (q), the pivots before and after, the slot angles and rates (before the impact, and
+/// of the trial velocities after it), and the lists of held, wrongly moving, seating candidate
+/// and newly seated slots.
+#[derive(Clone, Debug)]
 pub(super) struct ImpactBuffers {
+    q: DVector<f64>,
+    qdot: DVector<f64>,
+    q_at: DVector<f64>,
+    before: ActivePivots,
+    after: ActivePivots,
     angles: Vec<f64>,
     rates_before: Vec<f64>,
     rates: Vec<f64>,
@@ -132,6 +136,39 @@ pub(super) struct ImpactBuffers {
     pending: Vec<usize>,
 }
 
+impl Default for ImpactBuffers {
+    fn default() -> Self {
+        let (q, qdot, q_at) = (DVector::zeros(0), DVector::zeros(0), DVector::zeros(0));
+        let (before, after) = (
+            ActivePivots { sides: Vec::new() },
+            ActivePivots { sides: Vec::new() },
+        );
+        Self {
+            q,
+            qdot,
+            q_at,
+            before,
+            after,
+            angles: Vec::new(),
+            rates_before: Vec::new(),
+            rates: Vec::new(),
+            held: Vec::new(),
+            wrong: Vec::new(),
+            candidates: Vec::new(),
+            pending: Vec::new(),
+        }
+    }
+}
+
+/// `v` = `values`, reusing `v`'s storage when the lengths agree.
+fn set_vector(v: &mut DVector<f64>, values: &[f64]) {
+    if v.len() == values.len() {
+        copy_short(v.as_mut_slice(), values);
+    } else {
+        *v = DVector::from_column_slice(values);
+    }
+}
+
 impl Simulation<'_> {
     /// Handles an impact fired by `slot` at the current time.
     pub(super) fn impact(&mut self, slot: usize) -> Result<usize, SimulationError> {
@@ -139,8 +176,7 @@ impl Simulation<'_> {
             return Err(SimulationError::TooManyImpacts(self.params.max_impacts));
         }
         let model = self.model;
-        let (t, q, qdot) = (self.t, self.q(), self.qdot());
-        let before = self.dynamics.pivots.clone();
+        let (t, n) = (self.t, model.dof());
         // Workspaces of the run (given back below; an error return only costs a reallocation).
         let mut kin = self
             .spare
@@ -151,6 +187,11 @@ impl Simulation<'_> {
         // Scratch of the run (given back below, or reallocated after an error return).
         let mut laws = std::mem::take(&mut self.spare.laws);
         let ImpactBuffers {
+            mut q,
+            mut qdot,
+            mut q_at,
+            mut before,
+            mut after,
             mut angles,
             mut rates_before,
             mut rates,
@@ -159,6 +200,9 @@ impl Simulation<'_> {
             mut candidates,
             mut pending,
         } = std::mem::take(&mut self.spare.impact);
+        set_vector(&mut q, &self.y[..n]);
+        set_vector(&mut qdot, &self.y[n..2 * n]);
+        before.clone_from(&self.dynamics.pivots);
         angles.clear();
         angles.resize(model.slot_count, 0.0);
         slot_angles(model, &mut kin, &q, &before, &mut angles);
@@ -181,8 +225,9 @@ impl Simulation<'_> {
         held.extend((0..model.slot_count).filter(|&s| self.seated[s]));
         // A rocking joint at φ ≈ 0 that the impact sends into its closed side impacts too (its
         // pivot switches): enlarge the impacting set until no joint penetrates.
-        let (after, q_new, result, mut qdot_after, mut kinetic_after) = loop {
-            let mut after = before.clone();
+        // Each round leaves its pivots in `after` and its configuration in `q_at`.
+        let (result, mut qdot_after, mut kinetic_after) = loop {
+            after.clone_from(&before);
             for &s in &impacting {
                 after.sides[s] = before.sides[s].flipped();
             }
@@ -190,15 +235,15 @@ impl Simulation<'_> {
             // (and a joint impacting with it within `simultaneity`). The laws act at φ = 0
             // exactly, where the two chains place every body identically; at the located
             // angle the pivot switch would move the bodies above by φ·|P⁺ − P⁻|.
-            let mut q_at = q.clone();
+            set_vector(&mut q_at, q.as_slice());
             for &s in &impacting {
-                if s < model.dof() {
+                if s < n {
                     q_at[s] = 0.0;
                 }
             }
-            let q = q_at;
+            let q = &q_at;
             let mut result = apply_law(
-                model, &mut kin, &mut laws, &q, &qdot, &before, &after, &impacting,
+                model, &mut kin, &mut laws, q, &qdot, &before, &after, &impacting,
             )
             .map_err(|source| SimulationError::Impact { t, source })?;
             // Joints that were seated stay seated through the impact: a plastic impulse on them
@@ -212,13 +257,13 @@ impl Simulation<'_> {
                     &mut work,
                     self.ground,
                     t,
-                    &q,
+                    q,
                     &result.qdot,
                     &after,
                     &held,
                 )
             };
-            forward_kinematics(model, &mut kin, &q, &after);
+            forward_kinematics(model, &mut kin, q, &after);
             crr_kinematics::velocities(model, &mut kin, &qd);
             slot_rates(model, &kin, &qd, &mut rates);
             wrong.clear();
@@ -229,7 +274,7 @@ impl Simulation<'_> {
                     && after.sides[s].sign() * rates[s] < -1e-12
             }));
             if wrong.is_empty() {
-                break (after, q, result, qd, k);
+                break (result, qd, k);
             }
             impacting.extend_from_slice(&wrong);
         };
@@ -261,12 +306,12 @@ impl Simulation<'_> {
                 &mut work,
                 self.ground,
                 t,
-                &q_new,
+                &q_at,
                 &qdot_after,
                 &after,
                 &all,
             );
-            forward_kinematics(model, &mut kin, &q_new, &after);
+            forward_kinematics(model, &mut kin, &q_at, &after);
             crr_kinematics::velocities(model, &mut kin, &qdot_after);
             slot_rates(model, &kin, &qdot_after, &mut rates);
             pending.clear();
@@ -277,7 +322,7 @@ impl Simulation<'_> {
             }));
             to_seat.extend_from_slice(&pending);
         }
-        // `kin` holds the kinematics of q_new on the `after` chain (the last evaluation above).
+        // `kin` holds the kinematics of q_at on the `after` chain (the last evaluation above).
         let u_snapped = potential_energy(model, &kin);
         let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;
@@ -309,7 +354,8 @@ impl Simulation<'_> {
         for &s in &record.seated {
             self.seated[s] = true;
         }
-        self.dynamics.pivots = after;
+        // The switch; the pivots before go back to the scratch.
+        std::mem::swap(&mut self.dynamics.pivots, &mut after);
         self.dynamics.seated.clear();
         self.dynamics
             .seated
@@ -319,7 +365,14 @@ impl Simulation<'_> {
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(work);
         self.spare.laws = laws;
+        self.y[..n].copy_from_slice(q_at.as_slice());
+        self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
         self.spare.impact = ImpactBuffers {
+            q,
+            qdot,
+            q_at,
+            before,
+            after,
             angles,
             rates_before,
             rates,
@@ -329,9 +382,6 @@ impl Simulation<'_> {
             pending,
         };
         self.dissipated_at_impacts += lost + u_snap;
-        let n = model.dof();
-        self.y[..n].copy_from_slice(q_new.as_slice());
-        self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
         self.impacts.push(record);
         self.reset_solver();
         // The joints that open right after the impact open before the post-impact sample, so
