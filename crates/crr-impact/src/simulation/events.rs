@@ -22,7 +22,9 @@ pub(super) struct SegmentEvents<'b> {
     pub(super) pivots: ActivePivots,
     pub(super) angles: Vec<f64>,
     /// Present when some slot is seated: the dynamics to test releases with.
-    pub(super) uplift: Option<Dynamics>,
+    /// Boxed: the segment's events are built and taken apart once per segment, and a
+    /// [`Dynamics`] in place would make each of those moves a copy of about 1.7 kB.
+    pub(super) uplift: Option<Box<Dynamics>>,
     /// Workspace of the uplift test (a copy of the dynamics, reused at every evaluation).
     pub(super) trial: Box<Dynamics>,
     /// The uplift test's factorisations at rest.

@@ -624,7 +624,7 @@ impl<'a> Simulation<'a> {
                 .unwrap_or_else(|| Box::new(Data::new(model))),
             pivots: std::mem::replace(&mut seg.pivots, ActivePivots { sides: Vec::new() }),
             angles: std::mem::take(&mut seg.angles),
-            uplift: (!self.dynamics.seated.is_empty()).then(|| self.dynamics.clone()),
+            uplift: (!self.dynamics.seated.is_empty()).then(|| Box::new(self.dynamics.clone())),
             trial: self.take_trial(),
             rest: std::mem::take(&mut self.spare.rest),
             slot_part: &self.parts.of_slot,
