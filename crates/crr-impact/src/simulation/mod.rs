@@ -345,13 +345,14 @@ struct SettleBuffers {
 /// given back after it).
 #[derive(Clone, Debug)]
 struct Workspaces {
-    /// Boxed, so that taking and giving back a workspace moves a pointer, not the structure.
+    /// Boxed, so that taking and giving back a workspace moves a pointer, not the structure
+    /// (a `memcpy` of its size otherwise, at every step or segment).
     events_kin: Option<Box<Data>>,
     trial: Option<Box<Dynamics>>,
     /// The buffers of a segment's events and output, taken by each segment and given back.
-    segment: SegmentBuffers,
+    segment: Option<Box<SegmentBuffers>>,
     /// The buffers of the test for joints coming to rest ([`Simulation::step`]'s first task).
-    settle: SettleBuffers,
+    settle: Option<Box<SettleBuffers>>,
     monitor: Dynamics,
     /// q, q̇ and the slot states of the sample being taken.
     sample_q: DVector<f64>,
@@ -451,8 +452,8 @@ impl<'a> Simulation<'a> {
             spare: Workspaces {
                 events_kin: Some(Box::new(Data::new(model))),
                 trial: Some(Box::new(trial)),
-                segment: SegmentBuffers::default(),
-                settle: SettleBuffers::default(),
+                segment: None,
+                settle: None,
                 monitor: Dynamics::new(model, initial.pivots.clone()),
                 sample_q: DVector::zeros(n),
                 sample_qdot: DVector::zeros(n),
@@ -599,7 +600,7 @@ impl<'a> Simulation<'a> {
         {
             return Ok(stop);
         }
-        let mut seg = std::mem::take(&mut self.spare.segment);
+        let mut seg = self.spare.segment.take().unwrap_or_default();
         seg.rocking.clear();
         seg.rocking.extend(
             (0..model.slot_count)
@@ -752,7 +753,7 @@ impl<'a> Simulation<'a> {
         self.peaks.extend_from_slice(&peaks);
         (seg.rocking, seg.pivots, seg.angles, seg.q, seg.qdot) = (rocking, pivots, angles, q, qdot);
         (seg.peaks, seg.rocking_coords, seg.y) = (peaks, rocking_coords, buf);
-        self.spare.segment = seg;
+        self.spare.segment = Some(seg);
         for sample in pending.chunks_exact(stride) {
             let s = self.sample_at(sample[0], &sample[1..]);
             self.record_sample(s);

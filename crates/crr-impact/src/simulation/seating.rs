@@ -524,11 +524,11 @@ impl Simulation<'_> {
             .take()
             .unwrap_or_else(|| Box::new(Data::new(self.model)));
         let mut d = self.take_trial();
-        let mut buffers = std::mem::take(&mut self.spare.settle);
+        let mut buffers = self.spare.settle.take().unwrap_or_default();
         let result = self.settle_resting_joints_in(&mut d, &mut kin, &mut buffers);
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(d);
-        self.spare.settle = buffers;
+        self.spare.settle = Some(buffers);
         result
     }
 
