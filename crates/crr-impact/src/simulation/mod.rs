@@ -339,6 +339,8 @@ struct SettleBuffers {
     angles: Vec<f64>,
     rates: Vec<f64>,
     candidates: Vec<usize>,
+    /// A slot's rate row aᵀ (n entries).
+    row: DVector<f64>,
 }
 
 /// Workspaces of a simulation reused from segment to segment (taken by a segment's events and

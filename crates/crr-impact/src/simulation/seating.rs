@@ -548,10 +548,12 @@ impl Simulation<'_> {
             angles,
             rates,
             candidates,
+            row,
         } = buffers;
         if q.len() != n {
             *q = DVector::zeros(n);
             *qdot = DVector::zeros(n);
+            *row = DVector::zeros(n);
         }
         copy_short(q.as_mut_slice(), &self.y[..n]);
         copy_short(qdot.as_mut_slice(), &self.y[n..2 * n]);
@@ -577,12 +579,11 @@ impl Simulation<'_> {
         rates.clear();
         rates.resize(model.slot_count, 0.0);
         slot_rates(model, &d.kin, qdot, rates);
-        let mut row = DVector::zeros(model.dof());
         // A joint leaving φ = 0 against its acceleration returns after τ = 2|φ̇|/|φ̈|: the
         // segment is capped at τ/2 (the turning point) so the return is a plain sign change.
         let mut cap: Option<f64> = None;
         for &s in candidates.iter() {
-            let bias = slot_row(model, &d.kin, s, &mut row);
+            let bias = slot_row(model, &d.kin, s, row);
             let acc = row.dot(&d.qddot) + bias;
             let side = self.dynamics.pivots.sides[s].sign();
             if side * rates[s] > 0.0 && side * acc < 0.0 {
@@ -594,7 +595,7 @@ impl Simulation<'_> {
             .iter()
             .copied()
             .filter(|&s| {
-                let bias = slot_row(model, &d.kin, s, &mut row);
+                let bias = slot_row(model, &d.kin, s, row);
                 let acc = row.dot(&d.qddot) + bias;
                 let side = self.dynamics.pivots.sides[s].sign();
                 rates[s].abs() < self.params.seat_rate
