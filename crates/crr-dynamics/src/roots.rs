@@ -17,6 +17,12 @@ const FINISH_ULPS: f64 = 8.0;
 /// below the rounding of f, a probe this far still lands across the crossing.
 const PROBE_ULPS: f64 = 4.0;
 
+/// The widest bracket, in units of the spacing of doubles at its end nearest 0, from which
+/// [`MAX_HALVINGS`] halvings surely reach adjacent doubles: 2⁵², eight halvings to spare for the
+/// rounding of the midpoints. A wider bracket (one near t = 0) is only halved, so that the answer
+/// is the bisection's there too: the bracket after 60 halvings.
+const CHORD_MAX_WIDTH: f64 = 4_503_599_627_370_496.0;
+
 /// The bracket `(lo, hi)` of adjacent doubles across which `f` changes sign, inside the bracket
 /// `[lo, hi]` given with `flo = f(lo)` and `fhi = f(hi)` of different signs. Signs are those of
 /// `f64::signum`: +0 counts as positive, −0 as negative, and a NaN as the side of `hi` (not the
@@ -28,8 +34,10 @@ const PROBE_ULPS: f64 = 4.0;
 /// over one ulp. It takes fewer evaluations of `f`: rounds of a chord's zero (regula falsi) and
 /// a probe past it shrink the bracket to 8 ulps, and halvings finish. From a step's width a
 /// bisection takes 42–50 evaluations, this 6–9 (`tests/roots.rs`). If `f` changes sign more than
-/// once in `[lo, hi]`, one of the crossings is returned. Halvings stop after 60 (a bracket within
-/// about 1e-3 s of t = 0 is then narrower than 1e-19 s but not down to adjacent doubles).
+/// once in `[lo, hi]`, one of the crossings is returned. Halvings stop after 60, as the
+/// bisection's do: from a bracket wider than 2⁵² times the spacing of doubles at its end nearest
+/// 0 (a step starting near t = 0) they may not reach adjacent doubles, and such a bracket is only
+/// halved, which gives the bisection's answer there too.
 pub fn sign_change(
     mut f: impl FnMut(f64) -> f64,
     mut lo: f64,
@@ -38,6 +46,18 @@ pub fn sign_change(
     mut fhi: f64,
 ) -> (f64, f64) {
     let sign_lo = flo.signum();
+    let nearest_zero = if lo <= 0.0 && hi >= 0.0 {
+        0.0
+    } else {
+        lo.abs().min(hi.abs())
+    };
+    // Half the spacing of doubles at `nearest_zero` is a lower bound of the spacing in [lo, hi].
+    let spacing = 0.5 * f64::EPSILON * nearest_zero;
+    let rounds = if hi - lo <= CHORD_MAX_WIDTH * spacing {
+        MAX_ROUNDS
+    } else {
+        0
+    };
     // Moves the end of [lo, hi] on t's side of the crossing to t.
     let narrow = |t: f64, ft: f64, lo: &mut f64, flo: &mut f64, hi: &mut f64, fhi: &mut f64| {
         if ft.signum() == sign_lo {
@@ -46,7 +66,7 @@ pub fn sign_change(
             (*hi, *fhi) = (t, ft);
         }
     };
-    for _ in 0..MAX_ROUNDS {
+    for _ in 0..rounds {
         let ulp = f64::EPSILON * lo.abs().max(hi.abs());
         if hi - lo <= FINISH_ULPS * ulp {
             break;

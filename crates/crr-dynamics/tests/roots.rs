@@ -139,6 +139,46 @@ fn random_monotone_crossings_are_the_bisections() {
     }
 }
 
+/// Brackets at or near t = 0, where 60 halvings of a step do not reach adjacent doubles (doubles
+/// are dense there): the answer is still the bisection's, the bracket after its 60 halvings. The
+/// first case is a run's first step from a state with a velocity, q̇ = 1e-6 − 5t on [0, 1e-3]
+/// (the bisection ends 33 ulps wide there); then 2 000 random monotone crossings on brackets of
+/// 1e-4 to 0.5 s starting at 0 or at 1e-9 to 1e-2 s.
+#[test]
+fn brackets_near_zero_are_the_bisections() {
+    let first = |t: f64| 1e-6 - 5.0 * t;
+    let (expected, _) = bisection(first, 0.0, 1e-3);
+    assert_ne!(
+        expected.0.next_up(),
+        expected.1,
+        "60 halvings reach adjacent doubles"
+    );
+    assert_eq!(located(first, 0.0, 1e-3).0, expected);
+    let mut rng = SplitMix(11);
+    for case in 0..2000 {
+        let lo = if case % 4 == 0 {
+            0.0
+        } else {
+            10f64.powf(rng.uniform(-9.0, -2.0))
+        };
+        let hi = lo + 10f64.powf(rng.uniform(-4.0, -0.3));
+        let r = lo + (hi - lo) * rng.uniform(0.001, 0.999);
+        let (c1, c3) = (rng.uniform(0.5, 2.0), rng.uniform(0.0, 50.0));
+        let sign = if case % 2 == 0 { 1.0 } else { -1.0 };
+        let f = |t: f64| {
+            let x = t - r;
+            sign * (c1 * x + c3 * x * x * x)
+        };
+        let (expected, _) = bisection(f, lo, hi);
+        let (got, _) = located(f, lo, hi);
+        assert_eq!(
+            (got.0.to_bits(), got.1.to_bits()),
+            (expected.0.to_bits(), expected.1.to_bits()),
+            "case {case}: [{lo}, {hi}] crossing at {r}"
+        );
+    }
+}
+
 /// Whatever `f` is (several crossings, a jump, zeros of either sign, NaN), the result is a
 /// bracket inside the given one whose ends differ in sign, and adjacent doubles.
 #[test]
