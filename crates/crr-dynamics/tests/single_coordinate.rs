@@ -16,6 +16,23 @@ use nalgebra::{DVector, Vector3};
 mod common;
 use common::{Tau, constant_ground};
 
+/// The random body of `seed` (`fixtures::random_chain`) when it is on a hinge; None for a rocking
+/// base (two tilt coordinates).
+fn hinged_body(seed: u64) -> Option<Model> {
+    let model = Model::from_spec(&random_chain(seed, 1, 0)).expect("valid random body");
+    (model.dof() == 1).then_some(model)
+}
+
+/// A uniform ground acceleration with random components, up to 6 m/s² horizontally and 3 m/s²
+/// vertically.
+fn random_acceleration(rng: &mut SplitMix) -> Vector3<f64> {
+    Vector3::new(
+        rng.uniform(-6.0, 6.0),
+        rng.uniform(-6.0, 6.0),
+        rng.uniform(-3.0, 3.0),
+    )
+}
+
 /// Solves at (θ, θ̇) under `ground` with `solver` (and τ when given).
 fn solve(
     model: &Model,
@@ -52,18 +69,13 @@ fn solve(
 fn closed_form_agrees_with_aba_and_cholesky_on_random_bodies() {
     let mut checked = 0;
     for seed in 0u64..400 {
-        let model = Model::from_spec(&random_chain(seed, 1, 0)).expect("valid random body");
-        if model.dof() != 1 {
-            continue; // a rocking base: two tilt coordinates
-        }
+        let Some(model) = hinged_body(seed) else {
+            continue;
+        };
         let mut rng = SplitMix(seed ^ 0x0051_C00D);
         let theta = rng.uniform(-0.6, 0.6);
         let theta_dot = rng.uniform(-3.0, 3.0);
-        let a = Vector3::new(
-            rng.uniform(-6.0, 6.0),
-            rng.uniform(-6.0, 6.0),
-            rng.uniform(-3.0, 3.0),
-        );
+        let a = random_acceleration(&mut rng);
         let ground = constant_ground(a);
         let moment = model.total_mass() * model.gravity * model.size;
         let tau = (rng.uniform(0.0, 1.0) < 0.5).then(|| moment * rng.uniform(-1.0, 1.0));
@@ -179,16 +191,11 @@ fn seated_block_takes_the_articulated_path() {
 fn seated_closed_form_agrees_with_the_general_solve() {
     let mut checked = 0;
     for seed in 0u64..100 {
-        let model = Model::from_spec(&random_chain(seed, 1, 0)).expect("valid random body");
-        if model.dof() != 1 {
+        let Some(model) = hinged_body(seed) else {
             continue;
-        }
+        };
         let mut rng = SplitMix(seed ^ 0x5EA7_ED00);
-        let ground = constant_ground(Vector3::new(
-            rng.uniform(-6.0, 6.0),
-            rng.uniform(-6.0, 6.0),
-            rng.uniform(-3.0, 3.0),
-        ));
+        let ground = constant_ground(random_acceleration(&mut rng));
         let force_scale = model.total_mass() * (model.gravity + 10.0) * model.size;
         for theta_dot in [0.0, rng.uniform(-2.0, 2.0)] {
             let (q, qdot) = (DVector::zeros(1), DVector::from_element(1, theta_dot));
@@ -239,16 +246,11 @@ fn seated_closed_form_agrees_with_the_general_solve() {
 fn integration_kernel_agrees_with_the_full_evaluation() {
     let mut checked = 0;
     for seed in 0u64..300 {
-        let model = Model::from_spec(&random_chain(seed, 1, 0)).expect("valid random body");
-        if model.dof() != 1 {
+        let Some(model) = hinged_body(seed) else {
             continue;
-        }
+        };
         let mut rng = SplitMix(seed ^ 0x00CE_EE11);
-        let ground = constant_ground(Vector3::new(
-            rng.uniform(-6.0, 6.0),
-            rng.uniform(-6.0, 6.0),
-            rng.uniform(-3.0, 3.0),
-        ));
+        let ground = constant_ground(random_acceleration(&mut rng));
         let mut kernel = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
         for _ in 0..4 {
             let theta = rng.uniform(-0.6, 0.6);

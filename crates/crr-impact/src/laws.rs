@@ -27,6 +27,7 @@ use crr_dynamics::linalg::{
     pinv_solve,
 };
 use crr_kinematics::mass_matrix::world_inertia;
+use crr_kinematics::short_copy::assign;
 use crr_kinematics::{
     ActivePivots, Data, InterfaceKind, Model, Role, constraint_jacobian, forward_kinematics,
     jacobians, mass_matrix,
@@ -144,22 +145,13 @@ pub fn slot_rate_direction(model: &Model, kin: &Data, slot: usize) -> DVector<f6
 }
 
 /// Everything an impact law needs of one dynamic chain at the impact configuration.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 struct Chain {
     /// M(q) of this chain.
     mass: DMatrix<f64>,
     /// Orthonormal basis of ker Φ_q (n × DOF(2)); None for an open chain, where it is the
     /// identity.
     null: Option<DMatrix<f64>>,
-}
-
-impl Default for Chain {
-    fn default() -> Self {
-        Self {
-            mass: DMatrix::zeros(0, 0),
-            null: None,
-        }
-    }
 }
 
 /// Evaluates the kinematics of the chain `pivots` into `kin` (forward kinematics, Jacobians, M,
@@ -185,15 +177,6 @@ fn evaluate_chain(
 /// `dst` = `src`, reusing `dst`'s storage when the shapes agree.
 fn copy_matrix(dst: &mut DMatrix<f64>, src: &DMatrix<f64>) {
     if dst.shape() == src.shape() {
-        dst.copy_from(src);
-    } else {
-        *dst = src.clone();
-    }
-}
-
-/// `dst` = `src`, reusing `dst`'s storage when the lengths agree.
-fn copy_vector(dst: &mut DVector<f64>, src: &DVector<f64>) {
-    if dst.len() == src.len() {
         dst.copy_from(src);
     } else {
         *dst = src.clone();
@@ -485,20 +468,11 @@ pub fn dirac_law(
 /// On an open chain N = I and z = q̇: the products with N are skipped (each entry of a product
 /// with I is one entry times 1 plus zeros, so the results are the same to the last bit; for n
 /// coordinates this saves the O(n³) products NᵀMN and NᵀA at every impact).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 struct Metric {
     /// N, None for the identity (an open chain).
     null: Option<DMatrix<f64>>,
     chol: DMatrix<f64>,
-}
-
-impl Default for Metric {
-    fn default() -> Self {
-        Self {
-            null: None,
-            chol: DMatrix::zeros(0, 0),
-        }
-    }
 }
 
 impl Metric {
@@ -548,7 +522,7 @@ impl Metric {
     fn w_of_momentum_into(&self, p: &DVector<f64>, w: &mut DVector<f64>) {
         match &self.null {
             Some(null) => *w = null.tr_mul(p),
-            None => copy_vector(w, p),
+            None => assign(w, p.as_slice()),
         }
         forward_substitute(&self.chol, w.as_mut_slice());
     }

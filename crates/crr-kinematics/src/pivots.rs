@@ -8,7 +8,8 @@ use crate::short_copy::copy_short;
 /// The active pivot of every angle slot (the paper's "dynamic chain"): slot k < DOF(1) is
 /// coordinate k; the slots after them are the angles of the loop closures
 /// ([`crate::Interface::slots`]). Part of the state: an angle at exactly 0 keeps its side.
-#[derive(Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// The default has no slots: an empty workspace, filled by `clone_from` before it is read.
+#[derive(Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct ActivePivots {
     /// One side per slot.
     pub sides: Vec<Side>,

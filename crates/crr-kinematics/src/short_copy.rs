@@ -4,6 +4,8 @@
 //! free-rocking block makes several for every output sample and every event evaluation. Longer
 //! slices take the library copy.
 
+use nalgebra::DVector;
+
 /// `dst.copy_from_slice(src)`, element by element up to four; panics on different lengths as it
 /// does.
 #[inline]
@@ -29,6 +31,17 @@ pub fn extend_short<T: Copy>(dst: &mut Vec<T>, src: &[T]) {
     }
 }
 
+/// `dst` = `src`, reusing `dst`'s storage when the lengths agree (a workspace vector set from a
+/// state), else reallocating it to `src`'s length.
+#[inline]
+pub fn assign(dst: &mut DVector<f64>, src: &[f64]) {
+    if dst.len() == src.len() {
+        copy_short(dst.as_mut_slice(), src);
+    } else {
+        *dst = DVector::from_column_slice(src);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -46,6 +59,16 @@ mod tests {
             let mut expected = vec![9.0];
             expected.extend_from_slice(&src);
             assert_eq!(grown, expected);
+        }
+    }
+
+    /// `assign` gives `src` whether the lengths agree (storage reused) or not.
+    #[test]
+    fn assign_gives_the_source_at_any_length() {
+        let mut dst = DVector::from_element(3, f64::NAN);
+        for src in [vec![1.0, -2.0, 3.5], vec![4.0, 5.0], vec![0.5; 6]] {
+            assign(&mut dst, &src);
+            assert_eq!(dst.as_slice(), &src[..]);
         }
     }
 

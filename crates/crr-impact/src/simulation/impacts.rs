@@ -120,7 +120,7 @@ pub(super) fn apply_law(
 /// at φ = 0 (q), the pivots before and after, the slot angles and rates (before the impact, and
 /// of the trial velocities after it), and the lists of held, wrongly moving, seating candidate
 /// and newly seated slots.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct ImpactBuffers {
     q: DVector<f64>,
     qdot: DVector<f64>,
@@ -134,39 +134,6 @@ pub(super) struct ImpactBuffers {
     wrong: Vec<usize>,
     candidates: Vec<usize>,
     pending: Vec<usize>,
-}
-
-impl Default for ImpactBuffers {
-    fn default() -> Self {
-        let (q, qdot, q_at) = (DVector::zeros(0), DVector::zeros(0), DVector::zeros(0));
-        let (before, after) = (
-            ActivePivots { sides: Vec::new() },
-            ActivePivots { sides: Vec::new() },
-        );
-        Self {
-            q,
-            qdot,
-            q_at,
-            before,
-            after,
-            angles: Vec::new(),
-            rates_before: Vec::new(),
-            rates: Vec::new(),
-            held: Vec::new(),
-            wrong: Vec::new(),
-            candidates: Vec::new(),
-            pending: Vec::new(),
-        }
-    }
-}
-
-/// `v` = `values`, reusing `v`'s storage when the lengths agree.
-fn set_vector(v: &mut DVector<f64>, values: &[f64]) {
-    if v.len() == values.len() {
-        copy_short(v.as_mut_slice(), values);
-    } else {
-        *v = DVector::from_column_slice(values);
-    }
 }
 
 impl Simulation<'_> {
@@ -200,8 +167,8 @@ impl Simulation<'_> {
             mut candidates,
             mut pending,
         } = std::mem::take(&mut self.spare.impact);
-        set_vector(&mut q, &self.y[..n]);
-        set_vector(&mut qdot, &self.y[n..2 * n]);
+        assign(&mut q, &self.y[..n]);
+        assign(&mut qdot, &self.y[n..2 * n]);
         before.clone_from(&self.dynamics.pivots);
         angles.clear();
         angles.resize(model.slot_count, 0.0);
@@ -235,7 +202,7 @@ impl Simulation<'_> {
             // (and a joint impacting with it within `simultaneity`). The laws act at φ = 0
             // exactly, where the two chains place every body identically; at the located
             // angle the pivot switch would move the bodies above by φ·|P⁺ − P⁻|.
-            set_vector(&mut q_at, q.as_slice());
+            assign(&mut q_at, q.as_slice());
             for &s in &impacting {
                 if s < n {
                     q_at[s] = 0.0;
@@ -344,10 +311,7 @@ impl Simulation<'_> {
             seated: to_seat,
         };
         // Sample just before the impact, then switch.
-        let y = std::mem::take(&mut self.y);
-        let pre = self.sample_at(t, &y);
-        self.y = y;
-        self.record_sample(pre);
+        self.record_current_sample(t);
         for &s in &record.slots {
             self.last_impact[s] = t;
         }
@@ -388,10 +352,7 @@ impl Simulation<'_> {
         // that its contact forces are those of the motion that follows (with the impact's
         // mode alone, a joint that must open at once shows a spurious tension).
         let released = self.release_if_opening();
-        let y = std::mem::take(&mut self.y);
-        let post = self.sample_at(t, &y);
-        self.y = y;
-        self.record_sample(post);
+        self.record_current_sample(t);
         released?;
         Ok(self.impacts.len() - 1)
     }

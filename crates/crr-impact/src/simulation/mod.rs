@@ -29,7 +29,7 @@ use crr_dynamics::integrator::{
 };
 use crr_dynamics::roots::sign_change;
 use crr_dynamics::{ConstrainedSystem, InitialState};
-use crr_kinematics::short_copy::{copy_short, extend_short};
+use crr_kinematics::short_copy::{assign, copy_short, extend_short};
 use crr_kinematics::spec::ImpactLaw;
 use crr_kinematics::{
     ActivePivots, Data, InterfaceKind, Model, Side, closure_angles, forward_kinematics,
@@ -303,7 +303,7 @@ pub struct Simulation<'a> {
 
 /// The buffers of one integration segment ([`Simulation::step`]): the events' state and pivots,
 /// the watched slots and the output's scratch.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 struct SegmentBuffers {
     rocking: Vec<(usize, Side)>,
     rocking_coords: Vec<usize>,
@@ -313,21 +313,6 @@ struct SegmentBuffers {
     qdot: DVector<f64>,
     y: Vec<f64>,
     peaks: Vec<Peak>,
-}
-
-impl Default for SegmentBuffers {
-    fn default() -> Self {
-        Self {
-            rocking: Vec::new(),
-            rocking_coords: Vec::new(),
-            pivots: ActivePivots { sides: Vec::new() },
-            angles: Vec::new(),
-            q: DVector::zeros(0),
-            qdot: DVector::zeros(0),
-            y: Vec::new(),
-            peaks: Vec::new(),
-        }
-    }
 }
 
 /// The buffers of the test for joints coming to rest: q, q̇, the slot angles and rates, the
@@ -625,7 +610,7 @@ impl<'a> Simulation<'a> {
                 .events_kin
                 .take()
                 .unwrap_or_else(|| Box::new(Data::new(model))),
-            pivots: std::mem::replace(&mut seg.pivots, ActivePivots { sides: Vec::new() }),
+            pivots: std::mem::take(&mut seg.pivots),
             angles: std::mem::take(&mut seg.angles),
             uplift: (!self.dynamics.seated.is_empty()).then(|| Box::new(self.dynamics.clone())),
             trial: self.take_trial(),
@@ -769,10 +754,7 @@ impl<'a> Simulation<'a> {
                 if self.t >= self.params.duration {
                     self.finished = true;
                     if self.last_sample_t < self.t {
-                        let y = std::mem::take(&mut self.y);
-                        let s = self.sample_at(self.t, &y);
-                        self.y = y;
-                        self.record_sample(s);
+                        self.record_current_sample(self.t);
                     }
                     return Ok(StopReason::End(self.t));
                 }
@@ -788,10 +770,7 @@ impl<'a> Simulation<'a> {
                         let c = self.collapse_record();
                         self.collapse = Some(c.clone());
                         self.finished = true;
-                        let y = std::mem::take(&mut self.y);
-                        let s = self.sample_at(self.t, &y);
-                        self.y = y;
-                        self.record_sample(s);
+                        self.record_current_sample(self.t);
                         Ok(StopReason::Collapse(c))
                     } else {
                         self.reset_solver();

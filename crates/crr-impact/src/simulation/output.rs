@@ -92,6 +92,14 @@ impl Simulation<'_> {
         taken
     }
 
+    /// Takes and records the sample of the current state at `t`.
+    pub(super) fn record_current_sample(&mut self, t: f64) {
+        let y = std::mem::take(&mut self.y);
+        let s = self.sample_at(t, &y);
+        self.y = y;
+        self.record_sample(s);
+    }
+
     /// Records the sample [`Self::sample_at`] has just taken (its scalars `s`, its q, q̇ and
     /// slot states from the workspace) and updates the running peaks and energy balance.
     pub(super) fn record_sample(&mut self, s: Taken) {
