@@ -17,7 +17,7 @@ use crr_impact::laws::momentum_law;
 use crr_impact::simulation::{Parameters, Simulation, StopReason};
 use crr_kinematics::{ActivePivots, Data, Model, Side};
 
-use crate::static_multiplier::{StaticMultiplier, static_multipliers};
+use crate::static_multiplier::{StaticMultiplier, horizontal_directions, static_multiplier_with};
 
 /// One line of the frequency table.
 #[derive(Clone, Debug, Serialize)]
@@ -226,8 +226,19 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
 /// Largest angle (rad) of the step along the mechanism used for the finite-mobility check.
 pub const FINITE_STEP: f64 = 0.01;
 
-/// Builds the report.
+/// Builds the report, with the static multipliers along ±x and ±y without sliding.
 pub fn check(model: &Model) -> CheckReport {
+    check_with(model, &horizontal_directions(), None)
+}
+
+/// Builds the report, with the static multipliers along `directions` (unit or not; the ground
+/// accelerating along each) and Coulomb friction μ = `friction` at the contacts (`None`: no
+/// sliding).
+pub fn check_with(
+    model: &Model,
+    directions: &[Vector3<f64>],
+    friction: Option<f64>,
+) -> CheckReport {
     let zero = DVector::zeros(model.dof());
     let mob = mobility(model, &zero, &ActivePivots::uniform(model, Side::Positive));
     let (finite, finite_note) = if model.closure_rows > 0 && !mob.locked {
@@ -260,16 +271,15 @@ pub fn check(model: &Model) -> CheckReport {
             )),
         )
     };
-    let (statics, statics_note) = if mob.locked {
-        (
-            Vec::new(),
-            Some("locked: the structure cannot move".to_string()),
-        )
-    } else {
-        match static_multipliers(model) {
-            Ok(v) => (v, None),
-            Err(e) => (Vec::new(), Some(e)),
-        }
+    // The statics run on the contact faces whatever the CRR chain's mobility: a chain locked by
+    // its hinges can still open by a block lifting off a support.
+    let statics = directions
+        .iter()
+        .map(|&d| static_multiplier_with(model, d, friction))
+        .collect::<Result<Vec<_>, _>>();
+    let (statics, statics_note) = match statics {
+        Ok(v) => (v, None),
+        Err(e) => (Vec::new(), Some(e)),
     };
     CheckReport {
         model: model.name.clone(),
@@ -345,7 +355,8 @@ pub fn to_text(r: &CheckReport) -> String {
         s += &format!("note: {note}\n");
     }
     if !r.static_multipliers.is_empty() {
-        s += "static multiplier at rest (constant ground acceleration λ g along d; the joints that open):\n";
+        s += "static multiplier at rest (constant ground acceleration λ g along d; limit analysis on the contact faces; \
+              the friction λ needs; the joints that open):\n";
         for m in &r.static_multipliers {
             let d = m.direction;
             let dir = if d == [1.0, 0.0, 0.0] {
@@ -363,7 +374,27 @@ pub fn to_text(r: &CheckReport) -> String {
                 Some(l) => {
                     let joints: Vec<String> =
                         m.opening.iter().map(|(k, v)| format!("{k} {v}")).collect();
-                    s += &format!("  d = {dir}: λ = {l:.6} opening {}\n", joints.join(", "));
+                    let friction = match m.required_friction {
+                        Some(mu) if mu.is_finite() => format!(" (μ ≥ {mu:.4})"),
+                        Some(_) => " (needs μ > 1000)".to_string(),
+                        None => String::new(),
+                    };
+                    s += &format!(
+                        "  d = {dir}: λ = {l:.6}{friction} opening {}\n",
+                        joints.join(", ")
+                    );
+                    let lifting: Vec<&str> = m
+                        .mechanism
+                        .iter()
+                        .filter(|j| j.motion == crr_impact::statics::Motion::LiftsOff)
+                        .map(|j| j.interface.as_str())
+                        .collect();
+                    if !lifting.is_empty() {
+                        s += &format!(
+                            "    lifting off: {} (a block leaves a support: outside the CRR chain, which keeps every interface on a pivot)\n",
+                            lifting.join(", ")
+                        );
+                    }
                 }
                 None => {
                     s += &format!(

@@ -140,6 +140,14 @@ enum Command {
             requires = "size_sweep",
             default_value_t = crr::size_sweep::DEFAULT_AMPLITUDE_RATIO)]
         amplitude_ratio: f64,
+        /// A direction of the ground acceleration for the static multiplier, instead of ±x and
+        /// ±y: `+x`, `-y`, … or `X,Y,Z` (may have a vertical part); repeat for several.
+        #[arg(long, value_name = "D", allow_hyphen_values = true)]
+        direction: Vec<String>,
+        /// Coulomb friction coefficient μ at every contact of the static multiplier (default: no
+        /// sliding, and the report gives the μ each multiplier needs).
+        #[arg(long, value_name = "MU")]
+        friction: Option<f64>,
     },
     /// Run every case of a study file (a pulse family's amplitude × frequency grid, or records
     /// scaled to intensity levels) in parallel into cases.csv and study.json (docs/studies.md);
@@ -329,16 +337,37 @@ fn check_models(
     plot: Option<&Path>,
     size_sweep: Option<&str>,
     amplitude_ratio: f64,
+    directions: &[String],
+    friction: Option<f64>,
 ) -> Result<(), Failure> {
     use crr::levels::{DEFAULT_STEP, mechanism_levels};
     use crr::size_sweep::{check_amplitude_ratio, parse_sweep};
     let scales = size_sweep.map(parse_sweep).transpose()?;
     let ratio = check_amplitude_ratio(amplitude_ratio)?;
+    let directions = if directions.is_empty() {
+        crr::static_multiplier::horizontal_directions()
+    } else {
+        directions
+            .iter()
+            .map(|d| crr::static_multiplier::parse_direction(d))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| Failure::Input(InputError::Argument(format!("--direction: {e}"))))?
+    };
+    if let Some(mu) = friction
+        && !(mu.is_finite() && mu >= 0.0)
+    {
+        return Err(Failure::Input(InputError::Argument(format!(
+            "--friction must be a finite number ≥ 0, got {mu}"
+        ))));
+    }
     let loaded = paths
         .iter()
         .map(|p| load_model(p))
         .collect::<Result<Vec<_>, _>>()?;
-    let reports: Vec<_> = loaded.iter().map(|(_, m)| crr::check::check(m)).collect();
+    let reports: Vec<_> = loaded
+        .iter()
+        .map(|(_, m)| crr::check::check_with(m, &directions, friction))
+        .collect();
     // The sweep needs a one-DOF mechanism; its failure is reported after the reports.
     let mut sweeps: Vec<Option<crr::size_sweep::SizeSweep>> = vec![None; reports.len()];
     let mut sweep_error = None;
@@ -722,12 +751,16 @@ fn run(cli: Cli) -> Result<(), Failure> {
             plot,
             size_sweep,
             amplitude_ratio,
+            direction,
+            friction,
         } => check_models(
             &models,
             json,
             plot.as_deref(),
             size_sweep.as_deref(),
             amplitude_ratio,
+            &direction,
+            friction,
         )?,
         Command::Study {
             action: Some(StudyAction::Merge { dirs, out }),

@@ -1,147 +1,185 @@
-//! The static (activation) multiplier of a seated structure along a horizontal direction: the
-//! smallest constant ground acceleration, as a fraction λ of g, at which the structure at rest
-//! starts to move, and the mechanism it opens in.
+//! The static (collapse) multiplier of a structure at rest along a direction of the ground
+//! acceleration: the smallest constant ground acceleration, as a fraction λ of g, at which the
+//! structure at rest cannot stay in equilibrium, with the mechanism it opens in and the friction
+//! the answer relies on.
 //!
-//! It is the engine's own uplift test ([`crr_impact::simulation::opening_mode`], the test a
-//! simulation runs at every step from a seated state), asked at rest under a constant ground
-//! acceleration a = λ g d and bisected on λ. So it applies to any structure (several mechanisms,
-//! loops, DOF(2) > 1), where the one-DOF report of `crr check` (λ = U′(0)/|Q_h(0)|) applies only
-//! to a single mechanism. With infinite friction and rigid contacts the loads that the structure
-//! carries at rest form a convex set containing 0 (the static theorem of limit analysis: a load
-//! is carried if an equilibrium with compressive contact forces exists, a convex condition), so
-//! along a ray from 0 the structure holds on [0, λ) and moves beyond: the bisection is well posed.
+//! It is the static theorem of limit analysis posed on the contact faces
+//! ([`crr_impact::statics`]): one linear program over the corner forces of every interface
+//! (compressive, no sliding), whose dual is the mechanism. Its answer is global: it does not
+//! depend on the order in which the model lists its bodies, interfaces or corners, and a
+//! mirror-symmetric structure gives equal multipliers in mirrored directions. A mechanism in
+//! which a block lifts off one of its supports (which the CRR chain does not represent) is
+//! reported as such.
 
 use std::collections::BTreeMap;
 
-use nalgebra::{DVector, Vector3};
+use nalgebra::Vector3;
 use serde::Serialize;
 
-use crr_dynamics::Dynamics;
-use crr_dynamics::ground_motion::{Axis, ComponentSpec, ConstantSpec, GroundMotion, SignalSpec};
-use crr_impact::simulation::opening_mode;
-use crr_kinematics::{ActivePivots, Model, Side};
+use crr_impact::statics::{
+    Collapse, Friction, Motion, StaticsOptions, collapse_multiplier, required_friction,
+};
+use crr_kinematics::{Model, Side};
 
-/// Largest multiplier searched (ground acceleration 10 g): a structure that holds beyond it is
-/// reported as not opening.
-pub const LAMBDA_MAX: f64 = 10.0;
+pub use crr_impact::statics::LAMBDA_MAX;
 
-/// Relative width of the final bracket of λ.
-pub const LAMBDA_RTOL: f64 = 1e-12;
+/// One interface that moves in the mechanism.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MechanismJoint {
+    /// The interface's name.
+    pub interface: String,
+    /// `rocks` (about the points in `about`) or `lifts_off` (every point separates: outside the
+    /// CRR chain).
+    pub motion: Motion,
+    /// The contact points that stay closed while it turns (m, world at rest): a hinge's pivot
+    /// line, a rocking base's corner or edge.
+    pub about: Vec<[f64; 3]>,
+    /// Relative angular velocity of the child on the parent in the mechanism (rad/s, scaled so
+    /// that the fastest body moves at unit speed).
+    pub rotation: [f64; 3],
+}
 
 /// The static multiplier along one direction of the ground acceleration.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StaticMultiplier {
-    /// Unit horizontal direction d of the ground acceleration (the inertial load on the bodies
-    /// acts along −d).
+    /// Unit direction d of the ground acceleration (the inertial load on the bodies acts along
+    /// −d).
     pub direction: [f64; 3],
-    /// λ (in g): the structure at rest holds under a = λ′ g d for every λ′ < λ and opens beyond;
+    /// λ (in g): the structure at rest holds under a = λ′ g d for every λ′ < λ and not beyond;
     /// `None` when it holds up to [`LAMBDA_MAX`].
     pub lambda: Option<f64>,
-    /// The joints that open at λ (just above it), by coordinate or slot name, with the side of
-    /// their pivot (`+` or `-`); empty when `lambda` is `None`.
+    /// The CRR angles that open at λ, by coordinate or slot name, with the side of their pivot
+    /// (`+` or `-`); empty when `lambda` is `None`.
     pub opening: BTreeMap<String, String>,
+    /// Every interface that moves in the mechanism.
+    pub mechanism: Vec<MechanismJoint>,
+    /// The smallest Coulomb friction coefficient with which λ is reached (the no-sliding answer
+    /// relies on it); `None` when `lambda` is.
+    pub required_friction: Option<f64>,
 }
 
-/// The static multiplier of `model` at rest along the horizontal unit direction `direction` (the
-/// ground accelerates along +d). Errors name what is wrong with the direction.
+impl StaticMultiplier {
+    /// Whether the mechanism lifts a block off a support (outside the CRR chain).
+    pub fn lifts_off(&self) -> bool {
+        self.mechanism.iter().any(|j| j.motion == Motion::LiftsOff)
+    }
+}
+
+/// The static multiplier of `model` at rest along the unit direction `direction` (the ground
+/// accelerates along +d; d may have a vertical part), without sliding. Errors name what is wrong
+/// with the direction or why the structure has no multiplier.
 pub fn static_multiplier(
     model: &Model,
     direction: Vector3<f64>,
 ) -> Result<StaticMultiplier, String> {
-    let norm = direction.norm();
-    if !(norm.is_finite() && norm > 0.0) {
+    static_multiplier_with(model, direction, None)
+}
+
+/// [`static_multiplier`] with Coulomb friction `friction` = μ at every contact point (a pyramid
+/// on each tangent, exact for planar loads) instead of no sliding; `required_friction` is then
+/// `None`.
+pub fn static_multiplier_with(
+    model: &Model,
+    direction: Vector3<f64>,
+    friction: Option<f64>,
+) -> Result<StaticMultiplier, String> {
+    let options = StaticsOptions {
+        friction: friction.map_or(Friction::NoSliding, Friction::Pyramid),
+        ..StaticsOptions::default()
+    };
+    let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
+    let required = match (collapse.lambda, friction) {
+        (Some(_), None) => {
+            required_friction(model, direction, options.lambda_max).map_err(|e| e.to_string())?
+        }
+        _ => None,
+    };
+    Ok(report(model, &collapse, required))
+}
+
+/// A direction of the ground acceleration from the command line: `+x`, `-x`, `+y`, `-y`, `+z`,
+/// `-z` (or without the `+`), or three numbers `X,Y,Z`, not all zero.
+pub fn parse_direction(text: &str) -> Result<Vector3<f64>, String> {
+    let named = match text.trim() {
+        "+x" | "x" => Some(Vector3::x()),
+        "-x" | "−x" => Some(-Vector3::x()),
+        "+y" | "y" => Some(Vector3::y()),
+        "-y" | "−y" => Some(-Vector3::y()),
+        "+z" | "z" => Some(Vector3::z()),
+        "-z" | "−z" => Some(-Vector3::z()),
+        _ => None,
+    };
+    if let Some(d) = named {
+        return Ok(d);
+    }
+    let parts: Vec<&str> = text.split(',').collect();
+    if parts.len() != 3 {
         return Err(format!(
-            "direction ({}, {}, {}) is not a non-zero finite vector",
-            direction.x, direction.y, direction.z
+            "'{text}' is neither ±x, ±y, ±z nor three numbers X,Y,Z"
         ));
     }
-    let d = direction / norm;
-    if d.z.abs() > 1e-12 {
-        return Err(format!(
-            "direction ({}, {}, {}) is not horizontal (z must be 0)",
-            direction.x, direction.y, direction.z
-        ));
+    let mut d = Vector3::zeros();
+    for (k, p) in parts.iter().enumerate() {
+        d[k] = p
+            .trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{}' in '{text}' is not a number", p.trim()))?;
     }
-    let n = model.dof();
-    let zero = DVector::zeros(n);
-    let mut template = Dynamics::new(model, ActivePivots::uniform(model, Side::Positive));
-    template.seated = (0..model.slot_count).collect();
-    let opens = |lambda: f64| -> Result<Option<Vec<(usize, Side)>>, String> {
-        let ground = constant_ground(d * (lambda * model.gravity))?;
-        Ok(opening_mode(model, &ground, &template, 0.0, &zero, &zero))
-    };
-    let unopened = StaticMultiplier {
-        direction: [d.x, d.y, d.z],
-        lambda: None,
-        opening: BTreeMap::new(),
-    };
-    if opens(0.0)?.is_some() {
-        return Err("the structure does not hold at rest without ground motion".into());
+    if !(d.iter().all(|x| x.is_finite()) && d.norm() > 0.0) {
+        return Err(format!("'{text}' is not a non-zero finite vector"));
     }
-    // Bracket: λ doubles from 1/64 until the structure opens.
-    let mut low = 0.0;
-    let mut high = 1.0 / 64.0;
-    let mut mode = loop {
-        if let Some(mode) = opens(high)? {
-            break mode;
-        }
-        if high >= LAMBDA_MAX {
-            return Ok(unopened);
-        }
-        low = high;
-        high = (2.0 * high).min(LAMBDA_MAX);
-    };
-    while high - low > LAMBDA_RTOL * high {
-        let mid = 0.5 * (low + high);
-        if mid <= low || mid >= high {
-            break;
-        }
-        match opens(mid)? {
-            Some(m) => {
-                high = mid;
-                mode = m;
-            }
-            None => low = mid,
-        }
-    }
-    Ok(StaticMultiplier {
-        direction: [d.x, d.y, d.z],
-        lambda: Some(high),
-        opening: mode
-            .iter()
-            .map(|&(slot, side)| {
-                (
-                    slot_name(model, slot),
-                    match side {
-                        Side::Positive => "+".to_string(),
-                        Side::Negative => "-".to_string(),
-                    },
-                )
-            })
-            .collect(),
-    })
+    Ok(d)
+}
+
+/// The four horizontal directions ±x, ±y.
+pub fn horizontal_directions() -> Vec<Vector3<f64>> {
+    vec![Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()]
 }
 
 /// The multipliers along ±x and ±y (the ground accelerating along each).
 pub fn static_multipliers(model: &Model) -> Result<Vec<StaticMultiplier>, String> {
-    [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()]
+    horizontal_directions()
         .into_iter()
         .map(|d| static_multiplier(model, d))
         .collect()
 }
 
-/// A ground motion with the constant horizontal acceleration `a` (m/s²).
-fn constant_ground(a: Vector3<f64>) -> Result<GroundMotion, String> {
-    let mut ground = GroundMotion::none();
-    for (axis, value) in [(Axis::X, a.x), (Axis::Y, a.y)] {
-        if value != 0.0 {
-            let spec = ComponentSpec::new(SignalSpec::Constant(ConstantSpec { value }));
-            ground = ground
-                .with_component(axis, &spec, std::path::Path::new("."))
-                .map_err(|e| e.to_string())?;
-        }
+/// The report of one collapse.
+fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMultiplier {
+    let moving = || {
+        collapse
+            .interfaces
+            .iter()
+            .filter(|i| i.motion != Motion::Closed)
+    };
+    let opening = moving()
+        .filter(|i| i.motion == Motion::Rocks)
+        .flat_map(|i| i.sides.iter())
+        .map(|&(slot, side)| {
+            (
+                slot_name(model, slot),
+                match side {
+                    Side::Positive => "+".to_string(),
+                    Side::Negative => "-".to_string(),
+                },
+            )
+        })
+        .collect();
+    let mechanism = moving()
+        .map(|i| MechanismJoint {
+            interface: i.name.clone(),
+            motion: i.motion.clone(),
+            about: i.pivots.iter().map(|&p| i.forces[p].point).collect(),
+            rotation: i.rotation,
+        })
+        .collect();
+    StaticMultiplier {
+        direction: collapse.direction,
+        lambda: collapse.lambda,
+        opening,
+        mechanism,
+        required_friction: friction,
     }
-    Ok(ground)
 }
 
 /// The name of a pivot slot: its interface's name, with `.1`/`.2` for the tilts of a rocking base

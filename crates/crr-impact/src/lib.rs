@@ -9,6 +9,8 @@
 //!   ones in loops), seating in the Zeno limit, uplift from rest, collapse, and the trajectory with
 //!   its impact log and energy balance.
 //! - [`monitor`]: the hypotheses monitor (compressive contacts, friction demand).
+//! - [`statics`]: the collapse multiplier at rest by the static theorem, one linear program on
+//!   the contact faces, and its mechanism.
 //!
 //! ## Example: Housner's block released from half its slenderness
 //!
@@ -43,6 +45,7 @@ pub mod laws;
 pub mod monitor;
 pub mod nnls;
 pub mod simulation;
+pub mod statics;
 
 pub use simulation::{
     Interrupted, Parameters, Sample, Samples, Simulation, SimulationError, SlotState, StopReason,

@@ -32,6 +32,7 @@
 //! ```
 
 pub mod closure;
+pub mod contact_face;
 pub mod data;
 pub mod error;
 pub mod fixtures;
@@ -50,6 +51,7 @@ pub mod velocity;
 pub use closure::{
     closure_angles, constraint_jacobian, constraint_residual, interface_angles, relative_angles,
 };
+pub use contact_face::{ContactFace, contact_faces};
 pub use data::Data;
 pub use error::ModelError;
 pub use gamma::mass_matrix_gamma;

@@ -1,0 +1,619 @@
+//! The collapse multiplier of a structure at rest by the static theorem of limit analysis, posed
+//! on the contact faces as one linear (or second-order cone) program with one global answer.
+//!
+//! **Load.** Gravity g (along −z) plus a constant ground acceleration λ g d: in the frame of the
+//! ground every body n carries its weight Mⁿg and the inertial load −λ Mⁿ g d at its centre of
+//! mass. d is any unit direction (horizontal, or with a vertical part).
+//!
+//! **Statics.** Every interface's contact face ([`crr_kinematics::ContactFace`]) carries at each
+//! contact point a force f = fₙn + f₁t₁ + f₂t₂ from the parent on the child, with fₙ ≥ 0 (no
+//! tension); a hinge also carries the couples out of its plane (it is a line). Friction is
+//! either unlimited (no sliding, the CRR hypothesis), a pyramid |f_k| ≤ μfₙ on each tangent, or
+//! the exact cone ‖(f₁, f₂)‖ ≤ μfₙ. The static theorem (Heyman 1966; Livesley 1978 for blocks):
+//! the structure holds under λ if an equilibrium of every body with admissible contact forces
+//! exists. The admissible (f, λ) form a convex set, so the collapse multiplier
+//!
+//!   λ_c = max λ subject to  equilibrium of every body,  fₙ ≥ 0,  friction,
+//!
+//! is a linear program (a second-order cone program with the exact cone), solved by the interior
+//! point method of `clarabel` (Goulart & Chen 2024). Its answer does not depend on the order of
+//! the bodies, the interfaces or the corners of a face, and mirror-symmetric structures give the
+//! same λ in mirrored directions.
+//!
+//! **Mechanism.** The dual variables of the equilibrium rows are a virtual velocity (v, ω) of
+//! every body (the kinematic theorem): at every contact point the gap rate n·(v_child − v_parent)
+//! is ≥ 0 and vanishes where the point carries a force, no point slides where friction is
+//! unlimited, and the load's virtual power is positive. An interface whose points all keep
+//! contact is closed; one that keeps some points rocks about them (its pivot sides are the signs
+//! of the relative rotation about its axes, the CRR chain's sides); one that keeps none lifts off,
+//! which the CRR chain does not represent.
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+use crr_kinematics::{ContactFace, Model, Parent, Side, contact_faces};
+
+/// Largest multiplier sought by default (a ground acceleration of 10 g): a structure that holds
+/// beyond it is reported as holding.
+pub const LAMBDA_MAX: f64 = 10.0;
+
+/// Relative size below which a gap rate, slip rate or relative rotation of the mechanism counts
+/// as zero (against the mechanism's largest).
+pub const MECHANISM_TOLERANCE: f64 = 1e-6;
+
+/// Friction at the contact points.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum Friction {
+    /// No sliding at any load (the CRR hypothesis: the tangential forces are unlimited).
+    NoSliding,
+    /// Coulomb friction μ as a pyramid: |f_k| ≤ μ fₙ on each tangent (exact for planar loads).
+    Pyramid(f64),
+    /// Coulomb friction μ as the exact cone ‖(f₁, f₂)‖ ≤ μ fₙ.
+    Cone(f64),
+}
+
+/// Options of [`collapse_multiplier`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StaticsOptions {
+    /// Friction at the contact points.
+    pub friction: Friction,
+    /// The multiplier beyond which the structure is reported as holding.
+    pub lambda_max: f64,
+}
+
+impl Default for StaticsOptions {
+    fn default() -> Self {
+        StaticsOptions {
+            friction: Friction::NoSliding,
+            lambda_max: LAMBDA_MAX,
+        }
+    }
+}
+
+/// What is wrong with a statics question.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StaticsError {
+    /// The load direction is not a non-zero finite vector.
+    #[error("direction ({0}, {1}, {2}) is not a non-zero finite vector")]
+    Direction(f64, f64, f64),
+    /// A friction coefficient that is negative or not finite.
+    #[error("friction coefficient {0} is not a finite number ≥ 0")]
+    Friction(f64),
+    /// The structure has no admissible equilibrium under gravity alone.
+    #[error(
+        "the structure does not hold at rest without ground motion (no equilibrium with compressive contacts{0})"
+    )]
+    DoesNotHold(String),
+    /// The solver did not reach an answer.
+    #[error("the linear program of the statics did not solve: {0}")]
+    Solver(String),
+}
+
+/// The force of one contact point (N, from the parent on the child).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PointForce {
+    /// The point (m, world at rest).
+    pub point: [f64; 3],
+    /// Normal force fₙ (compression positive; a pin's component along its face's n).
+    pub normal: f64,
+    /// Tangential components (f₁, f₂) along the face's tangents.
+    pub tangential: [f64; 2],
+}
+
+/// How an interface moves in the mechanism.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Motion {
+    /// Every contact point keeps contact and nothing slides.
+    Closed,
+    /// It rocks about the points that keep contact.
+    Rocks,
+    /// Every contact point separates: the child lifts off the parent (outside the CRR chain).
+    LiftsOff,
+}
+
+/// One interface in the collapse: its forces at λ_c and its motion in the mechanism.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct InterfaceCollapse {
+    /// Index into [`Model::interfaces`].
+    pub interface: usize,
+    /// The interface's name.
+    pub name: String,
+    /// Contact forces at λ_c (N).
+    pub forces: Vec<PointForce>,
+    /// How it moves.
+    pub motion: Motion,
+    /// The pivot side of each of its angles that opens (by slot index), from the sign of the
+    /// relative rotation about the angle's axis; angles that do not turn are absent.
+    pub sides: Vec<(usize, Side)>,
+    /// Indices (into the face's points) of the points that keep contact while it moves.
+    pub pivots: Vec<usize>,
+    /// Gap rates n·(v_child − v_parent) of the face's points in the mechanism.
+    pub gap_rates: Vec<f64>,
+    /// Largest tangential slip rate of its points (0 without sliding).
+    pub slip_rate: f64,
+    /// Relative angular velocity ω_child − ω_parent in the mechanism (rad/s at unit scale).
+    pub rotation: [f64; 3],
+}
+
+/// The virtual velocity of one body in the mechanism (at its centre of mass).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BodyMotion {
+    /// Velocity of the centre of mass.
+    pub velocity: [f64; 3],
+    /// Angular velocity.
+    pub angular: [f64; 3],
+}
+
+/// The answer of [`collapse_multiplier`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Collapse {
+    /// Unit direction d of the ground acceleration.
+    pub direction: [f64; 3],
+    /// λ_c (in g), `None` when the structure holds up to the options' `lambda_max`.
+    pub lambda: Option<f64>,
+    /// Per interface, in the model's order: forces at λ_c (at `lambda_max` when it holds) and
+    /// motion in the mechanism (all closed when it holds).
+    pub interfaces: Vec<InterfaceCollapse>,
+    /// Virtual velocities of the bodies in the mechanism, scaled so that the largest of |v| and
+    /// size·|ω| over the bodies is 1 (all zero when it holds).
+    pub bodies: Vec<BodyMotion>,
+}
+
+impl Collapse {
+    /// The interfaces that lift off in the mechanism.
+    pub fn lifting_off(&self) -> impl Iterator<Item = &InterfaceCollapse> {
+        self.interfaces
+            .iter()
+            .filter(|i| i.motion == Motion::LiftsOff)
+    }
+}
+
+/// The collapse multiplier of `model` at rest under gravity plus a constant ground acceleration
+/// λ g `direction` (see the module's docs).
+pub fn collapse_multiplier(
+    model: &Model,
+    direction: Vector3<f64>,
+    options: &StaticsOptions,
+) -> Result<Collapse, StaticsError> {
+    let norm = direction.norm();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(StaticsError::Direction(
+            direction.x,
+            direction.y,
+            direction.z,
+        ));
+    }
+    if let Friction::Pyramid(mu) | Friction::Cone(mu) = options.friction
+        && !(mu.is_finite() && mu >= 0.0)
+    {
+        return Err(StaticsError::Friction(mu));
+    }
+    let d = direction / norm;
+    let faces = contact_faces(model);
+    let program = Program::build(model, &faces, d, options);
+    let solution = program.solve()?;
+    let lambda = solution.x[0];
+    if lambda < -1e-9 {
+        return Err(StaticsError::DoesNotHold(format!(
+            ": it would need a ground acceleration of {:.6} g along ({}, {}, {})",
+            -lambda, -d.x, -d.y, -d.z
+        )));
+    }
+    Ok(program.collapse(model, &faces, d, options, &solution))
+}
+
+/// The smallest Coulomb friction coefficient (pyramid on each tangent, exact for planar loads)
+/// at which the collapse multiplier along `direction` reaches (1 − 1e-6) of its value without
+/// sliding: the friction the no-sliding answer relies on. `None` when the structure holds up to
+/// `lambda_max` without sliding; 0 when it needs none.
+pub fn required_friction(
+    model: &Model,
+    direction: Vector3<f64>,
+    lambda_max: f64,
+) -> Result<Option<f64>, StaticsError> {
+    let no_sliding = StaticsOptions {
+        friction: Friction::NoSliding,
+        lambda_max,
+    };
+    let Some(target) = collapse_multiplier(model, direction, &no_sliding)?.lambda else {
+        return Ok(None);
+    };
+    let target = target - 1e-6 * target.abs();
+    let reaches = |mu: f64| -> Result<bool, StaticsError> {
+        let options = StaticsOptions {
+            friction: Friction::Pyramid(mu),
+            lambda_max,
+        };
+        match collapse_multiplier(model, direction, &options) {
+            Ok(c) => Ok(c.lambda.is_none_or(|l| l >= target)),
+            Err(StaticsError::DoesNotHold(_)) => Ok(false),
+            Err(e) => Err(e),
+        }
+    };
+    if reaches(0.0)? {
+        return Ok(Some(0.0));
+    }
+    let mut low = 0.0;
+    let mut high = 0.25;
+    while !reaches(high)? {
+        low = high;
+        high *= 2.0;
+        if high > 1e3 {
+            return Ok(Some(f64::INFINITY));
+        }
+    }
+    // μ to four significant digits.
+    while high - low > 1e-4 * high {
+        let mid = 0.5 * (low + high);
+        if reaches(mid)? {
+            high = mid;
+        } else {
+            low = mid;
+        }
+    }
+    Ok(Some(high))
+}
+
+/// The multipliers along ±x and ±y without sliding.
+pub fn horizontal_multipliers(model: &Model) -> Result<Vec<Collapse>, StaticsError> {
+    [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()]
+        .into_iter()
+        .map(|d| collapse_multiplier(model, d, &StaticsOptions::default()))
+        .collect()
+}
+
+/// What a variable of the program is: a force or a couple at an interface.
+#[derive(Clone, Copy, Debug)]
+struct Unknown {
+    /// Interface index.
+    interface: usize,
+    /// Point index within the face (couples: none).
+    point: Option<usize>,
+    /// Its direction (world).
+    direction: Vector3<f64>,
+}
+
+/// The linear (conic) program: min −λ s.t. A x + s = b, s ∈ K.
+struct Program {
+    /// Columns 1.. (column 0 is λ).
+    unknowns: Vec<Unknown>,
+    /// Per interface, per point, the columns of (fₙ, f₁, f₂).
+    point_columns: Vec<Vec<[usize; 3]>>,
+    rows: usize,
+    triplets: (Vec<usize>, Vec<usize>, Vec<f64>),
+    b: Vec<f64>,
+    cones: Vec<SupportedConeT<f64>>,
+    /// Forces are in units of the total weight W; moments in W·size.
+    weight: f64,
+}
+
+impl Program {
+    fn build(
+        model: &Model,
+        faces: &[ContactFace],
+        d: Vector3<f64>,
+        options: &StaticsOptions,
+    ) -> Program {
+        let mut unknowns = Vec::new();
+        let mut point_columns = Vec::with_capacity(faces.len());
+        for face in faces {
+            let mut columns = Vec::with_capacity(face.points.len());
+            for p in 0..face.points.len() {
+                let mut triple = [0; 3];
+                for (k, direction) in [face.normal, face.tangents[0], face.tangents[1]]
+                    .into_iter()
+                    .enumerate()
+                {
+                    triple[k] = 1 + unknowns.len();
+                    unknowns.push(Unknown {
+                        interface: face.interface,
+                        point: Some(p),
+                        direction,
+                    });
+                }
+                columns.push(triple);
+            }
+            for &direction in &face.bilateral_couples {
+                unknowns.push(Unknown {
+                    interface: face.interface,
+                    point: None,
+                    direction,
+                });
+            }
+            point_columns.push(columns);
+        }
+        let total_mass: f64 = model.bodies.iter().map(|b| b.mass).sum();
+        let weight = total_mass * model.gravity;
+        let size = model.size;
+        let mut program = Program {
+            unknowns,
+            point_columns,
+            rows: 0,
+            triplets: (Vec::new(), Vec::new(), Vec::new()),
+            b: Vec::new(),
+            cones: Vec::new(),
+            weight,
+        };
+        program.equilibrium_rows(model, faces, d, total_mass, size);
+        program.inequality_rows(faces, options);
+        program
+    }
+
+    fn push(&mut self, row: usize, column: usize, value: f64) {
+        if value != 0.0 {
+            self.triplets.0.push(row);
+            self.triplets.1.push(column);
+            self.triplets.2.push(value);
+        }
+    }
+
+    /// Six rows per body: Σ forces + weight − λ·load = 0, Σ moments about the centre of mass /
+    /// size = 0 (the zero cone).
+    fn equilibrium_rows(
+        &mut self,
+        model: &Model,
+        faces: &[ContactFace],
+        d: Vector3<f64>,
+        total_mass: f64,
+        size: f64,
+    ) {
+        let bodies = model.bodies.len();
+        let first = self.rows;
+        for (column, u) in self.unknowns.clone().into_iter().enumerate() {
+            let column = column + 1;
+            let interface = &model.interfaces[u.interface];
+            let face = &faces[u.interface];
+            let add = |body: usize, sign: f64, program: &mut Program| {
+                let row = first + 6 * body;
+                let com = model.bodies[body].com;
+                match u.point {
+                    Some(p) => {
+                        let arm = (face.points[p] - com).cross(&u.direction) / size;
+                        for k in 0..3 {
+                            program.push(row + k, column, sign * u.direction[k]);
+                            program.push(row + 3 + k, column, sign * arm[k]);
+                        }
+                    }
+                    None => {
+                        for k in 0..3 {
+                            program.push(row + 3 + k, column, sign * u.direction[k] / size);
+                        }
+                    }
+                }
+            };
+            add(interface.child, 1.0, self);
+            if let Parent::Body(parent) = interface.parent {
+                add(parent, -1.0, self);
+            }
+        }
+        self.b.resize(first + 6 * bodies, 0.0);
+        for (n, body) in model.bodies.iter().enumerate() {
+            let share = body.mass / total_mass;
+            for k in 0..3 {
+                // −λ·share·d on the left; the weight share·(−z) moves to the right.
+                self.push(first + 6 * n + k, 0, -share * d[k]);
+            }
+            self.b[first + 6 * n + 2] = share;
+        }
+        self.rows = first + 6 * bodies;
+        self.cones.push(SupportedConeT::ZeroConeT(6 * bodies));
+    }
+
+    /// No tension, λ ≤ λ_max, friction.
+    fn inequality_rows(&mut self, faces: &[ContactFace], options: &StaticsOptions) {
+        let first = self.rows;
+        let mut row = first;
+        let mut cone_rows = Vec::new();
+        for (face, columns) in faces.iter().zip(self.point_columns.clone()) {
+            if face.pin {
+                continue;
+            }
+            for [normal, t1, t2] in columns {
+                self.push(row, normal, -1.0);
+                row += 1;
+                let tangents = [t1, t2];
+                match options.friction {
+                    Friction::NoSliding => {}
+                    Friction::Cone(mu) if face.friction_tangents == 2 => {
+                        cone_rows.push((normal, t1, t2, mu));
+                    }
+                    Friction::Pyramid(mu) | Friction::Cone(mu) => {
+                        for &t in &tangents[..face.friction_tangents] {
+                            for sign in [1.0, -1.0] {
+                                self.push(row, t, sign);
+                                self.push(row, normal, -mu);
+                                row += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self.push(row, 0, 1.0);
+        row += 1;
+        self.b.resize(row, 0.0);
+        self.b[row - 1] = options.lambda_max;
+        self.cones
+            .push(SupportedConeT::NonnegativeConeT(row - first));
+        for (normal, t1, t2, mu) in cone_rows {
+            self.push(row, normal, -mu);
+            self.push(row + 1, t1, -1.0);
+            self.push(row + 2, t2, -1.0);
+            row += 3;
+            self.cones.push(SupportedConeT::SecondOrderConeT(3));
+        }
+        self.b.resize(row, 0.0);
+        self.rows = row;
+    }
+
+    fn solve(&self) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
+        let n = 1 + self.unknowns.len();
+        let p = CscMatrix::zeros((n, n));
+        let mut q = vec![0.0; n];
+        q[0] = -1.0;
+        let a = CscMatrix::new_from_triplets(
+            self.rows,
+            n,
+            self.triplets.0.clone(),
+            self.triplets.1.clone(),
+            self.triplets.2.clone(),
+        );
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .tol_gap_abs(1e-12)
+            .tol_gap_rel(1e-12)
+            .tol_feas(1e-12)
+            .tol_ktratio(1e-10)
+            .max_iter(400)
+            .build()
+            .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
+        let mut solver = DefaultSolver::new(&p, &q, &a, &self.b, &self.cones, settings)
+            .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
+        solver.solve();
+        let solution = solver.solution;
+        match solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(solution),
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                Err(StaticsError::DoesNotHold(String::new()))
+            }
+            other => Err(StaticsError::Solver(format!("{other:?}"))),
+        }
+    }
+
+    fn collapse(
+        &self,
+        model: &Model,
+        faces: &[ContactFace],
+        d: Vector3<f64>,
+        options: &StaticsOptions,
+        solution: &clarabel::solver::DefaultSolution<f64>,
+    ) -> Collapse {
+        let lambda = solution.x[0];
+        let holds = lambda >= options.lambda_max * (1.0 - 1e-9);
+        let size = model.size;
+        // Virtual velocities: the duals of the equilibrium rows (forces → v, moments → size·ω).
+        let mut bodies: Vec<(Vector3<f64>, Vector3<f64>)> = (0..model.bodies.len())
+            .map(|n| {
+                let z = &solution.z[6 * n..6 * n + 6];
+                (
+                    Vector3::new(z[0], z[1], z[2]),
+                    Vector3::new(z[3], z[4], z[5]) / size,
+                )
+            })
+            .collect();
+        let scale = bodies
+            .iter()
+            .map(|(v, w)| v.norm().max(size * w.norm()))
+            .fold(0.0, f64::max);
+        for (v, w) in &mut bodies {
+            if holds || scale == 0.0 {
+                *v = Vector3::zeros();
+                *w = Vector3::zeros();
+            } else {
+                *v /= scale;
+                *w /= scale;
+            }
+        }
+        let point_velocity = |parent: Parent, x: &Vector3<f64>| match parent {
+            Parent::Ground => Vector3::zeros(),
+            Parent::Body(n) => {
+                let (v, w) = &bodies[n];
+                v + w.cross(&(x - model.bodies[n].com))
+            }
+        };
+        let interfaces = faces
+            .iter()
+            .map(|face| {
+                let interface = &model.interfaces[face.interface];
+                let forces = self.point_columns[face.interface]
+                    .iter()
+                    .zip(&face.points)
+                    .map(|(&[n, t1, t2], x)| PointForce {
+                        point: [x.x, x.y, x.z],
+                        normal: self.weight * solution.x[n],
+                        tangential: [self.weight * solution.x[t1], self.weight * solution.x[t2]],
+                    })
+                    .collect();
+                let mut gap_rates = Vec::with_capacity(face.points.len());
+                let mut slip_rate: f64 = 0.0;
+                for x in &face.points {
+                    let relative = point_velocity(Parent::Body(interface.child), x)
+                        - point_velocity(interface.parent, x);
+                    gap_rates.push(face.normal.dot(&relative));
+                    let slip = face.tangents[..face.friction_tangents]
+                        .iter()
+                        .map(|t| t.dot(&relative).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    slip_rate = slip_rate.max(slip);
+                }
+                let parent_angular = match interface.parent {
+                    Parent::Ground => Vector3::zeros(),
+                    Parent::Body(n) => bodies[n].1,
+                };
+                let rotation = bodies[interface.child].1 - parent_angular;
+                let measure = gap_rates
+                    .iter()
+                    .map(|g| g.abs())
+                    .fold(size * rotation.norm(), f64::max)
+                    .max(slip_rate);
+                let zero = MECHANISM_TOLERANCE;
+                let pivots: Vec<usize> = (0..face.points.len())
+                    .filter(|&p| gap_rates[p] <= zero)
+                    .collect();
+                let motion = if measure <= zero {
+                    Motion::Closed
+                } else if pivots.is_empty() && !face.pin {
+                    Motion::LiftsOff
+                } else {
+                    Motion::Rocks
+                };
+                let sides = if motion == Motion::Closed {
+                    Vec::new()
+                } else {
+                    interface
+                        .slots
+                        .clone()
+                        .enumerate()
+                        .filter_map(|(component, slot)| {
+                            let turn = rotation.dot(&interface.kind.axis(component));
+                            let side = if turn > 0.0 {
+                                Side::Positive
+                            } else {
+                                Side::Negative
+                            };
+                            (size * turn.abs() > zero).then_some((slot, side))
+                        })
+                        .collect()
+                };
+                InterfaceCollapse {
+                    interface: face.interface,
+                    name: interface.name.clone(),
+                    forces,
+                    motion,
+                    sides,
+                    pivots: if measure <= zero { Vec::new() } else { pivots },
+                    gap_rates,
+                    slip_rate,
+                    rotation: [rotation.x, rotation.y, rotation.z],
+                }
+            })
+            .collect();
+        Collapse {
+            direction: [d.x, d.y, d.z],
+            lambda: (!holds).then_some(lambda),
+            interfaces,
+            bodies: bodies
+                .iter()
+                .map(|(v, w)| BodyMotion {
+                    velocity: [v.x, v.y, v.z],
+                    angular: [w.x, w.y, w.z],
+                })
+                .collect(),
+        }
+    }
+}
