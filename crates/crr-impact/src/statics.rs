@@ -617,3 +617,91 @@ impl Program {
         }
     }
 }
+
+/// The global test of a structure at rest with every joint seated: does it hold under a ground
+/// acceleration a? The loads a structure at rest carries form a convex set containing 0 (static
+/// theorem), so it holds under a iff |a| < λ_c(a/|a|)·g. The multipliers along ±x, ±y, ±z are
+/// computed once; a load inside their convex hull (the octahedron Σ|a_k|/(λ_k g) < 1) holds
+/// without a program; outside it, the program runs along a's direction (its answers kept by
+/// direction, so that a constant load or a one-component record costs one program per sense).
+#[derive(Clone, Debug, Default)]
+pub struct RestStatics {
+    /// λ along +x, −x, +y, −y, +z, −z (capped at [`LAMBDA_MAX`]); `None` until first asked.
+    axes: Option<[f64; 6]>,
+    /// Answers along directions asked before (exact bits of the unit direction).
+    by_direction: Vec<([u64; 3], Collapse)>,
+}
+
+/// Most directions a [`RestStatics`] keeps.
+const REST_DIRECTIONS: usize = 64;
+
+impl RestStatics {
+    /// `None` when the structure at rest holds under the ground acceleration `a` (m/s²), else
+    /// the collapse along a's direction (its mechanism says which joints open, to which side,
+    /// and whether a block lifts off). A load exceeds the multiplier only beyond λ_c(1 + 1e-9):
+    /// at the threshold itself the dynamics' own test decides.
+    pub fn exceeded(
+        &mut self,
+        model: &Model,
+        a: &Vector3<f64>,
+    ) -> Result<Option<&Collapse>, StaticsError> {
+        let g = model.gravity;
+        let magnitude = a.norm();
+        if magnitude == 0.0 || !magnitude.is_finite() {
+            return Ok(None);
+        }
+        let axes = match self.axes {
+            Some(axes) => axes,
+            None => {
+                let mut axes = [LAMBDA_MAX; 6];
+                for (k, d) in [
+                    Vector3::x(),
+                    -Vector3::x(),
+                    Vector3::y(),
+                    -Vector3::y(),
+                    Vector3::z(),
+                    -Vector3::z(),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let c = collapse_multiplier(model, d, &StaticsOptions::default())?;
+                    axes[k] = c.lambda.unwrap_or(LAMBDA_MAX);
+                }
+                self.axes = Some(axes);
+                axes
+            }
+        };
+        let hull: f64 = (0..3)
+            .map(|k| {
+                let lambda = if a[k] >= 0.0 {
+                    axes[2 * k]
+                } else {
+                    axes[2 * k + 1]
+                };
+                a[k].abs() / (lambda * g)
+            })
+            .sum();
+        if hull < 1.0 {
+            return Ok(None);
+        }
+        let d = a / magnitude;
+        let key = [d.x.to_bits(), d.y.to_bits(), d.z.to_bits()];
+        let index = match self.by_direction.iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                let c = collapse_multiplier(model, d, &StaticsOptions::default())?;
+                if self.by_direction.len() >= REST_DIRECTIONS {
+                    self.by_direction.remove(0);
+                }
+                self.by_direction.push((key, c));
+                self.by_direction.len() - 1
+            }
+        };
+        let collapse = &self.by_direction[index].1;
+        Ok(match collapse.lambda {
+            Some(l) if magnitude > l * g * (1.0 + 1e-9) => Some(collapse),
+            _ => None,
+        })
+    }
+}

@@ -699,3 +699,333 @@ pub fn forest(parts: &[StructureSpec], spacing: f64) -> StructureSpec {
     }
     out
 }
+
+/// Density of the masonry fixtures below ([`voussoir_arch`], [`stacked_panel`],
+/// [`running_bond_wall`], [`running_bond_wall_3d`]) (kg/m³).
+pub const MASONRY_DENSITY: f64 = 2000.0;
+
+/// A semicircular arch of `n` voussoirs of equal angle π/n: annular sectors of radii `r_in`,
+/// `r_out` and depth `depth` along y, centred on the origin in the x–z plane (the convention of
+/// `examples/models/arch.toml`: axis −y, angle 0 along +x, so angle β is the point
+/// (r cos β, 0, r sin β)), springings on z = 0 at x = ±r. Voussoir `v{k}` (k = 1 … n) spans
+/// [(k − 1)π/n, kπ/n]. Every radial joint is a hinge about +y that pivots on its extrados or its
+/// intrados: `springing_right` (ground → `v1`, at 0), `joint_{j}` (`v{j}` → `v{j+1}`, at jπ/n) and
+/// `springing_left` (ground → `v{n}`, at π). The child is the voussoir of larger index (or the
+/// arch above the ground at a springing), and P⁺, P⁻ are chosen so that the face normal
+/// n = u × (P⁻ − P⁺)/|…| points into it: P⁺ the extrados and P⁻ the intrados at the springing
+/// at 0 and at the inner joints (n the direction of increasing angle), P⁺ the intrados and P⁻ the
+/// extrados at the springing at π (n = +z). Density [`MASONRY_DENSITY`].
+pub fn voussoir_arch(n: usize, r_in: f64, r_out: f64, depth: f64) -> StructureSpec {
+    assert!(n >= 1, "an arch needs at least one voussoir");
+    let step = std::f64::consts::PI / n as f64;
+    let body: Vec<BodySpec> = (0..n)
+        .map(|k| BodySpec {
+            name: format!("v{}", k + 1),
+            density: Some(MASONRY_DENSITY),
+            mass: None,
+            box_shape: None,
+            polyhedron: None,
+            prism: None,
+            annular_sector: Some(AnnularSectorShape {
+                center: [0.0, 0.0, 0.0],
+                axis: [0.0, -1.0, 0.0],
+                inner_radius: r_in,
+                outer_radius: r_out,
+                start: [1.0, 0.0, 0.0],
+                from_angle: step * k as f64,
+                to_angle: if k + 1 == n {
+                    std::f64::consts::PI
+                } else {
+                    step * (k + 1) as f64
+                },
+                thickness: depth,
+            }),
+        })
+        .collect();
+    // The point at radius r on the joint j (angle jπ/n, exact at the springings).
+    let at = |j: usize, r: f64| -> [f64; 3] {
+        if j == 0 {
+            [r, 0.0, 0.0]
+        } else if j == n {
+            [-r, 0.0, 0.0]
+        } else {
+            let beta = step * j as f64;
+            [r * beta.cos(), 0.0, r * beta.sin()]
+        }
+    };
+    let y = [0.0, 1.0, 0.0];
+    let mut interface = Vec::with_capacity(n + 1);
+    interface.push(hinge(
+        "springing_right",
+        "ground",
+        "v1",
+        y,
+        at(0, r_out),
+        at(0, r_in),
+    ));
+    for j in 1..n {
+        interface.push(hinge(
+            &format!("joint_{j}"),
+            &format!("v{j}"),
+            &format!("v{}", j + 1),
+            y,
+            at(j, r_out),
+            at(j, r_in),
+        ));
+    }
+    interface.push(hinge(
+        "springing_left",
+        "ground",
+        &format!("v{n}"),
+        y,
+        at(n, r_in),
+        at(n, r_out),
+    ));
+    StructureSpec {
+        name: format!("voussoir_arch_{n}"),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+        symmetry: Vec::new(),
+    }
+}
+
+/// A panel of half-width `b` (x), total height `2h` and depth `depth` (y) standing on the ground
+/// at z = 0, cut into `courses` equal courses `course{k}` (k = 0 from the bottom). Each course
+/// rests on the one below (the bottom one on the ground) by a hinge `bed{k}` about +y with
+/// P⁺ = (b, 0, z) and P⁻ = (−b, 0, z), the two bottom edges (face normal +z). With one course it
+/// is a single block on the ground. Density [`MASONRY_DENSITY`].
+pub fn stacked_panel(courses: usize, b: f64, h: f64, depth: f64) -> StructureSpec {
+    assert!(courses >= 1, "a panel needs at least one course");
+    let hc = 2.0 * h / courses as f64;
+    let mut body = Vec::with_capacity(courses);
+    let mut interface = Vec::with_capacity(courses);
+    for k in 0..courses {
+        let z = hc * k as f64;
+        body.push(box_body(
+            &format!("course{k}"),
+            MASONRY_DENSITY,
+            [0.0, 0.0, z + hc / 2.0],
+            [2.0 * b, depth, hc],
+        ));
+        let parent = if k == 0 {
+            "ground".to_string()
+        } else {
+            format!("course{}", k - 1)
+        };
+        interface.push(hinge(
+            &format!("bed{k}"),
+            &parent,
+            &format!("course{k}"),
+            [0.0, 1.0, 0.0],
+            [b, 0.0, z],
+            [-b, 0.0, z],
+        ));
+    }
+    StructureSpec {
+        name: format!("stacked_panel_{courses}"),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+        symmetry: Vec::new(),
+    }
+}
+
+/// One block of a running-bond wall: its name and its extent along x and z.
+struct WallBlock {
+    name: String,
+    x: [f64; 2],
+    z: [f64; 2],
+}
+
+/// One bed-joint contact of a running-bond wall: the block below (`None`: the ground), the block
+/// above, and the overlap segment [x₀, x₁] at height z.
+struct BedContact {
+    below: Option<usize>,
+    above: usize,
+    x: [f64; 2],
+    z: f64,
+}
+
+/// The blocks and bed-joint contacts of [`running_bond_wall`].
+fn running_bond_layout(
+    courses: usize,
+    blocks: usize,
+    block_length: f64,
+    block_height: f64,
+) -> (Vec<WallBlock>, Vec<BedContact>) {
+    assert!(
+        courses >= 1 && blocks >= 1,
+        "a wall needs a course and a block"
+    );
+    let half_total = blocks as f64 * block_length / 2.0;
+    let mut list: Vec<WallBlock> = Vec::new();
+    let mut by_course: Vec<Vec<usize>> = Vec::with_capacity(courses);
+    for c in 0..courses {
+        // Block ends along the course, from −L_tot/2 to +L_tot/2.
+        let ends: Vec<f64> = if c % 2 == 0 {
+            (0..=blocks)
+                .map(|i| -half_total + block_length * i as f64)
+                .collect()
+        } else {
+            let mut e = vec![-half_total];
+            e.extend((0..blocks).map(|i| -half_total + block_length * (i as f64 + 0.5)));
+            e.push(half_total);
+            e
+        };
+        let z0 = block_height * c as f64;
+        let mut row = Vec::new();
+        for (i, w) in ends.windows(2).enumerate() {
+            row.push(list.len());
+            list.push(WallBlock {
+                name: format!("c{c}_b{i}"),
+                x: [w[0], w[1]],
+                z: [z0, z0 + block_height],
+            });
+        }
+        by_course.push(row);
+    }
+    let tol = 1e-9 * block_length;
+    let mut contacts = Vec::new();
+    for c in 0..courses {
+        for &a in &by_course[c] {
+            let xa = list[a].x;
+            let z = list[a].z[0];
+            if c == 0 {
+                contacts.push(BedContact {
+                    below: None,
+                    above: a,
+                    x: xa,
+                    z,
+                });
+                continue;
+            }
+            for &b in &by_course[c - 1] {
+                let xb = list[b].x;
+                let (lo, hi) = (xa[0].max(xb[0]), xa[1].min(xb[1]));
+                if hi - lo > tol {
+                    contacts.push(BedContact {
+                        below: Some(b),
+                        above: a,
+                        x: [lo, hi],
+                        z,
+                    });
+                }
+            }
+        }
+    }
+    (list, contacts)
+}
+
+/// The bodies and contacts of a running-bond wall, with the interfaces made by `joint` from
+/// (name, parent, child, x₀, x₁, z).
+fn running_bond_spec(
+    name: &str,
+    courses: usize,
+    blocks: usize,
+    block_length: f64,
+    block_height: f64,
+    depth: f64,
+    joint: impl Fn(&str, &str, &str, f64, f64, f64) -> InterfaceSpec,
+) -> StructureSpec {
+    let (list, contacts) = running_bond_layout(courses, blocks, block_length, block_height);
+    let body = list
+        .iter()
+        .map(|b| {
+            box_body(
+                &b.name,
+                MASONRY_DENSITY,
+                [(b.x[0] + b.x[1]) / 2.0, 0.0, (b.z[0] + b.z[1]) / 2.0],
+                [b.x[1] - b.x[0], depth, b.z[1] - b.z[0]],
+            )
+        })
+        .collect();
+    let interface = contacts
+        .iter()
+        .map(|c| {
+            let above = &list[c.above].name;
+            let below = c.below.map_or("ground", |b| list[b].name.as_str());
+            joint(
+                &format!("{above}_on_{below}"),
+                below,
+                above,
+                c.x[0],
+                c.x[1],
+                c.z,
+            )
+        })
+        .collect();
+    StructureSpec {
+        name: format!("{name}_{courses}x{blocks}"),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+        symmetry: Vec::new(),
+    }
+}
+
+/// A planar running-bond wall in the x–z plane (depth `depth` along y) standing on the ground at
+/// z = 0, centred on x = 0: `courses` courses of height `block_height`; even courses (0, 2, …)
+/// are `blocks` whole blocks of length `block_length`, odd courses are offset by half a block,
+/// with a half block at each end, so every course spans the same length `blocks · block_length`.
+/// Bodies `c{course}_b{index}` (index from −x). Every contact of a block with a block below (or
+/// with the ground), over the overlap segment [x₀, x₁] at height z, is a hinge
+/// `{above}_on_{below}` about +y with P⁺ = (x₁, 0, z) (the +x end) and P⁻ = (x₀, 0, z) (the −x
+/// end): face normal +z, into the block above. Head joints (between blocks of one course) are not
+/// contacts. Density [`MASONRY_DENSITY`].
+pub fn running_bond_wall(
+    courses: usize,
+    blocks: usize,
+    block_length: f64,
+    block_height: f64,
+    depth: f64,
+) -> StructureSpec {
+    running_bond_spec(
+        "running_bond_wall",
+        courses,
+        blocks,
+        block_length,
+        block_height,
+        depth,
+        |name, parent, child, x0, x1, z| {
+            hinge(
+                name,
+                parent,
+                child,
+                [0.0, 1.0, 0.0],
+                [x1, 0.0, z],
+                [x0, 0.0, z],
+            )
+        },
+    )
+}
+
+/// [`running_bond_wall`] with rocking bases instead of hinges: every bed-joint contact is the
+/// overlap rectangle [x₀, x₁] × [−depth/2, depth/2] at height z, its corners in the order of
+/// [`colonnade`]'s bases, (x₀, −d/2), (x₁, −d/2), (x₁, d/2), (x₀, d/2), counter-clockwise seen from
+/// above (normal +z, e₁ = x, e₂ = y).
+pub fn running_bond_wall_3d(
+    courses: usize,
+    blocks: usize,
+    block_length: f64,
+    block_height: f64,
+    depth: f64,
+) -> StructureSpec {
+    let e = depth / 2.0;
+    running_bond_spec(
+        "running_bond_wall_3d",
+        courses,
+        blocks,
+        block_length,
+        block_height,
+        depth,
+        |name, parent, child, x0, x1, z| {
+            rocking_base(
+                name,
+                parent,
+                child,
+                [[x0, -e, z], [x1, -e, z], [x1, e, z], [x0, e, z]],
+            )
+        },
+    )
+}

@@ -239,6 +239,18 @@ pub enum SimulationError {
     /// A bad parameter.
     #[error("{0}")]
     Parameter(String),
+    /// The structure at rest cannot hold, and the mechanism the load opens lifts blocks off a
+    /// support, which the CRR chain (every interface on a pivot) cannot follow.
+    #[error(
+        "at t = {t} s the ground acceleration exceeds the structure's collapse multiplier in a mechanism where {} lift(s) off a support (a block leaves one of its supports): outside the CRR model, which keeps every interface on a pivot; see `crr check` for the mechanism",
+        interfaces.join(", ")
+    )]
+    LiftOff {
+        /// Time (s).
+        t: f64,
+        /// The interfaces that open entirely.
+        interfaces: Vec<String>,
+    },
 }
 
 /// A run that failed part-way: the error and everything computed before it.

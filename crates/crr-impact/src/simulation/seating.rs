@@ -45,8 +45,53 @@ pub fn opening_mode(
 /// the test costs 2·(most seated slots in one part) solves of O(DOF(1)) instead of 2·|seated|:
 /// O(DOF(1)) for a structure of independent blocks. A round whose solve fails (a singular part)
 /// is redone slot by slot, so every release keeps the result it has alone.
+///
+/// A structure at rest with every joint seated is also tested globally: where the search finds
+/// no opening, the contact faces' linear program ([`crate::statics::RestStatics`]) decides
+/// whether the load exceeds the collapse multiplier along its direction, and its mechanism gives
+/// the joints that open and their sides. A mechanism in which blocks lift off a support is
+/// recorded in `rest.lift_off` (the run stops with [`super::SimulationError::LiftOff`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn opening_mode_in(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    rest: &mut RestCache,
+    slot_part: &[usize],
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<Vec<(usize, Side)>> {
+    let local = opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot);
+    let rate_scale = (model.gravity / model.size).sqrt();
+    if local.is_some()
+        || template.seated.len() < model.slot_count
+        || qdot.amax() > 1e-12 * rate_scale
+    {
+        return local;
+    }
+    let a = ground.acceleration(t);
+    // A failed program leaves the local answer standing (it has held every bundled case).
+    let Ok(Some(collapse)) = rest.global.exceeded(model, &a) else {
+        return local;
+    };
+    let lifting: Vec<String> = collapse.lifting_off().map(|i| i.name.clone()).collect();
+    let sides: Vec<(usize, Side)> = collapse
+        .interfaces
+        .iter()
+        .flat_map(|i| i.sides.iter().copied())
+        .collect();
+    if !lifting.is_empty() {
+        rest.lift_off = Some(lifting);
+    }
+    Some(sides)
+}
+
+/// The local test of [`opening_mode_in`]: single releases, the active set, and Gauss' principle
+/// over the sides at rest.
+#[allow(clippy::too_many_arguments)]
+fn opening_mode_local(
     model: &Model,
     ground: &GroundMotion,
     template: &Dynamics,
@@ -396,6 +441,7 @@ impl Simulation<'_> {
         }
         let (q, qdot) = (self.q(), self.qdot());
         let mut trial = self.take_trial();
+        self.spare.rest.lift_off = None;
         let mode = opening_mode_in(
             self.model,
             self.ground,
@@ -408,6 +454,12 @@ impl Simulation<'_> {
             &qdot,
         );
         self.spare.trial = Some(trial);
+        if let Some(interfaces) = self.spare.rest.lift_off.take() {
+            return Err(SimulationError::LiftOff {
+                t: self.t,
+                interfaces,
+            });
+        }
         if let Some(mode) = &mode {
             for &(s, side) in mode {
                 self.seated[s] = false;

@@ -32,6 +32,12 @@ use crr_kinematics::{ActivePivots, Model, Side};
 #[derive(Clone, Debug, Default)]
 pub(super) struct RestCache {
     entries: Vec<RestEntry>,
+    /// The global statics of the structure at rest with every joint seated (the contact faces'
+    /// linear program), which decides where the local search over sides finds no opening.
+    pub(super) global: crate::statics::RestStatics,
+    /// Set by the uplift test when the load exceeds the collapse multiplier in a mechanism where
+    /// blocks lift off a support (outside the CRR chain): those interfaces' names.
+    pub(super) lift_off: Option<Vec<String>>,
 }
 
 #[derive(Clone, Debug)]
