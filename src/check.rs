@@ -383,16 +383,25 @@ pub fn to_text(r: &CheckReport) -> String {
                         "  d = {dir}: λ = {l:.6}{friction} opening {}\n",
                         joints.join(", ")
                     );
-                    let lifting: Vec<&str> = m
-                        .mechanism
-                        .iter()
-                        .filter(|j| j.motion == crr_impact::statics::Motion::LiftsOff)
-                        .map(|j| j.interface.as_str())
-                        .collect();
+                    let with = |motion: crr_impact::statics::Motion| -> Vec<&str> {
+                        m.mechanism
+                            .iter()
+                            .filter(|j| j.motion == motion)
+                            .map(|j| j.interface.as_str())
+                            .collect()
+                    };
+                    let lifting = with(crr_impact::statics::Motion::LiftsOff);
                     if !lifting.is_empty() {
                         s += &format!(
                             "    lifting off: {} (a block leaves a support: outside the CRR chain, which keeps every interface on a pivot)\n",
                             lifting.join(", ")
+                        );
+                    }
+                    let sliding = with(crr_impact::statics::Motion::Slides);
+                    if !sliding.is_empty() {
+                        s += &format!(
+                            "    sliding: {} (outside the CRR chain, which allows no sliding)\n",
+                            sliding.join(", ")
                         );
                     }
                 }

@@ -28,8 +28,8 @@ pub use crr_impact::statics::LAMBDA_MAX;
 pub struct MechanismJoint {
     /// The interface's name.
     pub interface: String,
-    /// `rocks` (about the points in `about`) or `lifts_off` (every point separates: outside the
-    /// CRR chain).
+    /// `rocks` (about the points in `about`), `lifts_off` (every point separates: outside the CRR
+    /// chain) or, with `--friction`, `slides`.
     pub motion: Motion,
     /// The contact points that stay closed while it turns (m, world at rest): a hinge's pivot
     /// line, a rocking base's corner or edge.

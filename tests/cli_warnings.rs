@@ -153,7 +153,7 @@ fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
 }
 
 #[test]
-fn the_bundled_models_run_without_warnings_but_the_drum_columns_flight() {
+fn the_bundled_models_run_without_warnings_but_the_flights_of_the_drum_column_and_the_temple() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
     let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -183,6 +183,17 @@ fn the_bundled_models_run_without_warnings_but_the_drum_columns_flight() {
             let w = warnings(&s);
             assert_eq!(w.len(), 1, "{w:?}");
             assert!(w[0].contains("\"bed_3\" would need tension"), "{w:?}");
+            continue;
+        }
+        // The temple leaves rest in its y mechanism, in which the entablature turns on the back
+        // row's capitals; at 4.24 s a seat of the entablature would need tension (tests/temple.rs).
+        if stem == "temple" {
+            let w = warnings(&s);
+            assert_eq!(w.len(), 1, "{w:?}");
+            assert!(
+                w[0].contains("\"entablature_on_c21\" would need tension"),
+                "{w:?}"
+            );
             continue;
         }
         assert!(warnings(&s).is_empty(), "{stem}: {s}");

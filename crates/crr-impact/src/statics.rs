@@ -62,6 +62,9 @@ pub struct StaticsOptions {
     pub friction: Friction,
     /// The multiplier beyond which the structure is reported as holding.
     pub lambda_max: f64,
+    /// Without sliding: also seek mechanisms in which a block lifts off a support while sliding
+    /// over it (see [`collapse_multiplier`]). `false` gives the convex program alone.
+    pub sliding_lift_off: bool,
 }
 
 impl Default for StaticsOptions {
@@ -69,9 +72,16 @@ impl Default for StaticsOptions {
         StaticsOptions {
             friction: Friction::NoSliding,
             lambda_max: LAMBDA_MAX,
+            sliding_lift_off: true,
         }
     }
 }
+
+/// Friction coefficients of the probes that look for sliding lift-offs (largest first).
+const PROBE_FRICTION: [f64; 4] = [2.0, 1.0, 0.5, 0.25];
+
+/// Most rounds of the search for sliding lift-offs (each frees at least one interface).
+const LIFT_OFF_ROUNDS: usize = 8;
 
 /// What is wrong with a statics question.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -113,6 +123,8 @@ pub enum Motion {
     Rocks,
     /// Every contact point separates: the child lifts off the parent (outside the CRR chain).
     LiftsOff,
+    /// It slides (with finite friction only; outside the CRR chain).
+    Slides,
 }
 
 /// One interface in the collapse: its forces at λ_c and its motion in the mechanism.
@@ -194,16 +206,124 @@ pub fn collapse_multiplier(
     }
     let d = direction / norm;
     let faces = contact_faces(model);
-    let program = Program::build(model, &faces, d, options);
+    let mut free = vec![false; faces.len()];
+    let convex = solve_program(model, &faces, d, options, &free)?;
+    if !options.sliding_lift_off || options.friction != Friction::NoSliding {
+        return Ok(convex);
+    }
+    sliding_lift_offs(model, &faces, d, options, &mut free, convex)
+}
+
+/// One program: `free` marks the interfaces whose points carry normal forces only (they may
+/// slide where they separate).
+fn solve_program(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    free: &[bool],
+) -> Result<Collapse, StaticsError> {
+    let program = Program::build(model, faces, d, options, free);
     let solution = program.solve()?;
     let lambda = solution.x[0];
     if lambda < -1e-9 {
         return Err(StaticsError::DoesNotHold(format!(
             ": it would need a ground acceleration of {:.6} g along ({}, {}, {})",
-            -lambda, -d.x, -d.y, -d.z
+            -lambda,
+            -d.x + 0.0,
+            -d.y + 0.0,
+            -d.z + 0.0
         )));
     }
-    Ok(program.collapse(model, &faces, d, options, &solution))
+    Ok(program.collapse(model, faces, d, options, &solution))
+}
+
+/// The search for mechanisms in which a block lifts off a support while sliding over it.
+///
+/// Without sliding, the convex program lets a contact carry shear with no compression (the
+/// closure of the friction cone as μ → ∞), and its mechanisms separate contacts only along their
+/// normal. A real joint that opens carries nothing and may slide: the corner wedge of a wall in
+/// running bond (an end half block and the block over it turning about the half block's outer
+/// foot, the block over it leaving its other support sideways) opens below the convex answer.
+/// This freedom (non-associated: the separated joint's slip does no work against friction) makes
+/// the problem non-convex. Its mechanisms are admissible in the convex program with a finite
+/// friction μ wherever their separation exceeds μ times their slip, so probes with
+/// μ = 2, 1, 0.5, 0.25 find candidates: the interfaces that separate and slide in a probe's
+/// mechanism are freed (normal forces only) and the program without sliding is solved again. A
+/// candidate is kept when its λ is lower and its mechanism is physical: every freed interface
+/// either separates at all its points or does not slide (a compressed joint cannot slide). Rounds
+/// repeat until no probe lowers λ. Every answer kept is an admissible mechanism with an
+/// equilibrium at its λ (an upper bound of the true multiplier, never above the convex one); the
+/// search is not proved to find the lowest.
+fn sliding_lift_offs(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    free: &mut Vec<bool>,
+    convex: Collapse,
+) -> Result<Collapse, StaticsError> {
+    let Some(mut best_lambda) = convex.lambda else {
+        return Ok(convex);
+    };
+    let mut best = convex;
+    for _ in 0..LIFT_OFF_ROUNDS {
+        let mut improved = false;
+        for mu in PROBE_FRICTION {
+            let probe_options = StaticsOptions {
+                friction: Friction::Pyramid(mu),
+                sliding_lift_off: false,
+                ..*options
+            };
+            let Ok(probe) = solve_program(model, faces, d, &probe_options, free) else {
+                continue;
+            };
+            if probe.lambda.is_none_or(|l| l >= best_lambda * (1.0 - 1e-6)) {
+                continue;
+            }
+            let mut trial = free.clone();
+            let mut added = false;
+            for i in &probe.interfaces {
+                if i.gap_rates.iter().all(|&g| g > MECHANISM_TOLERANCE)
+                    && i.slip_rate > MECHANISM_TOLERANCE
+                    && !trial[i.interface]
+                    && !faces[i.interface].pin
+                {
+                    trial[i.interface] = true;
+                    added = true;
+                }
+            }
+            if !added {
+                continue;
+            }
+            let Ok(candidate) = solve_program(model, faces, d, options, &trial) else {
+                continue;
+            };
+            let Some(lambda) = candidate.lambda else {
+                continue;
+            };
+            if lambda < best_lambda * (1.0 - 1e-9) && physical(&candidate, &trial) {
+                best_lambda = lambda;
+                best = candidate;
+                *free = trial;
+                improved = true;
+                break;
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    Ok(best)
+}
+
+/// Whether every freed interface of a mechanism separates at all its points or does not slide.
+fn physical(collapse: &Collapse, free: &[bool]) -> bool {
+    collapse.interfaces.iter().all(|i| {
+        !free[i.interface]
+            || i.slip_rate <= MECHANISM_TOLERANCE
+            || i.gap_rates.iter().all(|&g| g > MECHANISM_TOLERANCE)
+    })
 }
 
 /// The smallest Coulomb friction coefficient (pyramid on each tangent, exact for planar loads)
@@ -218,6 +338,7 @@ pub fn required_friction(
     let no_sliding = StaticsOptions {
         friction: Friction::NoSliding,
         lambda_max,
+        sliding_lift_off: true,
     };
     let Some(target) = collapse_multiplier(model, direction, &no_sliding)?.lambda else {
         return Ok(None);
@@ -227,6 +348,7 @@ pub fn required_friction(
         let options = StaticsOptions {
             friction: Friction::Pyramid(mu),
             lambda_max,
+            sliding_lift_off: false,
         };
         match collapse_multiplier(model, direction, &options) {
             Ok(c) => Ok(c.lambda.is_none_or(|l| l >= target)),
@@ -297,6 +419,7 @@ impl Program {
         faces: &[ContactFace],
         d: Vector3<f64>,
         options: &StaticsOptions,
+        free: &[bool],
     ) -> Program {
         let mut unknowns = Vec::new();
         let mut point_columns = Vec::with_capacity(faces.len());
@@ -339,6 +462,7 @@ impl Program {
             weight,
         };
         program.equilibrium_rows(model, faces, d, total_mass, size);
+        program.free_rows(faces, free);
         program.inequality_rows(faces, options);
         program
     }
@@ -401,6 +525,28 @@ impl Program {
         }
         self.rows = first + 6 * bodies;
         self.cones.push(SupportedConeT::ZeroConeT(6 * bodies));
+    }
+
+    /// The tangential forces of the freed interfaces' points are zero (another zero cone).
+    fn free_rows(&mut self, faces: &[ContactFace], free: &[bool]) {
+        let first = self.rows;
+        let mut row = first;
+        for (face, columns) in faces.iter().zip(self.point_columns.clone()) {
+            if !free[face.interface] || face.pin {
+                continue;
+            }
+            for [_, t1, t2] in columns {
+                for &t in &[t1, t2][..face.friction_tangents] {
+                    self.push(row, t, 1.0);
+                    row += 1;
+                }
+            }
+        }
+        if row > first {
+            self.b.resize(row, 0.0);
+            self.rows = row;
+            self.cones.push(SupportedConeT::ZeroConeT(row - first));
+        }
     }
 
     /// No tension, λ ≤ λ_max, friction.
@@ -565,8 +711,11 @@ impl Program {
                 let pivots: Vec<usize> = (0..face.points.len())
                     .filter(|&p| gap_rates[p] <= zero)
                     .collect();
+                let sliding_friction = options.friction != Friction::NoSliding;
                 let motion = if measure <= zero {
                     Motion::Closed
+                } else if sliding_friction && slip_rate > zero {
+                    Motion::Slides
                 } else if pivots.is_empty() && !face.pin {
                     Motion::LiftsOff
                 } else {
@@ -604,7 +753,7 @@ impl Program {
             })
             .collect();
         Collapse {
-            direction: [d.x, d.y, d.z],
+            direction: [d.x + 0.0, d.y + 0.0, d.z + 0.0],
             lambda: (!holds).then_some(lambda),
             interfaces,
             bodies: bodies

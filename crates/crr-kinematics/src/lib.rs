@@ -33,6 +33,7 @@
 
 pub mod closure;
 pub mod contact_face;
+pub mod contact_kinematics;
 pub mod data;
 pub mod error;
 pub mod fixtures;
@@ -52,6 +53,7 @@ pub use closure::{
     closure_angles, constraint_jacobian, constraint_residual, interface_angles, relative_angles,
 };
 pub use contact_face::{ContactFace, contact_faces};
+pub use contact_kinematics::{ContactKinematics, contact_bias, contact_geometry};
 pub use data::Data;
 pub use error::ModelError;
 pub use gamma::mass_matrix_gamma;

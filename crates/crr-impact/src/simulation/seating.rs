@@ -84,8 +84,16 @@ pub(super) fn opening_mode_in(
         .collect();
     if !lifting.is_empty() {
         rest.lift_off = Some(lifting);
+        return Some(sides);
     }
-    Some(sides)
+    // Gauss' principle from the mechanism's sides gives the opening accelerations' own mode
+    // when they exceed its threshold; at the crossing itself (a load 1e-9 above λ_c) they do
+    // not, and the mechanism's sides open.
+    let mut start = template.clone();
+    for &(slot, side) in &sides {
+        start.pivots.sides[slot] = side;
+    }
+    opening_mode_local(model, ground, &start, trial, rest, slot_part, t, q, qdot).or(Some(sides))
 }
 
 /// The local test of [`opening_mode_in`]: single releases, the active set, and Gauss' principle
