@@ -11,14 +11,17 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
+use crr::kinematics::Model;
 use crr::kinematics::fixtures::{SplitMix, running_bond_wall, running_bond_wall_3d, voussoir_arch};
 use crr::kinematics::spec::{PivotSpec, StructureSpec};
-use crr::kinematics::Model;
 
 fn bundled_spec(name: &str) -> StructureSpec {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join(format!("examples/models/{name}.toml"));
-    crr::load_model(&path).expect("bundled model loads").0.structure()
+    crr::load_model(&path)
+        .expect("bundled model loads")
+        .0
+        .structure()
 }
 
 fn lambda(spec: &StructureSpec, d: Vector3<f64>) -> f64 {
@@ -99,7 +102,13 @@ fn mirrored_x(spec: &StructureSpec) -> StructureSpec {
 fn symmetric_structures_have_equal_multipliers_in_mirrored_directions() {
     let mut cases: Vec<(String, StructureSpec, bool)> = [5, 9, 17, 25, 41]
         .into_iter()
-        .map(|n| (format!("arch of {n}"), voussoir_arch(n, 2.0, 2.5, 1.0), false))
+        .map(|n| {
+            (
+                format!("arch of {n}"),
+                voussoir_arch(n, 2.0, 2.5, 1.0),
+                false,
+            )
+        })
         .collect();
     for (name, both) in [
         ("trilithon", false),
@@ -109,8 +118,16 @@ fn symmetric_structures_have_equal_multipliers_in_mirrored_directions() {
     ] {
         cases.push((name.to_string(), bundled_spec(name), both));
     }
-    cases.push(("wall 5×4".into(), running_bond_wall(5, 4, 1.0, 0.5, 0.5), false));
-    cases.push(("3D wall 3×3".into(), running_bond_wall_3d(3, 3, 1.0, 0.5, 0.5), false));
+    cases.push((
+        "wall 5×4".into(),
+        running_bond_wall(5, 4, 1.0, 0.5, 0.5),
+        false,
+    ));
+    cases.push((
+        "3D wall 3×3".into(),
+        running_bond_wall_3d(3, 3, 1.0, 0.5, 0.5),
+        false,
+    ));
     for (name, spec, both) in &cases {
         let mut axes = vec![Vector3::x()];
         if *both {
@@ -119,7 +136,10 @@ fn symmetric_structures_have_equal_multipliers_in_mirrored_directions() {
         for d in axes {
             let (plus, minus) = (lambda(spec, d), lambda(spec, -d));
             println!("{name} along ±{d:?}: {plus} / {minus}");
-            assert!(plus.is_finite() && same(plus, minus), "{name}: {plus} against {minus}");
+            assert!(
+                plus.is_finite() && same(plus, minus),
+                "{name}: {plus} against {minus}"
+            );
         }
     }
 }
@@ -130,10 +150,19 @@ fn the_order_of_the_file_changes_no_multiplier() {
         .into_iter()
         .map(|n| (format!("arch of {n}"), voussoir_arch(n, 2.0, 2.5, 1.0)))
         .collect();
-    for name in ["trilithon", "baldachin", "temple", "wall", "two_block_stack"] {
+    for name in [
+        "trilithon",
+        "baldachin",
+        "temple",
+        "wall",
+        "two_block_stack",
+    ] {
         cases.push((name.to_string(), bundled_spec(name)));
     }
-    cases.push(("3D wall 3×3".into(), running_bond_wall_3d(3, 3, 1.0, 0.5, 0.5)));
+    cases.push((
+        "3D wall 3×3".into(),
+        running_bond_wall_3d(3, 3, 1.0, 0.5, 0.5),
+    ));
     for (name, spec) in &cases {
         for d in [Vector3::x(), -Vector3::y(), Vector3::new(0.6, 0.8, 0.0)] {
             let reference = lambda(spec, d);
