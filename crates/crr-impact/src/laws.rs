@@ -21,7 +21,7 @@
 //! mechanism's velocities and are never over-determined. A singular system is an [`ImpactError`],
 //! never a panic.
 
-use crr_dynamics::eom::constraint_row_scale;
+use crr_dynamics::eom::{constraint_row_scale, slot_row};
 use crr_dynamics::linalg::{
     JacobiSvd, back_substitute_transposed, cholesky_in_place, cholesky_solve, forward_substitute,
     pinv_solve,
@@ -174,6 +174,40 @@ fn evaluate_chain(
     copy_matrix(&mut chain.mass, &kin.mass_matrix);
 }
 
+/// [`evaluate_chain`] with the slots `held` kept at rate 0 through the impact (seated joints: a
+/// rocking base's seated tilt): the chain's mechanism is then the null space of Φ_q (row-scaled)
+/// and the held slots' rate rows aᵀ together, also on an open chain.
+fn evaluate_chain_holding(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+    held: &[usize],
+    chain: &mut Chain,
+) {
+    evaluate_chain(model, kin, q, pivots, chain);
+    if held.is_empty() {
+        return;
+    }
+    let n = model.dof();
+    let closure_rows = model.constraint_rows;
+    let mut rows = DMatrix::zeros(closure_rows + held.len(), n);
+    if closure_rows > 0 {
+        let scale = constraint_row_scale(model);
+        for i in 0..closure_rows {
+            for j in 0..n {
+                rows[(i, j)] = scale[i] * kin.phi_q[(i, j)];
+            }
+        }
+    }
+    let mut row = DVector::zeros(n);
+    for (i, &s) in held.iter().enumerate() {
+        slot_row(model, kin, s, &mut row);
+        rows.row_mut(closure_rows + i).copy_from(&row.transpose());
+    }
+    chain.null = Some(JacobiSvd::new(&rows).null_space());
+}
+
 /// `dst` = `src`, reusing `dst`'s storage when the shapes agree.
 fn copy_matrix(dst: &mut DMatrix<f64>, src: &DMatrix<f64>) {
     if dst.shape() == src.shape() {
@@ -323,7 +357,7 @@ pub(crate) fn momentum_law_with(
     after: &ActivePivots,
 ) -> Result<ImpactResult, ImpactError> {
     check_inputs(model, q, qdot_minus, before, after)?;
-    pre_impact_momentum(model, kin, q, qdot_minus, before, after, ws);
+    pre_impact_momentum(model, kin, q, qdot_minus, before, after, &[], ws);
     ws.metric.refactor("momentum law", &ws.plus)?;
     ws.metric.w_of_momentum_into(&ws.momentum, &mut ws.w);
     let qdot = ws.metric.qdot_of_w(&ws.w);
@@ -345,15 +379,16 @@ fn pre_impact_momentum(
     qdot_minus: &DVector<f64>,
     before: &ActivePivots,
     after: &ActivePivots,
+    held: &[usize],
     ws: &mut LawWorkspace,
 ) {
-    evaluate_chain(model, kin, q, before, &mut ws.minus);
+    evaluate_chain_holding(model, kin, q, before, held, &mut ws.minus);
     let (vc, wv) = (&mut ws.linear, &mut ws.angular);
     with_len(vc, kin.com_jacobian.nrows());
     with_len(wv, kin.angular_jacobian.nrows());
     kin.com_jacobian.mul_to(qdot_minus, vc);
     kin.angular_jacobian.mul_to(qdot_minus, wv);
-    evaluate_chain(model, kin, q, after, &mut ws.plus);
+    evaluate_chain_holding(model, kin, q, after, held, &mut ws.plus);
     // In place: body bi's entries are read before they are overwritten.
     for (bi, body) in model.bodies.iter().enumerate() {
         let i_w = world_inertia(body, &kin.rot_ops[model.body_coord[bi]]);
@@ -399,6 +434,25 @@ pub fn restitution_law(
     after: &ActivePivots,
     slots: &[(usize, f64)],
 ) -> Result<ImpactResult, ImpactError> {
+    restitution_law_holding(model, kin, q, qdot_minus, before, after, slots, &[])
+}
+
+/// [`restitution_law`] with the slots `held` (seated joints) kept at rate 0 through the impact,
+/// like the closures: the law is posed on the motions that leave them seated. A rocking base
+/// that rocks about one tilt with the other seated (a block on an edge of its base) then keeps
+/// exactly r of its rate; posed on every motion, part of the impact mode would go into the seated
+/// tilt and be taken out afterwards by the plastic impulse that keeps it seated.
+#[allow(clippy::too_many_arguments)]
+pub fn restitution_law_holding(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    qdot_minus: &DVector<f64>,
+    before: &ActivePivots,
+    after: &ActivePivots,
+    slots: &[(usize, f64)],
+    held: &[usize],
+) -> Result<ImpactResult, ImpactError> {
     check_inputs(model, q, qdot_minus, before, after)?;
     for &(s, r) in slots {
         check_slot(model, s)?;
@@ -409,6 +463,9 @@ pub fn restitution_law(
         }
     }
     check_distinct(slots.iter().map(|s| s.0))?;
+    for &s in held {
+        check_slot(model, s)?;
+    }
     rate_law(
         "restitution law",
         model,
@@ -418,6 +475,7 @@ pub fn restitution_law(
         before,
         after,
         slots,
+        held,
     )
 }
 
@@ -439,6 +497,22 @@ pub fn dirac_law(
     after: &ActivePivots,
     slots: &[(usize, f64, f64)],
 ) -> Result<ImpactResult, ImpactError> {
+    dirac_law_holding(model, kin, q, qdot_minus, before, after, slots, &[])
+}
+
+/// [`dirac_law`] with the slots `held` (seated joints) kept at rate 0 through the impact (see
+/// [`restitution_law_holding`]).
+#[allow(clippy::too_many_arguments)]
+pub fn dirac_law_holding(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    qdot_minus: &DVector<f64>,
+    before: &ActivePivots,
+    after: &ActivePivots,
+    slots: &[(usize, f64, f64)],
+    held: &[usize],
+) -> Result<ImpactResult, ImpactError> {
     check_inputs(model, q, qdot_minus, before, after)?;
     for &(s, r, c) in slots {
         check_slot(model, s)?;
@@ -449,6 +523,9 @@ pub fn dirac_law(
         }
     }
     check_distinct(slots.iter().map(|s| s.0))?;
+    for &s in held {
+        check_slot(model, s)?;
+    }
     let factors: Vec<(usize, f64)> = slots.iter().map(|&(s, r, c)| (s, r.powf(c))).collect();
     rate_law(
         "Dirac law",
@@ -459,6 +536,7 @@ pub fn dirac_law(
         before,
         after,
         &factors,
+        held,
     )
 }
 
@@ -592,9 +670,10 @@ fn rate_law(
     before: &ActivePivots,
     after: &ActivePivots,
     slots: &[(usize, f64)],
+    held: &[usize],
 ) -> Result<ImpactResult, ImpactError> {
     let mut ws = LawWorkspace::default();
-    pre_impact_momentum(model, kin, q, qdot_minus, before, after, &mut ws);
+    pre_impact_momentum(model, kin, q, qdot_minus, before, after, held, &mut ws);
     let (minus, plus, momentum) = (&ws.minus, &ws.plus, &ws.momentum);
     // The slot directions do not depend on the pivots (only on the Γ's).
     let a = directions(model, kin, slots.iter().map(|x| x.0));

@@ -87,6 +87,7 @@ pub(super) fn apply_law(
     before: &ActivePivots,
     after: &ActivePivots,
     impacting: &[usize],
+    held: &[usize],
 ) -> Result<crate::laws::ImpactResult, ImpactError> {
     let law = |s: usize| model.interfaces[slot_interface(model, s)].impact;
     if impacting
@@ -103,7 +104,7 @@ pub(super) fn apply_law(
         })
         .collect::<Option<Vec<_>>>()
     {
-        return dirac_law(model, kin, q, qdot, before, after, &dirac);
+        return dirac_law_holding(model, kin, q, qdot, before, after, &dirac, held);
     }
     let factors: Vec<(usize, f64)> = impacting
         .iter()
@@ -113,7 +114,7 @@ pub(super) fn apply_law(
             _ => (s, 1.0),
         })
         .collect();
-    restitution_law(model, kin, q, qdot, before, after, &factors)
+    restitution_law_holding(model, kin, q, qdot, before, after, &factors, held)
 }
 
 /// Scratch of [`Simulation::impact`], kept by the run: the state before the impact (q, q̇) and
@@ -210,7 +211,7 @@ impl Simulation<'_> {
             }
             let q = &q_at;
             let mut result = apply_law(
-                model, &mut kin, &mut laws, q, &qdot, &before, &after, &impacting,
+                model, &mut kin, &mut laws, q, &qdot, &before, &after, &impacting, &held,
             )
             .map_err(|source| SimulationError::Impact { t, source })?;
             // Joints that were seated stay seated through the impact: a plastic impulse on them

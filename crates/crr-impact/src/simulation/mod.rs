@@ -37,8 +37,8 @@ use crr_kinematics::{
 };
 
 use crate::laws::{
-    ImpactError, LawWorkspace, dirac_law, dirac_regularised_force, momentum_law_with,
-    restitution_law,
+    ImpactError, LawWorkspace, dirac_law_holding, dirac_regularised_force, momentum_law_with,
+    restitution_law_holding,
 };
 
 mod events;
