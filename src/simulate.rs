@@ -483,6 +483,15 @@ fn warnings(
         ));
     }
     let analysis = p.file.analysis.clone().unwrap_or_default();
+    if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)
+        && analysis.rtol > crr_dynamics::analysis::RTOL_WARNING
+    {
+        out.push(format!(
+            "rtol = {} is loose: impacts, uplifts and loop closures are located to about that \
+             relative precision; check the results with a smaller rtol (default 1e-10)",
+            num(analysis.rtol)
+        ));
+    }
     if matches!(analysis.method, crr_dynamics::MethodName::Rk4) {
         let time_scale = (p.model.size / p.model.gravity).sqrt();
         if analysis.rk4_step > RK4_STEP_WARNING * time_scale {

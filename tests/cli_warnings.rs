@@ -66,24 +66,37 @@ fn assert_reported(tag: &str, summary: &serde_json::Value, stderr: &str) {
     );
 }
 
+/// An RK4 step of 10 s on Housner's block misses impacts: the run's invariant stops it where its
+/// angle has passed its pivot, naming the angle and the setting to change (before the invariant
+/// it went on and only warned that the energy balance was off), with the partial results kept.
 #[test]
-fn a_long_rk4_step_breaks_the_energy_balance_and_says_so() {
-    let (s, err) = run(
-        "rk4",
-        &single_block_with("duration = 5.0\nmethod = \"rk4\"\nrk4_step = 10.0"),
-        &["--quiet"],
-    );
-    assert_reported("rk4", &s, &err);
-    let w = warnings(&s);
+fn a_long_rk4_step_stops_the_run_at_the_missed_impact() {
+    let dir = scratch("rk4");
+    let model = dir.join("model.toml");
+    std::fs::write(
+        &model,
+        single_block_with("duration = 5.0\nmethod = \"rk4\"\nrk4_step = 10.0"),
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = crr(&[
+        "simulate",
+        model.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--force",
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
     assert!(
-        w.iter()
-            .any(|x| x.starts_with("rk4_step = 1e1 s is longer")),
-        "{w:?}"
+        err.contains("the angle \"base\"") && err.contains("wrong side of its pivot"),
+        "{err}"
     );
-    assert!(
-        w.iter().any(|x| x.starts_with("the energy balance is off")),
-        "{w:?}"
-    );
+    assert!(err.contains("shorten analysis.rk4_step"), "{err}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["completed"], false);
 }
 
 #[test]
@@ -199,4 +212,55 @@ fn the_bundled_models_run_without_warnings_but_the_flights_of_the_drum_column_an
         assert!(warnings(&s).is_empty(), "{stem}: {s}");
         assert!(!err.contains("warning"), "{stem}: {err}");
     }
+}
+
+/// Settings that would change the physics rather than the numerics are refused with the reason
+/// (issue: each of these was accepted and turned a collapse into survival or let a block pass
+/// through the ground): a seat rate or a minimum impact interval as large as the structure's own
+/// rate and time scales √(g/L), √(L/g), a collapse drop beyond a fall, an rtol that keeps no
+/// digit. A loose but admissible rtol is a warning.
+#[test]
+fn settings_beyond_the_physics_are_refused_and_a_loose_rtol_warns() {
+    for (setting, word) in [
+        ("seat_rate = 1e10", "seat_rate"),
+        ("min_impact_interval = 1e10", "min_impact_interval"),
+        ("collapse_drop = 2.0", "collapse_drop"),
+        ("rtol = 1.0", "rtol"),
+    ] {
+        let dir = scratch(&format!("bounds_{word}"));
+        let model = dir.join("model.toml");
+        std::fs::write(
+            &model,
+            single_block_with(&format!("duration = 1.0\n{setting}")),
+        )
+        .unwrap();
+        let out = dir.join("out");
+        let o = crr(&[
+            "simulate",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+            "--force",
+        ]);
+        assert!(!o.status.success(), "{setting} was accepted");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains(word) && err.contains("default"),
+            "{setting}: {err}"
+        );
+    }
+    let (s, err) = run(
+        "loose_rtol",
+        &single_block_with("duration = 2.0\nrtol = 1e-5"),
+        &["--quiet", "--force"],
+    );
+    assert_reported("loose_rtol", &s, &err);
+    assert!(
+        warnings(&s)
+            .iter()
+            .any(|w| w.starts_with("rtol = 1e-5 is loose")),
+        "{:?}",
+        warnings(&s)
+    );
 }

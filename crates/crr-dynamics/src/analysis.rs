@@ -17,6 +17,14 @@ pub enum MethodName {
     Rk4,
 }
 
+/// Largest `rtol` accepted: above it the step control keeps no digit of a rocking motion.
+pub const RTOL_MAX: f64 = 1e-2;
+
+/// `rtol` above which a run warns that its results need a smaller tolerance to be trusted (at
+/// 1e-3 the bundled trilithon's loops opened and, before the run's invariant, it reported a
+/// false collapse).
+pub const RTOL_WARNING: f64 = 1e-6;
+
 /// `[analysis]`: duration, output interval and integrator settings, with documented defaults.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -83,6 +91,13 @@ impl AnalysisSpec {
         };
         positive("output_interval", self.output_interval)?;
         positive("rtol", self.rtol)?;
+        if self.rtol > RTOL_MAX {
+            return Err(format!(
+                "analysis.rtol must be at most {RTOL_MAX:e}: a step control at rtol = {} keeps no \
+                 digit of the motion (default 1e-10; above 1e-6 the run warns)",
+                self.rtol
+            ));
+        }
         positive("atol", self.atol)?;
         positive("rk4_step", self.rk4_step)?;
         positive("seat_rate", self.seat_rate)?;
