@@ -187,6 +187,11 @@ impl Simulation<'_> {
                     || (!self.seated[s]
                         && angles[s].abs() <= self.params.simultaneity
                         && rates_before[s] * before.sides[s].sign() < 0.0)
+                    // A joint already past its pivot by more than `simultaneity` (it crossed
+                    // φ = 0 between two impacts of its neighbours without an event of its own)
+                    // switches pivot now too, instead of rocking on past it.
+                    || (!self.seated[s]
+                        && before.sides[s].sign() * angles[s] < -self.params.simultaneity)
             })
             .collect();
         held.clear();
