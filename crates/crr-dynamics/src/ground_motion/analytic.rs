@@ -58,6 +58,17 @@ fn first_after(t: f64, candidates: &[f64]) -> Option<f64> {
 }
 
 impl Signal {
+    /// The shortest time over which the signal changes shape (a sine's or pulse's period, a
+    /// Ricker wavelet's 1/f); `None` for signals that are constant or affine between their
+    /// breakpoints (constant, rectangular pulses, records).
+    pub(super) fn time_scale(&self) -> Option<f64> {
+        match self {
+            Signal::Sine { period, .. } | Signal::CosinePulse { period, .. } => Some(*period),
+            Signal::Ricker { frequency, .. } => Some(1.0 / frequency),
+            Signal::Rectangular { .. } | Signal::Constant { .. } | Signal::Record(_) => None,
+        }
+    }
+
     fn window_end(&self) -> f64 {
         match self {
             Signal::Sine { end, .. } => end.unwrap_or(f64::INFINITY),

@@ -290,6 +290,18 @@ impl GroundMotion {
         GroundMotion::default()
     }
 
+    /// The shortest time over which any component changes shape (the smallest period of its
+    /// sines and pulses, 1/f of its Ricker wavelets); `None` when every component is constant or
+    /// affine between breakpoints. A test of the motion on a time grid must sample finer than
+    /// this: a 1 ms grid under a 500 Hz sine samples only its zeros.
+    pub fn time_scale(&self) -> Option<f64> {
+        self.components
+            .iter()
+            .flatten()
+            .filter_map(|c| c.signal.time_scale())
+            .reduce(f64::min)
+    }
+
     /// True if no component is set.
     pub fn is_none(&self) -> bool {
         self.components.iter().all(Option::is_none)

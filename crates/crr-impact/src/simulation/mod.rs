@@ -62,6 +62,19 @@ use uplift_from_rest::{RestCache, opening_from_rest};
 /// uplift test (exact location then by bisection on the release test).
 pub const SEATED_MAX_STEP: f64 = 1e-3;
 
+/// Samples per shortest period of the ground motion on the seated grid: the grid step is
+/// min([`SEATED_MAX_STEP`], period / this), so that no sine or pulse is sampled at its zeros only
+/// (a 1 ms grid under a 500 Hz sine) and the sampled peak is within 1 − cos(π/32) = 0.5 % of the
+/// true one.
+pub const SEATED_SAMPLES_PER_PERIOD: f64 = 32.0;
+
+/// The grid step of the uplift test while joints are seated under `ground`.
+pub(crate) fn seated_step(ground: &GroundMotion) -> f64 {
+    ground.time_scale().map_or(SEATED_MAX_STEP, |t| {
+        SEATED_MAX_STEP.min(t / SEATED_SAMPLES_PER_PERIOD)
+    })
+}
+
 /// Tunable parameters of a simulation, with documented defaults.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Parameters {
@@ -859,7 +872,7 @@ impl<'a> Simulation<'a> {
             && !self.ground.is_none()
             && self.t < self.ground.duration()
         {
-            h_max = h_max.min(SEATED_MAX_STEP);
+            h_max = h_max.min(seated_step(self.ground));
         }
         if let Some(r) = &self.regularised {
             let mut angles = vec![0.0; model.slot_count];

@@ -526,7 +526,7 @@ impl Simulation<'_> {
             let t1 = if whole {
                 t_stop
             } else {
-                (t0 + SEATED_MAX_STEP).min(t_stop)
+                (t0 + seated_step(ground)).min(t_stop)
             };
             if opens(t1) {
                 let (mut lo, mut hi) = (t0, t1);
