@@ -148,6 +148,9 @@ enum Command {
         /// sliding, and the report gives the μ each multiplier needs).
         #[arg(long, value_name = "MU")]
         friction: Option<f64>,
+        /// Replace the plots of an earlier `crr check --plot` in DIR.
+        #[arg(long)]
+        force: bool,
     },
     /// Run every case of a study file (a pulse family's amplitude × frequency grid, or records
     /// scaled to intensity levels) in parallel into cases.csv and study.json (docs/studies.md);
@@ -330,6 +333,18 @@ fn record_arg(
     }))
 }
 
+/// A file of an earlier `crr check --plot` in `dir` (the frequency plot, the energy levels, the
+/// size sweep), if any.
+fn earlier_check_plot(dir: &Path) -> Option<PathBuf> {
+    let entries = std::fs::read_dir(dir).ok()?;
+    entries.flatten().map(|e| e.path()).find(|p| {
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        let stem = name.split('.').next().unwrap_or("");
+        (stem == "housner" || stem == "levels" || stem.ends_with("_levels") || stem == "size_sweep")
+            && [".png", ".svg", ".csv"].iter().any(|e| name.ends_with(e))
+    })
+}
+
 /// `crr check MODEL… [--json] [--plot DIR] [--size-sweep s0:s1:n] [--amplitude-ratio R]`.
 fn check_models(
     paths: &[PathBuf],
@@ -339,6 +354,7 @@ fn check_models(
     amplitude_ratio: f64,
     directions: &[String],
     friction: Option<f64>,
+    force: bool,
 ) -> Result<(), Failure> {
     use crr::levels::{DEFAULT_STEP, mechanism_levels};
     use crr::size_sweep::{check_amplitude_ratio, parse_sweep};
@@ -358,6 +374,16 @@ fn check_models(
     {
         return Err(Failure::Input(InputError::Argument(format!(
             "--friction must be a finite number ≥ 0, got {mu}"
+        ))));
+    }
+    if let Some(dir) = plot
+        && !force
+        && let Some(earlier) = earlier_check_plot(dir)
+    {
+        return Err(Failure::Input(InputError::Argument(format!(
+            "{}: the folder holds the plots of an earlier `crr check --plot` ({}): pass --force to replace them",
+            dir.display(),
+            earlier.display()
         ))));
     }
     let loaded = paths
@@ -753,6 +779,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             amplitude_ratio,
             direction,
             friction,
+            force,
         } => check_models(
             &models,
             json,
@@ -761,6 +788,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             amplitude_ratio,
             &direction,
             friction,
+            force,
         )?,
         Command::Study {
             action: Some(StudyAction::Merge { dirs, out }),

@@ -224,3 +224,31 @@ fn every_bundled_model_simulates_and_plots() {
         assert_svg(&out.join("coordinates.svg"), &names);
     }
 }
+
+/// `crr check --plot DIR` into a folder that holds an earlier check's plots is refused (exit 2,
+/// naming the folder and a file) unless `--force`, which replaces them; the refused run leaves
+/// the earlier plots as they were.
+#[test]
+fn check_plot_does_not_overwrite_without_force() {
+    let out = scratch("plot_check_force");
+    let args = |force: bool| {
+        let mut a = vec![
+            "check",
+            "examples/models/single_block.toml",
+            "--plot",
+            out.to_str().unwrap(),
+        ];
+        if force {
+            a.push("--force");
+        }
+        crr(&a)
+    };
+    assert!(args(false).status.success());
+    let before = std::fs::read(out.join("housner.svg")).unwrap();
+    let o = args(false);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("pass --force"), "{err}");
+    assert_eq!(std::fs::read(out.join("housner.svg")).unwrap(), before);
+    assert!(args(true).status.success());
+}

@@ -288,7 +288,10 @@ impl TableOptions {
 
 fn read_text(path: &Path) -> Result<String, GroundMotionError> {
     match crate::input::read_regular_file(path, crate::input::DATA_FILE_LIMIT) {
-        Ok(bytes) => Ok(String::from_utf8_lossy(&bytes).into_owned()),
+        Ok(bytes) => {
+            let text = String::from_utf8_lossy(&bytes);
+            Ok(text.strip_prefix('\u{feff}').unwrap_or(&text).to_string())
+        }
         Err(error) => Err(GroundMotionError::Io {
             path: path.display().to_string(),
             error,
@@ -523,6 +526,9 @@ pub fn parse_table(
     source: &str,
     options: &TableOptions,
 ) -> Result<Record, GroundMotionError> {
+    // A UTF-8 byte-order mark (spreadsheets write one) is not part of the first field: left in,
+    // it made a headerless file's first line look like a header, and its sample was lost.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let err = |line: usize, message: String| GroundMotionError::Parse {
         path: source.to_string(),
         line,

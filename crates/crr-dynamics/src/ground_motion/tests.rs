@@ -204,6 +204,18 @@ fn non_increasing_times_error_names_line() {
     assert!(e.to_string().contains("strictly increasing"), "{e}");
 }
 
+/// A headerless CSV that starts with a UTF-8 byte-order mark keeps its first sample (the issue:
+/// the mark made the first line look like a header and it was dropped).
+#[test]
+fn a_byte_order_mark_keeps_the_first_sample() {
+    let opts = TableOptions::new(RecordFormat::Csv, Units::MetersPerSecondSquared);
+    let plain = parse_table("0,1.5\n0.01,2\n0.02,3\n", "a.csv", &opts).unwrap();
+    let marked = parse_table("\u{feff}0,1.5\n0.01,2\n0.02,3\n", "a.csv", &opts).unwrap();
+    assert_eq!(marked.len(), 3);
+    assert_eq!(marked.accel(), plain.accel());
+    assert_eq!(marked.times().collect::<Vec<_>>(), vec![0.0, 0.01, 0.02]);
+}
+
 #[test]
 fn table_errors() {
     let opts = TableOptions::new(RecordFormat::Csv, Units::MetersPerSecondSquared);
