@@ -469,6 +469,11 @@ impl Simulation<'_> {
             });
         }
         if let Some(mode) = &mode {
+            // The structure leaves rest only when every joint was seated: a joint seated at an
+            // impact and released at once while others rock (the end of free rocking) is no
+            // uplift of the structure (`uplift_time` stays null for a run released from rest
+            // angles).
+            let from_rest = self.seated.iter().all(|&s| s);
             for &(s, side) in mode {
                 self.seated[s] = false;
                 self.dynamics.pivots.sides[s] = side;
@@ -476,7 +481,9 @@ impl Simulation<'_> {
             self.dynamics.seated = (0..self.model.slot_count)
                 .filter(|&s| self.seated[s])
                 .collect();
-            self.uplift_time.get_or_insert(self.t);
+            if from_rest {
+                self.uplift_time.get_or_insert(self.t);
+            }
             self.reset_solver();
         }
         Ok(mode)
