@@ -426,6 +426,20 @@ pub fn parse_acceleration(text: &str, option: &str) -> Result<f64, String> {
     Ok(v)
 }
 
+/// Most points of one range (`--amplitudes`, `--frequencies`, each axis of `--grid`): each is a
+/// whole run, and their results are held until written.
+pub const MAX_RANGE_POINTS: usize = 100_000;
+
+/// Most cases of a basins grid (angle points × rate points).
+pub const MAX_GRID_CASES: usize = 1_000_000;
+
+/// Most section points or transient periods (`--periods`, `--transient`): a run keeps every
+/// section point.
+pub const MAX_PERIODS: usize = 10_000_000;
+
+/// Longest simulated time of one run, (transient + periods)/F (s).
+pub const MAX_SECTION_TIME: f64 = 1e7;
+
 /// Parses `start:end:count`, each endpoint with `value` (which names the option in its errors).
 pub fn parse_range(
     text: &str,
@@ -444,6 +458,12 @@ pub fn parse_range(
     if count == 0 {
         return Err(format!(
             "{option}: the count must be at least 1, got 0 (START:END:COUNT)"
+        ));
+    }
+    if count > MAX_RANGE_POINTS {
+        return Err(format!(
+            "{option}: the count {count} is more than {MAX_RANGE_POINTS} points (START:END:COUNT): \
+             each point is a whole run"
         ));
     }
     Ok(Range {
@@ -633,6 +653,21 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, InputErr
     if opts.periods == 0 {
         return Err(arg("--periods must be at least 1, got 0".into()));
     }
+    for (name, value) in [("--periods", opts.periods), ("--transient", opts.transient)] {
+        if value > MAX_PERIODS {
+            return Err(arg(format!(
+                "{name} must be at most {MAX_PERIODS}, got {value}: the run keeps every section point"
+            )));
+        }
+    }
+    if let Sweep::Grid { angle, rate } = &opts.sweep
+        && angle.count.saturating_mul(rate.count) > MAX_GRID_CASES
+    {
+        return Err(arg(format!(
+            "--grid asks for {} × {} cases, more than {MAX_GRID_CASES}",
+            angle.count, rate.count
+        )));
+    }
     if opts.jobs == Some(0) {
         return Err(arg("--jobs must be at least 1, got 0".into()));
     }
@@ -700,6 +735,17 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, InputErr
         // Unforced: F plays no part.
         (None, _) => 1.0,
     };
+    let lowest = match opts.sweep {
+        Sweep::Frequencies(r) => r.start.min(r.end),
+        _ => frequency,
+    };
+    let section_time = (opts.transient + opts.periods) as f64 / lowest;
+    if kind == SectionKind::Stroboscopic && !(section_time <= MAX_SECTION_TIME) {
+        return Err(arg(format!(
+            "(transient + periods) / F = {section_time:e} s at F = {lowest:e} Hz: more than {MAX_SECTION_TIME:e} s \
+             of simulated time per run; raise the frequency or lower --periods/--transient"
+        )));
+    }
     if opts.duration.is_some() && kind == SectionKind::Stroboscopic {
         return Err(arg(
             "--duration applies to a crossing section (--section COORD, or --amplitude 0) only: \
