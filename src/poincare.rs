@@ -740,7 +740,9 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, InputErr
         _ => frequency,
     };
     let section_time = (opts.transient + opts.periods) as f64 / lowest;
-    if kind == SectionKind::Stroboscopic && !(section_time <= MAX_SECTION_TIME) {
+    if kind == SectionKind::Stroboscopic
+        && (section_time.is_nan() || section_time > MAX_SECTION_TIME)
+    {
         return Err(arg(format!(
             "(transient + periods) / F = {section_time:e} s at F = {lowest:e} Hz: more than {MAX_SECTION_TIME:e} s \
              of simulated time per run; raise the frequency or lower --periods/--transient"
