@@ -111,3 +111,27 @@ fn records_scale_to_spectral_levels_and_the_impact_law_is_replaced() {
     let err = Study::load(&bad).unwrap_err().to_string();
     assert!(err.contains("impact"), "{err}");
 }
+
+/// A range whose count is not a whole number ≥ 1 is refused with its own message (issue:
+/// `count = -3` said "data did not match any variant of untagged enum Values").
+#[test]
+fn a_range_count_below_one_is_named() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("study_bad_count");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
+    for (count, shown) in [("-3", "-3"), ("0", "0"), ("2.5", "2.5")] {
+        let text = format!(
+            "name = \"bad\"\nmodel = \"{}\"\nduration = 1.0\n\n[pulses]\nkind = \"one_sine_pulse\"\n\
+             amplitude_ratios = {{ from = 1.0, to = 2.0, count = {count} }}\n\
+             frequency_ratios = {{ from = 1.0, to = 2.0, count = 2 }}\n",
+            model.display()
+        );
+        let bad = write(&dir, "bad.toml", &text);
+        let err = Study::load(&bad).unwrap_err().to_string();
+        assert!(
+            err.contains(&format!(
+                "count must be a whole number ≥ 1 in {{ from, to, count }}, got {shown}"
+            )),
+            "{count}: {err}"
+        );
+    }
+}

@@ -13,7 +13,7 @@ use crate::InputError;
 /// A list of values: explicit (`[0.1, 0.2]`) or evenly spaced (`{ from, to, count }`, both ends
 /// included).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(untagged, try_from = "RawValues")]
 pub enum Values {
     /// The values as given.
     List(Vec<f64>),
@@ -26,6 +26,37 @@ pub enum Values {
         /// Number of values (≥ 1).
         count: usize,
     },
+}
+
+/// [`Values`] as written, with any number as the count, so that a count that is not a whole
+/// number ≥ 1 gets its own error instead of serde's "did not match any variant".
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawValues {
+    List(Vec<f64>),
+    Range { from: f64, to: f64, count: f64 },
+}
+
+impl TryFrom<RawValues> for Values {
+    type Error = String;
+
+    fn try_from(raw: RawValues) -> Result<Self, String> {
+        match raw {
+            RawValues::List(v) => Ok(Values::List(v)),
+            RawValues::Range { from, to, count } => {
+                if !(count >= 1.0 && count.fract() == 0.0 && count <= usize::MAX as f64) {
+                    return Err(format!(
+                        "count must be a whole number ≥ 1 in {{ from, to, count }}, got {count}"
+                    ));
+                }
+                Ok(Values::Range {
+                    from,
+                    to,
+                    count: count as usize,
+                })
+            }
+        }
+    }
 }
 
 impl Values {
