@@ -323,3 +323,23 @@ fn bundled_studies_load() {
     let e = Study::load(&bad).unwrap_err().to_string();
     assert!(e.contains("scales") && e.contains("> 0"), "{e}");
 }
+
+/// A Sa(T₁) study's levels are its `sa_g` column, not the scale factor (issue: the fragility of an
+/// Sa study was fitted against the factor and its axis labelled so).
+#[test]
+fn a_spectral_acceleration_study_is_read_against_sa() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("products_sa");
+    let _ = std::fs::remove_dir_all(&dir);
+    write(&dir, "study.json", "{\"name\": \"sa\"}");
+    write(
+        &dir,
+        "cases.csv",
+        "id,record,sa_g,factor,status,collapse\n\
+         c0,\"a.AT2\",0.2,0.5,ok,0\n\
+         c1,\"a.AT2\",0.4,1,ok,1\n",
+    );
+    let r = crr::study::products::StudyResults::read(&dir).unwrap();
+    assert_eq!(r.intensity.as_deref(), Some("sa_g"));
+    let levels: Vec<Option<f64>> = r.cases.iter().map(|c| c.level).collect();
+    assert_eq!(levels, vec![Some(0.2), Some(0.4)]);
+}

@@ -120,8 +120,9 @@ impl StudyResults {
         let status = col("status").ok_or_else(|| bad("no `status` column".into()))?;
         let pulses = col("amplitude_m_s2").is_some();
         let ratio_cols = (col("frequency_ratio"), col("amplitude_ratio"));
-        // The level's column comes before the `factor` column in records studies.
-        let intensity = ["pga_g", "pgv_m_s", "factor"]
+        // The level's column comes before the `factor` column in records studies (Sa(T₁) too:
+        // its fragility is fitted against Sa, not against the scale factor).
+        let intensity = ["pga_g", "pgv_m_s", "sa_g", "factor"]
             .into_iter()
             .find(|n| !pulses && col(n).is_some())
             .map(String::from);
