@@ -65,7 +65,12 @@ pub(super) fn opening_mode_in(
 ) -> Option<Vec<(usize, Side)>> {
     let local = opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot);
     let rate_scale = (model.gravity / model.size).sqrt();
+    // On open chains the single releases are exact: every mechanism of a tree of one-support
+    // joints is a positive combination of single-joint openings, and a ratio of two linear
+    // forms (the loads' and the weight's power) is least at an extreme ray; a block cannot lift
+    // off its only support under less than g. The global test is for loops.
     if local.is_some()
+        || model.constraint_rows == 0
         || template.seated.len() < model.slot_count
         || qdot.amax() > 1e-12 * rate_scale
     {
