@@ -89,9 +89,10 @@ pub fn static_multiplier_with(
     };
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
     let required = match (collapse.lambda, friction) {
-        (Some(_), None) => {
-            required_friction(model, direction, options.lambda_max).map_err(|e| e.to_string())?
-        }
+        (Some(lambda), None) => Some(
+            required_friction(model, direction, options.lambda_max, lambda)
+                .map_err(|e| e.to_string())?,
+        ),
         _ => None,
     };
     Ok(report(model, &collapse, required))
@@ -157,7 +158,7 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         .flat_map(|i| i.sides.iter())
         .map(|&(slot, side)| {
             (
-                slot_name(model, slot),
+                model.slot_name(slot),
                 match side {
                     Side::Positive => "+".to_string(),
                     Side::Negative => "-".to_string(),
@@ -180,21 +181,4 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         mechanism,
         required_friction: friction,
     }
-}
-
-/// The name of a pivot slot: its interface's name, with `.1`/`.2` for the tilts of a rocking base
-/// (the names of `crr inspect`; a closure's slots are named like a tree interface's).
-fn slot_name(model: &Model, slot: usize) -> String {
-    model
-        .interfaces
-        .iter()
-        .find(|i| i.slots.contains(&slot))
-        .map(|i| {
-            if i.slots.len() > 1 {
-                format!("{}.{}", i.name, slot - i.slots.start + 1)
-            } else {
-                i.name.clone()
-            }
-        })
-        .unwrap_or_else(|| format!("slot {slot}"))
 }

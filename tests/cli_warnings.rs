@@ -71,24 +71,10 @@ fn assert_reported(tag: &str, summary: &serde_json::Value, stderr: &str) {
 /// it went on and only warned that the energy balance was off), with the partial results kept.
 #[test]
 fn a_long_rk4_step_stops_the_run_at_the_missed_impact() {
-    let dir = scratch("rk4");
-    let model = dir.join("model.toml");
-    std::fs::write(
-        &model,
-        single_block_with("duration = 5.0\nmethod = \"rk4\"\nrk4_step = 10.0"),
-    )
-    .unwrap();
-    let out = dir.join("out");
-    let o = crr(&[
-        "simulate",
-        model.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--force",
-    ]);
-    assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let (err, out) = common::simulate_failing(
+        "rk4",
+        &single_block_with("duration = 5.0\nmethod = \"rk4\"\nrk4_step = 10.0"),
+    );
     assert!(
         err.contains("the angle \"base\"") && err.contains("wrong side of its pivot"),
         "{err}"
@@ -227,24 +213,10 @@ fn settings_beyond_the_physics_are_refused_and_a_loose_rtol_warns() {
         ("collapse_drop = 2.0", "collapse_drop"),
         ("rtol = 1.0", "rtol"),
     ] {
-        let dir = scratch(&format!("bounds_{word}"));
-        let model = dir.join("model.toml");
-        std::fs::write(
-            &model,
-            single_block_with(&format!("duration = 1.0\n{setting}")),
-        )
-        .unwrap();
-        let out = dir.join("out");
-        let o = crr(&[
-            "simulate",
-            model.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-            "--force",
-        ]);
-        assert!(!o.status.success(), "{setting} was accepted");
-        let err = String::from_utf8_lossy(&o.stderr);
+        let (err, _) = common::simulate_failing(
+            &format!("bounds_{word}"),
+            &single_block_with(&format!("duration = 1.0\n{setting}")),
+        );
         assert!(
             err.contains(word) && err.contains("default"),
             "{setting}: {err}"

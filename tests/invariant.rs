@@ -6,23 +6,10 @@
 //! error, with the results until then kept ("completed": false).
 mod common;
 
-use std::path::Path;
-
 #[test]
 fn a_loose_tolerance_is_an_error_not_a_false_collapse() {
     let text = common::bundled_text("trilithon") + "\n[analysis]\nrtol = 1e-3\n";
-    let path = common::write_model("trilithon_loose", &text);
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("invariant_trilithon");
-    let o = common::crr(&[
-        "simulate",
-        path.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--force",
-    ]);
-    assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
+    let (err, out) = common::simulate_failing("trilithon_loose", &text);
     assert!(err.contains("tighten analysis.rtol"), "{err}");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();

@@ -85,3 +85,22 @@ pub fn write_model(tag: &str, text: &str) -> PathBuf {
     std::fs::write(&path, text).unwrap();
     path
 }
+
+/// Runs `crr simulate` on `text` (written as `<tag>.toml` in the scratch folder `models`) into a
+/// fresh folder, expects it to fail, and returns its stderr and the results folder (the partial
+/// results a failed run keeps).
+#[allow(dead_code)]
+pub fn simulate_failing(tag: &str, text: &str) -> (String, PathBuf) {
+    let path = write_model(tag, text);
+    let out = scratch(&format!("failing_{tag}"));
+    let o = crr(&[
+        "simulate",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--force",
+    ]);
+    assert!(!o.status.success(), "{tag}: the run was accepted");
+    (String::from_utf8_lossy(&o.stderr).into_owned(), out)
+}

@@ -327,23 +327,16 @@ fn physical(collapse: &Collapse, free: &[bool]) -> bool {
 }
 
 /// The smallest Coulomb friction coefficient (pyramid on each tangent, exact for planar loads)
-/// at which the collapse multiplier along `direction` reaches (1 − 1e-6) of its value without
-/// sliding: the friction the no-sliding answer relies on. `None` when the structure holds up to
-/// `lambda_max` without sliding; 0 when it needs none.
+/// at which the collapse multiplier along `direction` reaches (1 − 1e-6) of `lambda`, its value
+/// without sliding ([`collapse_multiplier`]'s answer, which the caller has): the friction the
+/// no-sliding answer relies on. 0 when it needs none, infinity beyond μ = 1000.
 pub fn required_friction(
     model: &Model,
     direction: Vector3<f64>,
     lambda_max: f64,
-) -> Result<Option<f64>, StaticsError> {
-    let no_sliding = StaticsOptions {
-        friction: Friction::NoSliding,
-        lambda_max,
-        sliding_lift_off: true,
-    };
-    let Some(target) = collapse_multiplier(model, direction, &no_sliding)?.lambda else {
-        return Ok(None);
-    };
-    let target = target - 1e-6 * target.abs();
+    lambda: f64,
+) -> Result<f64, StaticsError> {
+    let target = lambda - 1e-6 * lambda.abs();
     let reaches = |mu: f64| -> Result<bool, StaticsError> {
         let options = StaticsOptions {
             friction: Friction::Pyramid(mu),
@@ -357,7 +350,7 @@ pub fn required_friction(
         }
     };
     if reaches(0.0)? {
-        return Ok(Some(0.0));
+        return Ok(0.0);
     }
     let mut low = 0.0;
     let mut high = 0.25;
@@ -365,7 +358,7 @@ pub fn required_friction(
         low = high;
         high *= 2.0;
         if high > 1e3 {
-            return Ok(Some(f64::INFINITY));
+            return Ok(f64::INFINITY);
         }
     }
     // μ to four significant digits.
@@ -377,7 +370,7 @@ pub fn required_friction(
             low = mid;
         }
     }
-    Ok(Some(high))
+    Ok(high)
 }
 
 /// The multipliers along ±x and ±y without sliding.

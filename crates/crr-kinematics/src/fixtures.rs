@@ -401,6 +401,30 @@ pub fn trilithon(b: f64, h: f64, spacing: f64, beam_height: f64, gamma: f64) -> 
     }
 }
 
+/// A voussoir of a semicircular arch in the x–z plane: the annular sector of `radii` = (inner,
+/// outer, depth along y) between the angles `span` = (from, to) from +x, turning about −y (the
+/// convention of `examples/models/arch.toml`).
+fn voussoir(name: &str, density: f64, radii: (f64, f64, f64), span: (f64, f64)) -> BodySpec {
+    BodySpec {
+        name: name.into(),
+        density: Some(density),
+        mass: None,
+        box_shape: None,
+        polyhedron: None,
+        prism: None,
+        annular_sector: Some(AnnularSectorShape {
+            center: [0.0, 0.0, 0.0],
+            axis: [0.0, -1.0, 0.0],
+            inner_radius: radii.0,
+            outer_radius: radii.1,
+            start: [1.0, 0.0, 0.0],
+            from_angle: span.0,
+            to_angle: span.1,
+            thickness: radii.2,
+        }),
+    }
+}
+
 /// A semicircular arch of three voussoirs (annular sectors of radii `r_in`, `r_out`, depth
 /// `depth` along y, springings on z = 0 at x = ±r) with joints at 0°, 60°, 120° and 180° from
 /// the +x springing. With `two_sided`, every joint can pivot on its intrados or extrados (P⁺ and
@@ -411,23 +435,9 @@ pub fn four_hinge_arch(r_in: f64, r_out: f64, depth: f64, two_sided: bool) -> St
     let deg = std::f64::consts::PI / 180.0;
     let names = ["v1", "v2", "v3"];
     let body: Vec<BodySpec> = (0..3)
-        .map(|k| BodySpec {
-            name: names[k].into(),
-            density: Some(2200.0),
-            mass: None,
-            box_shape: None,
-            polyhedron: None,
-            prism: None,
-            annular_sector: Some(AnnularSectorShape {
-                center: [0.0, 0.0, 0.0],
-                axis: [0.0, -1.0, 0.0],
-                inner_radius: r_in,
-                outer_radius: r_out,
-                start: [1.0, 0.0, 0.0],
-                from_angle: 60.0 * deg * k as f64,
-                to_angle: 60.0 * deg * (k + 1) as f64,
-                thickness: depth,
-            }),
+        .map(|k| {
+            let (from, to) = (60.0 * deg * k as f64, 60.0 * deg * (k + 1) as f64);
+            voussoir(names[k], 2200.0, (r_in, r_out, depth), (from, to))
         })
         .collect();
     let coms: Vec<Vector3<f64>> = body.iter().map(centroid).collect();
@@ -719,27 +729,19 @@ pub fn voussoir_arch(n: usize, r_in: f64, r_out: f64, depth: f64) -> StructureSp
     assert!(n >= 1, "an arch needs at least one voussoir");
     let step = std::f64::consts::PI / n as f64;
     let body: Vec<BodySpec> = (0..n)
-        .map(|k| BodySpec {
-            name: format!("v{}", k + 1),
-            density: Some(MASONRY_DENSITY),
-            mass: None,
-            box_shape: None,
-            polyhedron: None,
-            prism: None,
-            annular_sector: Some(AnnularSectorShape {
-                center: [0.0, 0.0, 0.0],
-                axis: [0.0, -1.0, 0.0],
-                inner_radius: r_in,
-                outer_radius: r_out,
-                start: [1.0, 0.0, 0.0],
-                from_angle: step * k as f64,
-                to_angle: if k + 1 == n {
-                    std::f64::consts::PI
-                } else {
-                    step * (k + 1) as f64
-                },
-                thickness: depth,
-            }),
+        .map(|k| {
+            let to = if k + 1 == n {
+                std::f64::consts::PI
+            } else {
+                step * (k + 1) as f64
+            };
+            let name = format!("v{}", k + 1);
+            voussoir(
+                &name,
+                MASONRY_DENSITY,
+                (r_in, r_out, depth),
+                (step * k as f64, to),
+            )
         })
         .collect();
     // The point at radius r on the joint j (angle jπ/n, exact at the springings).

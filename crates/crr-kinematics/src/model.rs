@@ -896,6 +896,22 @@ impl Model {
         self.coords.len()
     }
 
+    /// The name of a pivot slot: its interface's name, with `.1`/`.2` for the tilts of a rocking
+    /// base (the names of `crr inspect`; a closure's slots are named like a tree interface's).
+    pub fn slot_name(&self, slot: usize) -> String {
+        self.interfaces
+            .iter()
+            .find(|i| i.slots.contains(&slot))
+            .map(|i| {
+                if i.slots.len() > 1 {
+                    format!("{}.{}", i.name, slot - i.slots.start + 1)
+                } else {
+                    i.name.clone()
+                }
+            })
+            .unwrap_or_else(|| format!("slot {slot}"))
+    }
+
     /// Index of a coordinate by name.
     pub fn coord_index(&self, name: &str) -> Option<usize> {
         self.coords.iter().position(|c| c.name == name)

@@ -386,8 +386,11 @@ struct Workspaces {
     impact: ImpactBuffers,
     /// The impact laws' buffers.
     laws: crate::laws::LawWorkspace,
-    /// The slot angles of the invariant's check.
+    /// The slot angles, q and the closure rows' scale of the invariant's check (no allocation
+    /// per step).
     invariant_angles: Vec<f64>,
+    invariant_q: DVector<f64>,
+    constraint_scale: DVector<f64>,
 }
 
 /// Largest `seat_rate` as a fraction of the structure's rate scale √(g/L): a joint rocking at a
@@ -435,22 +438,6 @@ fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), Simul
         )));
     }
     Ok(())
-}
-
-/// A slot's name for messages: its interface's name, with `.1`/`.2` for a rocking base's tilts.
-fn slot_label(model: &Model, slot: usize) -> String {
-    model
-        .interfaces
-        .iter()
-        .find(|i| i.slots.contains(&slot))
-        .map(|i| {
-            if i.slots.len() > 1 {
-                format!("\"{}.{}\"", i.name, slot - i.slots.start + 1)
-            } else {
-                format!("\"{}\"", i.name)
-            }
-        })
-        .unwrap_or_else(|| format!("of slot {slot}"))
 }
 
 impl<'a> Simulation<'a> {
@@ -547,6 +534,8 @@ impl<'a> Simulation<'a> {
                 impact: ImpactBuffers::default(),
                 laws: Default::default(),
                 invariant_angles: Vec::with_capacity(model.slot_count),
+                invariant_q: DVector::zeros(model.dof()),
+                constraint_scale: crr_dynamics::eom::constraint_row_scale(model),
             },
             parts: model.parts(),
             y,
@@ -678,21 +667,16 @@ impl<'a> Simulation<'a> {
         angles.extend_from_slice(&self.y[..n]);
         angles.resize(model.slot_count, 0.0);
         if model.constraint_rows > 0 {
-            let q = self.q();
-            forward_kinematics(model, &mut self.out_kin, &q, &self.dynamics.pivots);
+            let q = &mut self.spare.invariant_q;
+            assign(q, &self.y[..n]);
+            forward_kinematics(model, &mut self.out_kin, q, &self.dynamics.pivots);
             closure_angles(model, &self.out_kin, &mut angles[n..]);
-            crr_kinematics::constraint_residual(
-                model,
-                &mut self.out_kin,
-                &self.dynamics.pivots,
-                &q,
-            );
-            let scale = crr_dynamics::eom::constraint_row_scale(model);
+            crr_kinematics::constraint_residual(model, &mut self.out_kin, &self.dynamics.pivots, q);
             let residual = self
                 .out_kin
                 .phi
                 .iter()
-                .zip(scale.iter())
+                .zip(self.spare.constraint_scale.iter())
                 .map(|(r, s)| (r * s).abs())
                 .fold(0.0, f64::max);
             // NaN counts as open.
@@ -721,9 +705,9 @@ impl<'a> Simulation<'a> {
         self.spare.invariant_angles = angles;
         if let Some((s, side, angle)) = broken {
             return Err(SimulationError::Invariant(format!(
-                "at t = {} s the angle {} is {angle:.6} rad while it rocks on its {} pivot: the state is on the wrong side of its pivot (an impact was missed); {}",
+                "at t = {} s the angle \"{}\" is {angle:.6} rad while it rocks on its {} pivot: the state is on the wrong side of its pivot (an impact was missed); {}",
                 self.t,
-                slot_label(model, s),
+                model.slot_name(s),
                 match side {
                     Side::Positive => "+",
                     Side::Negative => "-",
