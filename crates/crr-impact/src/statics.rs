@@ -789,9 +789,8 @@ impl RestStatics {
     ) -> Result<Option<&Collapse>, StaticsError> {
         let g = model.gravity;
         let magnitude = a.norm();
-        if magnitude == 0.0 || !magnitude.is_finite() {
-            return Ok(None);
-        }
+        // The axes first: a structure that cannot stand under its own weight has no collapse
+        // set to be inside of, even under no load (the caller's local test decides then).
         let axes = match self.axes {
             Some(axes) => axes,
             None => {
@@ -807,13 +806,25 @@ impl RestStatics {
                 .into_iter()
                 .enumerate()
                 {
-                    let c = collapse_multiplier(model, d, &StaticsOptions::default())?;
-                    axes[k] = c.lambda.unwrap_or(LAMBDA_MAX);
+                    // A structure that cannot stand: 0 (kept, so the programs run once).
+                    axes[k] = match collapse_multiplier(model, d, &StaticsOptions::default()) {
+                        Ok(c) => c.lambda.unwrap_or(LAMBDA_MAX),
+                        Err(StaticsError::DoesNotHold(_)) => 0.0,
+                        Err(e) => return Err(e),
+                    };
                 }
                 self.axes = Some(axes);
                 axes
             }
         };
+        if axes.iter().any(|&l| l <= 0.0) {
+            return Err(StaticsError::DoesNotHold(
+                "the structure does not stand under its own weight".into(),
+            ));
+        }
+        if magnitude == 0.0 || !magnitude.is_finite() {
+            return Ok(None);
+        }
         let hull: f64 = (0..3)
             .map(|k| {
                 let lambda = if a[k] >= 0.0 {

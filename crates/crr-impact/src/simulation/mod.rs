@@ -31,6 +31,7 @@ use crr_dynamics::roots::sign_change;
 use crr_dynamics::{ConstrainedSystem, InitialState};
 use crr_kinematics::short_copy::{assign, copy_short, extend_short};
 use crr_kinematics::spec::ImpactLaw;
+use crr_kinematics::velocity::point_bias_acceleration;
 use crr_kinematics::{
     ActivePivots, Data, InterfaceKind, Model, Side, closure_angles, forward_kinematics,
     potential_energy,

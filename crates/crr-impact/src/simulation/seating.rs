@@ -2,6 +2,7 @@
 //! by single releases and an active set), releasing them, and seating joints that come to rest.
 
 use super::*;
+use nalgebra::Vector3;
 
 /// Finds the interfaces that open from a seated state at (t, q, q̇): releasing a seated slot on a
 /// side must give it an opening acceleration on that side. First every single release is tried
@@ -63,24 +64,37 @@ pub(super) fn opening_mode_in(
     q: &DVector<f64>,
     qdot: &DVector<f64>,
 ) -> Option<Vec<(usize, Side)>> {
-    let local = opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot);
     let rate_scale = (model.gravity / model.size).sqrt();
     // On open chains the single releases are exact: every mechanism of a tree of one-support
     // joints is a positive combination of single-joint openings, and a ratio of two linear
     // forms (the loads' and the weight's power) is least at an extreme ray; a block cannot lift
     // off its only support under less than g. The global test is for loops.
-    if local.is_some()
-        || model.constraint_rows == 0
+    if model.constraint_rows == 0
         || template.seated.len() < model.slot_count
         || qdot.amax() > 1e-12 * rate_scale
     {
-        return local;
+        return opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot);
     }
     let a = ground.acceleration(t);
-    // A failed program leaves the local answer standing (it has held every bundled case).
-    let Ok(Some(collapse)) = rest.global.exceeded(model, &a) else {
-        return local;
+    // The linear program decides first: a load inside the collapse set holds (static theorem: a
+    // compressive equilibrium exists, so no mechanism of the CRR model, each one admissible on
+    // the contact faces, has positive power), and then no local search is needed; most instants
+    // at rest cost no solve at all (the load inside the cached octahedron of the six axis
+    // multipliers). A failed program leaves the decision to the local test.
+    let collapse = match rest.global.exceeded(model, &a) {
+        Ok(None) => return None,
+        Ok(Some(collapse)) => collapse.clone(),
+        Err(_) => {
+            return opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot);
+        }
     };
+    // Beyond the multiplier the local test gives the opening accelerations' own mode when it
+    // finds one; the mechanism's sides open otherwise.
+    if let Some(local) =
+        opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot)
+    {
+        return Some(local);
+    }
     let lifting: Vec<String> = collapse.lifting_off().map(|i| i.name.clone()).collect();
     let sides: Vec<(usize, Side)> = collapse
         .interfaces
@@ -400,19 +414,32 @@ fn releases_that_may_open(
     Some(may_open)
 }
 
-/// [`releases_that_may_open`] on a structure with loops, for the releases on the current sides
-/// (those on the other sides are all solved).
+/// [`releases_that_may_open`] on a structure with loops.
 ///
-/// With every seated slot held, the seated rows and the closure rows B carry multipliers with
-/// M q̈ = Q + Bᵀλ. Releasing seated slot k alone removes its row bₖ. If bₖ is in the span of the
-/// other rows the motion does not change and the release cannot open. Otherwise every λ that
-/// solves the locked problem has the same component λₖ (a self-stress state ν, Bᵀν = 0, has
-/// νₖ = 0, or bₖ would be a combination of the others), and the release changes q̈ along the
-/// one new direction d of the admissible accelerations, d the part of M⁻¹bₖ M-orthogonal to the
-/// other rows' span, so that the released slot's acceleration is bₖ·Δq̈ = −λₖ (bₖ·d) with
-/// bₖ·d > 0: it opens on its side σ only if −σλₖ > 0, whichever solution of the locked problem
-/// gave λ. Reactions within 1e-9 of the largest of the closing sign are solved all the same
-/// (round-off of a near-dependent row), so no release that opens is skipped.
+/// **Current sides.** With every seated slot held, the seated rows and the closure rows B carry
+/// multipliers with M q̈ = Q + Bᵀλ. Releasing seated slot k alone removes its row bₖ. If bₖ is in
+/// the span of the other rows the motion does not change and the release cannot open. Otherwise
+/// every λ that solves the locked problem has the same component λₖ (a self-stress state ν,
+/// Bᵀν = 0, has νₖ = 0, or bₖ would be a combination of the others), and the release changes q̈
+/// along the one new direction d of the admissible accelerations, d the part of M⁻¹bₖ
+/// M-orthogonal to the other rows' span, so that the released slot's acceleration is
+/// bₖ·Δq̈ = −λₖ (bₖ·d) with bₖ·d > 0: it opens on its side σ only if −σλₖ > 0, whichever solution
+/// of the locked problem gave λ.
+///
+/// **Other sides.** Gauss' principle says the same in body space: releasing k adds one direction
+/// d′ to the admissible accelerations, and the release opens along d′ only if the locked
+/// structure's constraint forces R = M_b a − f do negative power on it (the Gauss function's
+/// gradient at the locked motion is R, which does no power on the locked directions, so any d′
+/// with the same opening rate gives the same power). A tree coordinate k at its seat (qₖ = q̇ₖ = 0)
+/// turned about the other pivot P′ moves its subtree as a rotation about P plus the translation
+/// t = u × (P − P′) per unit rate, so that its reaction there is rₖ′ = rₖ + t·fₖ, fₖ the force the
+/// joint passes to its subtree: the subtree's Σ mᵢ(aᵢ − g_eff) less the closure forces λ on its
+/// point rows (a loop's point row moves with the translation when one of its two frames is in
+/// the subtree; angle rows, seated slot rows and symmetry rows do not). The release on P′ opens
+/// only if −σ′rₖ′ > 0. As in the open-chain test this is skipped, and the release solved, where
+/// the flip also moves a free coordinate's pivot, or qₖ, q̇ₖ are not at the seat, or the slot is
+/// a closure angle. Reactions within 1e-9 of the largest of the closing sign are solved all the
+/// same (round-off of a near-dependent row), so no release that opens is skipped.
 fn loop_releases_that_may_open(
     model: &Model,
     ground: &GroundMotion,
@@ -433,7 +460,126 @@ fn loop_releases_that_may_open(
         let r = trial.seat_reactions[i];
         may_open[2 * i + usize::from(side == Side::Negative)] = -side.sign() * r > -margin;
     }
+    if !trial.used_articulated_body() {
+        other_side_releases(model, template, trial, q, qdot, margin, &mut may_open);
+    }
     Some(may_open)
+}
+
+/// The other-side part of [`loop_releases_that_may_open`]: marks in `may_open` the releases on
+/// the other pivot that cannot open, from the locked solve in `trial`.
+fn other_side_releases(
+    model: &Model,
+    template: &Dynamics,
+    trial: &Dynamics,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    margin: f64,
+    may_open: &mut [bool],
+) {
+    let rate_scale = (model.gravity / model.size).sqrt();
+    let mut is_seated = vec![false; model.slot_count];
+    for &k in &template.seated {
+        is_seated[k] = true;
+    }
+    let loads = SubtreeLoads::new(model, trial);
+    for (i, &k) in template.seated.iter().enumerate() {
+        if k >= model.dof() || q[k].abs() > 1e-12 || qdot[k].abs() > 1e-12 * rate_scale {
+            continue;
+        }
+        let iface = &model.interfaces[model.coords[k].interface];
+        if iface.slots.clone().any(|s| s != k && !is_seated[s]) {
+            continue;
+        }
+        let other = template.pivots.sides[k].flipped();
+        let (r_other, round_off) =
+            loads.other_side_reaction(model, trial, &template.pivots, k, trial.seat_reactions[i]);
+        may_open[2 * i + usize::from(other == Side::Negative)] =
+            -other.sign() * r_other > -(margin + round_off);
+    }
+}
+
+/// The forces of a locked solve that a seated joint passes to its subtree.
+pub(super) struct SubtreeLoads {
+    /// mᵢ(aᵢ − g_eff) of every body i, aᵢ its centre of mass' acceleration (N).
+    body_force: Vec<Vector3<f64>>,
+}
+
+impl SubtreeLoads {
+    /// From the solve in `trial` (q̈, λ and the kinematics of its state; not the
+    /// articulated-body path, which leaves no bias accelerations).
+    pub(super) fn new(model: &Model, trial: &Dynamics) -> Self {
+        let kin = &trial.kin;
+        let g_eff = trial.effective_gravity();
+        // aᵢ = Σⱼ (uⱼ × (cᵢ − pⱼ)) q̈ⱼ over the coordinates carrying body i, plus the bias
+        // acceleration of cᵢ.
+        let body_force = (0..model.bodies.len())
+            .map(|b| {
+                let frame = model.body_coord[b];
+                let c = kin.com[b];
+                let mut a = point_bias_acceleration(kin, Some(frame), &c);
+                let mut j = Some(frame);
+                while let Some(jj) = j {
+                    a += kin.axis[jj].cross(&(c - kin.pivot[jj])) * trial.qddot[jj];
+                    j = model.coords[jj].parent;
+                }
+                model.bodies[b].mass * (a - g_eff)
+            })
+            .collect();
+        Self { body_force }
+    }
+
+    /// Seated tree coordinate k's reaction rₖ′ on its other pivot P′, from its reaction `r` on
+    /// the current one: rₖ′ = rₖ + t·fₖ, t = u × (P − P′) and fₖ the subtree's Σ mᵢ(aᵢ − g_eff)
+    /// less the closure forces λ on the subtree's side of each loop's point rows. Also returns
+    /// the round-off of the correction (1e-9 |t| |fₖ|).
+    pub(super) fn other_side_reaction(
+        &self,
+        model: &Model,
+        trial: &Dynamics,
+        pivots: &ActivePivots,
+        k: usize,
+        r: f64,
+    ) -> (f64, f64) {
+        let kin = &trial.kin;
+        let in_subtree = |frame: Option<usize>| {
+            let mut j = frame;
+            while let Some(jj) = j {
+                if jj == k {
+                    return true;
+                }
+                j = model.coords[jj].parent;
+            }
+            false
+        };
+        let mut force = Vector3::zeros();
+        for (b, f) in self.body_force.iter().enumerate() {
+            if in_subtree(Some(model.body_coord[b])) {
+                force += f;
+            }
+        }
+        for cl in &model.closures {
+            let closing = &model.interfaces[cl.interface];
+            let a_side = in_subtree(model.frame_of(closing.parent));
+            let b_side = in_subtree(Some(model.body_coord[closing.child]));
+            let share = f64::from(u8::from(a_side)) - f64::from(u8::from(b_side));
+            if share != 0.0 {
+                force -= share * trial.lambda.fixed_rows::<3>(cl.first_row);
+            }
+        }
+        let coord = &model.coords[k];
+        let iface = &model.interfaces[coord.interface];
+        let mut sides = pivots.sides[iface.slots.clone()].to_vec();
+        let local = k - iface.slots.start;
+        sides[local] = sides[local].flipped();
+        let p_rest = iface.kind.pivot(&sides);
+        let pivot = match coord.parent {
+            Some(p) => kin.rot_ops[p] * p_rest + kin.frame_translation[p],
+            None => p_rest,
+        };
+        let shift = kin.axis[k].cross(&(kin.pivot[k] - pivot));
+        (r + shift.dot(&force), 1e-9 * shift.norm() * force.norm())
+    }
 }
 
 impl Simulation<'_> {
@@ -715,5 +861,155 @@ impl Simulation<'_> {
         self.reset_solver();
         self.release_if_opening()?;
         Ok(None)
+    }
+}
+
+#[cfg(test)]
+mod other_side_tests {
+    //! The reaction of a seated joint on its other pivot, rₖ′ = rₖ + t·fₖ (subtree forces), against
+    //! the flipped chain's own equations of motion: its kinematics, M′, h′, Q′ and Φ′_q evaluated
+    //! anew, and row k of M′q̈ + h′ − Q′ − Φ′_qᵀλ − Σ ρₛ row′ₛ with the locked solve's q̈, λ and
+    //! seat reactions ρ (any consistent set of multipliers gives the same value).
+    use nalgebra::DVector;
+
+    use crr_dynamics::eom::{Dynamics, slot_row};
+    use crr_dynamics::ground_motion::GroundMotion;
+    use crr_kinematics::fixtures::{SplitMix, colonnade, random_chain};
+    use crr_kinematics::{ActivePivots, Model, Side};
+
+    use super::SubtreeLoads;
+
+    /// Row k of the equations of motion of `d` (evaluated) at q̈, λ and the seat reactions of
+    /// `locked` (seated closure slots only: tree coordinates' rows are unit rows).
+    fn generalized_reaction(model: &Model, d: &Dynamics, locked: &Dynamics, k: usize) -> f64 {
+        let n = model.dof();
+        let m = &d.kin.mass_matrix;
+        let mut r: f64 = (0..n).map(|j| m[(k, j)] * locked.qddot[j]).sum::<f64>()
+            + d.kin.velocity_product[k]
+            - d.load[k];
+        for row in 0..model.constraint_rows {
+            r -= d.kin.phi_q[(row, k)] * locked.lambda[row];
+        }
+        let mut row = DVector::zeros(n);
+        for (i, &s) in locked.seated.iter().enumerate() {
+            if s >= n {
+                slot_row(model, &d.kin, s, &mut row);
+                r -= row[k] * locked.seat_reactions[i];
+            }
+        }
+        r
+    }
+
+    fn check(model: &Model, seed: u64) -> usize {
+        let n = model.dof();
+        let mut rng = SplitMix(seed);
+        let ground = GroundMotion::none();
+        let mut pivots = ActivePivots::uniform(model, Side::Positive);
+        for s in pivots.sides.iter_mut() {
+            *s = if rng.uniform(0.0, 1.0) < 0.5 {
+                Side::Positive
+            } else {
+                Side::Negative
+            };
+        }
+        // Seat whole interfaces (every slot of a rocking base), about half of them.
+        let mut seated = Vec::new();
+        for iface in &model.interfaces {
+            if rng.uniform(0.0, 1.0) < 0.6 {
+                seated.extend(iface.slots.clone());
+            }
+        }
+        // Rates that keep the loops closed and the seated slots at rest: a random combination of
+        // the null space of [Φ_q; seated rows] at q = 0.
+        let q = DVector::zeros(n);
+        let mut at_rest = Dynamics::new(model, pivots.clone());
+        at_rest.evaluate(model, &ground, 0.0, &q, &DVector::zeros(n));
+        let mut rows: Vec<DVector<f64>> = (0..model.constraint_rows)
+            .map(|r| at_rest.kin.phi_q.row(r).transpose())
+            .collect();
+        for &s in &seated {
+            let mut row = DVector::zeros(n);
+            slot_row(model, &at_rest.kin, s, &mut row);
+            rows.push(row);
+        }
+        let mut qdot = DVector::zeros(n);
+        if rows.is_empty() {
+            qdot = DVector::from_fn(n, |_, _| rng.uniform(-0.3, 0.3));
+        } else {
+            let b = nalgebra::DMatrix::from_rows(
+                &rows.iter().map(|r| r.transpose()).collect::<Vec<_>>(),
+            );
+            let full = b.transpose() * &b;
+            let eig = full.symmetric_eigen();
+            let top = eig.eigenvalues.amax().max(1e-300);
+            for (i, &l) in eig.eigenvalues.iter().enumerate() {
+                if l <= 1e-12 * top {
+                    qdot += eig.eigenvectors.column(i) * rng.uniform(-0.3, 0.3);
+                }
+            }
+        }
+        let mut locked = Dynamics::new(model, pivots.clone());
+        locked.seated = seated.clone();
+        if locked
+            .accelerations(model, &ground, 0.0, &q, &qdot)
+            .is_err()
+        {
+            return 0;
+        }
+        let scale = locked.seat_reactions.amax().max(1.0);
+        // The seated slots are held (q̈ₖ = 0), which the identity needs.
+        for &k in seated.iter().filter(|&&k| k < n) {
+            assert!(
+                locked.qddot[k].abs() <= 1e-9,
+                "{}: q̈ = {}",
+                model.slot_name(k),
+                locked.qddot[k]
+            );
+        }
+        let loads = SubtreeLoads::new(model, &locked);
+        let mut checked = 0;
+        for (i, &k) in seated.iter().enumerate() {
+            if k >= n {
+                continue;
+            }
+            // The generalized route on the current chain gives the solve's own reaction.
+            let mut same = Dynamics::new(model, pivots.clone());
+            same.evaluate(model, &ground, 0.0, &q, &qdot);
+            let r_same = generalized_reaction(model, &same, &locked, k);
+            assert!(
+                (r_same - locked.seat_reactions[i]).abs() <= 1e-9 * scale,
+                "{}: {r_same} against the solve's {}",
+                model.slot_name(k),
+                locked.seat_reactions[i]
+            );
+            let mut flipped_pivots = pivots.clone();
+            flipped_pivots.sides[k] = pivots.sides[k].flipped();
+            let mut flipped = Dynamics::new(model, flipped_pivots);
+            flipped.evaluate(model, &ground, 0.0, &q, &qdot);
+            let expected = generalized_reaction(model, &flipped, &locked, k);
+            let (r_other, _) =
+                loads.other_side_reaction(model, &locked, &pivots, k, locked.seat_reactions[i]);
+            assert!(
+                (r_other - expected).abs() <= 1e-9 * scale,
+                "{}: subtree forces give {r_other}, the flipped chain {expected}",
+                model.slot_name(k)
+            );
+            checked += 1;
+        }
+        checked
+    }
+
+    #[test]
+    fn other_pivot_reaction_matches_the_flipped_chain() {
+        let mut checked = 0;
+        for seed in 0..40 {
+            let model = Model::from_spec(&random_chain(seed, 6, 2)).unwrap();
+            checked += check(&model, 1000 + seed);
+        }
+        let model = Model::from_spec(&colonnade(0.3, 2.0, 1.5, 0.4)).unwrap();
+        for seed in 0..10 {
+            checked += check(&model, seed);
+        }
+        assert!(checked > 100, "only {checked} reactions compared");
     }
 }
