@@ -28,6 +28,7 @@ pub use crr_kinematics as kinematics;
 
 pub mod animate;
 pub mod check;
+pub mod folder_lock;
 pub mod fuzzing;
 pub mod inspect;
 pub mod levels;

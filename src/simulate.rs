@@ -705,6 +705,8 @@ pub fn simulate(path: &Path, opts: &SimulateOptions) -> Result<SimulateResult, I
         dir: p.out.clone(),
         source,
     };
+    // One writer per folder: another run writing here would rename these files away.
+    let _lock = crate::folder_lock::FolderLock::acquire(&p.out)?;
     // history.csv is streamed to its temporary name while the run goes: memory stays flat in the
     // duration. It is renamed into place with the other files at the end.
     std::fs::create_dir_all(&p.out).map_err(output_error)?;

@@ -286,6 +286,86 @@ pub fn case_rows(
     }))
 }
 
+/// The file in a study folder that says which study computed its `cases.csv` ([`fingerprint`]).
+pub const FINGERPRINT_FILE: &str = "study.fingerprint";
+
+/// FNV-1a, 64 bits: a hash whose value is fixed by its definition (not by the Rust version), so
+/// that a fingerprint written by one build is read by the next.
+struct Fnv(u64);
+
+impl std::fmt::Write for Fnv {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        for b in s.bytes() {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        Ok(())
+    }
+}
+
+/// The fingerprint of a study (16 hex digits): a hash of the crr version, the study file as read,
+/// the model at every scale with its initial state, every case and every record's samples. Two
+/// runs may share a folder only when their fingerprints agree: a resume after the study file, its
+/// model or a record was edited (or with another crr) would otherwise keep the old rows under
+/// the new labels. The shard is not part of it (the shards of one study share it).
+pub fn fingerprint(study: &Study) -> String {
+    use std::fmt::Write as _;
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    // Debug output of f64 is exact (it reads back to the same bits), and these types hold no
+    // hash maps, so the text is the same on every run.
+    let spec = serde_json::to_string(&study.spec).unwrap_or_default();
+    let _ = write!(h, "crr {}\n{spec}\n", env!("CARGO_PKG_VERSION"));
+    for v in &study.variants {
+        let _ = write!(h, "{:?}\n{:?}\n{:?}\n", v.scale, v.model, v.initial);
+    }
+    let _ = write!(h, "{:?}\n{:?}\n", study.params, study.cases);
+    for r in &study.records {
+        let _ = writeln!(h, "{:?}", r.record);
+    }
+    format!("{:016x}", h.0)
+}
+
+/// The number of fields of a `cases.csv` line (commas outside double quotes, plus one).
+fn field_count(line: &str) -> usize {
+    let mut quoted = false;
+    let mut count = 1;
+    for c in line.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            ',' if !quoted => count += 1,
+            _ => {}
+        }
+    }
+    count
+}
+
+/// Checks one row of a `cases.csv` (line `number`, 1-based) against its header: the number of
+/// fields, and an id that is new in the file. Returns the id.
+fn checked_row<'a>(
+    path: &Path,
+    number: usize,
+    body: &'a str,
+    fields: usize,
+    rows: &BTreeMap<String, String>,
+) -> Result<&'a str, InputError> {
+    let bad = |what: String| {
+        InputError::Argument(format!(
+            "{}: line {number}: {what}; the file is damaged or was written by another program \
+             (remove the line, or use another --out folder)",
+            path.display()
+        ))
+    };
+    let found = field_count(body);
+    if found != fields {
+        return Err(bad(format!("{found} fields where the header has {fields}")));
+    }
+    let id = body.split_once(',').map_or(body, |(id, _)| id);
+    if rows.contains_key(id) {
+        return Err(bad(format!("case {id} appears a second time")));
+    }
+    Ok(id)
+}
+
 /// The ids of the complete rows of an existing `cases.csv` (a row is complete when its line ends
 /// with a newline), and the length of the file up to the last complete row. A file whose header
 /// differs is an error: it belongs to another study.
@@ -303,7 +383,7 @@ fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64
     let mut rows = BTreeMap::new();
     let mut complete = 0u64;
     let mut first = true;
-    for line in text.split_inclusive('\n') {
+    for (number, line) in text.split_inclusive('\n').enumerate() {
         if !line.ends_with('\n') {
             break;
         }
@@ -317,12 +397,38 @@ fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64
                 )));
             }
             first = false;
-        } else if let Some((id, _)) = body.split_once(',') {
+        } else {
+            let id = checked_row(path, number + 1, body, field_count(header), &rows)?;
             rows.insert(id.to_string(), body.to_string());
         }
         complete += line.len() as u64;
     }
     Ok((rows, complete))
+}
+
+/// Refuses to resume into a folder whose `cases.csv` (with `rows` cases) was computed for another
+/// study, or for a study that has changed since ([`fingerprint`]).
+fn same_study(csv: &Path, print_path: &Path, print: &str, rows: usize) -> Result<(), InputError> {
+    match std::fs::read_to_string(print_path) {
+        Ok(text) if text.trim() == print => Ok(()),
+        Ok(_) => Err(InputError::Argument(format!(
+            "{}: its {rows} case(s) were computed for another version of this study (the study \
+             file, its model, its records or the crr version changed since, {} differs); use \
+             another --out folder, or remove this one to start again",
+            csv.display(),
+            print_path.display()
+        ))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(InputError::Argument(format!(
+            "{}: holds {rows} case(s) but no {} saying which study computed them; use another \
+             --out folder, or remove this one to start again",
+            csv.display(),
+            print_path.display()
+        ))),
+        Err(source) => Err(InputError::Io {
+            file: print_path.to_path_buf(),
+            source,
+        }),
+    }
 }
 
 /// A progress line on stderr: cases done, rate and estimated time left, at most 5 times a second.
@@ -375,10 +481,17 @@ pub fn run_study(
         dir: opts.out.clone(),
         source,
     };
-    std::fs::create_dir_all(&opts.out).map_err(out_err)?;
+    // One writer per folder: two runs appending to one cases.csv would interleave their rows.
+    let _lock = crate::folder_lock::FolderLock::acquire(&opts.out)?;
     let csv = opts.out.join("cases.csv");
     let header = header(study);
     let (done, complete_len) = done_rows(&csv, &header)?;
+    let print = fingerprint(study);
+    let print_path = opts.out.join(FINGERPRINT_FILE);
+    if complete_len > 0 {
+        same_study(&csv, &print_path, &print, done.len())?;
+    }
+    std::fs::write(&print_path, format!("{print}\n")).map_err(out_err)?;
     let mine: Vec<&Case> = study
         .cases
         .iter()
@@ -451,6 +564,7 @@ pub fn run_study(
         "study_file": study_file.display().to_string(),
         "name": study.name,
         "crr_version": env!("CARGO_PKG_VERSION"),
+        "fingerprint": print,
         "model": study.model.name,
         "cases_in_study": study.cases.len(),
         "shard": format!("{}/{}", opts.shard.index, opts.shard.count),
@@ -493,6 +607,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
     let mut study: Option<serde_json::Value> = None;
     let mut first_json: Option<serde_json::Value> = None;
     let mut rows: BTreeMap<String, String> = BTreeMap::new();
+    let mut shards: Vec<(usize, usize)> = Vec::new();
     for dir in dirs {
         let csv = dir.join("cases.csv");
         let text = std::fs::read_to_string(&csv).map_err(|source| InputError::Io {
@@ -525,8 +640,21 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
             }
             _ => {}
         }
+        if let Some(first) = &first_json
+            && json["fingerprint"] != first["fingerprint"]
+        {
+            return Err(InputError::Argument(format!(
+                "{}: computed for another version of the study than {}'s (the fingerprints \
+                 differ: the study file, its model, its records or the crr version changed \
+                 between the shards); run the shards again with one study",
+                json_path.display(),
+                dirs[0].display()
+            )));
+        }
+        shards.push(shard_of(&json, &json_path)?);
         let mut lines = text.lines();
         let h = lines.next().unwrap_or_default().to_string();
+        let fields = field_count(&h);
         match &header {
             None => header = Some(h),
             Some(x) if *x != h => {
@@ -538,10 +666,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
             }
             _ => {}
         }
-        for line in lines {
-            let Some((id, _)) = line.split_once(',') else {
-                continue;
-            };
+        let mut in_file = BTreeMap::new();
+        for (number, line) in lines.enumerate() {
+            let id = checked_row(&csv, number + 2, line, fields, &in_file)?;
+            in_file.insert(id.to_string(), String::new());
             if let Some(prev) = rows.get(id)
                 && prev != line
             {
@@ -553,11 +681,27 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
             rows.insert(id.to_string(), line.to_string());
         }
     }
+    complete_shards(&shards, dirs)?;
+    let in_study = first_json
+        .as_ref()
+        .and_then(|j| j["cases_in_study"].as_u64())
+        .map(|n| n as usize);
+    if let Some(total) = in_study
+        && rows.len() != total
+    {
+        return Err(InputError::Argument(format!(
+            "the shards hold {} of the study's {total} cases: {} are missing (a shard that did \
+             not finish: run it again, it resumes, then merge)",
+            rows.len(),
+            total.saturating_sub(rows.len())
+        )));
+    }
     let out_err = |source: std::io::Error| InputError::Output {
         dir: out.to_path_buf(),
         source,
     };
     std::fs::create_dir_all(out).map_err(out_err)?;
+    let _lock = crate::folder_lock::FolderLock::acquire(out)?;
     let mut f = File::create(out.join("cases.csv")).map_err(out_err)?;
     writeln!(f, "{}", header.unwrap_or_default()).map_err(out_err)?;
     for r in rows.values() {
@@ -567,6 +711,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
         "study": study,
         "name": first_json.as_ref().map(|j| j["name"].clone()),
         "alpha_eq_rad": first_json.as_ref().map(|j| j["alpha_eq_rad"].clone()),
+        "fingerprint": first_json.as_ref().map(|j| j["fingerprint"].clone()),
         "merged_from": dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>(),
         "cases": rows.len(),
         "crr_version": env!("CARGO_PKG_VERSION"),
@@ -580,6 +725,43 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
         std::fs::write(out.join(BOUNDARY_FILE), text).map_err(out_err)?;
     }
     Ok(rows.len())
+}
+
+/// The shard (index, count) a study folder's `study.json` says it holds.
+fn shard_of(json: &serde_json::Value, path: &Path) -> Result<(usize, usize), InputError> {
+    json["shard"]
+        .as_str()
+        .and_then(|s| s.split_once('/'))
+        .and_then(|(i, n)| Some((i.parse().ok()?, n.parse().ok()?)))
+        .ok_or_else(|| InputError::Parse {
+            file: path.to_path_buf(),
+            message: "no \"shard\": \"i/n\" entry: not a folder written by `crr study`".into(),
+        })
+}
+
+/// Every shard of the study must be among the folders merged (each `i/n` with the same n).
+fn complete_shards(shards: &[(usize, usize)], dirs: &[PathBuf]) -> Result<(), InputError> {
+    let Some(&(_, count)) = shards.first() else {
+        return Ok(());
+    };
+    if let Some((k, &(i, n))) = shards.iter().enumerate().find(|(_, s)| s.1 != count) {
+        return Err(InputError::Argument(format!(
+            "{}: shard {i}/{n}, where {} holds a shard of {count}",
+            dirs[k].display(),
+            dirs[0].display()
+        )));
+    }
+    let missing: Vec<String> = (1..=count)
+        .filter(|i| !shards.iter().any(|s| s.0 == *i))
+        .map(|i| format!("{i}/{count}"))
+        .collect();
+    if !missing.is_empty() {
+        return Err(InputError::Argument(format!(
+            "shard(s) {} missing: give the folder of every shard of the study",
+            missing.join(", ")
+        )));
+    }
+    Ok(())
 }
 
 /// The file holding the analytic overturning boundary of a block map (`boundary.csv`).
