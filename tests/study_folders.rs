@@ -343,3 +343,35 @@ fn two_forced_runs_into_one_folder_leave_one_complete_result() {
         assert!(!out.join(".crr.lock").exists());
     }
 }
+
+#[cfg(unix)]
+#[test]
+fn a_study_file_or_cases_file_that_is_a_device_or_a_pipe_is_refused_at_once() {
+    let dir = scratch("study_folder_devices");
+    // /dev/zero as the study file: refused without reading (it read 2 GB before).
+    refused(&["study", "/dev/zero", "--quiet"], "not a regular file");
+    // A FIFO as the study file: refused instead of waiting for a writer.
+    let fifo = dir.join("study.fifo");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        refused(
+            &["study", fifo.to_str().unwrap(), "--quiet"],
+            "not a regular file",
+        );
+    }
+    // cases.csv linked to /dev/zero in the output folder: the resume refuses it.
+    let study = map(&dir, 3.0);
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", out.join("cases.csv")).unwrap();
+    refused(
+        &[
+            "study",
+            study.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "not a regular file",
+    );
+}

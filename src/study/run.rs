@@ -370,16 +370,19 @@ fn checked_row<'a>(
 /// with a newline), and the length of the file up to the last complete row. A file whose header
 /// differs is an error: it belongs to another study.
 fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64), InputError> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((BTreeMap::new(), 0)),
-        Err(source) => {
-            return Err(InputError::Io {
-                file: path.to_path_buf(),
-                source,
-            });
-        }
-    };
+    // Only a regular file, and at most 1 GiB (a cases.csv linked to /dev/zero, or a FIFO, is
+    // refused instead of read without end).
+    let text =
+        match crr_dynamics::input::read_regular_text(path, crr_dynamics::input::DATA_FILE_LIMIT) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((BTreeMap::new(), 0)),
+            Err(source) => {
+                return Err(InputError::Io {
+                    file: path.to_path_buf(),
+                    source,
+                });
+            }
+        };
     let mut rows = BTreeMap::new();
     let mut complete = 0u64;
     let mut first = true;
@@ -409,7 +412,7 @@ fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64
 /// Refuses to resume into a folder whose `cases.csv` (with `rows` cases) was computed for another
 /// study, or for a study that has changed since ([`fingerprint`]).
 fn same_study(csv: &Path, print_path: &Path, print: &str, rows: usize) -> Result<(), InputError> {
-    match std::fs::read_to_string(print_path) {
+    match crr_dynamics::input::read_regular_text(print_path, 1 << 10) {
         Ok(text) if text.trim() == print => Ok(()),
         Ok(_) => Err(InputError::Argument(format!(
             "{}: its {rows} case(s) were computed for another version of this study (the study \
@@ -610,22 +613,27 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
     let mut shards: Vec<(usize, usize)> = Vec::new();
     for dir in dirs {
         let csv = dir.join("cases.csv");
-        let text = std::fs::read_to_string(&csv).map_err(|source| InputError::Io {
-            file: csv.clone(),
-            source,
-        })?;
+        let text =
+            crr_dynamics::input::read_regular_text(&csv, crr_dynamics::input::DATA_FILE_LIMIT)
+                .map_err(|source| InputError::Io {
+                    file: csv.clone(),
+                    source,
+                })?;
         let json_path = dir.join("study.json");
-        let json: serde_json::Value = std::fs::read_to_string(&json_path)
-            .map_err(|source| InputError::Io {
+        let json: serde_json::Value = crr_dynamics::input::read_regular_text(
+            &json_path,
+            crr_dynamics::input::MODEL_FILE_LIMIT,
+        )
+        .map_err(|source| InputError::Io {
+            file: json_path.clone(),
+            source,
+        })
+        .and_then(|t| {
+            serde_json::from_str(&t).map_err(|e| InputError::Parse {
                 file: json_path.clone(),
-                source,
+                message: e.to_string(),
             })
-            .and_then(|t| {
-                serde_json::from_str(&t).map_err(|e| InputError::Parse {
-                    file: json_path.clone(),
-                    message: e.to_string(),
-                })
-            })?;
+        })?;
         if first_json.is_none() {
             first_json = Some(json.clone());
         }

@@ -249,10 +249,14 @@ fn default_component() -> String {
 impl StudySpec {
     /// Reads and parses a study file; errors name the file and, for TOML errors, the key.
     pub fn read(path: &Path) -> Result<Self, InputError> {
-        let text = std::fs::read_to_string(path).map_err(|source| InputError::Io {
-            file: path.to_path_buf(),
-            source,
-        })?;
+        // A regular file of at most 16 MiB: a FIFO or /dev/zero given as the study is refused
+        // at once instead of blocking or filling the memory.
+        let text =
+            crr_dynamics::input::read_regular_text(path, crr_dynamics::input::MODEL_FILE_LIMIT)
+                .map_err(|source| InputError::Io {
+                    file: path.to_path_buf(),
+                    source,
+                })?;
         Self::parse(path, &text)
     }
 
