@@ -345,10 +345,143 @@ fn warm_start_following_signs(
     }
 }
 
+/// Smallest fraction of the way from rest a step of [`continuation`] may take before it gives up.
+const MIN_CONTINUATION_STEP: f64 = 1.0 / 4096.0;
+
+/// The closed configuration connected to rest: the given angles raised from 0 to their values in
+/// steps, each predicted along the tangent of the solution path (Φ_q,free dq_free =
+/// −Φ_q,given dq_given, minimum norm) and closed by Newton with the pivots held, the pivots then
+/// following the signs (a joint changes pivot only where its angle passes 0, where both pivots
+/// give the same configuration). A step is accepted when Newton's correction is small against
+/// the step itself (at most a tenth of the predicted change, or 1e-9 rad): a jump to another
+/// branch of the loops' equations is refused, and the step halved. Returns the configuration and
+/// its pivots, or why the path stopped (the fraction of the way reached and the residual).
+fn continuation(
+    model: &Model,
+    kin: &mut Data,
+    angles: &[(usize, f64)],
+    free: &[usize],
+) -> Result<(DVector<f64>, ActivePivots), DynamicsError> {
+    let n = model.dof();
+    let mut q = DVector::zeros(n);
+    let mut pivots = ActivePivots::uniform(model, Side::Positive);
+    for &(k, v) in angles {
+        pivots.sides[k] = Side::of(v, Side::Positive);
+    }
+    let given: Vec<usize> = angles.iter().map(|a| a.0).collect();
+    let mut done = 0.0_f64;
+    let mut step = 1.0 / 16.0;
+    while done < 1.0 {
+        let next = (done + step).min(1.0);
+        match continuation_step(model, kin, &q, &pivots, angles, &given, free, done, next) {
+            Ok((q_next, pivots_next)) => {
+                q = q_next;
+                pivots = pivots_next;
+                done = next;
+                step = (2.0 * step).min(1.0 / 16.0);
+            }
+            Err(why) => {
+                step *= 0.5;
+                if step < MIN_CONTINUATION_STEP {
+                    return Err(DynamicsError::Closure(format!(
+                        "the loops could not be followed from rest beyond {:.1} % of the given \
+                         angles: {why}",
+                        100.0 * done
+                    )));
+                }
+            }
+        }
+    }
+    Ok((q, pivots))
+}
+
+/// One step of [`continuation`] from the fraction `from` of the given angles to `to`.
+#[allow(clippy::too_many_arguments)]
+fn continuation_step(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+    angles: &[(usize, f64)],
+    given: &[usize],
+    free: &[usize],
+    from: f64,
+    to: f64,
+) -> Result<(DVector<f64>, ActivePivots), String> {
+    // Tangent predictor. A coordinate at 0 pivots on the side it moves to: its Jacobian column
+    // depends on the pivot, so the tangent is taken again once the sides of those at 0 follow
+    // the predicted motion (at the angle 0 both pivots give the same configuration).
+    let n = model.dof();
+    let at_zero: Vec<usize> = (0..n).filter(|&k| q[k].abs() <= SIGN_TIE).collect();
+    // The closure angles at 0 likewise (a loop of rocking bases is a mechanism only when the
+    // pivots of its closures and of its tree agree: with a corner on the wrong side the loop
+    // closes to first order only, and Newton stalls at a residual of second order).
+    forward_kinematics(model, kin, q, pivots);
+    let mut closing = vec![0.0; model.slot_count - n];
+    closure_angles(model, kin, &mut closing);
+    let closures_at_zero: Vec<usize> = (0..closing.len())
+        .filter(|&j| closing[j].abs() <= SIGN_TIE)
+        .collect();
+    let mut step_pivots = pivots.clone();
+    let mut predicted = q.clone();
+    for _ in 0..3 {
+        let (_, jac) = scaled(model, kin, q, &step_pivots);
+        let rhs = jac.select_columns(given.iter())
+            * DVector::from_iterator(given.len(), angles.iter().map(|&(_, v)| v * (to - from)));
+        let (dfree, _) = pinv_solve_in(&jac.select_columns(free.iter()), &rhs, jac.norm());
+        predicted.copy_from(q);
+        for &(k, v) in angles {
+            predicted[k] = v * to;
+        }
+        for (j, &k) in free.iter().enumerate() {
+            predicted[k] -= dfree[j];
+        }
+        let before = step_pivots.clone();
+        for &k in &at_zero {
+            if predicted[k].abs() > SIGN_TIE {
+                step_pivots.sides[k] = Side::of(predicted[k], step_pivots.sides[k]);
+            }
+        }
+        forward_kinematics(model, kin, &predicted, &step_pivots);
+        closure_angles(model, kin, &mut closing);
+        for &j in &closures_at_zero {
+            if closing[j].abs() > SIGN_TIE {
+                step_pivots.sides[n + j] = Side::of(closing[j], step_pivots.sides[n + j]);
+            }
+        }
+        if step_pivots == before {
+            break;
+        }
+    }
+    let pivots = &step_pivots;
+    let change = (&predicted - q).amax();
+    let mut trial = predicted.clone();
+    let mut trial_pivots = pivots.clone();
+    for _ in 0..4 {
+        project_positions(model, kin, &trial_pivots, &mut trial, Some(free))
+            .map_err(|e| e.to_string())?;
+        let before = trial_pivots.clone();
+        follow_signs(model, kin, &trial, &mut trial_pivots);
+        if trial_pivots == before {
+            let correction = (&trial - &predicted).amax();
+            if correction > (0.1 * change).max(1e-9) {
+                return Err(format!(
+                    "Newton moved {correction:.3e} rad away from the path's prediction (a step \
+                     of {change:.3e} rad): another branch of the loops"
+                ));
+            }
+            return Ok((trial, trial_pivots));
+        }
+    }
+    Err("the pivot sides do not settle".into())
+}
+
 /// Solves the initial state: the given angles and rates are kept, the other coordinates are found
-/// by Newton from the rest configuration (minimum-norm steps) so that Φ = 0 and Φ_q q̇ = 0.
-/// The pivots follow the signs of the solution (re-solved until they agree). Errors when the given
-/// values admit no consistent state.
+/// so that Φ = 0 and Φ_q q̇ = 0, on the branch connected to rest ([`continuation`]); Newton from
+/// the rest configuration (minimum-norm steps, the pivots following the signs of the solution
+/// until they agree) gives the state where it lands on the path's end (within 1e-6 rad), and the
+/// path's end is the state where it lands elsewhere or fails. Errors when the given values admit
+/// no consistent state.
 pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, DynamicsError> {
     let angles = lookup(model, &spec.angles, "initial.angles")?;
     let rates = lookup(model, &spec.rates, "initial.rates")?;
@@ -379,6 +512,15 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
         ))
     };
     if model.constraint_rows > 0 {
+        // The configuration connected to rest by a path, when the path can be followed: the
+        // Newton solve below may land on a far root of the loops' equations (columns tilted
+        // 0.3 rad about the other axis for a 0.01 rad release of the baldachin), and is kept
+        // only where it agrees with the path's end.
+        let path = if angles.is_empty() {
+            None
+        } else {
+            continuation(model, &mut kin, &angles, &free).ok()
+        };
         warm_start_following_signs(model, &mut kin, &mut pivots, &mut q, &free);
         // Re-solve with the pivots held until they agree with the signs of the solution. Two
         // candidates: Newton from rest (minimum-norm steps) and from the current solution; the
@@ -404,12 +546,21 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
                 .min_by(|a, b| a.norm().total_cmp(&b.norm()))
             {
                 Some(c) => c,
+                // The path's end stands where Newton fails.
+                None if path.is_some() => break,
                 None => return Err(explain(&format!(": {}", failure.expect("both failed")))),
             };
             if signs_agree(model, &mut kin, &q, &pivots) && pivots == before {
                 settled = true;
                 break;
             }
+        }
+        if let Some((q_path, pivots_path)) = path
+            && (!settled || (&q - &q_path).amax() > 1e-6)
+        {
+            q = q_path;
+            pivots = pivots_path;
+            settled = true;
         }
         let (phi, _) = scaled(model, &mut kin, &q, &pivots);
         if phi.amax() > 1e-9 {
