@@ -477,7 +477,7 @@ fn continuation_step(
 }
 
 /// Solves the initial state: the given angles and rates are kept, the other coordinates are found
-/// so that Φ = 0 and Φ_q q̇ = 0, on the branch connected to rest ([`continuation`]); Newton from
+/// so that Φ = 0 and Φ_q q̇ = 0, on the branch connected to rest (a continuation from 0); Newton from
 /// the rest configuration (minimum-norm steps, the pivots following the signs of the solution
 /// until they agree) gives the state where it lands on the path's end (within 1e-6 rad), and the
 /// path's end is the state where it lands elsewhere or fails. Errors when the given values admit
