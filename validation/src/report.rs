@@ -623,7 +623,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
          compliant sequence, which dissipates less. Neither engine has a bug there: they apply \
          different impact models, and the arch after its first impact (crr keeps it standing at \
          12 m/s², rapier lets it collapse) depends on that choice. crr's momentum law is the \
-         published one (physics.md section 5) and is checked against an independent derivation \
+         published one (docs/physics.md section 5) and is checked against an independent derivation \
          on the two-block stack (validation/two_block_stack); where a user has measured an \
          arch's restitution, the `restitution` law takes it. The drum column under the record \
          (dozens of simultaneous bed impacts) diverges for the same reason after its onset.\n\

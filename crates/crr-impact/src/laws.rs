@@ -1,4 +1,4 @@
-//! The impact maps (physics.md §5): at an impact the angle of one or more interfaces crosses 0
+//! The impact maps (docs/physics.md §5): at an impact the angle of one or more interfaces crosses 0
 //! and their pivots switch (P⁺ ↔ P⁻). The configuration q is continuous; the body Jacobians change
 //! from J⁻ (pivots `before`) to J⁺ (pivots `after`), and q̇ jumps from q̇⁻ to q̇⁺.
 //!

@@ -1,4 +1,4 @@
-//! A single block rocking freely from θ₀ = α/2 (physics.md §6): impact times against the exact
+//! A single block rocking freely from θ₀ = α/2 (docs/physics.md §6): impact times against the exact
 //! energy quadrature, the momentum law's r = 1 − 1.5 sin²α, the amplitude recurrence
 //! cos(α − θₙ₊₁) − cos α = r²[cos(α − θₙ) − cos α], the energy lost (1 − r²)T⁻ at each impact,
 //! and rest in finite time.

@@ -1,4 +1,4 @@
-//! Physical facts of the impact maps (physics.md §5 and §6).
+//! Physical facts of the impact maps (docs/physics.md §5 and §6).
 
 use crr_dynamics::eom::constraint_row_scale;
 use crr_dynamics::integrator::{

@@ -1,4 +1,4 @@
-//! Uplift and overturning of a block under ground motion (physics.md §6), and activation of a
+//! Uplift and overturning of a block under ground motion (docs/physics.md §6), and activation of a
 //! one-DOF mechanism at its multiplier λ.
 
 use std::path::Path;
