@@ -2,7 +2,7 @@
 //! Jacobi SVD written in `crr_dynamics::linalg`, nalgebra's bidiagonal SVD, faer's thin (and full)
 //! SVD and faer's column-pivoted QR; and Cholesky of M with one solve (the crate's plain loops,
 //! what the engine runs — those loops below `FAER_CHOLESKY_MIN`, faer's from there on —, faer's
-//! `llt` allocating and in place, nalgebra's). The table and the decision are in ARCHITECTURE.md
+//! `llt` allocating and in place, nalgebra's). The table and the decision are in docs/performance.md
 //! ("Dense factorisations").
 //!
 //! Matrices (built outside the timing, at consistent states):

@@ -163,7 +163,7 @@ pub struct Dynamics {
 /// On the serial chains of `benches/dynamics.rs` (`forward_dynamics_aba` against
 /// `forward_dynamics_cholesky`, N = 1 … 128) the articulated-body path is never the slower one,
 /// 0.21 µs against 0.25 µs already at N = 1 (it skips h and the second pass of Q), so the
-/// crossover is 1: every eligible chain uses it. See ARCHITECTURE.md, "Equations of motion".
+/// crossover is 1: every eligible chain uses it. See docs/engine.md, "Equations of motion".
 pub const ARTICULATED_BODY_MIN_DOF: usize = 1;
 
 /// The forward-dynamics algorithm of [`Dynamics::accelerations_with`].

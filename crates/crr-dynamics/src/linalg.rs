@@ -2,7 +2,7 @@
 //! below [`FAER_CHOLESKY_MIN`] = 32 coordinates; faer's blocked factorisation from there on) and
 //! rank-revealing least squares by a one-sided Jacobi singular value decomposition.
 //!
-//! Which code serves which size was decided by `cargo bench --bench linalg` (ARCHITECTURE.md,
+//! Which code serves which size was decided by `cargo bench --bench linalg` (docs/performance.md,
 //! "Dense factorisations: faer, nalgebra and the crate's own"): faer's Cholesky is slower than the
 //! loops below up to 16 coordinates and faster from 32 (7–10 times at 128); its SVD is 3–5 times
 //! slower than the Jacobi SVD on the 5 × 3 matrices of the engine and on par at 12 × 10, so the

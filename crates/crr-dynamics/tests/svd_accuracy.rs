@@ -1,6 +1,6 @@
 //! The SVDs on the rank-deficient matrices of the engine. The crate carries its own Jacobi SVD
 //! because nalgebra's recomposes such matrices with errors up to 1e-7 relative
-//! (dimforge/nalgebra#1072, #1172); faer's was measured as the replacement (ARCHITECTURE.md,
+//! (dimforge/nalgebra#1072, #1172); faer's was measured as the replacement (docs/performance.md,
 //! "Dense factorisations") and is as accurate, but slower on these sizes. These tests hold both
 //! to round-off on the 2 × 2 of #1072 and on the closed chains' B = Φ' L⁻ᵀ and Φ' (the colonnade's
 //! 12 rows of rank 8 over 10 coordinates). nalgebra's SVD fails the 100 ε bound below on the
