@@ -1,6 +1,6 @@
-//! One writer per results folder. `crr simulate`, `crr study` (and its resume) and `crr animate`
-//! write several files into a folder and rename them into place; two processes writing into the
-//! same folder would rename each other's files away (two `simulate --force` runs: one announced
+//! One writer per results folder. `crr simulate`, `crr study` (and its resume and merge),
+//! `crr poincare` and `crr animate` write several files into a folder and rename them into place;
+//! two processes writing into the same folder would rename each other's files away (two `simulate --force` runs: one announced
 //! its results while the folder held none). A writer takes `DIR/.crr.lock`, created exclusively
 //! and holding its process id, for as long as it writes, and removes it when done (also when it
 //! fails). A lock whose process no longer runs (a writer killed with SIGKILL) is taken over (two
@@ -19,6 +19,9 @@ pub const LOCK_FILE: &str = ".crr.lock";
 #[derive(Debug)]
 pub struct FolderLock {
     path: PathBuf,
+    /// The folder, when this lock created it: removed again on release if left empty (a run
+    /// that failed before writing anything leaves no folder behind).
+    created: Option<PathBuf>,
 }
 
 impl FolderLock {
@@ -28,12 +31,13 @@ impl FolderLock {
             dir: dir.to_path_buf(),
             source,
         };
+        let created = (!dir.exists()).then(|| dir.to_path_buf());
         std::fs::create_dir_all(dir).map_err(output)?;
         let path = dir.join(LOCK_FILE);
         // Twice at most: the second attempt follows the removal of a stale lock.
         for _ in 0..2 {
             match create_with_pid(dir, &path) {
-                Ok(()) => return Ok(Self { path }),
+                Ok(()) => return Ok(Self { path, created }),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                     let holder = std::fs::read_to_string(&path)
                         .ok()
@@ -71,6 +75,10 @@ impl FolderLock {
 impl Drop for FolderLock {
     fn drop(&mut self) {
         let _ = std::fs::remove_file(&self.path);
+        if let Some(dir) = &self.created {
+            // Fails, and so keeps the folder, unless it is empty.
+            let _ = std::fs::remove_dir(dir);
+        }
     }
 }
 
@@ -118,6 +126,7 @@ mod tests {
     fn a_second_writer_is_refused_and_a_dead_ones_lock_is_taken_over() {
         let dir = std::env::temp_dir().join(format!("crr_lock_{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
         let first = FolderLock::acquire(&dir).unwrap();
         let err = FolderLock::acquire(&dir).unwrap_err().to_string();
         assert!(err.contains("another crr process"), "{err}");
@@ -133,6 +142,16 @@ mod tests {
         let holder = std::fs::read_to_string(dir.join(LOCK_FILE)).unwrap();
         assert_eq!(holder.trim(), std::process::id().to_string());
         drop(taken);
+        std::fs::remove_dir_all(&dir).unwrap();
+        // A folder the lock created is removed again when nothing was written into it, and
+        // kept when something was.
+        let fresh = dir.join("fresh");
+        drop(FolderLock::acquire(&fresh).unwrap());
+        assert!(!fresh.exists());
+        let lock = FolderLock::acquire(&fresh).unwrap();
+        std::fs::write(fresh.join("result.csv"), "t\n").unwrap();
+        drop(lock);
+        assert!(fresh.join("result.csv").exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1174,6 +1174,8 @@ pub fn poincare(
 ) -> Result<PoincareResult, InputError> {
     let p = prepare(path, opts)?;
     let progress = !opts.quiet && std::io::stderr().is_terminal();
+    // One writer per folder for the whole computation (files and plots are renamed into place).
+    let _lock = crate::folder_lock::FolderLock::acquire(&p.out)?;
     let computed = compute(&p, opts, progress).map_err(InputError::Argument)?;
     let sum = summary(path, &p, opts, &computed);
     let mut files: Vec<(String, Vec<u8>)> = match &computed {

@@ -293,11 +293,40 @@ fn a_folder_another_process_writes_into_is_refused() {
         ],
         "another crr process",
     );
+    refused(
+        &[
+            "poincare",
+            model.to_str().unwrap(),
+            "--amplitude",
+            "1",
+            "--frequency",
+            "1",
+            "--periods",
+            "5",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "another crr process",
+    );
+    assert!(!out.join("poincare.json").exists());
     // A lock left by a process that no longer runs is taken over, and released at the end.
     std::fs::write(out.join(".crr.lock"), "4294967295\n").unwrap();
     run_ok(&args);
     assert!(out.join("summary.json").exists());
     assert!(!out.join(".crr.lock").exists());
+    // An animation of those results while another process holds the animation folder.
+    let animation = out.join("animation");
+    std::fs::create_dir_all(&animation).unwrap();
+    std::fs::write(
+        animation.join(".crr.lock"),
+        format!("{}\n", std::process::id()),
+    )
+    .unwrap();
+    refused(&["animate", out.to_str().unwrap()], "another crr process");
+    std::fs::remove_file(animation.join(".crr.lock")).unwrap();
+    run_ok(&["animate", out.to_str().unwrap(), "--every", "20"]);
+    assert!(!animation.join(".crr.lock").exists());
 }
 
 #[test]

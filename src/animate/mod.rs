@@ -511,9 +511,11 @@ pub fn animate(dir: &Path, opts: &AnimateOptions) -> Result<AnimateReport, Input
         dir: out.clone(),
         source,
     };
+    // One writer per folder: another animation into it would remove this one's frames.
+    let _lock = crate::folder_lock::FolderLock::acquire(&out)?;
     let tmp = partial_dir(&out);
     if tmp.exists() {
-        // Left by an interrupted animation: ours to remove.
+        // Left by an interrupted animation: ours to remove (the lock says no one writes it).
         std::fs::remove_dir_all(&tmp).map_err(output_error)?;
     }
     std::fs::create_dir_all(&tmp).map_err(output_error)?;
