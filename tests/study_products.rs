@@ -289,6 +289,49 @@ fn map_has_one_cell_per_case() {
         !out.join("fragility.csv").exists(),
         "no fragility for pulses"
     );
+    legend_hides_no_cell(&svg);
+}
+
+/// The rectangles of an SVG, in document order: (x, y, width, height, the tag's text).
+fn svg_rects(svg: &str) -> Vec<(f64, f64, f64, f64, String)> {
+    let attr = |tag: &str, name: &str| -> f64 {
+        let start = tag.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        let end = start + tag[start..].find('"').unwrap();
+        tag[start..end].parse().unwrap()
+    };
+    svg.match_indices("<rect ")
+        .map(|(i, _)| {
+            let tag = &svg[i..i + svg[i..].find('>').unwrap()];
+            (
+                attr(tag, "x"),
+                attr(tag, "y"),
+                attr(tag, "width"),
+                attr(tag, "height"),
+                tag.to_string(),
+            )
+        })
+        .collect()
+}
+
+/// The map's legend box overlaps none of its cells (before, it hid the top row of a map: the
+/// box is drawn over the cells, with their rectangles before it in the file).
+fn legend_hides_no_cell(svg: &str) {
+    let rects = svg_rects(svg);
+    let boxed = rects
+        .iter()
+        .position(|r| r.4.contains("stroke=\"#969696\""))
+        .expect("a legend box");
+    let (lx, ly, lw, lh, _) = rects[boxed].clone();
+    // Cells: every rectangle after the background and before the legend's own two.
+    let cells = &rects[1..boxed - 1];
+    assert!(cells.len() >= 20, "{} cells", cells.len());
+    for (x, y, w, h, _) in cells {
+        let apart = x + w <= lx || *x >= lx + lw || y + h <= ly || *y >= ly + lh;
+        assert!(
+            apart,
+            "the cell at ({x}, {y}) {w}×{h} px lies under the legend ({lx}, {ly}) {lw}×{lh}"
+        );
+    }
 }
 
 /// The bundled studies load with the documented numbers of cases, in size-major order, and a

@@ -40,6 +40,16 @@ fn half_gap(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// The headroom (a fraction of the data's range, [`headroom`]) that leaves a legend of `rows` rows
+/// above the data in a figure of [`super::SIZE`]: the legend takes 22 px a row, 15 px of padding
+/// and the 12 px margin from the top of the plotting area (plus 8 px to spare), out of the
+/// plotting area's 565 px (700 px less the caption, the margins and the x labels), all scaled
+/// alike with the figure. A share f of the plotting area is a headroom of f/(1 − f).
+fn legend_headroom(rows: usize) -> f64 {
+    let share = (22.0 * rows as f64 + 15.0 + 12.0 + 8.0) / 565.0;
+    share / (1.0 - share)
+}
+
 /// The overturning map: one cell per case of the first size, black when it collapsed, else
 /// coloured by its peak θ/α.
 pub fn draw_map<DB: DrawingBackend>(
@@ -65,9 +75,28 @@ pub fn draw_map<DB: DrawingBackend>(
     let hx = half_gap(cells.iter().map(|c| c.0).collect());
     let hy = half_gap(cells.iter().map(|c| c.1).collect());
     let xr = padded(cells.iter().flat_map(|c| [c.0 - hx, c.0 + hx]));
+    // Zhang & Makris's analytic minimum overturning amplitude (`boundary.csv`, written by the
+    // study for a single block on dimensionless axes), inside the plotted columns.
+    let boundary: Vec<(f64, f64)> = if r.ratios {
+        std::fs::read_to_string(r.dir.join(BOUNDARY_FILE))
+            .unwrap_or_default()
+            .lines()
+            .skip(1)
+            .filter_map(|l| {
+                let (x, y) = l.split_once(',')?;
+                Some((x.parse().ok()?, y.parse().ok()?))
+            })
+            .filter(|&(x, _): &(f64, f64)| xr.contains(&x))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    // Room above the cells for the legend (its rows: the four keys and the boundary's line), so
+    // that it hides none of them.
+    let rows = 4 + usize::from(!boundary.is_empty());
     let yr = headroom(
         padded(cells.iter().flat_map(|c| [c.1 - hy, c.1 + hy])),
-        0.18,
+        legend_headroom(rows),
     );
     let sized = if r.sized {
         format!(", scale {first}")
@@ -102,27 +131,14 @@ pub fn draw_map<DB: DrawingBackend>(
             Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], c.filled())
         }))
         .map_err(err)?;
-    // Zhang & Makris's analytic minimum overturning amplitude (`boundary.csv`, written by the
-    // study for a single block on dimensionless axes), inside the plotted range.
-    if r.ratios {
-        let boundary: Vec<(f64, f64)> = std::fs::read_to_string(r.dir.join(BOUNDARY_FILE))
-            .unwrap_or_default()
-            .lines()
-            .skip(1)
-            .filter_map(|l| {
-                let (x, y) = l.split_once(',')?;
-                Some((x.parse().ok()?, y.parse().ok()?))
-            })
-            .filter(|&(x, y): &(f64, f64)| xr.contains(&x) && yr.contains(&y))
-            .collect();
-        if !boundary.is_empty() {
-            let blue = RGBColor(30, 90, 200);
-            chart
-                .draw_series(LineSeries::new(boundary, blue.stroke_width(3 * k)))
-                .map_err(err)?
-                .label("Zhang & Makris (2001), linearised: minimum overturning")
-                .legend(line_key(blue, k));
-        }
+    let boundary: Vec<(f64, f64)> = boundary.into_iter().filter(|p| yr.contains(&p.1)).collect();
+    if !boundary.is_empty() {
+        let blue = RGBColor(30, 90, 200);
+        chart
+            .draw_series(LineSeries::new(boundary, blue.stroke_width(3 * k)))
+            .map_err(err)?
+            .label("Zhang & Makris (2001), linearised: minimum overturning")
+            .legend(line_key(blue, k));
     }
     let key = |c: RGBColor| {
         let w = 20 * k as i32;
