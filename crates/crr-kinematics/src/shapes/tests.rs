@@ -673,6 +673,19 @@ fn polyhedron_errors() {
         |v: Vec<[f64; 3]>| Shape::Polyhedron(PolyhedronShape { vertices: v }).mass_properties();
     let m = err_msg(poly(vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]));
     assert_eq!(m, "polyhedron needs at least 4 points, got 3");
+    // A cloud beyond the brute-force hull's limit is refused at once, before any hull work
+    // (3 000 points took minutes).
+    let cloud: Vec<[f64; 3]> = (0..3000)
+        .map(|i| {
+            let t = i as f64;
+            [t.cos(), t.sin(), (0.37 * t).sin()]
+        })
+        .collect();
+    let m = err_msg(poly(cloud));
+    assert!(
+        m.starts_with("polyhedron has 3000 vertices, more than the 1000"),
+        "{m}"
+    );
     let m = err_msg(poly(vec![
         [0.0; 3],
         [1.0, 0.0, 0.0],
