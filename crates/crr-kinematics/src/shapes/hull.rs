@@ -27,7 +27,7 @@ pub const MAX_HULL_POINTS: usize = 1000;
 /// Brute force over point triples with early rejection: O(n³) to O(n⁴),
 /// intended for up to a few hundred points (0.04 s for 200 points on a sphere,
 /// 0.55 s for 500, 4.5 s for 1 000, in an optimised build: `crr inspect`);
-/// more than [`MAX_HULL_POINTS`] are refused.
+/// more than `MAX_HULL_POINTS` (1 000) are refused.
 ///
 /// Errors: fewer than 4 points, non-finite coordinates, or all points
 /// coplanar (within the tolerance).
