@@ -31,6 +31,19 @@ fn run_ok(args: &[&str]) {
     );
 }
 
+/// `crr study STUDY --shard SHARD --out OUT`, which must succeed.
+fn run_shard(study: &str, shard: &str, out: &Path) {
+    run_ok(&[
+        "study",
+        study,
+        "--quiet",
+        "--shard",
+        shard,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+}
+
 fn read(p: &Path) -> String {
     std::fs::read_to_string(p).unwrap()
 }
@@ -121,24 +134,8 @@ fn a_merge_needs_every_shard_finished_and_of_one_study() {
     let study = map(&dir, 3.0);
     let s = study.to_str().unwrap();
     let (one, two) = (dir.join("one"), dir.join("two"));
-    run_ok(&[
-        "study",
-        s,
-        "--quiet",
-        "--shard",
-        "1/2",
-        "--out",
-        one.to_str().unwrap(),
-    ]);
-    run_ok(&[
-        "study",
-        s,
-        "--quiet",
-        "--shard",
-        "2/2",
-        "--out",
-        two.to_str().unwrap(),
-    ]);
+    run_shard(s, "1/2", &one);
+    run_shard(s, "2/2", &two);
     let merged = dir.join("merged");
     let (o1, o2, m) = (
         one.to_str().unwrap(),
@@ -194,15 +191,7 @@ fn a_merge_needs_every_shard_finished_and_of_one_study() {
     // The second shard run again after the study was edited.
     map(&dir, 4.0);
     let three = dir.join("three");
-    run_ok(&[
-        "study",
-        s,
-        "--quiet",
-        "--shard",
-        "2/2",
-        "--out",
-        three.to_str().unwrap(),
-    ]);
+    run_shard(s, "2/2", &three);
     refused(
         &[
             "study",
@@ -228,29 +217,13 @@ fn a_merge_needs_every_shard_finished_and_of_one_study() {
     std::fs::write(&copied, text).unwrap();
     let c = copied.to_str().unwrap();
     let (five, six) = (dir.join("five"), dir.join("six"));
-    run_ok(&[
-        "study",
-        c,
-        "--quiet",
-        "--shard",
-        "1/2",
-        "--out",
-        five.to_str().unwrap(),
-    ]);
+    run_shard(c, "1/2", &five);
     std::fs::write(
         &model_copy,
         original.replace("density = 2500.0", "density = 2600.0"),
     )
     .unwrap();
-    run_ok(&[
-        "study",
-        c,
-        "--quiet",
-        "--shard",
-        "2/2",
-        "--out",
-        six.to_str().unwrap(),
-    ]);
+    run_shard(c, "2/2", &six);
     refused(
         &[
             "study",

@@ -346,7 +346,7 @@ fn checked_row<'a>(
     number: usize,
     body: &'a str,
     fields: usize,
-    rows: &BTreeMap<String, String>,
+    seen: impl Fn(&str) -> bool,
 ) -> Result<&'a str, InputError> {
     let bad = |what: String| {
         InputError::Argument(format!(
@@ -360,7 +360,7 @@ fn checked_row<'a>(
         return Err(bad(format!("{found} fields where the header has {fields}")));
     }
     let id = body.split_once(',').map_or(body, |(id, _)| id);
-    if rows.contains_key(id) {
+    if seen(id) {
         return Err(bad(format!("case {id} appears a second time")));
     }
     Ok(id)
@@ -401,7 +401,9 @@ fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64
             }
             first = false;
         } else {
-            let id = checked_row(path, number + 1, body, field_count(header), &rows)?;
+            let id = checked_row(path, number + 1, body, field_count(header), |id| {
+                rows.contains_key(id)
+            })?;
             rows.insert(id.to_string(), body.to_string());
         }
         complete += line.len() as u64;
@@ -674,10 +676,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, InputError> {
             }
             _ => {}
         }
-        let mut in_file = BTreeMap::new();
+        let mut in_file = std::collections::BTreeSet::new();
         for (number, line) in lines.enumerate() {
-            let id = checked_row(&csv, number + 2, line, fields, &in_file)?;
-            in_file.insert(id.to_string(), String::new());
+            let id = checked_row(&csv, number + 2, line, fields, |id| in_file.contains(id))?;
+            in_file.insert(id.to_string());
             if let Some(prev) = rows.get(id)
                 && prev != line
             {

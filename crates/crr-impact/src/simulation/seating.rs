@@ -2,6 +2,7 @@
 //! by single releases and an active set), releasing them, and seating joints that come to rest.
 
 use super::*;
+use crr_kinematics::Interface;
 use crr_kinematics::kinematics::frame_point;
 use nalgebra::{Matrix3, Vector3};
 
@@ -394,7 +395,6 @@ fn releases_that_may_open(
         is_seated[k] = true;
     }
     let mut may_open = vec![true; 2 * seated.len()];
-    let mut sides = template.pivots.sides.clone();
     for (i, &k) in seated.iter().enumerate() {
         let f = trial.joint_force(k)?;
         let r = trial.seat_reactions[i];
@@ -409,13 +409,11 @@ fn releases_that_may_open(
             continue;
         }
         let other = side.flipped();
-        sides[k] = other;
-        let p_rest = iface.kind.pivot(&sides[iface.slots.clone()]);
-        sides[k] = side;
-        let pivot = match coord.parent {
-            Some(p) => trial.kin.rot_ops[p] * p_rest + trial.kin.frame_translation[p],
-            None => p_rest,
-        };
+        let pivot = frame_point(
+            &trial.kin,
+            coord.parent,
+            &other_pivot_rest(iface, &template.pivots, k),
+        );
         let arm = (pivot - trial.kin.pivot[k]).cross(&trial.kin.axis[k]);
         let r_other = r + arm.dot(&f.fixed_rows::<3>(3));
         may_open[index(other)] = -other.sign() * r_other > 0.0;
@@ -553,14 +551,27 @@ pub(super) fn closure_other_side_reaction(
             }
         }
     };
-    let sides = pivots.of_interface(model, index);
-    let mut flipped = sides.to_vec();
-    flipped[component] = flipped[component].flipped();
-    let p = frame_point(kin, parent, &iface.kind.pivot(sides));
-    let p_other = frame_point(kin, parent, &iface.kind.pivot(&flipped));
+    let p = frame_point(
+        kin,
+        parent,
+        &iface.kind.pivot(pivots.of_interface(model, index)),
+    );
+    let p_other = frame_point(kin, parent, &other_pivot_rest(iface, pivots, k));
     let lambda = trial.lambda.fixed_rows::<3>(closure.first_row);
     let arm = w.cross(&(p - p_other));
     Some((r - lambda.dot(&arm), 1e-9 * lambda.norm() * arm.norm()))
+}
+
+/// The rest position (in the coordinates of the frame that carries it) of interface `iface`'s
+/// pivot with its slot `k` on the other side, its other slots as in `pivots`.
+fn other_pivot_rest(iface: &Interface, pivots: &ActivePivots, k: usize) -> Vector3<f64> {
+    // An interface has one slot (a hinge) or two (a rocking base's tilts).
+    let current = &pivots.sides[iface.slots.clone()];
+    let mut sides = [Side::Positive; 2];
+    sides[..current.len()].copy_from_slice(current);
+    let local = k - iface.slots.start;
+    sides[local] = sides[local].flipped();
+    iface.kind.pivot(&sides[..current.len()])
 }
 
 /// Whether turning seated slot k to its other pivot moves the axis line of a free
@@ -580,10 +591,7 @@ pub(super) fn flip_moves_a_free_axis(
     let Some(iface) = model.interfaces.iter().find(|i| i.slots.contains(&k)) else {
         return true;
     };
-    let mut sides = pivots.sides[iface.slots.clone()].to_vec();
-    let local = k - iface.slots.start;
-    sides[local] = sides[local].flipped();
-    let p_rest = iface.kind.pivot(&sides);
+    let p_rest = other_pivot_rest(iface, pivots, k);
     iface.slots.clone().any(|j| {
         if j == k || is_seated[j] {
             return false;
@@ -591,10 +599,7 @@ pub(super) fn flip_moves_a_free_axis(
         if j >= model.dof() {
             return true;
         }
-        let moved = match model.coords[j].parent {
-            Some(p) => kin.rot_ops[p] * p_rest + kin.frame_translation[p],
-            None => p_rest,
-        };
+        let moved = frame_point(kin, model.coords[j].parent, &p_rest);
         kin.axis[j].cross(&(kin.pivot[j] - moved)).norm() > 1e-12 * model.size
     })
 }
@@ -669,14 +674,7 @@ impl SubtreeLoads {
         }
         let coord = &model.coords[k];
         let iface = &model.interfaces[coord.interface];
-        let mut sides = pivots.sides[iface.slots.clone()].to_vec();
-        let local = k - iface.slots.start;
-        sides[local] = sides[local].flipped();
-        let p_rest = iface.kind.pivot(&sides);
-        let pivot = match coord.parent {
-            Some(p) => kin.rot_ops[p] * p_rest + kin.frame_translation[p],
-            None => p_rest,
-        };
+        let pivot = frame_point(kin, coord.parent, &other_pivot_rest(iface, pivots, k));
         let shift = kin.axis[k].cross(&(kin.pivot[k] - pivot));
         (r + shift.dot(&force), 1e-9 * shift.norm() * force.norm())
     }
@@ -1002,12 +1000,8 @@ mod other_side_tests {
         r
     }
 
-    /// Compares every seated reaction the filter computes; returns how many, and how many of
-    /// them had another slot of their interface free.
-    fn check(model: &Model, seed: u64) -> (usize, usize) {
-        let n = model.dof();
-        let mut rng = SplitMix(seed);
-        let ground = GroundMotion::none();
+    /// Every slot on a random side.
+    fn random_pivots(model: &Model, rng: &mut SplitMix) -> ActivePivots {
         let mut pivots = ActivePivots::uniform(model, Side::Positive);
         for s in pivots.sides.iter_mut() {
             *s = if rng.uniform(0.0, 1.0) < 0.5 {
@@ -1016,6 +1010,16 @@ mod other_side_tests {
                 Side::Negative
             };
         }
+        pivots
+    }
+
+    /// Compares every seated reaction the filter computes; returns how many, and how many of
+    /// them had another slot of their interface free.
+    fn check(model: &Model, seed: u64) -> (usize, usize) {
+        let n = model.dof();
+        let mut rng = SplitMix(seed);
+        let ground = GroundMotion::none();
+        let pivots = random_pivots(model, &mut rng);
         // Seat whole interfaces (every slot of a rocking base), or one tilt of a rocking base
         // while the other rocks, about half of them.
         let mut seated = Vec::new();
@@ -1135,14 +1139,7 @@ mod other_side_tests {
         let n = model.dof();
         let mut rng = SplitMix(seed);
         let ground = GroundMotion::none();
-        let mut pivots = ActivePivots::uniform(model, Side::Positive);
-        for s in pivots.sides.iter_mut() {
-            *s = if rng.uniform(0.0, 1.0) < 0.5 {
-                Side::Positive
-            } else {
-                Side::Negative
-            };
-        }
+        let pivots = random_pivots(model, &mut rng);
         let mut seated: Vec<usize> = Vec::new();
         for iface in &model.interfaces {
             if iface.slots.start >= n || rng.uniform(0.0, 1.0) < 0.15 {
