@@ -308,19 +308,14 @@ fn bundled_models(c: &mut Criterion) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     for name in ["block_record", "drum_column", "baldachin"] {
         let path = root.join("examples/models").join(format!("{name}.toml"));
-        let opts = crr::simulate::SimulateOptions {
-            // Nothing is written: only the output folder's check reads this path.
-            out: Some(std::env::temp_dir().join("crr-bench-unused")),
-            force: true,
-            quiet: true,
-            ..Default::default()
-        };
-        let prepared = crr::simulate::prepare(&path, &opts).expect("bundled model");
-        let outcome = crr::simulate::run(&prepared, false).expect("runs");
-        assert!(outcome.error.is_none(), "{name}: {:?}", outcome.error);
+        let model = crr::ModelInput::read(&path).expect("bundled model");
+        let prepared = crr::analysis::simulation::prepare(&model, &crr::RunOptions::default())
+            .expect("bundled model");
+        let outcome = prepared.run();
+        assert!(outcome.completed(), "{name}: {:?}", outcome.summary.error);
         check(&format!("bundled_models/{name}"), &outcome.trajectory, None);
         group.bench_function(BenchmarkId::from_parameter(name), |b| {
-            b.iter(|| black_box(crr::simulate::run(black_box(&prepared), false).expect("runs")));
+            b.iter(|| black_box(black_box(&prepared).run()));
         });
     }
     group.finish();

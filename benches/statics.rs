@@ -28,7 +28,7 @@ fn temple_check(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(5));
     let model = bundled("temple");
     group.bench_function("temple", |b| {
-        b.iter(|| black_box(crr::static_multiplier::static_multipliers(&model).unwrap()))
+        b.iter(|| black_box(crr::analysis::static_multiplier::static_multipliers(&model).unwrap()))
     });
     group.finish();
 }

@@ -24,7 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let model = Model::from_spec(&spec)?;
     let initial = solve_initial(&model, &InitialSpec::default())?;
     let eq = equivalent_block(&model, &initial.pivots, 0, &Vector3::x())?;
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(crr::synthetic::FILE);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(crr::input::synthetic::FILE);
     let record = read_at2(&path)?;
     let pga = record.peak();
     let ground = GroundMotion::from_record(Axis::X, record, 1.0)?;

@@ -2,7 +2,7 @@
 //! record): SplitMix64 white noise (fixed seed), 4 passes of a 5-point moving average (−3 dB at
 //! ≈ 4.6 Hz), a trapezoidal–exponential envelope (rise 0–2 s, strong 2–10 s, decay τ = 2.5 s
 //! after), baseline-corrected to a final ground velocity of 0, scaled to a PGA of 0.25 g; 20 s at
-//! 0.01 s (NPTS = 2001). The procedure lives in `crr::synthetic` (also used by
+//! 0.01 s (NPTS = 2001). The procedure lives in `crr::input::synthetic` (also used by
 //! `tests/record_file.rs`, which checks the committed file is byte-identical).
 //!
 //! ```sh
@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use crr::synthetic;
+use crr::input::synthetic;
 
 fn main() -> std::io::Result<()> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(synthetic::FILE);

@@ -7,7 +7,7 @@ use std::path::Path;
 use crr_dynamics::ground_motion::{RecordFormat, TableOptions, Units, parse_at2, parse_table};
 use crr_kinematics::Model;
 
-use crate::model_file::parse_model_file;
+use crate::input::model_file::parse_model_file;
 
 /// The bytes as text, invalid UTF-8 replaced (the readers get text).
 fn text(data: &[u8]) -> String {
@@ -26,8 +26,8 @@ pub fn model_file(data: &[u8]) {
             continue;
         };
         let q = nalgebra::DVector::zeros(model.dof());
-        let _ = crate::inspect::inspect(&model, &q);
-        let _ = crate::check::check(&model);
+        let _ = crate::analysis::inspect::inspect(&model, &q);
+        let _ = crate::analysis::check::check(&model);
     }
 }
 
@@ -53,5 +53,5 @@ pub fn results(data: &[u8]) {
         parts.next().unwrap_or_default(),
         parts.next().unwrap_or_default(),
     );
-    let _ = crate::plot::parse_results(Path::new("fuzz"), &summary, &history, &impacts);
+    let _ = crate::output::plot::parse_results(Path::new("fuzz"), &summary, &history, &impacts);
 }

@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
 use common::{crr, refused, scratch};
-use crr::animate::render::{HEIGHT, WIDTH};
 use crr::kinematics::{Model, Parent, Role, Side};
 use crr::load_model;
+use crr::output::animate::render::{HEIGHT, WIDTH};
 
 fn ok(args: &[&str]) -> String {
     let o = crr(args);

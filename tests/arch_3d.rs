@@ -13,9 +13,9 @@ use std::f64::consts::PI;
 
 use nalgebra::Vector3;
 
-use crr::check::check;
+use crr::analysis::check::check;
+use crr::analysis::static_multiplier::static_multiplier;
 use crr::impact::Trajectory;
-use crr::static_multiplier::static_multiplier;
 
 fn bundled(name: &str) -> crr::kinematics::Model {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

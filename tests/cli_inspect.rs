@@ -159,7 +159,7 @@ fn json_model_files_are_accepted() {
         "/examples/models/single_block.toml"
     ))
     .unwrap();
-    let spec: crr::model_file::ModelFile = toml::from_str(&text).unwrap();
+    let spec: crr::input::model_file::ModelFile = toml::from_str(&text).unwrap();
     let path = dir.join("block.json");
     std::fs::write(&path, serde_json::to_string(&spec).unwrap()).unwrap();
     let a = json(&["inspect", path.to_str().unwrap(), "--json"]);

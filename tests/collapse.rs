@@ -5,9 +5,9 @@
 
 mod common;
 
+use crr::RunOptions;
 use crr::impact::Trajectory;
 use crr::kinematics::Model;
-use crr::simulate::{SimulateOptions, prepare};
 
 /// The collapse threshold: U − U(rest) < −collapse_drop·W·L (collapse_drop = 1e-3 by default).
 fn threshold(model: &Model) -> f64 {
@@ -74,9 +74,12 @@ fn impossible_initial_states_are_refused_naming_the_joint() {
             &format!("refused_{angle}"),
             &block.replace("base = 0.1", &format!("base = {angle}")),
         );
-        let e = prepare(&path, &SimulateOptions::default())
-            .expect_err("refused")
-            .to_string();
+        let e = crr::analysis::simulation::prepare(
+            &crr::ModelInput::read(&path).unwrap(),
+            &RunOptions::default(),
+        )
+        .expect_err("refused")
+        .to_string();
         assert!(
             e.contains("initial angle of base") && e.contains("±π/2"),
             "{angle}: {e}"
@@ -87,9 +90,12 @@ fn impossible_initial_states_are_refused_naming_the_joint() {
         "trilithon_2",
         &trilithon.replace("base_left = 0.06", "base_left = 2.0"),
     );
-    let e = prepare(&path, &SimulateOptions::default())
-        .expect_err("refused")
-        .to_string();
+    let e = crr::analysis::simulation::prepare(
+        &crr::ModelInput::read(&path).unwrap(),
+        &RunOptions::default(),
+    )
+    .expect_err("refused")
+    .to_string();
     assert!(e.contains("±π/2"), "{e}");
 }
 

@@ -83,7 +83,7 @@ fn markdown_files(dir: &Path, out: &mut Vec<PathBuf>) {
 #[test]
 fn the_extractor_finds_subcommands_in_code_only() {
     let md = "Run `crr simulate model.toml` or\n```sh\ntarget/release/crr check a.toml --json\n```\n\
-              crr is a library; `crr --help`; `crr <COMMAND>`; `crr::check`.\n";
+              crr is a library; `crr --help`; `crr <COMMAND>`; `crr::analysis::check`.\n";
     let found: Vec<String> = code_snippets(md)
         .into_iter()
         .flat_map(|(_, c)| named_subcommands(&c))

@@ -1,7 +1,7 @@
 //! Every model shown in the documentation is valid and says what the text says.
 //!
 //! Each ```` ```toml ```` block of `docs/model-format.md` (and of `README.md`, if present) is a
-//! complete model file: it must parse as a `crr::model_file::ModelFile` (structure plus the optional
+//! complete model file: it must parse as a `crr::input::model_file::ModelFile` (structure plus the optional
 //! `[ground_motion]`, `[initial]` and `[analysis]` tables) and its structure must build with
 //! `Model::from_spec`; the optional tables must be usable (ground motion built, initial state
 //! solved, analysis parameters accepted). A `toml-fragment` whose first line is
@@ -18,11 +18,11 @@ use std::path::Path;
 use crr::dynamics::ground_motion::GroundMotion;
 use crr::dynamics::{InitialState, solve_initial};
 use crr::impact::{Parameters, Simulation};
+use crr::input::model_file::ModelFile;
 use crr::kinematics::{
     ActivePivots, Data, ImpactLaw, InterfaceKind, Model, Role, Side, StructureSpec,
     constraint_residual, forward_kinematics, mass_matrix,
 };
-use crr::model_file::ModelFile;
 use nalgebra::{DVector, Vector3};
 
 /// A fenced block: its language tag, its text and the line of its opening fence.

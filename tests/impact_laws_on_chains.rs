@@ -22,7 +22,7 @@ use crr::kinematics::{ActivePivots, Data, Model, Side, forward_kinematics, jacob
 use crr::load_model;
 
 mod common;
-use crr::simulate::{SimulateOptions, prepare, run};
+use crr::RunOptions;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 fn bundled(name: &str) -> Model {
@@ -416,17 +416,18 @@ fn the_drum_column_under_its_pulse_keeps_momenta_and_never_gains_energy() {
     for law in ["restitution = 0.9", "dirac = { r = 0.9, c = 1.0 }"] {
         let tag = law.replace(|c: char| !c.is_ascii_alphanumeric(), "");
         let path = common::write_model(&tag, &with_law("drum_column", law, pulse));
-        let opts = SimulateOptions {
-            out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
+        let opts = RunOptions {
             ..Default::default()
         };
-        let prepared = prepare(&path, &opts).unwrap();
-        let outcome = run(&prepared, false).unwrap();
+        let prepared =
+            crr::analysis::simulation::prepare(&crr::ModelInput::read(&path).unwrap(), &opts)
+                .unwrap();
+        let outcome = prepared.run();
         // Near 0.5 s a joint crosses its pivot between two impacts of its neighbours without an
         // impact of its own (a defect the run's invariant found: before it, the run went on from
         // there with the joint rocking past its pivot); the run stops there, and the impacts
         // before are checked.
-        if let Some(e) = &outcome.error {
+        if let Some(e) = &outcome.summary.error {
             assert!(
                 e.to_string().contains("wrong side of its pivot"),
                 "{law}: {e}"
@@ -500,9 +501,13 @@ fn the_bundled_temple_and_arch_with_eq_5_keep_r_to_the_2c_of_their_energy() {
     for (name, r, c) in [("trilithon_dirac", 0.95f64, 1.5), ("arch_dirac", 0.9, 1.5)] {
         let path =
             Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/models/{name}.toml"));
-        let prepared = prepare(&path, &SimulateOptions::default()).unwrap();
-        let outcome = run(&prepared, false).unwrap();
-        assert!(outcome.error.is_none());
+        let prepared = crr::analysis::simulation::prepare(
+            &crr::ModelInput::read(&path).unwrap(),
+            &RunOptions::default(),
+        )
+        .unwrap();
+        let outcome = prepared.run();
+        assert!(outcome.summary.error.is_none());
         let traj = outcome.trajectory;
         // The four joints impact together (the last impacts before the arch comes to rest, at
         // rates of 1e-4 rad/s, may find one of them just outside `simultaneity`: the loop ties
@@ -631,17 +636,18 @@ fn every_bundled_model_with_every_law_loses_energy_at_every_impact() {
                 law.replace(|c: char| !c.is_ascii_alphanumeric(), "")
             );
             let path = common::write_model(&format!("every_law_{tag}"), &model_text);
-            let opts = SimulateOptions {
+            let opts = RunOptions {
                 duration: Some(2.0),
-                out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
                 ..Default::default()
             };
-            let prepared = prepare(&path, &opts).unwrap();
-            let outcome = run(&prepared, false).unwrap();
+            let prepared =
+                crr::analysis::simulation::prepare(&crr::ModelInput::read(&path).unwrap(), &opts)
+                    .unwrap();
+            let outcome = prepared.run();
             // The drum column under the rate laws misses an impact near 0.5 s (a joint that
             // crosses its pivot between two impacts of its neighbours): the run's invariant stops
             // it there; the impacts before are checked.
-            if let Some(e) = &outcome.error {
+            if let Some(e) = &outcome.summary.error {
                 assert!(
                     name == "drum_column" && e.to_string().contains("wrong side of its pivot"),
                     "{tag}: {e}"

@@ -11,7 +11,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crr::model_file::load_model;
+use crr::input::model_file::load_model;
 use crr_dynamics::{InitialSpec, solve_initial};
 use crr_kinematics::{Data, Model, forward_kinematics};
 use nalgebra::Matrix3;

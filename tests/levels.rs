@@ -1,4 +1,4 @@
-//! Energy levels of one-DOF mechanisms (`crr::levels`, `crr check --plot`, `crr plot`): the
+//! Energy levels of one-DOF mechanisms (`crr::analysis::levels`, `crr check --plot`, `crr plot`): the
 //! engine's U(θ) and M(θ) along the mechanism against closed forms (single block, trilithon of
 //! identical columns), against the engine's generalized gravity and its free-rocking simulation
 //! (arch), and the files written.
@@ -9,13 +9,13 @@ use std::process::{Command, Output};
 
 use nalgebra::DVector;
 
-use crr::dynamics::ground_motion::GroundMotion;
-use crr::dynamics::{InitialSpec, solve_initial};
-use crr::impact::simulation::{Parameters, Simulation, StopReason};
-use crr::levels::{
+use crr::analysis::levels::{
     LevelSample, MechanismLevels, SideEnd, evaluate, mechanism_levels, opening_pivots,
     rest_potential,
 };
+use crr::dynamics::ground_motion::GroundMotion;
+use crr::dynamics::{InitialSpec, solve_initial};
+use crr::impact::simulation::{Parameters, Simulation, StopReason};
 use crr::load_model;
 
 fn model(name: &str) -> crr::kinematics::Model {
@@ -404,7 +404,7 @@ axis = [0.0, 1.0, 0.0]
 pivot_positive = [0.1, 0.0, 0.0]
 pivot_negative = [-0.1, 0.0, 0.0]
 "#;
-    let file = crr::model_file::parse_model_file(Path::new("slender.toml"), text).unwrap();
+    let file = crr::input::model_file::parse_model_file(Path::new("slender.toml"), text).unwrap();
     let m = crr::kinematics::Model::from_spec(&file.structure()).unwrap();
     let levels = mechanism_levels(&m, 1e-3).unwrap();
     for side in [&levels.negative, &levels.positive] {

@@ -8,13 +8,14 @@
 //! cell of 0.10). The engine's boundary is known to a cell: between the first overturning
 //! amplitude on the grid, β₁, and the grid point below it, β₁ − Δβ; the analytic minimum must lie
 //! within Δβ of that bracket. The theory is computed in closed form
-//! (`crr::study::zhang_makris`), independently of the engine's integration.
+//! (`crr::analysis::study::zhang_makris`), independently of the engine's integration.
 
 use std::path::Path;
 
-use crr::study::spec::PulseKind;
-use crr::study::zhang_makris::minimum_overturning_ratio;
-use crr::study::{Shard, Study, StudyOptions, run_study};
+use crr::analysis::study::Study;
+use crr::analysis::study::spec::PulseKind;
+use crr::analysis::study::zhang_makris::minimum_overturning_ratio;
+use crr::output::study::{Shard, StudyOptions, run_study};
 
 #[test]
 fn the_map_boundary_follows_zhang_and_makris() {
@@ -96,12 +97,13 @@ fn the_map_boundary_follows_zhang_and_makris() {
         let want = minimum_overturning_ratio(PulseKind::OneSinePulse, w, r, 8.4).unwrap();
         assert!((b - want).abs() < 1e-5, "ω_p/p = {w}: {b} vs {want}");
     }
-    crr::plot::plot_study(&out).expect("the map is drawn");
+    crr::output::plot::plot_study(&out).expect("the map is drawn");
     let svg = std::fs::read_to_string(out.join("map.svg")).unwrap();
     assert!(svg.contains("Zhang &amp; Makris") || svg.contains("Zhang & Makris"));
     // The curve drawn on the map takes r from the engine's momentum law: the block's
     // 1 − (3/2) sin²α, so the same boundary to the bisection's 1e-6.
-    let drawn = crr::study::zhang_makris::map_boundary(&study, 1.0, 12.0, 12).expect("a block map");
+    let drawn = crr::analysis::study::zhang_makris::map_boundary(&study, 1.0, 12.0, 12)
+        .expect("a block map");
     assert!(drawn.len() >= 8);
     for (w, b) in drawn {
         let want = minimum_overturning_ratio(PulseKind::OneSinePulse, w, r, 50.0).unwrap();

@@ -9,11 +9,11 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{crr, refused, scratch};
-use crr::impact::{Parameters, Simulation};
-use crr::poincare::{
+use crr::analysis::poincare::{
     Computed, Forcing, Outcome, PoincareOptions, Prepared, Range, SAME_POINT_TOLERANCE,
     SectionKind, Sweep, compute, detect_period, distinct_points, prepare, run_section,
 };
+use crr::impact::{Parameters, Simulation};
 
 fn single_block() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml")

@@ -1,10 +1,10 @@
 //! The bundled synthetic accelerogram `examples/records/synthetic.AT2`: it reads as a PEER AT2
-//! record with the stated NPTS, DT and PGA, and `crr::synthetic` regenerates it byte for byte.
+//! record with the stated NPTS, DT and PGA, and `crr::input::synthetic` regenerates it byte for byte.
 
 use std::path::Path;
 
 use crr::dynamics::ground_motion::{STANDARD_GRAVITY, read_at2};
-use crr::synthetic;
+use crr::input::synthetic;
 
 fn bundled() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(synthetic::FILE)
@@ -35,7 +35,7 @@ fn regenerating_gives_the_same_bytes() {
     let committed = std::fs::read_to_string(bundled()).expect("the bundled record exists");
     assert!(
         committed == synthetic::at2_text(),
-        "examples/records/synthetic.AT2 differs from crr::synthetic::at2_text(); \
+        "examples/records/synthetic.AT2 differs from crr::input::synthetic::at2_text(); \
          regenerate with `cargo run --example make_record`"
     );
     let lines: Vec<&str> = committed.lines().collect();

@@ -246,9 +246,9 @@ fn bad_sweeps_are_input_errors() {
 /// structure's height × s, to round-off (1e-12 relative).
 #[test]
 fn scaling_multiplies_every_length() {
+    use crr::analysis::size_sweep::scale_structure;
+    use crr::input::model_file::parse_model_file;
     use crr::kinematics::{InterfaceKind, Model};
-    use crr::model_file::parse_model_file;
-    use crr::size_sweep::scale_structure;
     let frustum = r#"
 name = "frustum"
 [[body]]
@@ -293,7 +293,8 @@ pivot_negative = [-0.3, 0.0, 0.0]
     }
     assert!(files.len() >= 10);
     // Heights from the shapes: the frustum 1.5 m, the wall 2 m.
-    let height = |i: usize| crr::size_sweep::structure_height(&files[i].structure()).unwrap();
+    let height =
+        |i: usize| crr::analysis::size_sweep::structure_height(&files[i].structure()).unwrap();
     assert!((height(0) - 1.5).abs() < 1e-15 && (height(1) - 2.0).abs() < 1e-15);
     let s = 2.5f64;
     let close = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-12 * scale;
@@ -303,8 +304,8 @@ pivot_negative = [-0.3, 0.0, 0.0]
         let ms = Model::from_spec(&scale_structure(&spec, s)).unwrap();
         let l = m1.size * s;
         let (h1, hs) = (
-            crr::size_sweep::structure_height(&spec).unwrap(),
-            crr::size_sweep::structure_height(&scale_structure(&spec, s)).unwrap(),
+            crr::analysis::size_sweep::structure_height(&spec).unwrap(),
+            crr::analysis::size_sweep::structure_height(&scale_structure(&spec, s)).unwrap(),
         );
         assert!((hs - h1 * s).abs() <= 1e-12 * hs, "{}: height", spec.name);
         for (a, b) in m1.bodies.iter().zip(&ms.bodies) {

@@ -1,4 +1,4 @@
-//! The static multiplier (`crr::static_multiplier`, `crr check`'s `static_multipliers`): the
+//! The static multiplier (`crr::analysis::static_multiplier`, `crr check`'s `static_multipliers`): the
 //! static theorem's linear program on the contact faces (`crr_impact::statics`), against the
 //! limit-analysis closed forms of the bundled structures (kinematic theorem: the horizontal load
 //! λ m g at each centroid against the weight, in the virtual motion of the mechanism) and the
@@ -10,8 +10,8 @@ mod common;
 
 use nalgebra::Vector3;
 
-use crr::check::check;
-use crr::static_multiplier::{static_multiplier, static_multipliers};
+use crr::analysis::check::check;
+use crr::analysis::static_multiplier::{static_multiplier, static_multipliers};
 
 fn bundled(name: &str) -> crr::kinematics::Model {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -1,4 +1,4 @@
-//! The static multiplier (`crr::static_multiplier`) against values derived here independently of
+//! The static multiplier (`crr::analysis::static_multiplier`) against values derived here independently of
 //! crr's statics: small linear programs written in this file straight from the geometry (Heyman's
 //! thrust line of a voussoir arch, the equilibrium of the blocks of a running-bond wall), solved
 //! with clarabel, and closed forms (a panel's b/h, a wall's corner mechanisms by virtual work).
@@ -18,13 +18,13 @@ use clarabel::solver::{
 };
 use nalgebra::Vector3;
 
+use crr::analysis::static_multiplier::static_multiplier;
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
 use crr::kinematics::Model;
 use crr::kinematics::fixtures::{
     running_bond_wall, running_bond_wall_3d, stacked_panel, voussoir_arch,
 };
 use crr::kinematics::spec::StructureSpec;
-use crr::static_multiplier::static_multiplier;
 
 /// Cap of the multiplier in the independent programs, as in the engine (10 g).
 const LAMBDA_CAP: f64 = 10.0;

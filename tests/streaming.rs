@@ -1,79 +1,68 @@
-//! Long runs stream their history: `run_with_sink` hands the samples over after every step, a
-//! step never holds more than a few thousand of them, and the results (peaks, energy balance,
+//! Long runs stream their history: `crr::run_streaming` hands the samples over after every step,
+//! a step never holds more than a few thousand of them, and the results (peaks, energy balance,
 //! impacts) are those of the run that keeps everything in memory.
 
 use std::path::Path;
 
-use crr::simulate::{SampleStats, SimulateOptions, prepare, run, run_with_sink};
+use crr::{ModelInput, RunOptions};
+
+fn single_block(duration: f64) -> (ModelInput, RunOptions) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
+    let options = RunOptions {
+        duration: Some(duration),
+        ..Default::default()
+    };
+    (ModelInput::read(path).unwrap(), options)
+}
 
 #[test]
 fn a_streamed_run_holds_bounded_chunks_and_agrees_with_the_in_memory_run() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
-    let opts = SimulateOptions {
-        duration: Some(200.0),
-        out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
-        ..Default::default()
-    };
-    let p = prepare(&path, &opts).unwrap();
-    let whole = run(&p, false).unwrap();
-    assert!(whole.error.is_none());
-    let (mut chunks, mut largest, mut stats) = (0usize, 0usize, SampleStats::default());
+    let (model, options) = single_block(200.0);
+    let whole = crr::run(&model, &options).unwrap();
+    assert!(whole.completed());
+    let (mut chunks, mut largest) = (0usize, 0usize);
     let mut times = Vec::new();
-    let streamed = run_with_sink(
-        &p,
-        false,
-        |samples| {
-            chunks += 1;
-            largest = largest.max(samples.len());
-            stats.add(samples);
-            times.extend(samples.iter().map(|s| s.t));
-            Ok(())
-        },
-        true,
-    )
+    let streamed = crr::run_streaming(&model, &options, |samples| {
+        chunks += 1;
+        largest = largest.max(samples.len());
+        times.extend(samples.iter().map(|s| s.t));
+        Ok(())
+    })
     .unwrap();
-    assert!(streamed.error.is_none());
+    assert!(streamed.completed());
     let (a, b) = (&whole.trajectory, &streamed.trajectory);
     // 200 s at 0.01 s: 20 001 samples plus two per impact, in chunks of at most 4 096 (plus the
     // samples of the impacts of one step).
     assert!(b.samples.is_empty());
-    assert_eq!(stats.rows, a.samples.len());
+    assert_eq!(times.len(), a.samples.len());
+    assert_eq!(streamed.summary.samples, a.samples.len());
     assert_eq!(times, a.samples.iter().map(|s| s.t).collect::<Vec<_>>());
     assert!(
         chunks >= 5 && largest <= 4096 + 2 * a.impacts.len(),
         "{chunks} chunks, largest {largest}"
     );
-    // The same run: identical peaks, balance and impacts.
+    // The same run: identical peaks, balance and impacts, and the same summary.
     assert_eq!(a.peak_abs, b.peak_abs);
     assert_eq!(a.energy_balance_error, b.energy_balance_error);
     assert_eq!(a.impacts, b.impacts);
+    assert_eq!(whole.summary, streamed.summary);
 }
 
 #[test]
 fn a_sink_that_fails_stops_the_run_with_an_error_and_keeps_the_results() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
-    let opts = SimulateOptions {
-        duration: Some(100.0),
-        out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
-        ..Default::default()
-    };
-    let p = prepare(&path, &opts).unwrap();
+    let (model, options) = single_block(100.0);
     let mut calls = 0;
-    let o = run_with_sink(
-        &p,
-        false,
-        |_| {
-            calls += 1;
-            if calls == 3 {
-                Err(std::io::Error::other("disk full"))
-            } else {
-                Ok(())
-            }
-        },
-        true,
-    )
+    let o = crr::run_streaming(&model, &options, |_| {
+        calls += 1;
+        if calls == 3 {
+            Err(std::io::Error::other("disk full"))
+        } else {
+            Ok(())
+        }
+    })
     .unwrap();
-    let e = o.error.expect("the sink's error stops the run").to_string();
+    assert!(!o.completed());
+    let e = o.summary.error.expect("the sink's error stops the run");
     assert!(e.contains("cannot write the history: disk full"), "{e}");
     assert!(o.trajectory.end_time > 0.0 && o.trajectory.end_time < 100.0);
 }

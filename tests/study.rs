@@ -223,7 +223,8 @@ fn bad_study_input_is_a_clear_error() {
 /// `cases.csv` byte for byte.
 #[test]
 fn case_rows_joined_in_any_order_equal_the_command_line_file() {
-    use crr::study::{Study, StudySpec, case_rows, cases_csv, run::header};
+    use crr::analysis::study::{Study, StudySpec};
+    use crr::output::study::{case_rows, cases_csv, folder::header};
     let dir = scratch("study_rows");
     let study_file = small_map(&dir);
     let out = dir.join("cli");

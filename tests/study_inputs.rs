@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
+use crr::analysis::study::Study;
+use crr::analysis::study::cases::{IntensityMeasure, Motion, spectral_acceleration};
 use crr::dynamics::ground_motion::Record;
 use crr::kinematics::ImpactLaw;
-use crr::study::Study;
-use crr::study::cases::{IntensityMeasure, Motion, spectral_acceleration};
 
 /// A harmonic record at the oscillator's own period: after the transient (e^(−ζωt) ≈ e^(−31)
 /// after 100 periods at ζ = 0.05) the response is A/(2ζω²), so Sa = ω²·max|u| = A/(2ζ); the

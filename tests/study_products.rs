@@ -6,7 +6,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{crr, scratch};
-use crr::study::{Motion, Study};
+use crr::analysis::study::{Motion, Study};
 
 fn models() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models")
@@ -122,7 +122,7 @@ fn scale_axis_scales_p_mass_and_periods() {
 /// different from seed to seed, and the bundled seed is the bundled record.
 #[test]
 fn synthetic_records_by_seed() {
-    use crr::synthetic::{PGA_G, SEED, accelerogram, accelerogram_with_seed};
+    use crr::input::synthetic::{PGA_G, SEED, accelerogram, accelerogram_with_seed};
     let a1 = accelerogram_with_seed(1);
     assert_eq!(a1, accelerogram_with_seed(1), "same seed, same record");
     assert_eq!(accelerogram_with_seed(SEED), accelerogram());
@@ -381,7 +381,7 @@ fn a_spectral_acceleration_study_is_read_against_sa() {
          c0,\"a.AT2\",0.2,0.5,ok,0\n\
          c1,\"a.AT2\",0.4,1,ok,1\n",
     );
-    let r = crr::study::products::StudyResults::read(&dir).unwrap();
+    let r = crr::output::study::products::StudyResults::read(&dir).unwrap();
     assert_eq!(r.intensity.as_deref(), Some("sa_g"));
     let levels: Vec<Option<f64>> = r.cases.iter().map(|c| c.level).collect();
     assert_eq!(levels, vec![Some(0.2), Some(0.4)]);

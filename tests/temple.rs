@@ -422,7 +422,7 @@ fn separate_architraves_rock_as_walls_along_y() {
     let m_e = 2.0 * end;
     let expected = (b * m_walls + (b + 0.55) * m_e) / (mz_walls + 4.35 * m_e);
     for d in [nalgebra::Vector3::y(), -nalgebra::Vector3::y()] {
-        let s = crr::static_multiplier::static_multiplier(&model, d).unwrap();
+        let s = crr::analysis::static_multiplier::static_multiplier(&model, d).unwrap();
         let l = s.lambda.expect("it opens");
         assert!(
             (l - expected).abs() <= 1e-8 * expected,

@@ -190,9 +190,10 @@ fn the_twisting_baldachin_moves_as_the_rigid_one() {
     let rigid_text = common::bundled_text("baldachin");
     let (_, rigid) = common::run_model_text("baldachin_rigid", &rigid_text, None);
     let twist_path = common::write_model("baldachin_twist_run", &twisting_text());
-    let opts = crr::simulate::SimulateOptions::default();
-    let p = crr::simulate::prepare(&twist_path, &opts).unwrap();
-    let twisting = crr::simulate::run(&p, false).unwrap().trajectory;
+    let opts = crr::RunOptions::default();
+    let p = crr::analysis::simulation::prepare(&crr::ModelInput::read(&twist_path).unwrap(), &opts)
+        .unwrap();
+    let twisting = p.run().trajectory;
     assert_eq!(rigid.impacts.len(), twisting.impacts.len());
     assert!(rigid.impacts.len() >= 4);
     for (a, b) in rigid.peak_abs.iter().zip(&twisting.peak_abs) {

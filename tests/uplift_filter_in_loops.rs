@@ -53,12 +53,13 @@ fn reference(
 fn compare(name: &str, duration: f64) -> usize {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let path = root.join(format!("examples/models/{name}.toml"));
-    let opts = crr::simulate::SimulateOptions {
+    let opts = crr::RunOptions {
         duration: Some(duration),
         ..Default::default()
     };
-    let p = crr::simulate::prepare(&path, &opts).unwrap();
-    let o = crr::simulate::run(&p, false).unwrap();
+    let p =
+        crr::analysis::simulation::prepare(&crr::ModelInput::read(&path).unwrap(), &opts).unwrap();
+    let o = p.run();
     let model = &p.model;
     let rate_scale = (model.gravity / model.size).sqrt();
     let mut compared = 0;

@@ -8,7 +8,7 @@ mod common;
 
 use std::path::Path;
 
-use crr::simulate::{SimulateOptions, prepare, run};
+use crr::RunOptions;
 
 fn read_csv(path: &Path) -> Vec<Vec<String>> {
     std::fs::read_to_string(path)
@@ -36,9 +36,13 @@ fn compare(case: &str, law: &str, base: f64, joint: f64, ground: &str) -> (usize
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("{case}.toml"));
     std::fs::write(&path, model).unwrap();
-    let p = prepare(&path, &SimulateOptions::default()).unwrap();
-    let o = run(&p, false).unwrap();
-    assert!(o.error.is_none(), "{case}: {:?}", o.error);
+    let p = crr::analysis::simulation::prepare(
+        &crr::ModelInput::read(&path).unwrap(),
+        &RunOptions::default(),
+    )
+    .unwrap();
+    let o = p.run();
+    assert!(o.summary.error.is_none(), "{case}: {:?}", o.summary.error);
     let traj = o.trajectory;
 
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/two_block_stack/data");

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use criterion::Criterion;
 
-use crr::poincare::{
+use crr::analysis::poincare::{
     PoincareOptions, SAME_POINT_TOLERANCE, SectionKind, distinct_points, prepare, run_section,
 };
 

@@ -12,7 +12,8 @@ use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion};
 
-use crr::study::{Shard, Study, StudyOptions, run_study};
+use crr::analysis::study::Study;
+use crr::output::study::{Shard, StudyOptions, run_study};
 
 fn scratch() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("crr_bench_study_{}", std::process::id()));

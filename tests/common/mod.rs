@@ -57,8 +57,8 @@ pub fn refused(args: &[&str], needle: &str) {
     assert!(!err.contains("panicked"), "{err}");
 }
 
-/// Writes `text` as `<tag>.toml` in a scratch folder, prepares it as `crr simulate` does
-/// (`duration` overriding `[analysis]`) and runs it in memory; the run must complete. The model
+/// Writes `text` as `<tag>.toml` in a scratch folder and runs it with `crr::run` (`duration`
+/// overriding `[analysis]`); the run must complete. The model
 /// file stays in the folder (the record paths of a test may be relative to it).
 pub fn run_model_text(
     tag: &str,
@@ -66,15 +66,14 @@ pub fn run_model_text(
     duration: Option<f64>,
 ) -> (crr::kinematics::Model, crr::impact::Trajectory) {
     let path = write_model(tag, text);
-    let opts = crr::simulate::SimulateOptions {
+    let opts = crr::RunOptions {
         duration,
-        out: Some(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("no-results")),
         ..Default::default()
     };
-    let p = crr::simulate::prepare(&path, &opts).unwrap_or_else(|e| panic!("{tag}: {e}"));
-    let o = crr::simulate::run(&p, false).unwrap();
-    assert!(o.error.is_none(), "{tag}: {:?}", o.error);
-    (p.model, o.trajectory)
+    let model = crr::ModelInput::read(&path).unwrap_or_else(|e| panic!("{tag}: {e}"));
+    let run = crr::run(&model, &opts).unwrap_or_else(|e| panic!("{tag}: {e}"));
+    assert!(run.completed(), "{tag}: {:?}", run.summary.error);
+    (run.model, run.trajectory)
 }
 
 /// Writes `text` as `<tag>.toml` in the scratch folder `models` and returns its path.

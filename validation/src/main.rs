@@ -4,7 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use crr::simulate::{SimulateOptions, prepare};
+use crr::analysis::simulation::prepare;
+use crr::{ModelInput, RunOptions};
 use crr_validation::run::{run, write_history};
 use crr_validation::scene::Settings;
 
@@ -96,14 +97,11 @@ fn main() -> ExitCode {
                 );
                 return ExitCode::from(2);
             }
-            let opts = SimulateOptions {
-                out: None,
+            let options = RunOptions {
                 duration,
-                record: None,
-                quiet: true,
-                force: true,
+                ..Default::default()
             };
-            let p = match prepare(&model, &opts) {
+            let p = match ModelInput::read(&model).and_then(|m| prepare(&m, &options)) {
                 Ok(p) => p,
                 Err(e) => {
                     eprintln!("crr-validation: {e}");
@@ -118,7 +116,8 @@ fn main() -> ExitCode {
                 ..Settings::default()
             };
             let out = out.unwrap_or_else(|| {
-                let mut d = crr::simulate::default_out_dir(&p.file.name).into_os_string();
+                let mut d =
+                    crr::output::results_folder::default_out_dir(&p.file.name).into_os_string();
                 d.push("-rapier");
                 PathBuf::from(d)
             });

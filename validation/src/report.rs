@@ -4,10 +4,11 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use crr::analysis::simulation::{Prepared, prepare};
 use crr::dynamics::ground_motion::{Axis, ComponentSpec, GroundMotion, PulseSpec, SignalSpec};
 use crr::dynamics::{InitialSpec, solve_initial};
 use crr::impact::Trajectory;
-use crr::simulate::{Prepared, RecordArg, SimulateOptions, prepare, run as run_crr};
+use crr::{ModelInput, RecordFile, RunOptions};
 use plotters::prelude::*;
 
 use crate::closed_forms::Block;
@@ -15,17 +16,16 @@ use crate::run::{RapierRun, run as run_rapier};
 use crate::scene::Settings;
 
 /// The bundled model `name` (examples/models/NAME.toml), with `record` attached if given.
-pub fn bundled(name: &str, record: Option<RecordArg>) -> Result<Prepared, String> {
+pub fn bundled(name: &str, record: Option<RecordFile>) -> Result<Prepared, String> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/models")
         .join(format!("{name}.toml"));
-    let opts = SimulateOptions {
-        record,
-        quiet: true,
-        force: true,
-        ..SimulateOptions::default()
+    let options = RunOptions {
+        record_file: record,
+        ..RunOptions::default()
     };
-    prepare(&path, &opts).map_err(|e| e.to_string())
+    let model = ModelInput::read(&path).map_err(|e| e.to_string())?;
+    prepare(&model, &options).map_err(|e| e.to_string())
 }
 
 /// `p` released from rest at the given angles (others 0).
@@ -57,8 +57,8 @@ pub fn under_pulse(p: Prepared, amplitude: f64, period: f64) -> Result<Prepared,
 
 /// Runs crr on `p` (complete or up to its error).
 pub fn crr(p: &Prepared) -> Result<Trajectory, String> {
-    run_crr(p, false)
-        .map(|o| o.trajectory)
+    p.simulate(&mut |_| Ok(()), false)
+        .map(|(trajectory, _)| trajectory)
         .map_err(|e| e.to_string())
 }
 
@@ -137,7 +137,7 @@ pub fn overlay_png(
     title: &str,
     series: &[(String, Series, Series)],
 ) -> Result<(), String> {
-    crr::plot::register_fonts();
+    crr::output::plot::register_fonts();
     let root =
         BitMapBackend::new(path, (800, 230 * series.len().max(1) as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
@@ -150,7 +150,7 @@ pub fn overlay_png(
                 .max(b.0.last().copied().unwrap_or(1.0));
         let q_max = a.1.iter().chain(&b.1).fold(1e-6f64, |m, q| m.max(q.abs())) * 1.1;
         let mut chart = ChartBuilder::on(area)
-            .caption(format!("{title}: {name}"), (crr::plot::FONT, 18))
+            .caption(format!("{title}: {name}"), (crr::output::plot::FONT, 18))
             .margin(8)
             .x_label_area_size(30)
             .y_label_area_size(60)
@@ -160,7 +160,7 @@ pub fn overlay_png(
             .configure_mesh()
             .x_desc("t (s)")
             .y_desc("rad")
-            .label_style((crr::plot::FONT, 12))
+            .label_style((crr::output::plot::FONT, 12))
             .draw()
             .map_err(|e| e.to_string())?;
         chart
@@ -183,7 +183,7 @@ pub fn overlay_png(
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
-            .label_font((crr::plot::FONT, 12))
+            .label_font((crr::output::plot::FONT, 12))
             .draw()
             .map_err(|e| e.to_string())?;
     }
@@ -273,13 +273,13 @@ pub fn agreement(cells: &[Cell], n: usize) -> (f64, f64) {
 }
 
 fn map_png(path: &Path, block: &Block, cells: &[Cell]) -> Result<(), String> {
-    crr::plot::register_fonts();
+    crr::output::plot::register_fonts();
     let root = BitMapBackend::new(path, (800, 600)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
             "One-sine pulse on the block (b = 0.2 m, h = 1 m): overturning",
-            (crr::plot::FONT, 18),
+            (crr::output::plot::FONT, 18),
         )
         .margin(10)
         .x_label_area_size(40)
@@ -290,7 +290,7 @@ fn map_png(path: &Path, block: &Block, cells: &[Cell]) -> Result<(), String> {
         .configure_mesh()
         .x_desc("ω_p / p")
         .y_desc("A / (g tan α)")
-        .label_style((crr::plot::FONT, 13))
+        .label_style((crr::output::plot::FONT, 13))
         .draw()
         .map_err(|e| e.to_string())?;
     chart
@@ -338,7 +338,7 @@ fn map_png(path: &Path, block: &Block, cells: &[Cell]) -> Result<(), String> {
         .position(SeriesLabelPosition::UpperLeft)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .label_font((crr::plot::FONT, 13))
+        .label_font((crr::output::plot::FONT, 13))
         .draw()
         .map_err(|e| e.to_string())?;
     root.present().map_err(|e| e.to_string())
@@ -519,7 +519,7 @@ pub fn write_report(dir: &Path, grid: usize, s: &Settings) -> Result<PathBuf, St
         "first peaks within rapier's error (3 %); after the first impact, the impact model",
         "stack.png",
     )?);
-    let record = RecordArg {
+    let record = RecordFile {
         file: Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/records/synthetic.AT2"),
         format: crr::dynamics::ground_motion::RecordFormat::PeerAt2,
         units: None,

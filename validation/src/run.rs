@@ -6,8 +6,8 @@
 use std::io::Write;
 use std::path::Path;
 
+use crr::analysis::simulation::Prepared;
 use crr::kinematics::{InterfaceKind, Model, Parent, interface_angles};
-use crr::simulate::Prepared;
 use nalgebra::{Matrix3, Vector3};
 use rapier3d_f64::prelude::*;
 

@@ -11,21 +11,19 @@
 
 use std::path::Path;
 
-use crr::simulate::{SimulateOptions, prepare, run as run_crr};
+use crr::analysis::simulation::prepare;
+use crr::{ModelInput, RunOptions};
 use crr_validation::closed_forms::Block;
 use crr_validation::run::run;
 use crr_validation::scene::{Settings, build, rotation_matrix};
 
-fn block() -> crr::simulate::Prepared {
+fn block() -> crr::analysis::simulation::Prepared {
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/models/single_block.toml");
-    let opts = SimulateOptions {
-        out: None,
+    let options = RunOptions {
         duration: Some(1.5),
-        record: None,
-        quiet: true,
-        force: true,
+        ..Default::default()
     };
-    prepare(&model, &opts).unwrap()
+    prepare(&ModelInput::read(&model).unwrap(), &options).unwrap()
 }
 
 #[test]
@@ -49,7 +47,7 @@ fn first_crossing_of_the_free_block_in_crr_and_rapier() {
     let p = block();
     // The exact quadrature (src/closed_forms.rs, checked against Housner's linearised period).
     let exact = Block::new(0.2, 1.0, p.model.gravity).quarter_period(0.1);
-    let crr_run = run_crr(&p, false).unwrap();
+    let crr_run = p.run();
     let crr_first = crr_run.trajectory.impacts[0].t;
     assert!(
         ((crr_first - exact) / exact).abs() < 1e-6,

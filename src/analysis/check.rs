@@ -1,0 +1,476 @@
+//! `crr check`: the mobility report of a model and, for a one-DOF mechanism, its activation
+//! multiplier, equivalent single block, coefficient of restitution and free-rocking frequencies
+//! (keys documented in `docs/outputs.md`).
+
+use std::collections::BTreeMap;
+
+use nalgebra::{DVector, Vector3};
+use serde::Serialize;
+
+use crr_dynamics::ground_motion::GroundMotion;
+use crr_dynamics::mechanism::reduce_at;
+use crr_dynamics::{
+    FiniteMobility, InitialSpec, LagrangianParameters, Mobility, equivalent_block,
+    lagrangian_parameters, mobility, mobility_after_step, solve_initial,
+};
+use crr_impact::laws::momentum_law;
+use crr_impact::simulation::{Parameters, Simulation, StopReason};
+use crr_kinematics::{ActivePivots, Data, Model, Side};
+
+use crate::analysis::static_multiplier::{
+    StaticMultiplier, horizontal_directions, static_multiplier_with,
+};
+
+/// One line of the frequency table.
+#[derive(Clone, Debug, Serialize)]
+pub struct FrequencyRow {
+    /// θ_m/α_eq.
+    pub amplitude_ratio: f64,
+    /// θ_m (rad): the released angle of the mechanism coordinate.
+    pub theta_m: f64,
+    /// F_H = √χ / (4 arccosh(1/(1 − εθ_m))), χ = p_eq², ε = 1/α_eq (Hz).
+    pub housner_hz: f64,
+    /// 1/(4τ) with τ the time of the engine's first fall from θ_m to 0 (Hz); None if it did not
+    /// return to 0 (or the run failed).
+    pub engine_hz: Option<f64>,
+    /// engine_hz / housner_hz.
+    pub ratio: Option<f64>,
+}
+
+/// The one-DOF mechanism seen as a single block.
+#[derive(Clone, Debug, Serialize)]
+pub struct MechanismReport {
+    /// The mechanism coordinate θ (the first coordinate).
+    pub coordinate: String,
+    /// Unit horizontal direction of the ground acceleration used for λ (perpendicular to the
+    /// coordinate's axis).
+    pub direction: [f64; 3],
+    /// Pivot side of every angle slot in the opening state θ > 0 (`+` or `-`), by interface name
+    /// (joined by `/` for a rocking base).
+    pub pivots: BTreeMap<String, String>,
+    /// λ: activating ground acceleration in g (limit-analysis collapse multiplier).
+    pub lambda: f64,
+    /// Sign of the activating acceleration along `direction`.
+    pub lambda_sign: f64,
+    /// M(0) = Bᵀ M B (kg m²).
+    pub mass: f64,
+    /// U′(0) (N m).
+    pub potential_slope: f64,
+    /// U″(0) (N m).
+    pub potential_curvature: f64,
+    /// α_eq (rad).
+    pub alpha_eq: f64,
+    /// p_eq = √(√(U′² + U″²)/M(0)) (rad/s).
+    pub p_eq: f64,
+    /// p_eq² (1/s²).
+    pub p_squared: f64,
+    /// −U″(0)/M(0) (1/s²).
+    pub p_squared_linearised: f64,
+    /// r = θ̇⁺/θ̇⁻ of the momentum law at θ = 0 for the mechanism velocity, pivots flipped.
+    pub r: f64,
+    /// T⁺/T⁻ of that impact.
+    pub energy_ratio: f64,
+    /// max |q̇⁺ − r q̇⁻| / max |q̇⁻|: how far the velocity after the impact is from a multiple of
+    /// the velocity before (0 for a symmetric mechanism).
+    pub mode_change: f64,
+    /// The paper's one-DOF Lagrangian (eq 4): ν, ξ, η, χ, and eq 6's χ and ε (NOTATION.md).
+    pub lagrangian: LagrangianParameters,
+    /// Generalized Housner frequency against the engine's free rocking.
+    pub frequencies: Vec<FrequencyRow>,
+}
+
+/// Everything `crr check` reports.
+#[derive(Clone, Debug, Serialize)]
+pub struct CheckReport {
+    /// Model name.
+    pub model: String,
+    /// g (m/s²).
+    pub gravity: f64,
+    /// Coordinate names, in the order of q.
+    pub coordinates: Vec<String>,
+    /// Loop-closing interfaces.
+    pub closures: Vec<String>,
+    /// The mobility at rest (q = 0, every pivot `+`).
+    pub mobility: Mobility,
+    /// DOF(2) after a finite step along the mechanism (closed chains that can move; `None`
+    /// otherwise). Smaller than at rest when the loops only close to first order.
+    pub finite_mobility: Option<FiniteMobility>,
+    /// Why `finite_mobility` is missing for a closed chain that can move.
+    pub finite_mobility_note: Option<String>,
+    /// Present when DOF(2) = 1.
+    pub mechanism: Option<MechanismReport>,
+    /// Why the mechanism part is missing or incomplete.
+    pub note: Option<String>,
+    /// The static multipliers of the structure at rest along +x, −x, +y and −y
+    /// ([`crate::analysis::static_multiplier`]): any structure, whatever its DOF(2); empty when the search
+    /// failed (`static_multipliers_note` says why).
+    pub static_multipliers: Vec<StaticMultiplier>,
+    /// Why `static_multipliers` is empty, else `None`.
+    pub static_multipliers_note: Option<String>,
+}
+
+/// Housner's linearised frequency (Hz) at amplitude θ_m.
+pub fn housner_frequency(p: f64, alpha: f64, theta_m: f64) -> f64 {
+    p / (4.0 * (1.0 / (1.0 - theta_m / alpha)).acosh())
+}
+
+/// The time of the first return of the mechanism to θ = 0 after release from θ_m at rest.
+pub fn first_fall_time(model: &Model, coordinate: &str, theta_m: f64, limit: f64) -> Option<f64> {
+    let spec = InitialSpec {
+        angles: [(coordinate.to_string(), theta_m)].into_iter().collect(),
+        rates: BTreeMap::new(),
+    };
+    let initial = solve_initial(model, &spec).ok()?;
+    let ground = GroundMotion::none();
+    let params = Parameters {
+        duration: limit,
+        output_interval: limit / 4.0,
+        ..Parameters::default()
+    };
+    let mut sim = Simulation::new(model, &ground, &initial, params).ok()?;
+    loop {
+        match sim.step().ok()? {
+            StopReason::Impact(i) => return Some(sim.impacts[i].t),
+            StopReason::End(_) | StopReason::Collapse(_) => return None,
+            _ => {}
+        }
+    }
+}
+
+fn slot_codes(model: &Model, pivots: &ActivePivots) -> BTreeMap<String, String> {
+    model
+        .interfaces
+        .iter()
+        .map(|i| {
+            let codes: Vec<&str> = i
+                .slots
+                .clone()
+                .map(|s| match pivots.sides[s] {
+                    Side::Positive => "+",
+                    Side::Negative => "-",
+                })
+                .collect();
+            (i.name.clone(), codes.join("/"))
+        })
+        .collect()
+}
+
+fn mechanism(model: &Model) -> Result<MechanismReport, String> {
+    let name = model.coords[0].name.clone();
+    let opening = InitialSpec {
+        angles: [(name.clone(), 0.01)].into_iter().collect(),
+        rates: BTreeMap::new(),
+    };
+    let open = solve_initial(model, &opening).map_err(|e| e.to_string())?;
+    let pivots = open.pivots;
+    let u = model.coords[0].axis;
+    let mut d = u.cross(&Vector3::z());
+    if d.norm() < 1e-9 {
+        d = Vector3::x();
+    }
+    let d = d.normalize();
+    let eq = equivalent_block(model, &pivots, 0, &d).map_err(|e| e.to_string())?;
+    let lagrangian = lagrangian_parameters(model, &pivots, 0, &d).map_err(|e| e.to_string())?;
+    // r from the momentum law: closing velocity on the opening pivots, after the flip.
+    let zero = DVector::zeros(model.dof());
+    let b = reduce_at(model, &zero, &pivots, 0, &d)
+        .map_err(|e| e.to_string())?
+        .velocity_map;
+    let before = pivots.clone();
+    let after = ActivePivots {
+        sides: before.sides.iter().map(|s| s.flipped()).collect(),
+    };
+    let qd = -&b;
+    let mut kin = Data::new(model);
+    let res = momentum_law(model, &mut kin, &zero, &qd, &before, &after)
+        .map_err(|e| format!("momentum law: {e}"))?;
+    let r = res.qdot[0] / qd[0];
+    let mode_change = (&res.qdot - &qd * r).amax() / qd.amax();
+    let p = eq.p_squared.sqrt();
+    let alpha = eq.alpha;
+    let frequencies = (1..=9)
+        .map(|k| {
+            let ratio = k as f64 / 10.0;
+            let theta_m = ratio * alpha;
+            let fh = housner_frequency(p, alpha, theta_m);
+            let limit = 2.0 / fh + 1.0;
+            let engine = first_fall_time(model, &name, theta_m, limit).map(|tau| 1.0 / (4.0 * tau));
+            FrequencyRow {
+                amplitude_ratio: ratio,
+                theta_m,
+                housner_hz: fh,
+                engine_hz: engine,
+                ratio: engine.map(|e| e / fh),
+            }
+        })
+        .collect();
+    Ok(MechanismReport {
+        coordinate: name,
+        direction: [d.x, d.y, d.z],
+        pivots: slot_codes(model, &pivots),
+        lambda: eq.lambda,
+        lambda_sign: eq.lambda_sign,
+        mass: eq.mass,
+        potential_slope: eq.potential_slope,
+        potential_curvature: eq.potential_curvature,
+        alpha_eq: alpha,
+        p_eq: p,
+        p_squared: eq.p_squared,
+        p_squared_linearised: eq.p_squared_linearised,
+        r,
+        energy_ratio: res.energy_ratio(),
+        mode_change,
+        lagrangian,
+        frequencies,
+    })
+}
+
+/// Largest angle (rad) of the step along the mechanism used for the finite-mobility check.
+pub const FINITE_STEP: f64 = 0.01;
+
+/// Builds the report, with the static multipliers along ±x and ±y without sliding.
+pub fn check(model: &Model) -> CheckReport {
+    check_with(model, &horizontal_directions(), None)
+}
+
+/// Builds the report, with the static multipliers along `directions` (unit or not; the ground
+/// accelerating along each) and Coulomb friction μ = `friction` at the contacts (`None`: no
+/// sliding).
+pub fn check_with(
+    model: &Model,
+    directions: &[Vector3<f64>],
+    friction: Option<f64>,
+) -> CheckReport {
+    let zero = DVector::zeros(model.dof());
+    let mob = mobility(model, &zero, &ActivePivots::uniform(model, Side::Positive));
+    let (finite, finite_note) = if model.closure_rows > 0 && !mob.locked {
+        match mobility_after_step(model, FINITE_STEP) {
+            Ok(f) => (Some(f), None),
+            Err(e) => (None, Some(format!("not evaluated: {e}"))),
+        }
+    } else {
+        (None, None)
+    };
+    let (mech, note) = if mob.dof2 == 1 {
+        match mechanism(model) {
+            Ok(m) => (Some(m), None),
+            Err(e) => (
+                None,
+                Some(format!("one-DOF mechanism analysis failed: {e}")),
+            ),
+        }
+    } else if mob.locked {
+        (
+            None,
+            Some("locked: DOF(2) = 0, the structure cannot move".into()),
+        )
+    } else {
+        (
+            None,
+            Some(format!(
+                "DOF(2) = {}: no single equivalent block (only one-DOF mechanisms are reduced)",
+                mob.dof2
+            )),
+        )
+    };
+    // The statics run on the contact faces whatever the CRR chain's mobility: a chain locked by
+    // its hinges can still open by a block lifting off a support.
+    let statics = directions
+        .iter()
+        .map(|&d| static_multiplier_with(model, d, friction))
+        .collect::<Result<Vec<_>, _>>();
+    let (statics, statics_note) = match statics {
+        Ok(v) => (v, None),
+        Err(e) => (Vec::new(), Some(e)),
+    };
+    CheckReport {
+        model: model.name.clone(),
+        gravity: model.gravity,
+        coordinates: model.coords.iter().map(|c| c.name.clone()).collect(),
+        closures: model
+            .closures
+            .iter()
+            .map(|c| model.interfaces[c.interface].name.clone())
+            .collect(),
+        mobility: mob,
+        finite_mobility: finite,
+        finite_mobility_note: finite_note,
+        mechanism: mech,
+        note,
+        static_multipliers: statics,
+        static_multipliers_note: statics_note,
+    }
+}
+
+/// The report as text.
+pub fn to_text(r: &CheckReport) -> String {
+    let m = &r.mobility;
+    let mut s = format!("model: {}\n", r.model);
+    s += &format!(
+        "DOF(1) = {} (coordinates: {})\n",
+        m.dof1,
+        r.coordinates.join(", ")
+    );
+    s += &format!(
+        "loop closures: {} ({}), {} rows of Φ, rank {} ({} redundant)\n",
+        m.closures,
+        if r.closures.is_empty() {
+            "none".to_string()
+        } else {
+            r.closures.join(", ")
+        },
+        m.constraint_rows,
+        m.rank,
+        m.redundant
+    );
+    s += &format!(
+        "DOF(2) = {}{}\n",
+        m.dof2,
+        if m.locked { " (locked)" } else { "" }
+    );
+    if let Some(f) = &r.finite_mobility {
+        s += &format!(
+            "DOF(2) after a {} rad step along the mechanism = {}\n",
+            f.step, f.dof2
+        );
+        if f.dof2 < m.dof2 {
+            s += &format!(
+                "  the loops move only to first order at rest: {} of the {} independent motions at rest \
+                 have no finite continuation. Followed further, they would turn a \
+                 rocking base about its contact normal (a twist, which a rocking base \
+                 forbids) or pull a loop apart; the structure can only start along them. \
+                 Near rest its constrained solve is ill-conditioned. Where the order of a \
+                 rocking base's two tilts causes it, reorder its corners \
+                 (docs/model-format.md, rocking bases in loops)\n",
+                m.dof2 - f.dof2,
+                m.dof2
+            );
+        }
+    }
+    if let Some(note) = &r.finite_mobility_note {
+        s += &format!("DOF(2) after a finite step along the mechanism: {note}\n");
+    }
+    if m.symmetries > 0 {
+        s += &format!("symmetries: {}, DOF(3) = {}\n", m.symmetries, m.dof3);
+    }
+    if let Some(note) = &r.note {
+        s += &format!("note: {note}\n");
+    }
+    if !r.static_multipliers.is_empty() {
+        s += "static multiplier at rest (constant ground acceleration λ g along d; limit analysis on the contact faces; \
+              the friction λ needs; the joints that open):\n";
+        for m in &r.static_multipliers {
+            let d = m.direction;
+            let dir = if d == [1.0, 0.0, 0.0] {
+                "+x".to_string()
+            } else if d == [-1.0, 0.0, 0.0] {
+                "−x".to_string()
+            } else if d == [0.0, 1.0, 0.0] {
+                "+y".to_string()
+            } else if d == [0.0, -1.0, 0.0] {
+                "−y".to_string()
+            } else {
+                format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2])
+            };
+            match m.lambda {
+                Some(l) => {
+                    let joints: Vec<String> =
+                        m.opening.iter().map(|(k, v)| format!("{k} {v}")).collect();
+                    let friction = match m.required_friction {
+                        Some(mu) if mu.is_finite() => format!(" (μ ≥ {mu:.4})"),
+                        Some(_) => " (needs μ > 1000)".to_string(),
+                        None => String::new(),
+                    };
+                    s += &format!(
+                        "  d = {dir}: λ = {l:.6}{friction} opening {}\n",
+                        joints.join(", ")
+                    );
+                    let with = |motion: crr_impact::statics::Motion| -> Vec<&str> {
+                        m.mechanism
+                            .iter()
+                            .filter(|j| j.motion == motion)
+                            .map(|j| j.interface.as_str())
+                            .collect()
+                    };
+                    let lifting = with(crr_impact::statics::Motion::LiftsOff);
+                    if !lifting.is_empty() {
+                        s += &format!(
+                            "    lifting off: {} (a block leaves a support: outside the CRR chain, which keeps every interface on a pivot)\n",
+                            lifting.join(", ")
+                        );
+                    }
+                    let sliding = with(crr_impact::statics::Motion::Slides);
+                    if !sliding.is_empty() {
+                        s += &format!(
+                            "    sliding: {} (outside the CRR chain, which allows no sliding)\n",
+                            sliding.join(", ")
+                        );
+                    }
+                }
+                None => {
+                    s += &format!(
+                        "  d = {dir}: holds up to λ = {}\n",
+                        crate::analysis::static_multiplier::LAMBDA_MAX
+                    )
+                }
+            }
+        }
+    }
+    if let Some(note) = &r.static_multipliers_note {
+        s += &format!("static multiplier: {note}\n");
+    }
+    if let Some(k) = &r.mechanism {
+        s += &format!(
+            "\none-DOF mechanism, coordinate {} > 0 opening on pivots:",
+            k.coordinate
+        );
+        for (name, code) in &k.pivots {
+            s += &format!(" {name} {code}");
+        }
+        s += "\n";
+        s += &format!(
+            "activation multiplier λ = {:.6} (ground acceleration {:.4} m/s² along {}({:.3}, {:.3}, {:.3}))\n",
+            k.lambda,
+            k.lambda * r.gravity,
+            if k.lambda_sign < 0.0 { "−" } else { "+" },
+            k.direction[0],
+            k.direction[1],
+            k.direction[2]
+        );
+        s += &format!(
+            "equivalent block: M(0) = {:.6e} kg m², U′(0) = {:.6e} N m, U″(0) = {:.6e} N m\n",
+            k.mass, k.potential_slope, k.potential_curvature
+        );
+        s += &format!(
+            "  α_eq = {:.6} rad, p_eq = {:.6} rad/s (p_eq² = {:.6} 1/s², linearised {:.6})\n",
+            k.alpha_eq, k.p_eq, k.p_squared, k.p_squared_linearised
+        );
+        s += &format!(
+            "  r (momentum law) = {:.6}, T⁺/T⁻ = {:.6}, mode change {:.1e}\n",
+            k.r, k.energy_ratio, k.mode_change
+        );
+        let l = &k.lagrangian;
+        s += "one-DOF Lagrangian (eq 4): L/M(0) = ½(1 ± νθ + ξθ²)θ̇² ∓ ηθ + ½χθ² (NOTATION.md)\n";
+        s += &format!(
+            "  ν = {:.6e} 1/rad, ξ = {:.6e} 1/rad², η = {:.6} 1/s², χ = {:.6} 1/s²\n",
+            l.nu, l.xi, l.eta, l.chi
+        );
+        s += &format!(
+            "  eq 6: χ = p_eq² = {:.6} 1/s², ε = 1/α_eq = {:.6} 1/rad\n",
+            l.chi_housner, l.epsilon
+        );
+        s += "\nfree-rocking frequency versus amplitude\n";
+        s += "θm/α    θm (rad)   F_H Housner (Hz)   engine (Hz)   engine/F_H\n";
+        for f in &k.frequencies {
+            let (e, q) = match (f.engine_hz, f.ratio) {
+                (Some(e), Some(q)) => (format!("{e:.6}"), format!("{q:.5}")),
+                _ => ("–".to_string(), "–".to_string()),
+            };
+            s += &format!(
+                "{:<6.1} {:<10.6} {:<18.6} {:<13} {}\n",
+                f.amplitude_ratio, f.theta_m, f.housner_hz, e, q
+            );
+        }
+    }
+    s
+}

@@ -1,0 +1,675 @@
+//! A simulation in memory, behind [`crate::run`]: a model and [`RunOptions`] become a
+//! [`Prepared`] run (ground motion, consistent initial state, parameters), the event-driven
+//! simulation runs it, and the results come back as a [`Run`] with a typed [`Summary`] and the
+//! warnings a user must read before trusting them. Nothing here writes a file: `crr simulate`'s
+//! results folder is [`crate::output::simulate`]'s.
+
+use std::path::PathBuf;
+
+use nalgebra::Vector3;
+
+use crr_dynamics::ground_motion::{
+    Axis, GroundMotion, GroundMotionSpec, Record, RecordFormat, Units, read_record,
+};
+use crr_dynamics::{AnalysisSpec, InitialSpec, InitialState, solve_initial};
+use crr_impact::simulation::{
+    ImpactRecord, Parameters, Samples, Simulation, SimulationError, StopReason, Trajectory,
+    check_initial_state,
+};
+use crr_kinematics::{InterfaceKind, Model};
+
+use super::summary::{
+    CollapseSummary, CoordinateSummary, GroundMotionSummary, InitialSummary, RecordSummary,
+    SolverSettings, SolverStats, Summary, ViolationSummary,
+};
+use crate::Error;
+use crate::input::model_file::{ModelFile, ModelInput};
+
+/// A record file that replaces one component of the ground motion (`crr simulate --record`).
+#[derive(Clone, Debug)]
+pub struct RecordFile {
+    /// The file.
+    pub file: PathBuf,
+    /// Its format.
+    pub format: RecordFormat,
+    /// Units (required for csv/text).
+    pub units: Option<Units>,
+    /// The component it drives.
+    pub component: Axis,
+    /// Factor on the accelerations.
+    pub scale: f64,
+}
+
+/// A record in memory (accelerations in m/s²) that replaces one component.
+#[derive(Clone, Debug)]
+pub struct RecordSamples {
+    /// The component it drives.
+    pub component: Axis,
+    /// The record.
+    pub record: Record,
+    /// Factor on the accelerations.
+    pub scale: f64,
+}
+
+/// What a run changes from the model file: its tables, records and duration. The default runs
+/// the file as written.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Replaces `[ground_motion]`.
+    pub ground_motion: Option<GroundMotionSpec>,
+    /// Replaces `[initial]`.
+    pub initial: Option<InitialSpec>,
+    /// Replaces `[analysis]`.
+    pub analysis: Option<AnalysisSpec>,
+    /// A record file replacing one component (after `[ground_motion]`).
+    pub record_file: Option<RecordFile>,
+    /// Records in memory replacing components (after the record file).
+    pub records: Vec<RecordSamples>,
+    /// Duration (s), replacing `[analysis].duration`; the default is the ground motion's
+    /// duration + 5 s when it ends, else 10 s.
+    pub duration: Option<f64>,
+    /// Print the percentage done on stderr while running.
+    pub progress: bool,
+}
+
+/// Everything a run needs, read and checked from the inputs.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// The path (or label) that names the model.
+    pub path: PathBuf,
+    /// The model file as run (tables overridden).
+    pub file: ModelFile,
+    /// The validated model.
+    pub model: Model,
+    /// The ground motion (model table plus records).
+    pub ground: GroundMotion,
+    /// The consistent initial state.
+    pub initial: InitialState,
+    /// Simulation parameters.
+    pub params: Parameters,
+    /// The record file of the options, echoed in the summary.
+    pub record_file: Option<RecordFile>,
+    /// Print progress on stderr.
+    pub progress: bool,
+}
+
+/// The results of a run: complete, or partial with the reason it stopped.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// The structure that ran (coordinate and interface names, mass properties).
+    pub model: Model,
+    /// The history (samples, also just before and after each impact), the impacts, the peaks.
+    /// Its samples are empty when they were handed to a sink ([`run_streaming`]).
+    pub trajectory: Trajectory,
+    /// What `summary.json` holds, warnings included.
+    pub summary: Summary,
+}
+
+impl Run {
+    /// The run reached its duration or a collapse without an error.
+    pub fn completed(&self) -> bool {
+        self.summary.completed
+    }
+
+    /// What a user must know before trusting the results.
+    pub fn warnings(&self) -> &[String] {
+        &self.summary.warnings
+    }
+}
+
+/// Runs `model` with `options`: `crr::run`. Input problems are an [`Error`]; a simulation that
+/// fails part-way is a [`Run`] whose summary gives the error, with what was computed until then.
+pub fn run(model: &ModelInput, options: &RunOptions) -> Result<Run, Error> {
+    let prepared = prepare(model, options)?;
+    Ok(prepared.run())
+}
+
+/// [`run`], handing the samples to `sink` after every step instead of keeping them, so that
+/// memory stays flat however long the run (the trajectory's peaks and energy balance still cover
+/// all of them). A sink error stops the run; the summary gives it.
+pub fn run_streaming(
+    model: &ModelInput,
+    options: &RunOptions,
+    sink: impl FnMut(&Samples) -> std::io::Result<()>,
+) -> Result<Run, Error> {
+    let prepared = prepare(model, options)?;
+    Ok(prepared.run_streaming(sink))
+}
+
+/// The default duration: the ground motion's duration + 5 s when it ends, else 10 s.
+pub fn default_duration(ground: &GroundMotion) -> f64 {
+    let d = ground.duration();
+    if d.is_finite() && d > 0.0 {
+        d + 5.0
+    } else {
+        10.0
+    }
+}
+
+/// Reads the ground motion, solves the initial state and sets the parameters. Every failure is
+/// an [`Error`] naming the model or the item.
+pub fn prepare(input: &ModelInput, options: &RunOptions) -> Result<Prepared, Error> {
+    let path = &input.path;
+    let here = |msg: String| Error::Argument(format!("{}: {msg}", path.display()));
+    let mut file = input.file.clone();
+    if let Some(g) = &options.ground_motion {
+        file.ground_motion = Some(g.clone());
+    }
+    if let Some(i) = &options.initial {
+        file.initial = Some(i.clone());
+    }
+    if let Some(a) = &options.analysis {
+        file.analysis = Some(a.clone());
+    }
+    let ground = ground_motion(input, &file, options)?;
+    let initial_spec = file.initial.clone().unwrap_or_default();
+    let initial = solve_initial(&input.model, &initial_spec).map_err(|e| here(e.to_string()))?;
+    check_initial_state(&input.model, &initial).map_err(here)?;
+    let analysis = file.analysis.clone().unwrap_or_default();
+    let mut params =
+        Parameters::from_analysis(&analysis, default_duration(&ground)).map_err(here)?;
+    if let Some(d) = options.duration {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(Error::Argument(format!(
+                "duration must be a positive number of seconds, got {d}"
+            )));
+        }
+        params.duration = d;
+    }
+    Ok(Prepared {
+        path: path.clone(),
+        file,
+        model: input.model.clone(),
+        ground,
+        initial,
+        params,
+        record_file: options.record_file.clone(),
+        progress: options.progress,
+    })
+}
+
+/// The model's `[ground_motion]` with the record file, then the records in memory, replacing
+/// components.
+fn ground_motion(
+    input: &ModelInput,
+    file: &ModelFile,
+    options: &RunOptions,
+) -> Result<GroundMotion, Error> {
+    let mut ground = match &file.ground_motion {
+        Some(spec) => GroundMotion::from_spec(spec, &input.base_dir)
+            .map_err(|e| Error::Argument(format!("{}: {e}", input.path.display())))?,
+        None => GroundMotion::none(),
+    };
+    if let Some(r) = &options.record_file {
+        let record = read_record(&r.file, r.format, r.units)
+            .map_err(|e| Error::Argument(format!("record file: {e}")))?;
+        ground = ground
+            .with_record(r.component, record, r.scale)
+            .map_err(|e| Error::Argument(format!("record scale: {e}")))?;
+    }
+    for r in &options.records {
+        ground = ground
+            .with_record(r.component, r.record.clone(), r.scale)
+            .map_err(|e| Error::Argument(format!("ground motion: {e}")))?;
+    }
+    Ok(ground)
+}
+
+impl Prepared {
+    /// Runs the simulation and keeps the samples in the trajectory.
+    pub fn run(&self) -> Run {
+        self.run_with(|_| Ok(()), false)
+    }
+
+    /// Runs the simulation, handing the samples to `sink` after every step (see
+    /// [`run_streaming`]).
+    pub fn run_streaming(&self, sink: impl FnMut(&Samples) -> std::io::Result<()>) -> Run {
+        self.run_with(sink, true)
+    }
+
+    fn run_with(&self, mut sink: impl FnMut(&Samples) -> std::io::Result<()>, stream: bool) -> Run {
+        let mut stats = SampleStats::default();
+        let mut counted = |samples: &Samples| {
+            stats.add(samples);
+            sink(samples)
+        };
+        let (trajectory, error) = self.integrate(&mut counted, stream);
+        if !stream {
+            stats.add(&trajectory.samples);
+        }
+        let summary = self.summary(&trajectory, &stats, error.as_deref());
+        Run {
+            model: self.model.clone(),
+            trajectory,
+            summary,
+        }
+    }
+
+    /// Integrates to the end, a collapse or an error; the error as text, with the trajectory
+    /// computed until then (empty at t = 0 when the simulation could not start).
+    fn integrate(
+        &self,
+        sink: &mut dyn FnMut(&Samples) -> std::io::Result<()>,
+        stream: bool,
+    ) -> (Trajectory, Option<String>) {
+        match self.simulate(sink, stream) {
+            Ok((t, e)) => (t, e.map(|e| e.to_string())),
+            Err(e) => (Trajectory::empty(&self.model), Some(e.to_string())),
+        }
+    }
+
+    /// The event-driven simulation, step by step; the samples are drained into `sink` after
+    /// every step when `stream`.
+    pub fn simulate(
+        &self,
+        sink: &mut dyn FnMut(&Samples) -> std::io::Result<()>,
+        stream: bool,
+    ) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
+        let mut sim = Simulation::new(
+            &self.model,
+            &self.ground,
+            &self.initial,
+            self.params.clone(),
+        )?;
+        let total = self.params.duration;
+        let mut shown = -1i64;
+        let mut flush = |sim: &mut Simulation| -> Result<(), SimulationError> {
+            if stream {
+                sink(&sim.drain_samples()).map_err(|e| {
+                    SimulationError::Parameter(format!("cannot write the history: {e}"))
+                })?;
+            }
+            Ok(())
+        };
+        let error = loop {
+            match sim.step() {
+                Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => {
+                    break flush(&mut sim).err();
+                }
+                Ok(_) => {}
+                Err(e) => break flush(&mut sim).err().or(Some(e)),
+            }
+            if let Err(e) = flush(&mut sim) {
+                break Some(e);
+            }
+            if self.progress {
+                let pct = (100.0 * sim.time() / total).floor() as i64;
+                if pct != shown {
+                    shown = pct;
+                    eprint!("\rcrr: simulating {:>3}% (t = {:.2} s)", pct, sim.time());
+                }
+            }
+        };
+        if self.progress {
+            eprintln!("\rcrr: simulating 100% (t = {:.2} s)   ", sim.time());
+        }
+        Ok((sim.into_trajectory(), error))
+    }
+}
+
+/// Slenderness α of a coordinate, when defined: for a hinge with two distinct pivot lines or a
+/// rocking base tilt, atan(b/h) with b the half-distance between the pivot lines (perpendicular
+/// to the axis) and h the height of the child's centre above the line midway between them,
+/// measured normal to the joint face. None for a plain hinge (one pivot line).
+pub fn coordinate_alpha(model: &Model, coordinate: usize) -> Option<f64> {
+    let c = &model.coords[coordinate];
+    let iface = &model.interfaces[c.interface];
+    let com = model.bodies[iface.child].com;
+    match &iface.kind {
+        InterfaceKind::Hinge {
+            axis,
+            pivot_positive,
+            pivot_negative,
+        } => {
+            let d = pivot_negative - pivot_positive;
+            let d = d - axis * axis.dot(&d);
+            let width = d.norm();
+            if width < 1e-9 * model.size {
+                return None;
+            }
+            let n = axis.cross(&d) / width;
+            let mid = (pivot_negative + pivot_positive) / 2.0;
+            let h = (com - mid).dot(&n);
+            Some((width / 2.0).atan2(h))
+        }
+        InterfaceKind::RockingBase {
+            corners,
+            normal,
+            e1,
+            e2,
+            ..
+        } => {
+            let centre: Vector3<f64> = corners.iter().sum::<Vector3<f64>>() / 4.0;
+            // Tilt about e₁ pivots on edges parallel to e₁: half-extent along e₂, and vice versa.
+            let across = if c.component == 0 { e2 } else { e1 };
+            let extent = corners
+                .iter()
+                .map(|p| (p - centre).dot(across).abs())
+                .fold(0.0, f64::max);
+            let h = (com - centre).dot(normal);
+            Some(extent.atan2(h))
+        }
+    }
+}
+
+/// What the streamed samples leave for the summary: how many were written, and the run's energy
+/// scale (the largest T, |U|, |W| and D met).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SampleStats {
+    /// Rows of history.csv.
+    pub rows: usize,
+    /// The largest of T, |U|, |W| and D over the samples (J).
+    pub energy_scale: f64,
+}
+
+impl SampleStats {
+    /// Counts `samples` in.
+    pub fn add(&mut self, samples: &Samples) {
+        self.rows += samples.len();
+        for s in samples {
+            let e = s
+                .kinetic
+                .max(s.potential.abs())
+                .max(s.work_in.abs())
+                .max(s.dissipated);
+            self.energy_scale = self.energy_scale.max(e);
+        }
+    }
+}
+
+/// A run's energy balance T + U − W + D − E(0) larger than this fraction of its energy scale
+/// (the largest of T, |U|, |W| and D over the samples), and than the round-off 1e-9 W L, is a
+/// warning.
+pub const ENERGY_BALANCE_WARNING: f64 = 1e-3;
+
+/// An RK4 step longer than this fraction of the structure's time scale √(L/g) (L the model size)
+/// is a warning: rocking is resolved in steps far shorter than its quarter periods.
+pub const RK4_STEP_WARNING: f64 = 0.05;
+
+/// A simultaneity tolerance larger than this fraction of the smallest slenderness α is a warning.
+pub const SIMULTANEITY_WARNING: f64 = 1e-2;
+
+fn method_name(a: &AnalysisSpec) -> &'static str {
+    match a.method {
+        crr_dynamics::MethodName::Dop853 => "dop853",
+        crr_dynamics::MethodName::Dopri5 => "dopri5",
+        crr_dynamics::MethodName::Rk4 => "rk4",
+    }
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+impl Prepared {
+    /// The summary of `t`, a run of this preparation; `stats` counts its samples, `error` is what
+    /// stopped it early.
+    pub fn summary(&self, t: &Trajectory, stats: &SampleStats, error: Option<&str>) -> Summary {
+        let coordinates = t
+            .coordinates
+            .iter()
+            .enumerate()
+            .map(|(k, name)| {
+                let alpha = coordinate_alpha(&self.model, k);
+                CoordinateSummary {
+                    name: name.clone(),
+                    peak_abs: t.peak_abs[k],
+                    alpha,
+                    peak_over_alpha: alpha.map(|a| t.peak_abs[k] / a),
+                }
+            })
+            .collect();
+        let mut echo = self.file.clone();
+        echo.gravity = self.model.gravity;
+        let analysis = self.file.analysis.clone().unwrap_or_default();
+        let pga = self.ground.pga();
+        let p = &self.params;
+        let gains: Vec<&ImpactRecord> = t.impacts.iter().filter(|i| i.energy_gain).collect();
+        Summary {
+            crr_version: env!("CARGO_PKG_VERSION").to_string(),
+            completed: error.is_none(),
+            error: error.map(str::to_string),
+            model_file: self.path.display().to_string(),
+            model: echo,
+            record: self.record_file.as_ref().map(|r| RecordSummary {
+                file: r.file.display().to_string(),
+                format: r.format.name().to_string(),
+                units: r.units.map(|u| u.name().to_string()),
+                component: r.component.name().to_string(),
+                scale: r.scale,
+            }),
+            ground_motion: GroundMotionSummary {
+                pga: [pga.x, pga.y, pga.z],
+                duration: finite(self.ground.duration()),
+            },
+            initial: InitialSummary {
+                spec: self.file.initial.clone().unwrap_or_default(),
+                q: self.initial.q.as_slice().to_vec(),
+                qdot: self.initial.qdot.as_slice().to_vec(),
+            },
+            solver: SolverSettings {
+                method: method_name(&analysis).to_string(),
+                duration: p.duration,
+                output_interval: p.output_interval,
+                rtol: p.options.rtol,
+                atol: p.options.atol,
+                max_step: finite(p.options.h_max),
+                rk4_step: analysis.rk4_step,
+                seat_rate: p.seat_rate,
+                min_impact_interval: p.min_impact_interval,
+                simultaneity: p.simultaneity,
+                max_impacts: p.max_impacts,
+                collapse_drop: p.collapse_drop,
+                friction: p.friction,
+            },
+            solver_stats: SolverStats {
+                steps: t.solver_stats.steps,
+                accepted: t.solver_stats.accepted,
+                rejected: t.solver_stats.rejected,
+                rhs_evaluations: t.solver_stats.rhs_evals,
+            },
+            end_time: t.end_time,
+            samples: stats.rows,
+            coordinates,
+            impacts: t.impacts.len(),
+            energy_lost_at_impacts: t.impacts.iter().map(|i| i.energy_lost).sum::<f64>(),
+            impacts_with_energy_gain: gains.len(),
+            warnings: warnings(self, t, stats, &gains),
+            uplift_time: t.uplift_time,
+            collapse: CollapseSummary {
+                collapsed: t.collapse.is_some(),
+                time: t.collapse.as_ref().map(|c| c.t),
+                body: t.collapse.as_ref().map(|c| c.body.clone()),
+            },
+            energy_balance_error: t.energy_balance_error,
+            hypothesis_violation: t.violation.as_ref().map(|v| ViolationSummary {
+                time: v.t,
+                interface: v.interface.clone(),
+                kind: v.kind.clone(),
+                normal_force: v.normal,
+                friction_demand: finite(v.friction_demand),
+            }),
+        }
+    }
+}
+
+fn num(x: f64) -> String {
+    format!("{x:e}")
+}
+
+/// What a user must know before trusting the results (`warnings` in summary.json, also printed
+/// on stderr by `crr simulate`).
+fn warnings(
+    p: &Prepared,
+    t: &Trajectory,
+    stats: &SampleStats,
+    gains: &[&ImpactRecord],
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(worst) = gains
+        .iter()
+        .min_by(|a, b| a.energy_lost.total_cmp(&b.energy_lost))
+    {
+        out.push(format!(
+            "{} impact(s) raised the kinetic energy (the largest by {:.3e} J at t = {} s, {}); \
+             the impact laws never do so for r ≤ 1: the impact map failed numerically",
+            gains.len(),
+            -worst.energy_lost,
+            worst.t,
+            worst.interfaces.join(", ")
+        ));
+    }
+    let scale = stats.energy_scale;
+    // Below 1e-9 W L (W the weight, L the model size) an error is round-off of the energies.
+    let round_off = 1e-9 * p.model.total_mass() * p.model.gravity * p.model.size;
+    if t.energy_balance_error > (ENERGY_BALANCE_WARNING * scale).max(round_off) {
+        out.push(format!(
+            "the energy balance is off by {:.3e} J, {:.2} % of the run's energy scale {:.3e} J \
+             (more than {} %): tighten rtol/atol or shorten the step",
+            t.energy_balance_error,
+            100.0 * t.energy_balance_error / scale,
+            scale,
+            100.0 * ENERGY_BALANCE_WARNING
+        ));
+    }
+    let analysis = p.file.analysis.clone().unwrap_or_default();
+    if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)
+        && analysis.rtol > crr_dynamics::analysis::RTOL_WARNING
+    {
+        out.push(format!(
+            "rtol = {} is loose: impacts, uplifts and loop closures are located to about that \
+             relative precision; check the results with a smaller rtol (default 1e-10)",
+            num(analysis.rtol)
+        ));
+    }
+    if matches!(analysis.method, crr_dynamics::MethodName::Rk4) {
+        let time_scale = (p.model.size / p.model.gravity).sqrt();
+        if analysis.rk4_step > RK4_STEP_WARNING * time_scale {
+            out.push(format!(
+                "rk4_step = {} s is longer than {} of the structure's time scale √(L/g) = {:.3} s",
+                num(analysis.rk4_step),
+                RK4_STEP_WARNING,
+                time_scale
+            ));
+        }
+        if let Some(dt) = p.ground.record_sample_interval()
+            && analysis.rk4_step > dt
+        {
+            out.push(format!(
+                "rk4_step = {} s is longer than the record's sample interval {dt} s: the steps \
+                 skip samples of the ground motion",
+                num(analysis.rk4_step)
+            ));
+        }
+    }
+    let alpha_min = (0..p.model.dof())
+        .filter_map(|k| coordinate_alpha(&p.model, k))
+        .fold(f64::INFINITY, f64::min);
+    if alpha_min.is_finite() && p.params.simultaneity > SIMULTANEITY_WARNING * alpha_min {
+        out.push(format!(
+            "simultaneity = {} rad is not small against the smallest slenderness α = {:.4} rad: \
+             joints far from their seats are taken to impact together",
+            num(p.params.simultaneity),
+            alpha_min
+        ));
+    }
+    if let Some(v) = &t.violation {
+        let what = if v.kind == "tension" {
+            format!(
+                "would need tension (N = {:.4e} N): the bodies separate (flight)",
+                v.normal
+            )
+        } else {
+            format!(
+                "needs friction |F_t|/N = {:.4} above μ: it slides",
+                v.friction_demand
+            )
+        };
+        out.push(format!(
+            "the rigid-contact hypotheses fail at t = {} s: interface \"{}\" {what}; the results \
+             after that time are outside crr's model",
+            v.t, v.interface
+        ));
+    }
+    out.extend(p.ground.record_warnings());
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn record(t: f64, lost: f64) -> ImpactRecord {
+        ImpactRecord {
+            t,
+            interfaces: vec!["base".into()],
+            slots: vec![0],
+            rates_before: vec![-1.0],
+            rates_after: vec![1.5],
+            energy_lost: lost,
+            energy_gain: true,
+            seated: Vec::new(),
+        }
+    }
+
+    fn single_block() -> ModelInput {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
+        ModelInput::read(path).unwrap()
+    }
+
+    #[test]
+    fn a_record_given_as_samples_drives_the_run_and_sets_the_default_duration() {
+        let model = single_block();
+        let record = Record::from_samples(vec![0.0, 1.0, 2.0], vec![0.0, 3.0, 0.0]).unwrap();
+        let options = RunOptions {
+            records: vec![RecordSamples {
+                component: Axis::X,
+                record,
+                scale: 2.0,
+            }],
+            ..Default::default()
+        };
+        let p = prepare(&model, &options).unwrap();
+        // 3 m/s² peak × 2.
+        assert_eq!(p.ground.pga().x, 6.0);
+        // The record ends at 2 s: 5 s more.
+        assert_eq!(p.params.duration, 2.0 + 5.0);
+    }
+
+    #[test]
+    fn overrides_replace_the_tables_and_a_bad_duration_is_refused() {
+        let model = single_block();
+        let options = RunOptions {
+            initial: Some(InitialSpec::default()),
+            duration: Some(0.5),
+            ..Default::default()
+        };
+        let p = prepare(&model, &options).unwrap();
+        assert_eq!(p.params.duration, 0.5);
+        assert_eq!(p.file.initial, Some(InitialSpec::default()));
+        assert!(p.initial.q.iter().all(|q| *q == 0.0));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let options = RunOptions {
+                duration: Some(bad),
+                ..Default::default()
+            };
+            let e = prepare(&model, &options).unwrap_err().to_string();
+            assert!(e.contains("duration must be a positive number"), "{e}");
+        }
+    }
+
+    #[test]
+    fn an_energy_gain_is_a_warning_naming_the_worst_impact() {
+        // No law of crr raises T for r ≤ 1, so the case is built by hand.
+        let p = prepare(&single_block(), &RunOptions::default()).unwrap();
+        let t = Trajectory::empty(&p.model);
+        let stats = SampleStats::default();
+        assert!(warnings(&p, &t, &stats, &[]).is_empty());
+        let (a, b) = (record(0.5, -2.0), record(1.5, -7.0));
+        let w = warnings(&p, &t, &stats, &[&a, &b]);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].starts_with("2 impact(s) raised"), "{}", w[0]);
+        assert!(w[0].contains("7.000e0 J at t = 1.5 s, base"), "{}", w[0]);
+    }
+}

@@ -1,0 +1,5 @@
+//! The input layer: model files (TOML or JSON) read into validated models, and the reproducible
+//! synthetic record. Everything here reads; nothing runs an analysis or writes a result.
+
+pub mod model_file;
+pub mod synthetic;

@@ -1,0 +1,596 @@
+//! `crr animate RESULTS_DIR`: the bodies' motion of a `crr simulate` run as a ParaView series
+//! (`frame_NNNNN.vtu` + `animation.pvd`, [`vtk`]) and an animated GIF (`animation.gif`,
+//! [`render`] and [`gif`]), documented in `docs/animation.md`.
+//!
+//! The model is rebuilt from the copy `crr simulate` echoes into `summary.json` (`model`), the
+//! states are read from `history.csv` (the angles q and the active pivots of the `_state`
+//! columns), and every frame's body poses come from the engine's kinematics
+//! ([`crr_kinematics::forward_kinematics`], [`crr_kinematics::body_points`]) applied to each
+//! body's [`Surface`]. Everything is shown in the frame of the ground (the ground motion moves
+//! the whole picture, which is not drawn).
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::{DVector, Vector3};
+use serde_json::Value;
+
+use crr_kinematics::shapes::Surface;
+use crr_kinematics::{ActivePivots, Data, Model, Side, body_points, forward_kinematics};
+
+use crate::Error;
+use crate::input::model_file::ModelFile;
+
+pub mod gif;
+pub mod render;
+pub mod vtk;
+
+pub use render::View;
+
+/// The folder, inside the results folder, that holds the animation by default.
+pub const DEFAULT_DIR: &str = "animation";
+
+/// The ParaView index of the series.
+pub const PVD_FILE: &str = "animation.pvd";
+
+/// The animated GIF.
+pub const GIF_FILE: &str = "animation.gif";
+
+/// Default simulated time between two frames (s) when `--every` is not given: 20 frames per
+/// simulated second.
+pub const DEFAULT_FRAME_INTERVAL: f64 = 0.05;
+
+/// Default largest number of frames when `--every` is not given (the step K is raised to stay
+/// below it): keeps the GIF of a long run small.
+pub const DEFAULT_MAX_FRAMES: usize = 400;
+
+/// Which files `crr animate` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// The ParaView series only.
+    Vtk,
+    /// The GIF only.
+    Gif,
+    /// Both (the default).
+    Both,
+}
+
+impl std::str::FromStr for Format {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "vtk" => Ok(Format::Vtk),
+            "gif" => Ok(Format::Gif),
+            "both" => Ok(Format::Both),
+            _ => Err(format!("unknown format `{s}`: give vtk, gif or both")),
+        }
+    }
+}
+
+/// Options of `crr animate`.
+#[derive(Clone, Debug)]
+pub struct AnimateOptions {
+    /// Keep every K-th state of history.csv (after merging the two rows of an impact); None: a
+    /// K giving about [`DEFAULT_FRAME_INTERVAL`] between frames and at most
+    /// [`DEFAULT_MAX_FRAMES`] frames.
+    pub every: Option<usize>,
+    /// Output folder (default `RESULTS_DIR/animation`).
+    pub out: Option<PathBuf>,
+    /// The GIF's view direction.
+    pub view: View,
+    /// Which files to write.
+    pub format: Format,
+    /// GIF playback speed: a frame lasts its simulated time divided by this.
+    pub speed: f64,
+    /// Replace an earlier animation in the output folder.
+    pub force: bool,
+}
+
+impl Default for AnimateOptions {
+    fn default() -> Self {
+        AnimateOptions {
+            every: None,
+            out: None,
+            view: View::Iso,
+            format: Format::Both,
+            speed: 1.0,
+            force: false,
+        }
+    }
+}
+
+/// One state of the run: time, angles and active pivots.
+#[derive(Clone, Debug)]
+pub struct State {
+    /// Time (s).
+    pub t: f64,
+    /// Angles q (rad), in the order of the model's coordinates.
+    pub q: DVector<f64>,
+    /// The active pivot of every slot (`+`/`-` of the `_state` columns; a seated slot takes the
+    /// side of its angle's sign, which does not move anything since its angle is 0).
+    pub pivots: ActivePivots,
+    /// The largest |q| of any coordinate over history.csv up to this row (rad).
+    pub peak_so_far: f64,
+    /// The row of history.csv (1 = first data row).
+    pub row: usize,
+}
+
+/// A results folder read back for animation.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// The model rebuilt from summary.json.
+    pub model: Model,
+    /// Every state of history.csv, the two rows of an impact merged (the later one kept).
+    pub states: Vec<State>,
+}
+
+fn read_error(file: &Path, message: impl std::fmt::Display) -> Error {
+    Error::Argument(format!("{}: {message}", file.display()))
+}
+
+/// Reads `summary.json` (for the model) and `history.csv` of a results folder. A missing
+/// folder or file, a run still being written (its hidden `.NAME.partial` files), a summary
+/// without the model, or a history that does not fit the model is an error naming the file.
+pub fn read_run(dir: &Path) -> Result<Run, Error> {
+    if !dir.is_dir() {
+        return Err(Error::Argument(format!(
+            "{}: no such results folder (run `crr simulate MODEL --out DIR` first)",
+            dir.display()
+        )));
+    }
+    let summary_path = dir.join("summary.json");
+    let history_path = dir.join("history.csv");
+    for name in ["history.csv", "summary.json"] {
+        if !dir.join(name).is_file() {
+            let partial = crate::output::results_folder::partial_name(dir, name).exists();
+            let why = if partial {
+                "is missing and its temporary file is there: the run is still being written or \
+                 was interrupted; animate a completed run"
+            } else {
+                "is missing: not a results folder of `crr simulate` (or an interrupted run)"
+            };
+            return Err(read_error(&dir.join(name), why));
+        }
+    }
+    let limit = crr_dynamics::input::MODEL_FILE_LIMIT;
+    let summary_text = crr_dynamics::input::read_regular_text(&summary_path, limit)
+        .map_err(|e| read_error(&summary_path, format!("cannot read the file: {e}")))?;
+    let summary: Value = serde_json::from_str(&summary_text)
+        .map_err(|e| read_error(&summary_path, format!("not valid JSON: {e}")))?;
+    let model = model_of(&summary, &summary_path)?;
+    let history = std::fs::read_to_string(&history_path)
+        .map_err(|e| read_error(&history_path, format!("cannot read the file: {e}")))?;
+    let states = parse_history(&model, &history, &history_path)?;
+    Ok(Run { model, states })
+}
+
+/// The model echoed in summary.json's `model`, validated.
+fn model_of(summary: &Value, path: &Path) -> Result<Model, Error> {
+    let echo = summary
+        .get("model")
+        .filter(|m| m.is_object())
+        .ok_or_else(|| {
+            read_error(
+                path,
+                "holds no `model` (the model file echoed by `crr simulate`): rerun the simulation \
+             with this version of crr",
+            )
+        })?;
+    let file: ModelFile = serde_json::from_value(echo.clone())
+        .map_err(|e| read_error(path, format!("`model` is not a valid model: {e}")))?;
+    Model::from_spec(&file.structure()).map_err(|e| read_error(path, format!("`model`: {e}")))
+}
+
+/// Parses history.csv: the angle and `_state` columns of every row.
+pub fn parse_history(model: &Model, text: &str, path: &Path) -> Result<Vec<State>, Error> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| read_error(path, "empty file"))?
+        .split(',')
+        .collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| read_error(path, format!("no column `{name}`")))
+    };
+    let t_col = column("t")?;
+    let q_cols = model
+        .coords
+        .iter()
+        .map(|c| column(&c.name))
+        .collect::<Result<Vec<_>, _>>()?;
+    let state_cols = model
+        .interfaces
+        .iter()
+        .map(|i| column(&format!("{}_state", i.name)))
+        .collect::<Result<Vec<_>, _>>()?;
+    if !text.ends_with('\n') {
+        return Err(read_error(
+            path,
+            "the last line is not complete (no line end): a half-written file",
+        ));
+    }
+    let mut states: Vec<State> = Vec::new();
+    let mut peak = 0.0f64;
+    for (i, line) in lines.enumerate() {
+        let row = i + 1;
+        let line_no = i + 2;
+        let fields: Vec<&str> = line.split(',').collect();
+        if fields.len() != header.len() {
+            return Err(read_error(
+                path,
+                format!(
+                    "line {line_no}: {} fields, {} expected (a damaged or half-written file)",
+                    fields.len(),
+                    header.len()
+                ),
+            ));
+        }
+        let number = |c: usize| -> Result<f64, Error> {
+            fields[c]
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    read_error(
+                        path,
+                        format!(
+                            "line {line_no}: column `{}` is not a finite number",
+                            header[c]
+                        ),
+                    )
+                })
+        };
+        let t = number(t_col)?;
+        let q = DVector::from_iterator(
+            q_cols.len(),
+            q_cols
+                .iter()
+                .map(|&c| number(c))
+                .collect::<Result<Vec<_>, _>>()?,
+        );
+        let mut pivots = ActivePivots::uniform(model, Side::Positive);
+        for (iface, &c) in model.interfaces.iter().zip(&state_cols) {
+            let codes: Vec<&str> = fields[c].split('/').collect();
+            if codes.len() != iface.slots.len() {
+                return Err(read_error(
+                    path,
+                    format!(
+                        "line {line_no}: column `{}` is `{}`, {} code(s) expected",
+                        header[c],
+                        fields[c],
+                        iface.slots.len()
+                    ),
+                ));
+            }
+            for (k, (slot, code)) in iface.slots.clone().zip(codes).enumerate() {
+                pivots.sides[slot] = match code {
+                    "+" => Side::Positive,
+                    "-" => Side::Negative,
+                    "seated" => {
+                        // A seated tree angle is 0: either side gives the same pose.
+                        let angle = match iface.role {
+                            crr_kinematics::Role::Tree { first_coord } => q[first_coord + k],
+                            crr_kinematics::Role::Closure { .. } => 0.0,
+                        };
+                        Side::of(angle, Side::Positive)
+                    }
+                    other => {
+                        return Err(read_error(
+                            path,
+                            format!(
+                                "line {line_no}: column `{}` holds `{other}`, not +, - or seated",
+                                header[c]
+                            ),
+                        ));
+                    }
+                };
+            }
+        }
+        peak = q.iter().fold(peak, |m, v| m.max(v.abs()));
+        let state = State {
+            t,
+            q,
+            pivots,
+            peak_so_far: peak,
+            row,
+        };
+        match states.last_mut() {
+            Some(last) if t < last.t => {
+                return Err(read_error(
+                    path,
+                    format!("line {line_no}: time {t} goes backwards"),
+                ));
+            }
+            // The two rows of an impact (rates before, then after): one state, the later.
+            Some(last) if t == last.t => *last = state,
+            _ => states.push(state),
+        }
+    }
+    if states.is_empty() {
+        return Err(read_error(path, "holds no data rows"));
+    }
+    Ok(states)
+}
+
+/// The step K between frames: `every` when given (at least 1), else about
+/// [`DEFAULT_FRAME_INTERVAL`] of simulated time between frames and at most
+/// [`DEFAULT_MAX_FRAMES`] frames.
+pub fn frame_step(states: &[State], every: Option<usize>) -> Result<usize, Error> {
+    match every {
+        Some(0) => Err(Error::Argument(
+            "--every must be at least 1 (keep every K-th state)".into(),
+        )),
+        Some(k) => Ok(k),
+        None => {
+            let n = states.len();
+            let span = states[n - 1].t - states[0].t;
+            let dt = if n > 1 { span / (n - 1) as f64 } else { 1.0 };
+            let by_time = if dt > 0.0 {
+                (DEFAULT_FRAME_INTERVAL / dt).round().max(1.0) as usize
+            } else {
+                1
+            };
+            Ok(by_time.max(n.div_ceil(DEFAULT_MAX_FRAMES)))
+        }
+    }
+}
+
+/// The states kept as frames: the first and every K-th after it.
+pub fn frame_states(states: &[State], k: usize) -> Vec<&State> {
+    states.iter().step_by(k.max(1)).collect()
+}
+
+/// The bodies' surfaces at rest (the frame of the mass properties), in body order.
+pub fn body_surfaces(model: &Model) -> Result<Vec<Surface>, Error> {
+    model
+        .bodies
+        .iter()
+        .map(|b| {
+            b.shape
+                .surface()
+                .map_err(|e| Error::Argument(format!("body \"{}\": no surface: {e}", b.name)))
+        })
+        .collect()
+}
+
+/// World positions of every body's surface vertices at one state (one vector per body, in
+/// the order of its surface's vertices).
+pub fn pose_vertices(
+    model: &Model,
+    data: &mut Data,
+    surfaces: &[Surface],
+    state: &State,
+) -> Vec<Vec<Vector3<f64>>> {
+    forward_kinematics(model, data, &state.q, &state.pivots);
+    surfaces
+        .iter()
+        .enumerate()
+        .map(|(b, s)| {
+            let mut out = Vec::with_capacity(s.vertices.len());
+            body_points(model, data, b, &s.vertices, &mut out);
+            out
+        })
+        .collect()
+}
+
+/// The ground drawn under the structure: the rectangle at the lowest height of the bodies at
+/// rest, covering their footprint with a margin of a quarter of the model size.
+#[derive(Clone, Debug)]
+pub struct Ground {
+    /// Its four corners (m), counter-clockwise seen from above.
+    pub corners: [Vector3<f64>; 4],
+}
+
+impl Ground {
+    /// The ground of a model whose bodies have these surfaces at rest.
+    pub fn of(model: &Model, surfaces: &[Surface]) -> Ground {
+        let mut lo = Vector3::repeat(f64::INFINITY);
+        let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+        for v in surfaces.iter().flat_map(|s| &s.vertices) {
+            lo = lo.inf(v);
+            hi = hi.sup(v);
+        }
+        let m = 0.25 * model.size;
+        let z = lo.z;
+        Ground {
+            corners: [
+                Vector3::new(lo.x - m, lo.y - m, z),
+                Vector3::new(hi.x + m, lo.y - m, z),
+                Vector3::new(hi.x + m, hi.y + m, z),
+                Vector3::new(lo.x - m, hi.y + m, z),
+            ],
+        }
+    }
+}
+
+/// The file name of frame `j` of the series.
+pub fn frame_name(j: usize) -> String {
+    format!("frame_{j:05}.vtu")
+}
+
+/// Is `name` a file of an animation (a frame, the index or the GIF)?
+fn is_animation_file(name: &str) -> bool {
+    name == PVD_FILE
+        || name == GIF_FILE
+        || (name.starts_with("frame_")
+            && name.ends_with(".vtu")
+            && name["frame_".len()..name.len() - 4]
+                .bytes()
+                .all(|b| b.is_ascii_digit()))
+}
+
+/// The animation files in `dir` (sorted), none when it does not exist.
+pub fn animation_files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter_map(|e| e.file_name().into_string().ok())
+                .filter(|n| is_animation_file(n))
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    names
+}
+
+/// Removes the animation files of `dir` (frames, index, GIF; nothing else), and the folder
+/// itself when that leaves it empty.
+pub fn remove_animation(dir: &Path) -> std::io::Result<()> {
+    for name in animation_files(dir) {
+        std::fs::remove_file(dir.join(name))?;
+    }
+    if dir.is_dir() && std::fs::read_dir(dir)?.next().is_none() {
+        std::fs::remove_dir(dir)?;
+    }
+    Ok(())
+}
+
+/// The hidden folder inside the output folder where an animation is written before its files
+/// are moved into place.
+fn partial_dir(out: &Path) -> PathBuf {
+    out.join(".animation.partial")
+}
+
+/// What `crr animate` wrote.
+#[derive(Clone, Debug)]
+pub struct AnimateReport {
+    /// The output folder.
+    pub out: PathBuf,
+    /// Frames written.
+    pub frames: usize,
+    /// The step K used.
+    pub every: usize,
+    /// The files written (paths), the index and GIF last.
+    pub files: Vec<PathBuf>,
+    /// Size of the GIF (bytes), when written.
+    pub gif_bytes: Option<u64>,
+}
+
+/// `crr animate` end to end: reads the run, writes the frames (VTK) and the GIF into a hidden
+/// folder, then moves them into the output folder (an earlier animation there is refused
+/// without `force`, and removed with it, only after the new files are complete).
+pub fn animate(dir: &Path, opts: &AnimateOptions) -> Result<AnimateReport, Error> {
+    if !(opts.speed.is_finite() && opts.speed > 0.0) {
+        return Err(Error::Argument(format!(
+            "--speed must be a positive number, got {}",
+            opts.speed
+        )));
+    }
+    let out = opts.out.clone().unwrap_or_else(|| dir.join(DEFAULT_DIR));
+    let label = out.display().to_string();
+    if out.exists() && !out.is_dir() {
+        return Err(Error::Argument(format!(
+            "{label}: the output path exists and is not a folder"
+        )));
+    }
+    let earlier = animation_files(&out);
+    if !earlier.is_empty() && !opts.force {
+        let shown: Vec<&str> = earlier.iter().take(3).map(String::as_str).collect();
+        return Err(Error::Argument(format!(
+            "{label}: the folder holds an earlier animation ({}{}): pass --force to replace \
+             it, or --out DIR for another folder",
+            shown.join(", "),
+            if earlier.len() > 3 {
+                format!(" and {} more", earlier.len() - 3)
+            } else {
+                String::new()
+            }
+        )));
+    }
+    let run = read_run(dir)?;
+    let k = frame_step(&run.states, opts.every)?;
+    let frames = frame_states(&run.states, k);
+    let surfaces = body_surfaces(&run.model)?;
+    let ground = Ground::of(&run.model, &surfaces);
+    let model = &run.model;
+    let mut data = Data::new(model);
+
+    let output_error = |source| Error::Output {
+        dir: out.clone(),
+        source,
+    };
+    // One writer per folder: another animation into it would remove this one's frames.
+    let _lock = crate::output::folder_lock::FolderLock::acquire(&out)?;
+    let tmp = partial_dir(&out);
+    if tmp.exists() {
+        // Left by an interrupted animation: ours to remove (the lock says no one writes it).
+        std::fs::remove_dir_all(&tmp).map_err(output_error)?;
+    }
+    std::fs::create_dir_all(&tmp).map_err(output_error)?;
+    let vtk = matches!(opts.format, Format::Vtk | Format::Both);
+    let mut gif_writer = None;
+    if matches!(opts.format, Format::Gif | Format::Both) {
+        // The picture's framing is fixed: fitted to every frame first (poses recomputed below,
+        // one frame at a time, rather than kept).
+        let (slab, _) = gif::ground_faces(&ground);
+        let points = frames
+            .iter()
+            .flat_map(|s| pose_vertices(model, &mut data, &surfaces, s))
+            .flatten()
+            .chain(slab.vertices.iter().copied());
+        let renderer = render::Renderer::new(opts.view, points);
+        let file = std::fs::File::create(tmp.join(GIF_FILE)).map_err(output_error)?;
+        let times: Vec<f64> = frames.iter().map(|s| s.t).collect();
+        gif_writer = Some(gif::GifWriter::new(
+            std::io::BufWriter::new(file),
+            renderer,
+            &ground,
+            &times,
+            opts.speed,
+        )?);
+    }
+    let names_of_bodies: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
+    let mut names: Vec<String> = Vec::new();
+    for (j, state) in frames.iter().enumerate() {
+        let pose = pose_vertices(model, &mut data, &surfaces, state);
+        if vtk {
+            let text = vtk::vtu(&names_of_bodies, &surfaces, &pose, &ground, state.t);
+            let name = frame_name(j);
+            std::fs::write(tmp.join(&name), text).map_err(output_error)?;
+            names.push(name);
+        }
+        if let Some(g) = gif_writer.as_mut() {
+            g.add(state, &surfaces, &pose)?;
+        }
+    }
+    let mut gif_bytes = None;
+    if let Some(g) = gif_writer {
+        let file = g
+            .finish()?
+            .into_inner()
+            .map_err(|e| output_error(e.into_error()))?;
+        file.sync_all().map_err(output_error)?;
+        gif_bytes = Some(file.metadata().map_err(output_error)?.len());
+        names.push(GIF_FILE.to_string());
+    }
+    if vtk {
+        let entries: Vec<(f64, String)> = frames
+            .iter()
+            .enumerate()
+            .map(|(j, s)| (s.t, frame_name(j)))
+            .collect();
+        std::fs::write(tmp.join(PVD_FILE), vtk::pvd(&entries)).map_err(output_error)?;
+        // The index last: a folder with an index holds all its frames.
+        names.push(PVD_FILE.to_string());
+    }
+    // Complete: replace the earlier animation, the index and GIF last.
+    for name in &earlier {
+        std::fs::remove_file(out.join(name)).map_err(output_error)?;
+    }
+    let mut files = Vec::with_capacity(names.len());
+    for name in &names {
+        std::fs::rename(tmp.join(name), out.join(name)).map_err(output_error)?;
+        files.push(out.join(name));
+    }
+    std::fs::remove_dir_all(&tmp).map_err(output_error)?;
+    Ok(AnimateReport {
+        out,
+        frames: frames.len(),
+        every: k,
+        files,
+        gif_bytes,
+    })
+}
