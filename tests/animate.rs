@@ -485,7 +485,7 @@ fn bad_inputs_are_refused_naming_the_item() {
     refused(&["animate", s(&empty)], "history.csv: is missing");
     let half = scratch("animate_bad_half");
     std::fs::copy(results.join("summary.json"), half.join("summary.json")).unwrap();
-    std::fs::write(half.join(".history.csv.partial"), "t,base\n0e0,").unwrap();
+    std::fs::write(half.join(".partial.history.csv"), "t,base\n0e0,").unwrap();
     refused(&["animate", s(&half)], "the run is still being written");
     // A truncated last line.
     let text = std::fs::read_to_string(results.join("history.csv")).unwrap();

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use crr_impact::simulation::SlotState;
 use crr_kinematics::Model;
 
-use super::results_folder::{default_out_dir, refuse_earlier_results};
+use super::results_folder::{default_out_dir, partial_name, refuse_earlier_results};
 use crate::Error;
 use crate::analysis::poincare::{
     Computed, Outcome, PoincareOptions, Prepared, Range, SAME_POINT_TOLERANCE, Section,
@@ -431,10 +431,10 @@ pub fn summary(
     }
 }
 
-/// The hidden temporary name a result file is written to before it is renamed into place.
+/// The hidden temporary name a result file is written to before it is renamed into place
+/// ([`partial_name`], the convention of every command).
 pub fn partial(dir: &Path, name: &str) -> PathBuf {
-    // The extension stays last: the image encoder picks the format from it.
-    dir.join(format!(".partial.{name}"))
+    partial_name(dir, name)
 }
 
 /// Writes `files` into `dir`, each to its temporary name ([`partial`]); then the earlier run's

@@ -366,7 +366,7 @@ pub fn draw_basins<DB: DrawingBackend>(
 }
 
 /// Draws the plot of `computed` into `dir` under the temporary names of
-/// [`super::poincare::write_files`] (`.<name>.partial`); returns the final names.
+/// [`super::poincare::write_files`] (`.partial.<name>`); returns the final names.
 pub fn plot(p: &Prepared, computed: &Computed, dir: &Path) -> Result<Vec<String>, PlotError> {
     register_fonts();
     std::fs::create_dir_all(dir).map_err(|e| PlotError::Draw {

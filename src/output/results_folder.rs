@@ -125,7 +125,9 @@ pub fn write_outputs_with(
     Ok(())
 }
 
-/// The hidden temporary name a result file is written to before it is renamed into place.
+/// The hidden temporary name `.partial.NAME` a result file (or the animation's folder) is
+/// written to before it is renamed into place: every command uses this one. The name's
+/// extension stays last, as the image encoders pick the format from it.
 pub fn partial_name(dir: &Path, name: &str) -> PathBuf {
-    dir.join(format!(".{name}.partial"))
+    dir.join(format!(".partial.{name}"))
 }

@@ -128,7 +128,7 @@ fn read_error(file: &Path, message: impl std::fmt::Display) -> Error {
 }
 
 /// Reads `summary.json` (for the model) and `history.csv` of a results folder. A missing
-/// folder or file, a run still being written (its hidden `.NAME.partial` files), a summary
+/// folder or file, a run still being written (its hidden `.partial.NAME` files), a summary
 /// without the model, or a history that does not fit the model is an error naming the file.
 pub fn read_run(dir: &Path) -> Result<Run, Error> {
     if !dir.is_dir() {
@@ -451,7 +451,7 @@ pub fn remove_animation(dir: &Path) -> std::io::Result<()> {
 /// The hidden folder inside the output folder where an animation is written before its files
 /// are moved into place.
 fn partial_dir(out: &Path) -> PathBuf {
-    out.join(".animation.partial")
+    crate::output::results_folder::partial_name(out, DEFAULT_DIR)
 }
 
 /// What `crr animate` wrote.

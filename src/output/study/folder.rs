@@ -510,7 +510,7 @@ pub fn run_study(
     // Every case of the shard is done: rewrite in id order.
     let (rows, _) = done_rows(&csv, &header)?;
     let text = cases_csv(&header, rows.values().map(String::as_str));
-    let tmp = opts.out.join("cases.csv.partial");
+    let tmp = crate::output::results_folder::partial_name(&opts.out, "cases.csv");
     std::fs::write(&tmp, &text).map_err(out_err)?;
     std::fs::rename(&tmp, &csv).map_err(out_err)?;
     let failed = rows.values().filter(|r| r.contains(",error,")).count();
