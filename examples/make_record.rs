@@ -3,7 +3,7 @@
 //! ≈ 4.6 Hz), a trapezoidal–exponential envelope (rise 0–2 s, strong 2–10 s, decay τ = 2.5 s
 //! after), baseline-corrected to a final ground velocity of 0, scaled to a PGA of 0.25 g; 20 s at
 //! 0.01 s (NPTS = 2001). The procedure lives in `crr::input::synthetic` (also used by
-//! `tests/record_file.rs`, which checks the committed file is byte-identical).
+//! `tests/cli/record_file.rs`, which checks the committed file is byte-identical).
 //!
 //! ```sh
 //! cargo run --example make_record

@@ -1,5 +1,5 @@
 //! Entry points of the fuzz targets (`fuzz/`, run with `cargo +nightly fuzz run TARGET`) and of
-//! the regression test that replays their corpus (`tests/fuzz_corpus.rs`). Each takes arbitrary
+//! the regression test that replays their corpus (`tests/cli/fuzz_corpus.rs`). Each takes arbitrary
 //! bytes and must return without panicking: bad input is an error value, never a crash.
 
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! Benchmark of `crr poincare`: a 200-period stroboscopic section (no transient kept apart:
 //! M = 0, N = 200) of the bundled single block (`examples/models/single_block.toml`, b = 0.2 m,
 //! h = 1 m) from rest under a_g = 4 sin(2π·2 t) m/s² in x, the setting of the stable symmetric
-//! 1:1 orbit of `tests/poincare.rs`. The model is read outside the timing; the run is checked
+//! 1:1 orbit of `tests/analysis/poincare.rs`. The model is read outside the timing; the run is checked
 //! once before it is timed (200 points, no overturning, the last 20 points one point).
 
 use std::hint::black_box;

@@ -258,52 +258,21 @@ impl Prepared {
         }
     }
 
-    /// The event-driven simulation, step by step; the samples are drained into `sink` after
-    /// every step when `stream`.
+    /// The event-driven simulation of this preparation ([`simulate`]).
     pub fn simulate(
         &self,
         sink: &mut dyn FnMut(&Samples) -> std::io::Result<()>,
         stream: bool,
     ) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
-        let mut sim = Simulation::new(
+        simulate(
             &self.model,
             &self.ground,
             &self.initial,
-            self.params.clone(),
-        )?;
-        let total = self.params.duration;
-        let mut shown = -1i64;
-        let mut flush = |sim: &mut Simulation| -> Result<(), SimulationError> {
-            if stream {
-                sink(&sim.drain_samples()).map_err(|e| {
-                    SimulationError::Parameter(format!("cannot write the history: {e}"))
-                })?;
-            }
-            Ok(())
-        };
-        let error = loop {
-            match sim.step() {
-                Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => {
-                    break flush(&mut sim).err();
-                }
-                Ok(_) => {}
-                Err(e) => break flush(&mut sim).err().or(Some(e)),
-            }
-            if let Err(e) = flush(&mut sim) {
-                break Some(e);
-            }
-            if self.progress {
-                let pct = (100.0 * sim.time() / total).floor() as i64;
-                if pct != shown {
-                    shown = pct;
-                    eprint!("\rcrr: simulating {:>3}% (t = {:.2} s)", pct, sim.time());
-                }
-            }
-        };
-        if self.progress {
-            eprintln!("\rcrr: simulating 100% (t = {:.2} s)   ", sim.time());
-        }
-        Ok((sim.into_trajectory(), error))
+            &self.params,
+            sink,
+            stream,
+            self.progress,
+        )
     }
 }
 
@@ -388,6 +357,57 @@ pub const RK4_STEP_WARNING: f64 = 0.05;
 
 /// A simultaneity tolerance larger than this fraction of the smallest slenderness α is a warning.
 pub const SIMULTANEITY_WARNING: f64 = 1e-2;
+
+/// The event-driven simulation of `model` under `ground` from `initial`, step by step to the end,
+/// a collapse or an error: the one loop every run goes through (`crr::run`, `crr simulate`, the
+/// cases of a study). The samples are drained into `sink` after every step when `stream` (a sink
+/// error stops the run), else kept in the trajectory; a percentage goes to stderr when
+/// `progress`. An error before the first step is `Err`; one later comes back with the
+/// trajectory computed until then.
+pub fn simulate(
+    model: &Model,
+    ground: &GroundMotion,
+    initial: &InitialState,
+    params: &Parameters,
+    sink: &mut dyn FnMut(&Samples) -> std::io::Result<()>,
+    stream: bool,
+    progress: bool,
+) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
+    let mut sim = Simulation::new(model, ground, initial, params.clone())?;
+    let total = params.duration;
+    let mut shown = -1i64;
+    let mut flush = |sim: &mut Simulation| -> Result<(), SimulationError> {
+        if stream {
+            sink(&sim.drain_samples()).map_err(|e| {
+                SimulationError::Parameter(format!("cannot write the history: {e}"))
+            })?;
+        }
+        Ok(())
+    };
+    let error = loop {
+        match sim.step() {
+            Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => {
+                break flush(&mut sim).err();
+            }
+            Ok(_) => {}
+            Err(e) => break flush(&mut sim).err().or(Some(e)),
+        }
+        if let Err(e) = flush(&mut sim) {
+            break Some(e);
+        }
+        if progress {
+            let pct = (100.0 * sim.time() / total).floor() as i64;
+            if pct != shown {
+                shown = pct;
+                eprint!("\rcrr: simulating {:>3}% (t = {:.2} s)", pct, sim.time());
+            }
+        }
+    };
+    if progress {
+        eprintln!("\rcrr: simulating 100% (t = {:.2} s)   ", sim.time());
+    }
+    Ok((sim.into_trajectory(), error))
+}
 
 fn method_name(a: &AnalysisSpec) -> &'static str {
     match a.method {

@@ -739,8 +739,22 @@ pub fn regularised_delta(x: f64, width: f64) -> f64 {
     }
 }
 
-/// Generalized force of the regularised eq 5 for the listed slots `(s, r, C, ε)` at the current
-/// state, written into `out` (overwritten):
+/// A slot under the regularised Dirac law (eq 5): which slot, its r and C, and the width ε of
+/// its δ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RegularisedSlot {
+    /// The angle slot s.
+    pub slot: usize,
+    /// Coefficient r of the law.
+    pub r: f64,
+    /// Coefficient C of the law.
+    pub c: f64,
+    /// Width ε of the regularised δ (rad).
+    pub width: f64,
+}
+
+/// Generalized force of the regularised eq 5 for the listed slots at the current state,
+/// written into `out` (overwritten):
 /// F = Σ_s a_s C ln(r) ψ̇_s|ψ̇_s| δ_ε(ψ_s) / D_s, ψ̇_s = a_sᵀq̇ ([`slot_rate_direction`]).
 ///
 /// The normalisation D_s makes a crossing multiply the rate by r^C, as [`dirac_law`] does:
@@ -763,7 +777,7 @@ pub fn dirac_regularised_force(
     kin: &Data,
     qdot: &DVector<f64>,
     angles: &[f64],
-    slots: &[(usize, f64, f64, f64)],
+    slots: &[RegularisedSlot],
     out: &mut DVector<f64>,
 ) {
     out.fill(0.0);
@@ -771,7 +785,7 @@ pub fn dirac_regularised_force(
         .iter()
         .enumerate()
         .filter_map(|(i, z)| {
-            let d = regularised_delta(angles[z.0], z.3);
+            let d = regularised_delta(angles[z.slot], z.width);
             (d != 0.0).then_some((i, d))
         })
         .collect();
@@ -783,7 +797,7 @@ pub fn dirac_regularised_force(
     };
     let directions: Vec<DVector<f64>> = slots
         .iter()
-        .map(|z| slot_rate_direction(model, kin, z.0))
+        .map(|z| slot_rate_direction(model, kin, z.slot))
         .collect();
     let p_dirs: Vec<DVector<f64>> = directions.iter().map(|a| &inverse * a).collect();
     let kappa: Vec<f64> = directions
@@ -792,7 +806,7 @@ pub fn dirac_regularised_force(
         .map(|(a, pa)| a.dot(pa))
         .collect();
     for (i, delta) in active {
-        let (_, r, c, _) = slots[i];
+        let RegularisedSlot { r, c, .. } = slots[i];
         if !(kappa[i] > 0.0 && kappa[i].is_finite()) {
             continue;
         }

@@ -457,7 +457,19 @@ fn regularised_force_matches_the_scalar_formula_on_the_block() {
     let qd = DVector::from_element(1, -0.5);
     let mut out = DVector::zeros(1);
     let (r, c, eps) = (0.7, 2.0, 1e-2);
-    dirac_regularised_force(&model, &kin, &qd, &[1e-3], &[(0, r, c, eps)], &mut out);
+    dirac_regularised_force(
+        &model,
+        &kin,
+        &qd,
+        &[1e-3],
+        &[RegularisedSlot {
+            slot: 0,
+            r,
+            c,
+            width: eps,
+        }],
+        &mut out,
+    );
     // One coordinate: F/M = C ln r θ̇|θ̇| δ_ε(θ) (the normalised single-block equation).
     let expect = c * r.ln() * -0.5 * 0.5 * regularised_delta(1e-3, eps);
     assert!((out[0] / kin.mass_matrix[(0, 0)] - expect).abs() < 1e-12 * expect.abs());

@@ -567,296 +567,21 @@ impl Model {
     /// spanning tree from the ground (coordinates in breadth-first order, interfaces in file order)
     /// and the loop closures.
     pub fn from_spec(spec: &StructureSpec) -> Result<Model, ModelError> {
-        if !(spec.gravity.is_finite() && spec.gravity > 0.0) {
-            return Err(ModelError::new(
-                "gravity",
-                format!("must be a positive number of m/s², got {}", spec.gravity),
-            ));
-        }
-        if spec.body.is_empty() {
-            return Err(ModelError::new(
-                quoted("model", &spec.name),
-                "has no bodies",
-            ));
-        }
-        // Every body moves with at least one coordinate of its own: more bodies than
-        // MAX_COORDINATES are refused before any per-body work.
-        if spec.body.len() > MAX_COORDINATES {
-            return Err(too_many_coordinates(
-                &spec.name,
-                spec.body.len(),
-                "at least ",
-            ));
-        }
-        let mut body_index = HashMap::new();
-        let mut bodies = Vec::with_capacity(spec.body.len());
-        for (k, b) in spec.body.iter().enumerate() {
-            if b.name.trim().is_empty() {
-                return Err(ModelError::new(
-                    format!("body #{}", k + 1),
-                    "has an empty name",
-                ));
-            }
-            if let Some(why) = unusable_name(&b.name) {
-                return Err(ModelError::new(quoted("body", &b.name), why));
-            }
-            if b.name == "ground" {
-                return Err(ModelError::new(
-                    quoted("body", &b.name),
-                    "\"ground\" is reserved for the ground",
-                ));
-            }
-            if body_index.insert(b.name.clone(), k).is_some() {
-                return Err(ModelError::new(
-                    quoted("body", &b.name),
-                    "the name is used by two bodies",
-                ));
-            }
-            bodies.push(build_body(b)?);
-        }
-        // A length scale for tolerances: extent of the centres and of every given point.
-        let mut pts: Vec<Vector3<f64>> = bodies.iter().map(|b| b.com).collect();
-        for i in &spec.interface {
-            for p in [&i.pivot_positive, &i.pivot_negative].into_iter().flatten() {
-                match p {
-                    PivotSpec::Point(x) => pts.push(Vector3::from(*x)),
-                    PivotSpec::Segment(s) => pts.extend(s.iter().map(|x| Vector3::from(*x))),
-                }
-            }
-            if let Some(rb) = &i.rocking_base {
-                pts.extend(rb.corners.iter().map(|x| Vector3::from(*x)));
-            }
-        }
-        let pts: Vec<_> = pts
-            .into_iter()
-            .filter(|p| p.iter().all(|x| x.is_finite()))
-            .collect();
-        let mut size: f64 = bodies.iter().map(|b| b.volume.cbrt()).fold(1e-3, f64::max);
-        for a in &pts {
-            for b in &pts {
-                size = size.max((a - b).norm());
-            }
-        }
-
-        let mut names = HashMap::new();
-        let mut ends = Vec::with_capacity(spec.interface.len());
-        for (k, i) in spec.interface.iter().enumerate() {
-            let item = quoted("interface", &i.name);
-            if i.name.trim().is_empty() {
-                return Err(ModelError::new(
-                    format!("interface #{}", k + 1),
-                    "has an empty name",
-                ));
-            }
-            if let Some(why) = unusable_name(&i.name) {
-                return Err(ModelError::new(item, why));
-            }
-            if names.insert(i.name.clone(), k).is_some() {
-                return Err(ModelError::new(item, "the name is used by two interfaces"));
-            }
-            let parent = if i.parent == "ground" {
-                Parent::Ground
-            } else {
-                Parent::Body(*body_index.get(&i.parent).ok_or_else(|| {
-                    ModelError::new(
-                        format!("{item} (parent)"),
-                        format!("no body is named \"{}\"", i.parent),
-                    )
-                })?)
-            };
-            if i.child == "ground" {
-                return Err(ModelError::new(
-                    format!("{item} (child)"),
-                    "the child must be a body: to join a body to the ground make \"ground\" the parent",
-                ));
-            }
-            let child = *body_index.get(&i.child).ok_or_else(|| {
-                ModelError::new(
-                    format!("{item} (child)"),
-                    format!("no body is named \"{}\"", i.child),
-                )
-            })?;
-            if parent == Parent::Body(child) {
-                return Err(ModelError::new(
-                    item,
-                    format!("joins body \"{}\" to itself", i.child),
-                ));
-            }
-            let child_com = bodies[child].com;
-            // A contact lies on the child: a pivot far outside it is a typing or unit mistake
-            // (millimetres for metres). 100 times the child's size leaves room for any real
-            // joint and catches those.
-            let reach = PIVOT_REACH * bodies[child].volume.cbrt();
-            let given: Vec<[f64; 3]> = match (&i.rocking_base, &i.pivot_positive, &i.pivot_negative)
-            {
-                (Some(rb), _, _) => rb.corners.clone(),
-                (None, p, n) => [p, n]
-                    .into_iter()
-                    .flatten()
-                    .flat_map(|x| match x {
-                        PivotSpec::Point(a) => vec![*a],
-                        PivotSpec::Segment(s) => s.to_vec(),
-                    })
-                    .collect(),
-            };
-            if let Some(far) = given
-                .iter()
-                .map(|x| (Vector3::from(*x) - child_com).norm())
-                .find(|d| *d > reach)
-            {
-                return Err(ModelError::new(
-                    item,
-                    format!(
-                        "a pivot lies {far:.4e} m from the centre of body \"{}\", more than {PIVOT_REACH} times its size ({:.4e} m): pivots must lie on the child (check the units: metres)",
-                        i.child,
-                        bodies[child].volume.cbrt()
-                    ),
-                ));
-            }
-            let kind = match &i.rocking_base {
-                Some(rb) => {
-                    if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some()
-                    {
-                        return Err(ModelError::new(
-                            item,
-                            "a rocking_base defines its own axes and pivots: remove axis, pivot_positive and pivot_negative",
-                        ));
-                    }
-                    rocking_base_kind(&rb.corners, rb.twist, &child_com, &item, size)?
-                }
-                None => hinge_kind(i, &child_com, &item, size)?,
-            };
-            check_impact_law(&i.impact, &item)?;
-            ends.push((parent, child, kind));
-        }
-
-        // Spanning tree: breadth first from the ground along parent → child.
-        let n_i = spec.interface.len();
-        let mut in_tree = vec![false; n_i];
-        let mut reached = vec![false; bodies.len()];
-        let mut order = Vec::new(); // tree interfaces in coordinate order
-        let mut queue = VecDeque::from([Parent::Ground]);
-        while let Some(node) = queue.pop_front() {
-            for (k, (p, c, _)) in ends.iter().enumerate() {
-                if *p == node && !reached[*c] {
-                    reached[*c] = true;
-                    in_tree[k] = true;
-                    order.push(k);
-                    queue.push_back(Parent::Body(*c));
-                }
-            }
-        }
-        if let Some(b) = reached.iter().position(|r| !r) {
-            return Err(ModelError::new(
-                quoted("body", &bodies[b].name),
-                "has no path from the ground: every body must be reached from \"ground\" through interfaces, \
-                 following each interface from parent to child",
-            ));
-        }
-
-        if let Some(&k) = order
-            .iter()
-            .find(|&&k| matches!(ends[k].2, InterfaceKind::RockingBase { twist: true, .. }))
-        {
-            return Err(ModelError::new(
-                quoted("interface", &spec.interface[k].name),
-                "`twist = true` is allowed only on an interface that closes a loop (its child is \
-                 reached through another interface first, following the interfaces from the \
-                 ground in file order); here the child is reached through this interface, which \
-                 would need a third coordinate. List the other interface of the child first",
-            ));
-        }
-        let mut coords = Vec::new();
-        let mut body_coord = vec![usize::MAX; bodies.len()];
-        let mut roles = vec![Role::Closure { index: 0 }; n_i];
-        let mut slots = vec![0..0; n_i];
-        for &k in &order {
-            let (p, c, kind) = &ends[k];
-            let first = coords.len();
-            let mut parent = match p {
-                Parent::Ground => None,
-                Parent::Body(b) => Some(body_coord[*b]),
-            };
-            let n = kind.angle_count();
-            for comp in 0..n {
-                let name = if n == 1 {
-                    spec.interface[k].name.clone()
-                } else {
-                    format!("{}.{}", spec.interface[k].name, comp + 1)
-                };
-                coords.push(Coordinate {
-                    name,
-                    interface: k,
-                    component: comp,
-                    axis: kind.axis(comp),
-                    parent,
-                });
-                parent = Some(coords.len() - 1);
-            }
-            body_coord[*c] = coords.len() - 1;
-            roles[k] = Role::Tree { first_coord: first };
-            slots[k] = first..first + n;
-        }
-        let mut closures = Vec::new();
-        let mut slot = coords.len();
-        let mut row = 0;
-        for k in (0..n_i).filter(|&k| !in_tree[k]) {
-            let kind = &ends[k].2;
-            let rows = match kind {
-                InterfaceKind::Hinge { .. } => 5,
-                InterfaceKind::RockingBase { twist: false, .. } => 4,
-                InterfaceKind::RockingBase { twist: true, .. } => 3,
-            };
-            roles[k] = Role::Closure {
-                index: closures.len(),
-            };
-            slots[k] = slot..slot + kind.angle_count();
-            slot += kind.angle_count();
-            closures.push(Closure {
-                interface: k,
-                first_row: row,
-                rows,
-            });
-            row += rows;
-        }
-        let mut symmetries = Vec::new();
-        for (k, sy) in spec.symmetry.iter().enumerate() {
-            let item = format!(
-                "symmetry #{} ({} = {}{})",
-                k + 1,
-                sy.coordinates[0],
-                if sy.relation == crate::spec::SymmetryRelation::Opposite {
-                    "−"
-                } else {
-                    ""
-                },
-                sy.coordinates[1]
-            );
-            let find = |name: &str| {
-                coords
-                    .iter()
-                    .position(|c: &Coordinate| c.name == name)
-                    .ok_or_else(|| {
-                        let names: Vec<_> = coords.iter().map(|c| c.name.as_str()).collect();
-                        ModelError::new(
-                            item.clone(),
-                            format!(
-                                "no coordinate named \"{name}\"; coordinates are: {}",
-                                names.join(", ")
-                            ),
-                        )
-                    })
-            };
-            let (a, b) = (find(&sy.coordinates[0])?, find(&sy.coordinates[1])?);
-            if a == b {
-                return Err(ModelError::new(item, "relates a coordinate to itself"));
-            }
-            let sign = match sy.relation {
-                crate::spec::SymmetryRelation::Equal => 1.0,
-                crate::spec::SymmetryRelation::Opposite => -1.0,
-            };
-            symmetries.push((a, b, sign));
-        }
+        check_structure(spec)?;
+        let (bodies, body_index) = build_bodies(spec)?;
+        let size = length_scale(spec, &bodies);
+        let ends = build_interfaces(spec, &bodies, &body_index, size)?;
+        let (order, in_tree) = spanning_tree(&ends, &bodies)?;
+        check_twist_closes_a_loop(spec, &ends, &order)?;
+        let TreeCoordinates {
+            coords,
+            body_coord,
+            mut roles,
+            mut slots,
+        } = tree_coordinates(spec, &ends, &order, bodies.len());
+        let (closures, row, slot) =
+            loop_closures(&ends, &in_tree, &mut roles, &mut slots, coords.len());
+        let symmetries = symmetry_rows(spec, &coords)?;
         let closure_rows = row;
         let row = row + symmetries.len();
         if coords.len() > MAX_COORDINATES {
@@ -1059,4 +784,385 @@ fn check_impact_law(law: &ImpactLaw, item: &str) -> Result<(), ModelError> {
         Some(p) => Err(ModelError::new(format!("{item} (impact)"), p)),
         None => Ok(()),
     }
+}
+
+/// An interface's two ends and its kind, before the chain is built.
+type InterfaceEnds = (Parent, usize, InterfaceKind);
+
+/// Gravity, and at least one but not too many bodies.
+fn check_structure(spec: &StructureSpec) -> Result<(), ModelError> {
+    if !(spec.gravity.is_finite() && spec.gravity > 0.0) {
+        return Err(ModelError::new(
+            "gravity",
+            format!("must be a positive number of m/s², got {}", spec.gravity),
+        ));
+    }
+    if spec.body.is_empty() {
+        return Err(ModelError::new(
+            quoted("model", &spec.name),
+            "has no bodies",
+        ));
+    }
+    // Every body moves with at least one coordinate of its own: more bodies than
+    // MAX_COORDINATES are refused before any per-body work.
+    if spec.body.len() > MAX_COORDINATES {
+        return Err(too_many_coordinates(
+            &spec.name,
+            spec.body.len(),
+            "at least ",
+        ));
+    }
+    Ok(())
+}
+
+/// The bodies with their mass properties, and the index of each name; names are checked.
+fn build_bodies(spec: &StructureSpec) -> Result<(Vec<Body>, HashMap<String, usize>), ModelError> {
+    let mut body_index = HashMap::new();
+    let mut bodies = Vec::with_capacity(spec.body.len());
+    for (k, b) in spec.body.iter().enumerate() {
+        if b.name.trim().is_empty() {
+            return Err(ModelError::new(
+                format!("body #{}", k + 1),
+                "has an empty name",
+            ));
+        }
+        if let Some(why) = unusable_name(&b.name) {
+            return Err(ModelError::new(quoted("body", &b.name), why));
+        }
+        if b.name == "ground" {
+            return Err(ModelError::new(
+                quoted("body", &b.name),
+                "\"ground\" is reserved for the ground",
+            ));
+        }
+        if body_index.insert(b.name.clone(), k).is_some() {
+            return Err(ModelError::new(
+                quoted("body", &b.name),
+                "the name is used by two bodies",
+            ));
+        }
+        bodies.push(build_body(b)?);
+    }
+    Ok((bodies, body_index))
+}
+
+/// A length scale for tolerances: the extent of the centres and of every given point (at least
+/// the size of the largest body, and 1 mm).
+fn length_scale(spec: &StructureSpec, bodies: &[Body]) -> f64 {
+    let mut pts: Vec<Vector3<f64>> = bodies.iter().map(|b| b.com).collect();
+    for i in &spec.interface {
+        for p in [&i.pivot_positive, &i.pivot_negative].into_iter().flatten() {
+            match p {
+                PivotSpec::Point(x) => pts.push(Vector3::from(*x)),
+                PivotSpec::Segment(s) => pts.extend(s.iter().map(|x| Vector3::from(*x))),
+            }
+        }
+        if let Some(rb) = &i.rocking_base {
+            pts.extend(rb.corners.iter().map(|x| Vector3::from(*x)));
+        }
+    }
+    let pts: Vec<_> = pts
+        .into_iter()
+        .filter(|p| p.iter().all(|x| x.is_finite()))
+        .collect();
+    let mut size: f64 = bodies.iter().map(|b| b.volume.cbrt()).fold(1e-3, f64::max);
+    for a in &pts {
+        for b in &pts {
+            size = size.max((a - b).norm());
+        }
+    }
+
+    size
+}
+
+/// Every interface's ends and kind (hinge or rocking base), its names, pivots and impact law
+/// checked.
+fn build_interfaces(
+    spec: &StructureSpec,
+    bodies: &[Body],
+    body_index: &HashMap<String, usize>,
+    size: f64,
+) -> Result<Vec<InterfaceEnds>, ModelError> {
+    let mut names = HashMap::new();
+    let mut ends = Vec::with_capacity(spec.interface.len());
+    for (k, i) in spec.interface.iter().enumerate() {
+        let item = quoted("interface", &i.name);
+        if i.name.trim().is_empty() {
+            return Err(ModelError::new(
+                format!("interface #{}", k + 1),
+                "has an empty name",
+            ));
+        }
+        if let Some(why) = unusable_name(&i.name) {
+            return Err(ModelError::new(item, why));
+        }
+        if names.insert(i.name.clone(), k).is_some() {
+            return Err(ModelError::new(item, "the name is used by two interfaces"));
+        }
+        let parent = if i.parent == "ground" {
+            Parent::Ground
+        } else {
+            Parent::Body(*body_index.get(&i.parent).ok_or_else(|| {
+                ModelError::new(
+                    format!("{item} (parent)"),
+                    format!("no body is named \"{}\"", i.parent),
+                )
+            })?)
+        };
+        if i.child == "ground" {
+            return Err(ModelError::new(
+                format!("{item} (child)"),
+                "the child must be a body: to join a body to the ground make \"ground\" the parent",
+            ));
+        }
+        let child = *body_index.get(&i.child).ok_or_else(|| {
+            ModelError::new(
+                format!("{item} (child)"),
+                format!("no body is named \"{}\"", i.child),
+            )
+        })?;
+        if parent == Parent::Body(child) {
+            return Err(ModelError::new(
+                item,
+                format!("joins body \"{}\" to itself", i.child),
+            ));
+        }
+        let child_com = bodies[child].com;
+        // A contact lies on the child: a pivot far outside it is a typing or unit mistake
+        // (millimetres for metres). 100 times the child's size leaves room for any real
+        // joint and catches those.
+        let reach = PIVOT_REACH * bodies[child].volume.cbrt();
+        let given: Vec<[f64; 3]> = match (&i.rocking_base, &i.pivot_positive, &i.pivot_negative) {
+            (Some(rb), _, _) => rb.corners.clone(),
+            (None, p, n) => [p, n]
+                .into_iter()
+                .flatten()
+                .flat_map(|x| match x {
+                    PivotSpec::Point(a) => vec![*a],
+                    PivotSpec::Segment(s) => s.to_vec(),
+                })
+                .collect(),
+        };
+        if let Some(far) = given
+            .iter()
+            .map(|x| (Vector3::from(*x) - child_com).norm())
+            .find(|d| *d > reach)
+        {
+            return Err(ModelError::new(
+                item,
+                format!(
+                    "a pivot lies {far:.4e} m from the centre of body \"{}\", more than {PIVOT_REACH} times its size ({:.4e} m): pivots must lie on the child (check the units: metres)",
+                    i.child,
+                    bodies[child].volume.cbrt()
+                ),
+            ));
+        }
+        let kind = match &i.rocking_base {
+            Some(rb) => {
+                if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some() {
+                    return Err(ModelError::new(
+                        item,
+                        "a rocking_base defines its own axes and pivots: remove axis, pivot_positive and pivot_negative",
+                    ));
+                }
+                rocking_base_kind(&rb.corners, rb.twist, &child_com, &item, size)?
+            }
+            None => hinge_kind(i, &child_com, &item, size)?,
+        };
+        check_impact_law(&i.impact, &item)?;
+        ends.push((parent, child, kind));
+    }
+
+    Ok(ends)
+}
+
+/// The spanning tree, breadth first from the ground along parent → child: the tree interfaces
+/// in coordinate order, and which interfaces are in the tree. Every body must be reached.
+fn spanning_tree(
+    ends: &[InterfaceEnds],
+    bodies: &[Body],
+) -> Result<(Vec<usize>, Vec<bool>), ModelError> {
+    let n_i = ends.len();
+    let mut in_tree = vec![false; n_i];
+    let mut reached = vec![false; bodies.len()];
+    let mut order = Vec::new(); // tree interfaces in coordinate order
+    let mut queue = VecDeque::from([Parent::Ground]);
+    while let Some(node) = queue.pop_front() {
+        for (k, (p, c, _)) in ends.iter().enumerate() {
+            if *p == node && !reached[*c] {
+                reached[*c] = true;
+                in_tree[k] = true;
+                order.push(k);
+                queue.push_back(Parent::Body(*c));
+            }
+        }
+    }
+    if let Some(b) = reached.iter().position(|r| !r) {
+        return Err(ModelError::new(
+            quoted("body", &bodies[b].name),
+            "has no path from the ground: every body must be reached from \"ground\" through interfaces, \
+             following each interface from parent to child",
+        ));
+    }
+
+    Ok((order, in_tree))
+}
+
+/// A twisting rocking base must close a loop: in the tree it would need a third coordinate.
+fn check_twist_closes_a_loop(
+    spec: &StructureSpec,
+    ends: &[InterfaceEnds],
+    order: &[usize],
+) -> Result<(), ModelError> {
+    if let Some(&k) = order
+        .iter()
+        .find(|&&k| matches!(ends[k].2, InterfaceKind::RockingBase { twist: true, .. }))
+    {
+        return Err(ModelError::new(
+            quoted("interface", &spec.interface[k].name),
+            "`twist = true` is allowed only on an interface that closes a loop (its child is \
+             reached through another interface first, following the interfaces from the \
+             ground in file order); here the child is reached through this interface, which \
+             would need a third coordinate. List the other interface of the child first",
+        ));
+    }
+    Ok(())
+}
+
+/// The coordinates of the tree interfaces, each with its parent coordinate.
+struct TreeCoordinates {
+    coords: Vec<Coordinate>,
+    body_coord: Vec<usize>,
+    roles: Vec<Role>,
+    slots: Vec<std::ops::Range<usize>>,
+}
+
+/// The tree's coordinates in the order of `order` (one per hinge, two per rocking base), the
+/// coordinate each body moves with, and the tree interfaces' roles and slots.
+fn tree_coordinates(
+    spec: &StructureSpec,
+    ends: &[InterfaceEnds],
+    order: &[usize],
+    n_bodies: usize,
+) -> TreeCoordinates {
+    let n_i = ends.len();
+    let mut coords = Vec::new();
+    let mut body_coord = vec![usize::MAX; n_bodies];
+    let mut roles = vec![Role::Closure { index: 0 }; n_i];
+    let mut slots = vec![0..0; n_i];
+    for &k in order {
+        let (p, c, kind) = &ends[k];
+        let first = coords.len();
+        let mut parent = match p {
+            Parent::Ground => None,
+            Parent::Body(b) => Some(body_coord[*b]),
+        };
+        let n = kind.angle_count();
+        for comp in 0..n {
+            let name = if n == 1 {
+                spec.interface[k].name.clone()
+            } else {
+                format!("{}.{}", spec.interface[k].name, comp + 1)
+            };
+            coords.push(Coordinate {
+                name,
+                interface: k,
+                component: comp,
+                axis: kind.axis(comp),
+                parent,
+            });
+            parent = Some(coords.len() - 1);
+        }
+        body_coord[*c] = coords.len() - 1;
+        roles[k] = Role::Tree { first_coord: first };
+        slots[k] = first..first + n;
+    }
+    TreeCoordinates {
+        coords,
+        body_coord,
+        roles,
+        slots,
+    }
+}
+
+/// The loop closures of the interfaces outside the tree (5 rows for a hinge, 4 for a rocking
+/// base, 3 for a twisting one), their roles and slots after the tree's; returns the closures,
+/// their rows and the slot count.
+fn loop_closures(
+    ends: &[InterfaceEnds],
+    in_tree: &[bool],
+    roles: &mut [Role],
+    slots: &mut [std::ops::Range<usize>],
+    tree_slots: usize,
+) -> (Vec<Closure>, usize, usize) {
+    let n_i = ends.len();
+    let mut closures = Vec::new();
+    let mut slot = tree_slots;
+    let mut row = 0;
+    for k in (0..n_i).filter(|&k| !in_tree[k]) {
+        let kind = &ends[k].2;
+        let rows = match kind {
+            InterfaceKind::Hinge { .. } => 5,
+            InterfaceKind::RockingBase { twist: false, .. } => 4,
+            InterfaceKind::RockingBase { twist: true, .. } => 3,
+        };
+        roles[k] = Role::Closure {
+            index: closures.len(),
+        };
+        slots[k] = slot..slot + kind.angle_count();
+        slot += kind.angle_count();
+        closures.push(Closure {
+            interface: k,
+            first_row: row,
+            rows,
+        });
+        row += rows;
+    }
+    (closures, row, slot)
+}
+
+/// The symmetry rows (DOF(3)): pairs of coordinates equal or opposite.
+fn symmetry_rows(
+    spec: &StructureSpec,
+    coords: &[Coordinate],
+) -> Result<Vec<(usize, usize, f64)>, ModelError> {
+    let mut symmetries = Vec::new();
+    for (k, sy) in spec.symmetry.iter().enumerate() {
+        let item = format!(
+            "symmetry #{} ({} = {}{})",
+            k + 1,
+            sy.coordinates[0],
+            if sy.relation == crate::spec::SymmetryRelation::Opposite {
+                "−"
+            } else {
+                ""
+            },
+            sy.coordinates[1]
+        );
+        let find = |name: &str| {
+            coords
+                .iter()
+                .position(|c: &Coordinate| c.name == name)
+                .ok_or_else(|| {
+                    let names: Vec<_> = coords.iter().map(|c| c.name.as_str()).collect();
+                    ModelError::new(
+                        item.clone(),
+                        format!(
+                            "no coordinate named \"{name}\"; coordinates are: {}",
+                            names.join(", ")
+                        ),
+                    )
+                })
+        };
+        let (a, b) = (find(&sy.coordinates[0])?, find(&sy.coordinates[1])?);
+        if a == b {
+            return Err(ModelError::new(item, "relates a coordinate to itself"));
+        }
+        let sign = match sy.relation {
+            crate::spec::SymmetryRelation::Equal => 1.0,
+            crate::spec::SymmetryRelation::Opposite => -1.0,
+        };
+        symmetries.push((a, b, sign));
+    }
+    Ok(symmetries)
 }

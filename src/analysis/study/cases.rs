@@ -12,15 +12,15 @@ use crr_dynamics::ground_motion::{
     Axis, ComponentSpec, GroundMotion, GroundMotionSpec, PulseSpec, Record, RickerSpec,
     STANDARD_GRAVITY, SignalSpec, read_record,
 };
-use crr_dynamics::{InitialState, equivalent_block, solve_initial};
+use crr_dynamics::{InitialSpec, InitialState, equivalent_block, solve_initial};
 use crr_impact::Parameters;
-use crr_kinematics::Model;
+use crr_kinematics::{Model, StructureSpec};
 
-use super::spec::{PulseKind, Start, StudySpec, Values};
+use super::spec::{PulseKind, PulsesSpec, RecordsSpec, Start, StudySpec, Values};
 use crate::Error;
 use crate::analysis::simulation::default_duration;
 use crate::analysis::size_sweep::{scale_structure, structure_height};
-use crate::input::model_file::load_model;
+use crate::input::model_file::{ModelFile, load_model};
 
 /// What drives one case.
 #[derive(Clone, Debug, PartialEq)]
@@ -249,32 +249,8 @@ impl Study {
                 .unwrap_or("study")
                 .to_string()
         });
-        let (file, mut model) = load_model(&base.join(&spec.model))?;
-        let mut structure = file.structure();
-        if let Some(law) = spec.impact {
-            for i in &mut structure.interface {
-                i.impact = law;
-            }
-            model = Model::from_spec(&structure).map_err(|e| bad(path, format!("impact: {e}")))?;
-        }
-        let axis: Axis = spec
-            .component
-            .parse()
-            .map_err(|e: String| bad(path, format!("component: {e}")))?;
-        if axis == Axis::Z {
-            return Err(bad(
-                path,
-                "component: the study drives a horizontal component, x or y".into(),
-            ));
-        }
-        if let Some(d) = spec.duration
-            && !(d.is_finite() && d > 0.0)
-        {
-            return Err(bad(
-                path,
-                format!("duration must be a positive number of seconds, got {d}"),
-            ));
-        }
+        let (file, structure, model) = study_model(&spec, base, path)?;
+        let axis = study_axis(&spec, path)?;
         let initial_spec = match spec.start {
             Start::Rest => Default::default(),
             Start::Model => file.initial.clone().unwrap_or_default(),
@@ -286,37 +262,16 @@ impl Study {
         let mechanism = mechanism_scales(&model, axis);
         let lambda_p = mechanism.map(|m| (m.0, m.1));
         let alpha_eq = mechanism.map(|m| m.2).filter(|a| a.is_finite() && *a > 0.0);
-        let mut variants = Vec::new();
+        let variants = variants(
+            &spec,
+            path,
+            &structure,
+            &model,
+            &initial,
+            &initial_spec,
+            axis,
+        )?;
         let sized = spec.scales.is_some();
-        match &spec.scales {
-            None => variants.push(Variant {
-                scale: 1.0,
-                model: model.clone(),
-                initial: initial.clone(),
-                lambda_p,
-                height: structure_height(&structure),
-            }),
-            Some(v) => {
-                let scales = v.expand("scales").map_err(|e| bad(path, e))?;
-                if let Some(s) = scales.iter().find(|s| **s <= 0.0) {
-                    return Err(bad(path, format!("scales: a factor must be > 0, got {s}")));
-                }
-                for s in scales {
-                    let scaled = scale_structure(&structure, s);
-                    let m = Model::from_spec(&scaled)
-                        .map_err(|e| bad(path, format!("scales: the model scaled by {s}: {e}")))?;
-                    let init = solve_initial(&m, &initial_spec)
-                        .map_err(|e| bad(path, format!("scales: the model scaled by {s}: {e}")))?;
-                    variants.push(Variant {
-                        scale: s,
-                        lambda_p: mechanism_scales(&m, axis).map(|m| (m.0, m.1)),
-                        height: structure_height(&scaled),
-                        model: m,
-                        initial: init,
-                    });
-                }
-            }
-        }
         let mut study = Study {
             spec: spec.clone(),
             name,
@@ -348,92 +303,11 @@ impl Study {
                             .into(),
                     ));
                 }
-                study.pulse_kind = Some(p.kind);
-                for v in 0..study.variants.len() {
-                    let lp = study.variants[v].lambda_p;
-                    let gravity = study.variants[v].model.gravity;
-                    let (amplitudes, ratios_a) = pulse_axis(
-                        path,
-                        lp,
-                        gravity,
-                        &p.amplitudes,
-                        &p.amplitude_ratios,
-                        "pulses.amplitudes",
-                        "pulses.amplitude_ratios",
-                    )?;
-                    let (periods, ratios_f) = pulse_axis(
-                        path,
-                        lp,
-                        gravity,
-                        &p.periods,
-                        &p.frequency_ratios,
-                        "pulses.periods",
-                        "pulses.frequency_ratios",
-                    )?;
-                    if let Some(t) = periods.iter().find(|t| **t <= 0.0) {
-                        return Err(bad(
-                            path,
-                            format!("pulses: a period must be > 0, got {t} s"),
-                        ));
-                    }
-                    for (i, &a) in amplitudes.iter().enumerate() {
-                        for (j, &t) in periods.iter().enumerate() {
-                            study.push(
-                                v,
-                                Motion::Pulse {
-                                    amplitude: a,
-                                    period: t,
-                                    amplitude_ratio: ratios_a.as_ref().map(|r| r[i]),
-                                    frequency_ratio: ratios_f.as_ref().map(|r| r[j]),
-                                },
-                            );
-                        }
-                    }
-                }
+                study.pulse_cases(p, path)?;
             }
             (None, Some(r)) => {
-                let mut files: Vec<PathBuf> = r.files.clone();
-                if let Some(folder) = &r.folder {
-                    let ext = r.extension.clone().unwrap_or_else(|| "AT2".into());
-                    let dir = base.join(folder);
-                    let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
-                        .map_err(|e| {
-                            bad(path, format!("records.folder {}: {e}", folder.display()))
-                        })?
-                        .filter_map(|e| e.ok().map(|e| e.path()))
-                        .filter(|p| {
-                            p.extension()
-                                .and_then(|x| x.to_str())
-                                .is_some_and(|x| x.eq_ignore_ascii_case(&ext))
-                        })
-                        .filter_map(|p| p.file_name().map(|n| folder.join(n)))
-                        .collect();
-                    found.sort();
-                    files.extend(found);
-                }
-                let seeds: Vec<u64> = match &r.synthetic {
-                    None => Vec::new(),
-                    Some(syn) => {
-                        let v = syn
-                            .seeds
-                            .expand("records.synthetic.seeds")
-                            .map_err(|e| bad(path, e))?;
-                        let mut seeds = Vec::with_capacity(v.len());
-                        for x in v {
-                            if !(x >= 0.0 && x.fract() == 0.0 && x < 9.0e15) {
-                                return Err(bad(
-                                    path,
-                                    format!(
-                                        "records.synthetic.seeds: {x} is not a whole number from \
-                                         0 to 9e15"
-                                    ),
-                                ));
-                            }
-                            seeds.push(x as u64);
-                        }
-                        seeds
-                    }
-                };
+                let files = record_files(r, base, path)?;
+                let seeds = synthetic_seeds(r, path)?;
                 if files.is_empty() && seeds.is_empty() {
                     return Err(bad(path, "records: no record files".into()));
                 }
@@ -460,93 +334,114 @@ impl Study {
                     file: PathBuf::from(format!("synthetic:{seed}")),
                     record: synthetic_record(seed),
                 }));
-                let (measure, levels) = match &spec.intensity {
-                    None => (IntensityMeasure::Factor, vec![1.0]),
-                    Some(i) => {
-                        let sa = match &i.sa {
-                            Some(sa) => {
-                                if !(sa.period.is_finite() && sa.period > 0.0) {
-                                    return Err(bad(
-                                        path,
-                                        format!(
-                                            "intensity.sa.period must be > 0 s, got {}",
-                                            sa.period
-                                        ),
-                                    ));
-                                }
-                                if !(sa.damping.is_finite() && (0.0..1.0).contains(&sa.damping)) {
-                                    return Err(bad(
-                                        path,
-                                        format!(
-                                            "intensity.sa.damping must be in [0, 1), got {}",
-                                            sa.damping
-                                        ),
-                                    ));
-                                }
-                                Some((
-                                    IntensityMeasure::Sa {
-                                        period: sa.period,
-                                        damping: sa.damping,
-                                    },
-                                    &sa.levels,
-                                    "intensity.sa.levels",
-                                ))
-                            }
-                            None => None,
-                        };
-                        let given: Vec<(IntensityMeasure, &Values, &str)> = [
-                            (IntensityMeasure::Factor, &i.factors, "intensity.factors"),
-                            (IntensityMeasure::Pga, &i.pga, "intensity.pga"),
-                            (IntensityMeasure::Pgv, &i.pgv, "intensity.pgv"),
-                        ]
-                        .into_iter()
-                        .filter_map(|(m, v, k)| v.as_ref().map(|v| (m, v, k)))
-                        .chain(sa)
-                        .collect();
-                        if given.len() != 1 {
-                            return Err(bad(
-                                path,
-                                "[intensity]: give exactly one of factors, pga, pgv and sa".into(),
-                            ));
-                        }
-                        let (m, v, key) = given[0];
-                        let levels = v.expand(key).map_err(|e| bad(path, e))?;
-                        if let Some(x) = levels.iter().find(|x| **x < 0.0) {
-                            return Err(bad(path, format!("{key}: {x} is negative")));
-                        }
-                        (m, levels)
-                    }
-                };
-                study.intensity = measure;
-                for v in 0..study.variants.len() {
-                    for k in 0..study.records.len() {
-                        for &level in &levels {
-                            let factor = study.records[k].record.as_ref().ok().and_then(|rec| {
-                                let im = match measure {
-                                    IntensityMeasure::Factor => return Some(level),
-                                    IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
-                                    IntensityMeasure::Pgv => peak_ground_velocity(rec),
-                                    IntensityMeasure::Sa { period, damping } => {
-                                        spectral_acceleration(rec, period, damping)?
-                                            / STANDARD_GRAVITY
-                                    }
-                                };
-                                (im > 0.0).then(|| level / im)
-                            });
-                            study.push(
-                                v,
-                                Motion::Record {
-                                    record: k,
-                                    level,
-                                    factor,
-                                },
-                            );
-                        }
-                    }
-                }
+                study.read_records(r, base, &files, &seeds);
+                let (measure, levels) = intensity_levels(&spec, path)?;
+                study.record_cases(measure, &levels);
             }
         }
         Ok(study)
+    }
+
+    /// The cases of a pulse family: every amplitude × period of every variant (the grid may be
+    /// given in ratios to the variant's λg and p).
+    fn pulse_cases(&mut self, p: &PulsesSpec, path: &Path) -> Result<(), Error> {
+        let study = self;
+        study.pulse_kind = Some(p.kind);
+        for v in 0..study.variants.len() {
+            let lp = study.variants[v].lambda_p;
+            let gravity = study.variants[v].model.gravity;
+            let (amplitudes, ratios_a) = pulse_axis(
+                path,
+                lp,
+                gravity,
+                &p.amplitudes,
+                &p.amplitude_ratios,
+                "pulses.amplitudes",
+                "pulses.amplitude_ratios",
+            )?;
+            let (periods, ratios_f) = pulse_axis(
+                path,
+                lp,
+                gravity,
+                &p.periods,
+                &p.frequency_ratios,
+                "pulses.periods",
+                "pulses.frequency_ratios",
+            )?;
+            if let Some(t) = periods.iter().find(|t| **t <= 0.0) {
+                return Err(bad(
+                    path,
+                    format!("pulses: a period must be > 0, got {t} s"),
+                ));
+            }
+            for (i, &a) in amplitudes.iter().enumerate() {
+                for (j, &t) in periods.iter().enumerate() {
+                    study.push(
+                        v,
+                        Motion::Pulse {
+                            amplitude: a,
+                            period: t,
+                            amplitude_ratio: ratios_a.as_ref().map(|r| r[i]),
+                            frequency_ratio: ratios_f.as_ref().map(|r| r[j]),
+                        },
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The study's records: the files (each read now; one that cannot be read fails its cases),
+    /// then the synthetic records of the seeds.
+    fn read_records(&mut self, r: &RecordsSpec, base: &Path, files: &[PathBuf], seeds: &[u64]) {
+        self.records = files
+            .iter()
+            .map(|f| StudyRecord {
+                file: f.clone(),
+                record: match r.format {
+                    Some(format) => {
+                        read_record(&base.join(f), format, r.units).map_err(|e| e.to_string())
+                    }
+                    None => Err("no format".into()),
+                },
+            })
+            .collect();
+        self.records.extend(seeds.iter().map(|&seed| StudyRecord {
+            file: PathBuf::from(format!("synthetic:{seed}")),
+            record: synthetic_record(seed),
+        }));
+    }
+
+    /// The cases of a records study: every variant × record × intensity level, with the factor
+    /// that brings the record to the level.
+    fn record_cases(&mut self, measure: IntensityMeasure, levels: &[f64]) {
+        let study = self;
+        study.intensity = measure;
+        for v in 0..study.variants.len() {
+            for k in 0..study.records.len() {
+                for &level in levels {
+                    let factor = study.records[k].record.as_ref().ok().and_then(|rec| {
+                        let im = match measure {
+                            IntensityMeasure::Factor => return Some(level),
+                            IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
+                            IntensityMeasure::Pgv => peak_ground_velocity(rec),
+                            IntensityMeasure::Sa { period, damping } => {
+                                spectral_acceleration(rec, period, damping)? / STANDARD_GRAVITY
+                            }
+                        };
+                        (im > 0.0).then(|| level / im)
+                    });
+                    study.push(
+                        v,
+                        Motion::Record {
+                            record: k,
+                            level,
+                            factor,
+                        },
+                    );
+                }
+            }
+        }
     }
 
     fn push(&mut self, variant: usize, motion: Motion) {
@@ -681,4 +576,193 @@ fn mechanism_scales(model: &Model, axis: Axis) -> Option<(f64, f64, f64)> {
     let eq = equivalent_block(model, &open.pivots, 0, &d).ok()?;
     (eq.lambda.is_finite() && eq.p_squared > 0.0)
         .then(|| (eq.lambda, eq.p_squared.sqrt(), eq.alpha))
+}
+
+/// The model at every scale of the study (one variant, the model itself, without `scales`).
+fn variants(
+    spec: &StudySpec,
+    path: &Path,
+    structure: &StructureSpec,
+    model: &Model,
+    initial: &InitialState,
+    initial_spec: &InitialSpec,
+    axis: Axis,
+) -> Result<Vec<Variant>, Error> {
+    let lambda_p = mechanism_scales(model, axis).map(|m| (m.0, m.1));
+    let mut variants = Vec::new();
+    match &spec.scales {
+        None => variants.push(Variant {
+            scale: 1.0,
+            model: model.clone(),
+            initial: initial.clone(),
+            lambda_p,
+            height: structure_height(structure),
+        }),
+        Some(v) => {
+            let scales = v.expand("scales").map_err(|e| bad(path, e))?;
+            if let Some(s) = scales.iter().find(|s| **s <= 0.0) {
+                return Err(bad(path, format!("scales: a factor must be > 0, got {s}")));
+            }
+            for s in scales {
+                let scaled = scale_structure(structure, s);
+                let m = Model::from_spec(&scaled)
+                    .map_err(|e| bad(path, format!("scales: the model scaled by {s}: {e}")))?;
+                let init = solve_initial(&m, initial_spec)
+                    .map_err(|e| bad(path, format!("scales: the model scaled by {s}: {e}")))?;
+                variants.push(Variant {
+                    scale: s,
+                    lambda_p: mechanism_scales(&m, axis).map(|m| (m.0, m.1)),
+                    height: structure_height(&scaled),
+                    model: m,
+                    initial: init,
+                });
+            }
+        }
+    }
+    Ok(variants)
+}
+
+/// The record files of `[records]`: those listed, then those of `folder` with the extension, in
+/// name order.
+fn record_files(r: &RecordsSpec, base: &Path, path: &Path) -> Result<Vec<PathBuf>, Error> {
+    let mut files: Vec<PathBuf> = r.files.clone();
+    if let Some(folder) = &r.folder {
+        let ext = r.extension.clone().unwrap_or_else(|| "AT2".into());
+        let dir = base.join(folder);
+        let mut found: Vec<PathBuf> = std::fs::read_dir(&dir)
+            .map_err(|e| bad(path, format!("records.folder {}: {e}", folder.display())))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.extension()
+                    .and_then(|x| x.to_str())
+                    .is_some_and(|x| x.eq_ignore_ascii_case(&ext))
+            })
+            .filter_map(|p| p.file_name().map(|n| folder.join(n)))
+            .collect();
+        found.sort();
+        files.extend(found);
+    }
+    Ok(files)
+}
+
+/// The seeds of `[records.synthetic]`, whole numbers.
+fn synthetic_seeds(r: &RecordsSpec, path: &Path) -> Result<Vec<u64>, Error> {
+    let seeds: Vec<u64> = match &r.synthetic {
+        None => Vec::new(),
+        Some(syn) => {
+            let v = syn
+                .seeds
+                .expand("records.synthetic.seeds")
+                .map_err(|e| bad(path, e))?;
+            let mut seeds = Vec::with_capacity(v.len());
+            for x in v {
+                if !(x >= 0.0 && x.fract() == 0.0 && x < 9.0e15) {
+                    return Err(bad(
+                        path,
+                        format!(
+                            "records.synthetic.seeds: {x} is not a whole number from \
+                                 0 to 9e15"
+                        ),
+                    ));
+                }
+                seeds.push(x as u64);
+            }
+            seeds
+        }
+    };
+    Ok(seeds)
+}
+
+/// The intensity measure and its levels (`[intensity]`; without it the records run as given).
+fn intensity_levels(spec: &StudySpec, path: &Path) -> Result<(IntensityMeasure, Vec<f64>), Error> {
+    Ok(match &spec.intensity {
+        None => (IntensityMeasure::Factor, vec![1.0]),
+        Some(i) => {
+            let sa = match &i.sa {
+                Some(sa) => {
+                    if !(sa.period.is_finite() && sa.period > 0.0) {
+                        return Err(bad(
+                            path,
+                            format!("intensity.sa.period must be > 0 s, got {}", sa.period),
+                        ));
+                    }
+                    if !(sa.damping.is_finite() && (0.0..1.0).contains(&sa.damping)) {
+                        return Err(bad(
+                            path,
+                            format!("intensity.sa.damping must be in [0, 1), got {}", sa.damping),
+                        ));
+                    }
+                    Some((
+                        IntensityMeasure::Sa {
+                            period: sa.period,
+                            damping: sa.damping,
+                        },
+                        &sa.levels,
+                        "intensity.sa.levels",
+                    ))
+                }
+                None => None,
+            };
+            let given: Vec<(IntensityMeasure, &Values, &str)> = [
+                (IntensityMeasure::Factor, &i.factors, "intensity.factors"),
+                (IntensityMeasure::Pga, &i.pga, "intensity.pga"),
+                (IntensityMeasure::Pgv, &i.pgv, "intensity.pgv"),
+            ]
+            .into_iter()
+            .filter_map(|(m, v, k)| v.as_ref().map(|v| (m, v, k)))
+            .chain(sa)
+            .collect();
+            if given.len() != 1 {
+                return Err(bad(
+                    path,
+                    "[intensity]: give exactly one of factors, pga, pgv and sa".into(),
+                ));
+            }
+            let (m, v, key) = given[0];
+            let levels = v.expand(key).map_err(|e| bad(path, e))?;
+            if let Some(x) = levels.iter().find(|x| **x < 0.0) {
+                return Err(bad(path, format!("{key}: {x} is negative")));
+            }
+            (m, levels)
+        }
+    })
+}
+/// The study's model, with every interface's impact law replaced by the study's `impact`.
+fn study_model(
+    spec: &StudySpec,
+    base: &Path,
+    path: &Path,
+) -> Result<(ModelFile, StructureSpec, Model), Error> {
+    let (file, mut model) = load_model(&base.join(&spec.model))?;
+    let mut structure = file.structure();
+    if let Some(law) = spec.impact {
+        for i in &mut structure.interface {
+            i.impact = law;
+        }
+        model = Model::from_spec(&structure).map_err(|e| bad(path, format!("impact: {e}")))?;
+    }
+    Ok((file, structure, model))
+}
+
+/// The horizontal component the study drives; its duration checked on the way.
+fn study_axis(spec: &StudySpec, path: &Path) -> Result<Axis, Error> {
+    let axis: Axis = spec
+        .component
+        .parse()
+        .map_err(|e: String| bad(path, format!("component: {e}")))?;
+    if axis == Axis::Z {
+        return Err(bad(
+            path,
+            "component: the study drives a horizontal component, x or y".into(),
+        ));
+    }
+    if let Some(d) = spec.duration
+        && !(d.is_finite() && d > 0.0)
+    {
+        return Err(bad(
+            path,
+            format!("duration must be a positive number of seconds, got {d}"),
+        ));
+    }
+    Ok(axis)
 }

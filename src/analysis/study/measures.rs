@@ -1,7 +1,9 @@
 //! One case of a study run to its end, keeping only its measures (peaks, collapse, impacts,
 //! residual tilt, dissipated energy) with memory flat in the duration.
 
-use crr_impact::{Simulation, StopReason};
+use crr_impact::Samples;
+
+use crate::analysis::simulation::simulate;
 
 use super::cases::{Case, Study};
 
@@ -22,27 +24,35 @@ pub struct Measures {
     pub end_time: f64,
 }
 
-/// Runs one case to its end (or collapse), keeping only its measures: the samples are drained
-/// after every step, so memory does not grow with the duration.
+/// Runs one case to its end (or collapse) by the same loop as `crr::run`, keeping only its
+/// measures: the samples are drained after every step, so memory does not grow with the
+/// duration.
 pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
     let ground = study.ground_motion(case)?;
     let mut params = study.params.clone();
     params.duration = study.duration(&ground);
     let variant = &study.variants[case.variant];
-    let mut sim = Simulation::new(&variant.model, &ground, &variant.initial, params)
-        .map_err(|e| e.to_string())?;
     // The last sample's largest |q| (the residual tilt) and dissipated energy.
     let mut last = None;
-    loop {
-        let stop = sim.step().map_err(|e| e.to_string())?;
-        if let Some(s) = sim.drain_samples().last() {
+    let mut keep_last = |samples: &Samples| {
+        if let Some(s) = samples.last() {
             last = Some((s.q.iter().fold(0.0f64, |m, q| m.max(q.abs())), s.dissipated));
         }
-        if matches!(stop, StopReason::End(_) | StopReason::Collapse(_)) {
-            break;
-        }
+        Ok(())
+    };
+    let (t, error) = simulate(
+        &variant.model,
+        &ground,
+        &variant.initial,
+        &params,
+        &mut keep_last,
+        true,
+        false,
+    )
+    .map_err(|e| e.to_string())?;
+    if let Some(e) = error {
+        return Err(e.to_string());
     }
-    let t = sim.into_trajectory();
     let (residual, dissipated) = last.unwrap_or((0.0, 0.0));
     Ok(Measures {
         peak: t.peak_abs.clone(),

@@ -6,7 +6,7 @@ use super::*;
 
 /// Regularised Dirac-delta laws acting as a continuous generalized force.
 pub(super) struct Regularised {
-    pub(super) slots: Vec<(usize, f64, f64, f64)>,
+    pub(super) slots: Vec<RegularisedSlot>,
     pub(super) angles: Vec<f64>,
 }
 

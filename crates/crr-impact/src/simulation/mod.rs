@@ -38,8 +38,8 @@ use crr_kinematics::{
 };
 
 use crate::laws::{
-    ImpactError, LawWorkspace, dirac_law_holding, dirac_regularised_force, momentum_law_with,
-    restitution_law_holding,
+    ImpactError, LawWorkspace, RegularisedSlot, dirac_law_holding, dirac_regularised_force,
+    momentum_law_with, restitution_law_holding,
 };
 
 mod events;
@@ -488,10 +488,12 @@ impl<'a> Simulation<'a> {
         // with the minimum-norm multipliers.
         dynamics.min_norm_multipliers = false;
         dynamics.seated = (0..model.slot_count).filter(|&s| seated[s]).collect();
-        let regularised_slots: Vec<(usize, f64, f64, f64)> = (0..model.slot_count)
+        let regularised_slots: Vec<RegularisedSlot> = (0..model.slot_count)
             .filter_map(
-                |s| match model.interfaces[slot_interface(model, s)].impact {
-                    ImpactLaw::DiracRegularised { r, c, width } => Some((s, r, c, width)),
+                |slot| match model.interfaces[slot_interface(model, slot)].impact {
+                    ImpactLaw::DiracRegularised { r, c, width } => {
+                        Some(RegularisedSlot { slot, r, c, width })
+                    }
                     _ => None,
                 },
             )
@@ -801,8 +803,8 @@ impl<'a> Simulation<'a> {
                 .map(|r| {
                     r.slots
                         .iter()
-                        .filter(|z| !self.seated[z.0])
-                        .map(|z| (z.0, 0.5 * z.3))
+                        .filter(|z| !self.seated[z.slot])
+                        .map(|z| (z.slot, 0.5 * z.width))
                         .collect()
                 })
                 .unwrap_or_default(),
@@ -872,7 +874,8 @@ impl<'a> Simulation<'a> {
             crr_kinematics::velocities(model, &mut self.out_kin, &qdot);
             let mut rates = vec![0.0; model.slot_count];
             slot_rates(model, &self.out_kin, &qdot, &mut rates);
-            for &(s, _, _, width) in &r.slots {
+            for z in &r.slots {
+                let (s, width) = (z.slot, z.width);
                 if !self.seated[s] && angles[s].abs() < 0.5 * width * (1.0 + 1e-9) {
                     h_max = h_max.min(width / (8.0 * rates[s].abs().max(1e-12)));
                 }

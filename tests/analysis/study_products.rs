@@ -1,0 +1,386 @@
+//! `crr study` products and axes of issue 13: the size axis (`scales`), synthetic records by seed,
+//! and the figures and fragility table of `crr plot STUDY_DIR` / `crr study --plot`.
+
+use std::path::{Path, PathBuf};
+
+use crate::common::{crr, scratch};
+use crr::analysis::study::{Motion, Study};
+
+fn models() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models")
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn run_ok(args: &[&str]) -> String {
+    let out = crr(args);
+    assert!(
+        out.status.success(),
+        "crr {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// A PNG of the project's size that is not blank, and an SVG with at least `min_shapes` drawn
+/// elements.
+fn assert_figure(dir: &Path, stem: &str, min_shapes: usize) {
+    let png = std::fs::read(dir.join(format!("{stem}.png"))).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{stem}.png is a PNG");
+    // A blank 1000 × 700 PNG compresses to a few kB; axes, labels and data take tens of kB.
+    assert!(png.len() > 15_000, "{stem}.png has {} bytes", png.len());
+    let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
+    assert!(svg.contains("<svg"));
+    let shapes = ["<rect", "<polyline", "<circle", "<line", "<path"]
+        .iter()
+        .map(|t| svg.matches(t).count())
+        .sum::<usize>();
+    assert!(
+        shapes >= min_shapes,
+        "{stem}.svg: {shapes} shapes, expected at least {min_shapes}"
+    );
+}
+
+/// Scaling a block by s scales its lengths by s: its mass by s³ (densities kept), its height by
+/// s, and its frequency parameter p = √(3g/4R) by 1/√s, so that at fixed ω_p/p the pulse period
+/// T_p = 2π/(ω_p) scales by √s; a_p/(g tan α) converts to the same a_p since α is unchanged.
+#[test]
+fn scale_axis_scales_p_mass_and_periods() {
+    let dir = scratch("study_scales");
+    let study = write(
+        &dir,
+        "s.toml",
+        &format!(
+            "model = \"{}\"\nscales = [0.5, 2.0]\nduration = 3.0\n\n[pulses]\n\
+             kind = \"one_sine_pulse\"\namplitude_ratios = [3.0, 4.0]\nfrequency_ratios = [2.0]\n",
+            models().join("single_block.toml").display()
+        ),
+    );
+    let s = Study::load(&study).unwrap();
+    assert_eq!(s.variants.len(), 2);
+    let (a, b) = (&s.variants[0], &s.variants[1]);
+    let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
+    // Exact scalings, up to round-off of the mass and equivalent-block computations.
+    assert!(rel(b.model.total_mass() / a.model.total_mass(), 64.0) < 1e-12);
+    assert!(rel(a.height.unwrap(), 1.0) < 1e-12 && rel(b.height.unwrap(), 4.0) < 1e-12);
+    let (pa, pb) = (a.lambda_p.unwrap().1, b.lambda_p.unwrap().1);
+    assert!(rel(pa / pb, 2.0) < 1e-9, "p ∝ 1/√s: {pa} / {pb}");
+    // Housner's p = √(3g/4R) of the 0.4 × 0.4 × 2 m block scaled by 0.5: R = 0.5·√(0.04 + 1).
+    let r = 0.5 * (0.2f64 * 0.2 + 1.0).sqrt();
+    assert!(rel(pa, (3.0 * 9.81 / (4.0 * r)).sqrt()) < 1e-9);
+    assert!(rel(a.lambda_p.unwrap().0, b.lambda_p.unwrap().0) < 1e-12);
+    // Case order: scale-major, then the pulse grid (amplitude-major).
+    assert_eq!(s.cases.len(), 4);
+    let periods: Vec<(usize, f64, f64)> = s
+        .cases
+        .iter()
+        .map(|c| match c.motion {
+            Motion::Pulse {
+                amplitude, period, ..
+            } => (c.variant, amplitude, period),
+            _ => panic!("a pulse study"),
+        })
+        .collect();
+    assert_eq!(
+        periods.iter().map(|p| p.0).collect::<Vec<_>>(),
+        [0, 0, 1, 1]
+    );
+    assert_eq!(s.cases[3].id, "c000003");
+    assert!(rel(periods[2].2 / periods[0].2, 2.0) < 1e-9, "T_p ∝ √s");
+    assert!(
+        rel(periods[2].1, periods[0].1) < 1e-12,
+        "a_p = r λ g, size-free"
+    );
+    assert!(rel(periods[1].1 / periods[0].1, 4.0 / 3.0) < 1e-12);
+
+    // The run writes the scale and the height; the spectrum is drawn.
+    let out = dir.join("out");
+    run_ok(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--plot",
+    ]);
+    let csv = std::fs::read_to_string(out.join("cases.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.starts_with("id,scale,height_m,amplitude_m_s2,"));
+    assert!(csv.lines().nth(3).unwrap().starts_with("c000002,2,4,"));
+    assert_figure(&out, "map", 4);
+    assert_figure(&out, "spectrum", 4);
+}
+
+/// Synthetic records by seed: deterministic, every one with the family's PGA (0.25 g exactly),
+/// different from seed to seed, and the bundled seed is the bundled record.
+#[test]
+fn synthetic_records_by_seed() {
+    use crr::input::synthetic::{PGA_G, SEED, accelerogram, accelerogram_with_seed};
+    let a1 = accelerogram_with_seed(1);
+    assert_eq!(a1, accelerogram_with_seed(1), "same seed, same record");
+    assert_eq!(accelerogram_with_seed(SEED), accelerogram());
+    let a2 = accelerogram_with_seed(2);
+    for a in [&a1, &a2] {
+        let peak = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!((peak - PGA_G).abs() < 1e-12);
+    }
+    // Independent noises: the records differ by a good fraction of their PGA somewhere.
+    let diff = a1
+        .iter()
+        .zip(&a2)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(
+        diff > 0.1 * PGA_G,
+        "seeds 1 and 2 differ by at most {diff} g"
+    );
+
+    // In a study: one record per seed, after the files, named by the seed.
+    let dir = scratch("study_synthetic");
+    let study = write(
+        &dir,
+        "s.toml",
+        &format!(
+            "model = \"{}\"\n\n[records]\nsynthetic = {{ seeds = {{ from = 3, to = 5, count = 3 }} }}\n\
+             \n[intensity]\npga = [0.1]\n",
+            models().join("single_block.toml").display()
+        ),
+    );
+    let s = Study::load(&study).unwrap();
+    let names: Vec<String> = s
+        .records
+        .iter()
+        .map(|r| r.file.display().to_string())
+        .collect();
+    assert_eq!(names, ["synthetic:3", "synthetic:4", "synthetic:5"]);
+    let rec = s.records[1].record.as_ref().unwrap();
+    // PGA 0.25 g, in m/s², scaled to 0.1 g by the factor 0.4.
+    assert!((rec.peak() - 0.25 * 9.80665).abs() < 1e-12);
+    match s.cases[1].motion {
+        Motion::Record { factor, .. } => assert!((factor.unwrap() - 0.4).abs() < 1e-12),
+        _ => panic!("a records study"),
+    }
+    // A seed that is not a whole number is refused, naming the key.
+    let bad = write(
+        &dir,
+        "bad.toml",
+        &format!(
+            "model = \"{}\"\n\n[records]\nsynthetic = {{ seeds = [1.5] }}\n",
+            models().join("single_block.toml").display()
+        ),
+    );
+    let e = Study::load(&bad).unwrap_err().to_string();
+    assert!(e.contains("records.synthetic.seeds"), "{e}");
+}
+
+/// A records study of Housner's block (2 m tall, g tan α = 0.2 g) under 4 synthetic records at
+/// 8 PGA levels: the fragility table and figure are written, and each fitted median lies within
+/// the levels where the empirical fraction crosses 1/2 (the lognormal curve is 1/2 at its
+/// median, and the maximum-likelihood curve follows the fractions).
+#[test]
+fn fragility_products() {
+    let dir = scratch("study_fragility");
+    let study = write(
+        &dir,
+        "f.toml",
+        &format!(
+            "name = \"frag\"\nmodel = \"{}\"\nduration = 21.0\n\n[records]\n\
+             synthetic = {{ seeds = [1, 2, 3, 4] }}\n\n[intensity]\n\
+             pga = {{ from = 0.1, to = 0.8, count = 8 }}\n",
+            models().join("single_block.toml").display()
+        ),
+    );
+    let out = dir.join("out");
+    run_ok(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--jobs",
+        "2",
+    ]);
+    let listed = run_ok(&["plot", out.to_str().unwrap()]);
+    assert!(listed.contains("fragility.csv") && listed.contains("fragility.png"));
+    assert_figure(&out, "fragility", 8);
+    let fits = std::fs::read_to_string(out.join("fragility.csv")).unwrap();
+    let points = std::fs::read_to_string(out.join("fragility_points.csv")).unwrap();
+    let mut lines = fits.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "measure,threshold,median_pga_g,dispersion,log_likelihood,levels_used,cases_used,\
+         level_min,level_max"
+    );
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    assert_eq!(rows.len(), 4, "collapse and three thresholds");
+    let mut fitted = 0;
+    for r in &rows {
+        assert_eq!(r[5], "8");
+        assert_eq!(r[6], "32");
+        let key = format!("{},{},", r[0], r[1]);
+        let fr: Vec<(f64, f64)> = points
+            .lines()
+            .filter(|l| l.starts_with(&key))
+            .map(|l| {
+                let f: Vec<f64> = l.split(',').skip(2).map(|x| x.parse().unwrap()).collect();
+                (f[0], f[3])
+            })
+            .collect();
+        assert_eq!(fr.len(), 8);
+        let Ok(median) = r[2].parse::<f64>() else {
+            // No fit: every case exceeded, or none.
+            assert!(fr.iter().all(|p| p.1 == 1.0) || fr.iter().all(|p| p.1 == 0.0));
+            continue;
+        };
+        fitted += 1;
+        let dispersion: f64 = r[3].parse().unwrap();
+        assert!(dispersion > 0.0 && dispersion.is_finite());
+        let first_up = fr.iter().position(|p| p.1 >= 0.5).unwrap();
+        let last_down = fr.iter().rposition(|p| p.1 <= 0.5).unwrap();
+        let lo = fr[first_up.saturating_sub(1)].0;
+        let hi = fr[(last_down + 1).min(fr.len() - 1)].0;
+        assert!(
+            lo <= median && median <= hi,
+            "{key}: median {median} outside the crossing levels [{lo}, {hi}]"
+        );
+    }
+    // The collapse curve at least has a transition over 0.1–0.8 g for a block of g tan α = 0.2 g.
+    assert!(fitted >= 1);
+    assert!(!rows[0][2].is_empty(), "the collapse curve is fitted");
+}
+
+/// The overturning map of a pulse study: one cell per case, and `crr plot` on a folder that is
+/// neither a simulation's nor a study's results is refused.
+#[test]
+fn map_has_one_cell_per_case() {
+    let dir = scratch("study_map");
+    let study = write(
+        &dir,
+        "m.toml",
+        &format!(
+            "model = \"{}\"\nduration = 3.0\n\n[pulses]\nkind = \"one_sine_pulse\"\n\
+             amplitude_ratios = {{ from = 1.5, to = 6.0, count = 5 }}\n\
+             frequency_ratios = {{ from = 1.0, to = 8.0, count = 4 }}\n",
+            models().join("single_block.toml").display()
+        ),
+    );
+    let out = dir.join("out");
+    run_ok(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--plot",
+    ]);
+    let svg = std::fs::read_to_string(out.join("map.svg")).unwrap();
+    // 20 cells + 4 legend keys + the legend box + the background, at least.
+    assert!(svg.matches("<rect").count() >= 20 + 4);
+    assert_figure(&out, "map", 24);
+    assert!(
+        !out.join("fragility.csv").exists(),
+        "no fragility for pulses"
+    );
+    legend_hides_no_cell(&svg);
+}
+
+/// The rectangles of an SVG, in document order: (x, y, width, height, the tag's text).
+fn svg_rects(svg: &str) -> Vec<(f64, f64, f64, f64, String)> {
+    let attr = |tag: &str, name: &str| -> f64 {
+        let start = tag.find(&format!(" {name}=\"")).unwrap() + name.len() + 3;
+        let end = start + tag[start..].find('"').unwrap();
+        tag[start..end].parse().unwrap()
+    };
+    svg.match_indices("<rect ")
+        .map(|(i, _)| {
+            let tag = &svg[i..i + svg[i..].find('>').unwrap()];
+            (
+                attr(tag, "x"),
+                attr(tag, "y"),
+                attr(tag, "width"),
+                attr(tag, "height"),
+                tag.to_string(),
+            )
+        })
+        .collect()
+}
+
+/// The map's legend box overlaps none of its cells (before, it hid the top row of a map: the
+/// box is drawn over the cells, with their rectangles before it in the file).
+fn legend_hides_no_cell(svg: &str) {
+    let rects = svg_rects(svg);
+    let boxed = rects
+        .iter()
+        .position(|r| r.4.contains("stroke=\"#969696\""))
+        .expect("a legend box");
+    let (lx, ly, lw, lh, _) = rects[boxed].clone();
+    // Cells: every rectangle after the background and before the legend's own two.
+    let cells = &rects[1..boxed - 1];
+    assert!(cells.len() >= 20, "{} cells", cells.len());
+    for (x, y, w, h, _) in cells {
+        let apart = x + w <= lx || *x >= lx + lw || y + h <= ly || *y >= ly + lh;
+        assert!(
+            apart,
+            "the cell at ({x}, {y}) {w}×{h} px lies under the legend ({lx}, {ly}) {lw}×{lh}"
+        );
+    }
+}
+
+/// The bundled studies load with the documented numbers of cases, in size-major order, and a
+/// scale factor that is not positive is refused naming `scales`.
+#[test]
+fn bundled_studies_load() {
+    let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/studies");
+    let spectrum = Study::load(&studies.join("block_spectrum.toml")).unwrap();
+    assert_eq!(spectrum.variants.len(), 20);
+    assert_eq!(spectrum.records.len(), 5, "the bundled record and 4 seeds");
+    assert_eq!(spectrum.cases.len(), 100);
+    // Case k is at size k div 5 (5 records × 1 level per size).
+    assert!(spectrum.cases.iter().all(|c| c.variant == c.index / 5));
+    assert!((spectrum.variants[19].height.unwrap() - 10.0).abs() < 1e-12);
+    let drum = Study::load(&studies.join("drum_fragility.toml")).unwrap();
+    assert_eq!(drum.records.len(), 20);
+    assert_eq!(drum.cases.len(), 200);
+    assert!(!drum.sized);
+    let map = Study::load(&studies.join("housner_map.toml")).unwrap();
+    assert_eq!(map.cases.len(), 3600);
+
+    let dir = scratch("study_bad_scales");
+    let bad = write(
+        &dir,
+        "bad.toml",
+        &format!(
+            "model = \"{}\"\nscales = [1.0, 0.0]\n\n[pulses]\nkind = \"ricker\"\n\
+             amplitudes = [1.0]\nperiods = [0.5]\n",
+            models().join("single_block.toml").display()
+        ),
+    );
+    let e = Study::load(&bad).unwrap_err().to_string();
+    assert!(e.contains("scales") && e.contains("> 0"), "{e}");
+}
+
+/// A Sa(T₁) study's levels are its `sa_g` column, not the scale factor (issue: the fragility of an
+/// Sa study was fitted against the factor and its axis labelled so).
+#[test]
+fn a_spectral_acceleration_study_is_read_against_sa() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("products_sa");
+    let _ = std::fs::remove_dir_all(&dir);
+    write(&dir, "study.json", "{\"name\": \"sa\"}");
+    write(
+        &dir,
+        "cases.csv",
+        "id,record,sa_g,factor,status,collapse\n\
+         c0,\"a.AT2\",0.2,0.5,ok,0\n\
+         c1,\"a.AT2\",0.4,1,ok,1\n",
+    );
+    let r = crr::output::study::products::StudyResults::read(&dir).unwrap();
+    assert_eq!(r.intensity.as_deref(), Some("sa_g"));
+    let levels: Vec<Option<f64>> = r.cases.iter().map(|c| c.level).collect();
+    assert_eq!(levels, vec![Some(0.2), Some(0.4)]);
+}

@@ -1,0 +1,98 @@
+//! Damaged or hostile inputs get a clear error (exit 2, the file named), never a panic, a hang or
+//! an allocation the input does not justify.
+
+use crate::common;
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use crate::common::{crr, refused};
+
+fn scratch(name: &str) -> PathBuf {
+    common::scratch(&format!("hostile_{name}"))
+}
+
+#[test]
+fn record_headers_cannot_ask_for_absurd_allocations() {
+    let dir = scratch("at2");
+    for npts in ["18446744073709551615", "99999999999999", "4000000000"] {
+        let at2 = dir.join(format!("{npts}.AT2"));
+        std::fs::write(
+            &at2,
+            format!("TEST\nTEST\nACCELERATION IN G\nNPTS= {npts}, DT= .0100 SEC\n 0.0 0.1 0.2\n"),
+        )
+        .unwrap();
+        let out = dir.join(format!("out_{npts}"));
+        refused(
+            &[
+                "simulate",
+                "examples/models/single_block.toml",
+                "--out",
+                out.to_str().unwrap(),
+                "--record",
+                at2.to_str().unwrap(),
+                "--format",
+                "peer-at2",
+            ],
+            at2.to_str().unwrap(),
+        );
+    }
+}
+
+#[test]
+fn plot_refuses_empty_and_non_finite_histories() {
+    let dir = scratch("plot");
+    let good = dir.join("good");
+    let o = crr(&[
+        "simulate",
+        "examples/models/single_block.toml",
+        "--out",
+        good.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success());
+    let history = std::fs::read_to_string(good.join("history.csv")).unwrap();
+    let header = history.lines().next().unwrap();
+    let row = history.lines().nth(3).unwrap();
+    let with_value = |v: &str| {
+        let mut fields: Vec<&str> = row.split(',').collect();
+        fields[1] = v;
+        history.replacen(row, &fields.join(","), 1)
+    };
+    let cases = [
+        ("header_only", format!("{header}\n"), "no data rows"),
+        ("inf", with_value("inf"), "not a finite number"),
+        ("nan", with_value("NaN"), "not a finite number"),
+    ];
+    for (name, text, needle) in cases {
+        let bad = dir.join(name);
+        std::fs::create_dir_all(&bad).unwrap();
+        for f in ["impacts.csv", "summary.json"] {
+            std::fs::copy(good.join(f), bad.join(f)).unwrap();
+        }
+        std::fs::write(bad.join("history.csv"), text).unwrap();
+        refused(&["plot", bad.to_str().unwrap()], needle);
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn devices_pipes_and_folders_are_not_read() {
+    let dir = scratch("special");
+    let fifo = dir.join("model.toml");
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .map(|s| s.success());
+    let mut cases = vec!["/dev/zero".to_string(), dir.to_str().unwrap().to_string()];
+    if made.is_ok_and(|ok| ok) {
+        cases.push(fifo.to_str().unwrap().to_string());
+    }
+    for path in &cases {
+        refused(&["inspect", path], "not a regular file");
+        refused(
+            &["simulate", path, "--out", dir.join("out").to_str().unwrap()],
+            "not a regular file",
+        );
+    }
+}

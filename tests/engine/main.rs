@@ -1,0 +1,21 @@
+//! The engine through the library: closed forms, conservation laws and independent derivations on simulated runs (impact laws on chains, uplift, collapse, loops, the temple and the 3D arch).
+//!
+//! One test binary per group (`tests/<group>/main.rs`), sharing `tests/common`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod arch_3d;
+mod collapse;
+mod impact_laws_on_chains;
+mod initial_state_paths;
+mod invariant;
+mod streaming;
+mod temple;
+mod twist_closure;
+mod uplift_at_multiplier;
+mod uplift_fast_signals;
+mod uplift_filter_in_loops;
+mod uplift_in_loops;
+mod uplift_time;
+mod validation_two_block_stack;

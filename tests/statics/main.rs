@@ -1,0 +1,11 @@
+//! Contact statics: the static multiplier and its mechanism against independent linear programs, duality and invariance under mirroring and reordering.
+//!
+//! One test binary per group (`tests/<group>/main.rs`), sharing `tests/common`.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod duality;
+mod independent;
+mod invariance;
+mod static_multiplier;
