@@ -7,7 +7,7 @@
 //!
 //! Matrices (built outside the timing, at consistent states):
 //! - `B`: the equations of motion's B = Φ' L⁻ᵀ (row-scaled Φ_q, M = L Lᵀ), rows × DOF(1), solved
-//!   for the minimum-norm B⁺ r at every right-hand side evaluation (`eom.rs`);
+//!   for the minimum-norm B⁺ r at every right-hand side evaluation (`eom/closed_chain_path.rs`);
 //! - `Phi`: the row-scaled Φ_q whose null space the impact laws and `mobility_after_step` take;
 //! - `M`: the mass matrix of a serial chain of n bodies, n = 2 … 128, and of the models.
 //!

@@ -38,18 +38,18 @@ fn raise(py: Python<'_>, kind: &str, message: String) -> PyErr {
 }
 
 /// An input error of the library as the Python exception of its kind: files that cannot be
-/// read or written are `crr.FileError` (an `OSError`), everything else `crr.Error` (a
+/// read or written are `crr.FileError` (an `OSError`), everything else `crr.InputError` (a
 /// `ValueError`).
 fn input_error(py: Python<'_>, e: Error) -> PyErr {
     let kind = match e {
         Error::Io { .. } | Error::Output { .. } => "FileError",
-        _ => "Error",
+        _ => "InputError",
     };
     raise(py, kind, e.to_string())
 }
 
 fn argument(py: Python<'_>, message: String) -> PyErr {
-    raise(py, "Error", message)
+    raise(py, "InputError", message)
 }
 
 /// A model read and validated, with the name and folder its errors and relative record paths

@@ -1,0 +1,221 @@
+//! The closed-chain path of [`Dynamics`]: Gauss' principle on the constraint rows (loop
+//! closures and seated closure angles), through the Cholesky factor of M and either the selected
+//! independent rows ([`super::selected_rows`]) or the Jacobi SVD of B; the tree reactions.
+
+use super::*;
+
+impl Dynamics {
+    /// The solve of [`Self::accelerations_with`] on the state last given to [`Self::evaluate`]:
+    /// q̈, λ and the seat reactions for the current seated slots. The kinematics, M, h and Q do
+    /// not depend on which slots are seated, so that trying several seated sets at one state
+    /// (the uplift test) evaluates them once.
+    pub fn solve_evaluated(
+        &mut self,
+        model: &Model,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) -> Result<(), DynamicsError> {
+        if self.articulated_applies(model) {
+            return self.solve_articulated(model, t, q, qdot, extra);
+        }
+        self.used_articulated = false;
+        self.used_single_coordinate = false;
+        self.used_selected = false;
+        self.factorise(model)?;
+        self.add_extra_force(model, t, q, qdot, extra);
+        let n = model.dof();
+        let nf = self.free.len();
+        // r = Q + F_extra − h: the generalized force left for inertia and constraints.
+        self.residual.copy_from(&self.load);
+        self.residual += &self.extra_force;
+        self.residual -= &self.kin.velocity_product;
+        // Gauss' principle in the coordinates z = Lᵀq̈_f (M_ff = L Lᵀ): z is the point of the
+        // affine set B z = −c nearest to z_free = L⁻¹ r_f, with B = Φ'_f L⁻ᵀ the row-scaled closures
+        // and the seated rows not eliminated, over the free columns. Decomposing B (rows × free) rather
+        // than B Bᵀ keeps the conditioning unsquared and the matrix small when many rows are
+        // redundant.
+        self.z.resize_vertically_mut(nf, 0.0);
+        for (i, &k) in self.free.iter().enumerate() {
+            self.z[i] = self.residual[k];
+        }
+        forward_substitute(&self.factor, self.z.as_mut_slice());
+        let seated_rows = self.seated.iter().filter(|&&s| self.is_row(s)).count();
+        let rows = model.constraint_rows + seated_rows;
+        if rows == 0 {
+            back_substitute_transposed(&self.factor, self.z.as_mut_slice());
+            self.scatter_accelerations();
+            self.lambda.fill(0.0);
+            self.seat_reactions
+                .resize_vertically_mut(self.seated.len(), 0.0);
+            self.tree_reactions(None);
+            return self.check_finite(t);
+        }
+        // Bᵀ = L⁻¹ (row-scaled Φ_q, seated rows)ᵀ over the free columns, column by column.
+        let mut bt = DMatrix::zeros(nf, rows);
+        for i in 0..model.constraint_rows {
+            for (j, &k) in self.free.iter().enumerate() {
+                bt[(j, i)] = self.row_scale[i] * self.kin.phi_q[(i, k)];
+            }
+        }
+        let mut bias = DVector::zeros(rows);
+        bias.rows_mut(0, model.constraint_rows)
+            .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
+        let mut seated_row_matrix = DMatrix::zeros(n, seated_rows);
+        let mut row = DVector::zeros(n);
+        let row_slots = self.seated.iter().copied().filter(|&s| self.is_row(s));
+        for (k, slot) in row_slots.enumerate() {
+            bias[model.constraint_rows + k] = slot_row(model, &self.kin, slot, &mut row);
+            seated_row_matrix.column_mut(k).copy_from(&row);
+            for (j, &c) in self.free.iter().enumerate() {
+                bt[(j, model.constraint_rows + k)] = row[c];
+            }
+        }
+        for mut col in bt.column_iter_mut() {
+            forward_substitute(&self.factor, col.as_mut_slice());
+        }
+        // With seated coordinates eliminated, B's own σ_max can be round-off (a loop whose free
+        // coordinates do not enter its closure here): the rank threshold is then taken against the
+        // whole row-scaled Jacobian with every column, Jacobi-scaled by M's diagonal
+        // (‖Φ'_j‖/√M_jj, the size of B's column j), so that noise is never inverted.
+        let mut floor = 0.0;
+        if nf < n {
+            let mut whole = 0.0;
+            for j in 0..n {
+                let mut col = 0.0;
+                for i in 0..model.constraint_rows {
+                    col += (self.row_scale[i] * self.kin.phi_q[(i, j)]).powi(2);
+                }
+                for k in 0..seated_rows {
+                    col += seated_row_matrix[(j, k)].powi(2);
+                }
+                whole += col / self.kin.mass_matrix[(j, j)];
+            }
+            floor = RANK_TOLERANCE.sqrt() * whole.sqrt();
+        }
+        let residual = bt.tr_mul(&self.z) + &bias;
+        let cached = self
+            .selections
+            .iter()
+            .position(|sel| sel.rows == rows && sel.free == nf && sel.seated == self.seated);
+        let mut dz = DVector::zeros(nf);
+        let mut lambda_scaled = DVector::zeros(rows);
+        let fast = match (cached, self.closed_chain_solve) {
+            (Some(c), ClosedChainSolve::SelectedRows) => solve_selected_rows(
+                &mut self.rows_work,
+                &bt,
+                &residual,
+                &self.selections[c].selected,
+                floor,
+                self.min_norm_multipliers,
+                &mut dz,
+                &mut lambda_scaled,
+            ),
+            _ => false,
+        };
+        self.used_selected = fast;
+        if !fast {
+            let svd = JacobiSvd::thin(&bt.transpose());
+            // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
+            let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt()).max(floor);
+            dz = -svd.solve_with(&residual, tol);
+            // z − z_free = Bᵀ λ': the minimum-norm multipliers.
+            lambda_scaled = svd.solve_transposed_with(&dz, tol);
+            if self.closed_chain_solve == ClosedChainSolve::SelectedRows {
+                let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
+                let selection = RowSelection {
+                    rows,
+                    free: nf,
+                    seated: self.seated.clone(),
+                    selected: pivot_columns(&bt, rank),
+                };
+                match cached {
+                    Some(c) => self.selections[c] = selection,
+                    None if self.selections.len() < SELECTION_CACHE => {
+                        self.selections.push(selection);
+                    }
+                    None => {
+                        self.selections[self.next_evicted] = selection;
+                        self.next_evicted = (self.next_evicted + 1) % SELECTION_CACHE;
+                    }
+                }
+            }
+        }
+        self.z += &dz;
+        back_substitute_transposed(&self.factor, self.z.as_mut_slice());
+        self.scatter_accelerations();
+        self.lambda = lambda_scaled
+            .rows(0, model.constraint_rows)
+            .component_mul(&self.row_scale);
+        let row_reactions = lambda_scaled.rows(model.constraint_rows, seated_rows);
+        // Seat reactions in the order of `seated`: tree coordinates from their rows' residuals
+        // (below), closure angles from the decomposition.
+        self.seat_reactions
+            .resize_vertically_mut(self.seated.len(), 0.0);
+        let mut a = 0;
+        for (i, &s) in self.seated.iter().enumerate() {
+            if self.is_row(s) {
+                self.seat_reactions[i] = row_reactions[a];
+                a += 1;
+            }
+        }
+        let row_force = &seated_row_matrix * row_reactions;
+        self.tree_reactions(Some(&row_force));
+        self.check_finite(t)
+    }
+
+    /// Sets `extra_force` to the extra generalized force at this state (0 without one).
+    pub(super) fn add_extra_force(
+        &mut self,
+        model: &Model,
+        t: f64,
+        q: &DVector<f64>,
+        qdot: &DVector<f64>,
+        extra: Option<&mut dyn GeneralizedForce>,
+    ) {
+        self.extra_force.fill(0.0);
+        if let Some(f) = extra {
+            f.add(model, &self.kin, t, q, qdot, &mut self.extra_force);
+        }
+    }
+
+    /// True if seated slot `s` is held by a constraint row (a closure angle, or any slot of a
+    /// closed chain), false if eliminated (a tree coordinate of an open chain).
+    pub(super) fn is_row(&self, s: usize) -> bool {
+        s >= self.locked.len() || !self.locked[s]
+    }
+
+    /// Writes q̈ from the free accelerations in `z` (seated tree coordinates: 0).
+    pub(super) fn scatter_accelerations(&mut self) {
+        self.qddot.fill(0.0);
+        for (i, &k) in self.free.iter().enumerate() {
+            self.qddot[k] = self.z[i];
+        }
+    }
+
+    /// Reactions of the eliminated seated coordinates: the residual of their rows of the
+    /// equations of motion, M_k· q̈ − r_k − (Φ_qᵀλ)_k − (seated rows' force)_k, written at their
+    /// places in `seat_reactions` (sized to `seated`). q̈ vanishes on the seated coordinates, so
+    /// M_k· q̈ sums over the free ones only.
+    pub(super) fn tree_reactions(&mut self, row_force: Option<&DVector<f64>>) {
+        for (i, &s) in self.seated.iter().enumerate() {
+            if self.is_row(s) {
+                continue;
+            }
+            let inertial: f64 = self
+                .free
+                .iter()
+                .map(|&j| self.kin.mass_matrix[(s, j)] * self.qddot[j])
+                .sum();
+            let mut reaction = inertial - self.residual[s];
+            for r in 0..self.lambda.len() {
+                reaction -= self.kin.phi_q[(r, s)] * self.lambda[r];
+            }
+            if let Some(f) = row_force {
+                reaction -= f[s];
+            }
+            self.seat_reactions[i] = reaction;
+        }
+    }
+}
