@@ -233,6 +233,20 @@ pub struct Stats {
     pub rhs_evals: usize,
 }
 
+/// The step-size control's verdict on a step.
+enum StepControl {
+    /// Redo the step with this size.
+    Rejected {
+        /// The size to redo it with.
+        retry: f64,
+    },
+    /// Keep it; the next step's size.
+    Accepted {
+        /// The proposal for the next step.
+        next: f64,
+    },
+}
+
 /// Why [`Solver::advance`] returned.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Stop {
@@ -492,30 +506,9 @@ impl Solver {
             self.f_valid = true;
         }
 
-        // Event set-up.
-        let ne = events.count();
-        self.g_prev.resize(ne, 0.0);
-        self.g_new.resize(ne, 0.0);
-        self.g_ref.resize(ne, 0.0);
-        self.g_tmp.resize(ne, 0.0);
-        self.zero_start.resize(ne, false);
-        if ne > 0 {
-            events.eval(self.t, &self.y, &mut self.g_prev);
-            for i in 0..ne {
-                let just_fired = matches!(self.fired, Some((j, tf)) if j == i && tf == self.t);
-                self.zero_start[i] = just_fired || self.g_prev[i].abs() <= EVENT_ZERO_TOL;
-            }
-        }
-
+        let ne = self.setup_events(events);
         let adaptive = !matches!(self.method, Method::Rk4 { .. });
-        let mut h = match self.method {
-            Method::Rk4 { step } => step,
-            _ if self.h_next > 0.0 => self.h_next,
-            _ => match self.opts.h_init {
-                Some(h0) => h0,
-                None => self.initial_step(sys)?,
-            },
-        };
+        let mut h = self.first_step_size(sys)?;
         let mut steps_here = 0usize;
 
         loop {
@@ -551,106 +544,32 @@ impl Solver {
                 return Err(SolveError::NonFinite { t: self.t, h });
             }
 
-            // Step-size control.
             let mut h_new = h;
             if adaptive {
-                let (expo, beta, fac_min, fac_max): (f64, f64, f64, f64) = match self.method {
-                    Method::Dop853 => (1.0 / 8.0, 0.0, 0.333, 6.0),
-                    _ => (0.2 - 0.04 * 0.75, 0.04, 0.2, 10.0),
-                };
-                let safe = 0.9;
-                let fac11 = err.powf(expo);
-                if err > 1.0 {
-                    self.stats.rejected += 1;
-                    self.last_rejected = true;
-                    h /= (1.0 / fac_min).min(fac11 / safe);
-                    continue;
+                match self.control_step(err, h) {
+                    StepControl::Rejected { retry } => {
+                        h = retry;
+                        continue;
+                    }
+                    StepControl::Accepted { next } => h_new = next,
                 }
-                let fac = fac11 / self.facold.powf(beta);
-                let fac = (1.0 / fac_max).max((1.0 / fac_min).min(fac / safe));
-                h_new = (h / fac).min(self.opts.h_max);
-                if self.last_rejected {
-                    h_new = h_new.min(h);
-                }
-                self.facold = err.max(1e-4);
-                self.last_rejected = false;
             }
             self.stats.accepted += 1;
             self.finish_step(sys, h, t1)?;
 
-            // Event detection.
-            let mut found: Option<(usize, f64)> = None;
-            if ne > 0 {
-                events.eval(t1, &self.y_new, &mut self.g_new);
-                let any_zero = self.zero_start.iter().any(|&z| z);
-                let t_probe = self.t + ZERO_START_PROBE * h;
-                if any_zero {
-                    dense_eval(&self.dense, self.dim, self.t, h, t_probe, &mut self.y_tmp);
-                    events.eval(t_probe, &self.y_tmp, &mut self.g_ref);
-                }
-                for i in 0..ne {
-                    let gb = self.g_new[i];
-                    let (ta, ga) = if self.zero_start[i] {
-                        if self.g_ref[i].abs() > EVENT_ZERO_TOL {
-                            (t_probe, self.g_ref[i])
-                        } else {
-                            continue;
-                        }
-                    } else {
-                        (self.t, self.g_prev[i])
-                    };
-                    if !crosses(ga, gb, events.direction(i)) {
-                        continue;
-                    }
-                    let tb = match found {
-                        Some((_, tf)) => tf.min(t1),
-                        None => t1,
-                    };
-                    let root = self.locate(events, i, ta, ga, t1, gb, tb, h);
-                    if let Some(tr) = root
-                        && found.is_none_or(|(_, tf)| tr < tf)
-                    {
-                        found = Some((i, tr));
-                    }
-                }
-            }
+            let found = if ne > 0 {
+                self.first_event(events, t1, h)
+            } else {
+                None
+            };
 
             if let Some((index, t_star)) = found {
                 if t_star != t1 {
-                    // Land on t* with a genuine step from the step start. The root was located on
-                    // the interpolant of a step whose stages may have missed a narrow feature
-                    // (a regularised δ zone inside the step): then the landing step fails the
-                    // error control or disagrees with the interpolant, and its state may lie past
-                    // other roots that would never fire (formerly sub-steps carried the state on to
-                    // t* without event detection). Reject the long step and redo it with the
-                    // landing step's size, so events are located only on steps that resolve them.
+                    if let Some(retry) = self.land_on_event(sys, h, t_star, adaptive)? {
+                        h = retry;
+                        continue;
+                    }
                     let h_land = t_star - self.t;
-                    if adaptive {
-                        dense_eval(&self.dense, self.dim, self.t, h, t_star, &mut self.y_event);
-                    }
-                    let err = self.rk_step(sys, h_land, t_star)?;
-                    self.stats.steps += 1;
-                    if !err.is_finite() || self.y_new.iter().any(|v| !v.is_finite()) {
-                        return Err(SolveError::NonFinite {
-                            t: self.t,
-                            h: h_land,
-                        });
-                    }
-                    if adaptive {
-                        let mismatch = self.scaled_distance(&self.y_new, &self.y_event);
-                        if err > 1.0 || mismatch > DENSE_TRUST {
-                            self.stats.accepted -= 1;
-                            self.stats.rejected += 1;
-                            self.last_rejected = true;
-                            h = if err > 1.0 {
-                                h_land * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9)
-                            } else {
-                                h_land
-                            };
-                            continue;
-                        }
-                    }
-                    self.finish_step(sys, h_land, t_star)?;
                     self.emit(on_step, h_land, t_star);
                 } else {
                     self.emit(on_step, h, t1);
@@ -666,14 +585,7 @@ impl Solver {
             self.commit(t1);
             let projected = self.project(sys)?;
             if ne > 0 {
-                std::mem::swap(&mut self.g_prev, &mut self.g_new);
-                if projected {
-                    events.eval(self.t, &self.y, &mut self.g_prev);
-                }
-                for i in 0..ne {
-                    self.zero_start[i] =
-                        self.zero_start[i] && self.g_prev[i].abs() <= EVENT_ZERO_TOL;
-                }
+                self.carry_events(events, projected);
             }
             if adaptive {
                 // A step shortened to land on `t_end` says little about the
@@ -687,6 +599,168 @@ impl Solver {
             if last {
                 return Ok(Stop::Reached);
             }
+        }
+    }
+
+    /// Sizes the event buffers and evaluates the event functions at the start; an event that
+    /// just fired here, or is already zero, starts at zero (it fires only after leaving zero).
+    /// Returns the number of events.
+    fn setup_events(&mut self, events: &mut impl EventFunctions) -> usize {
+        let ne = events.count();
+        self.g_prev.resize(ne, 0.0);
+        self.g_new.resize(ne, 0.0);
+        self.g_ref.resize(ne, 0.0);
+        self.g_tmp.resize(ne, 0.0);
+        self.zero_start.resize(ne, false);
+        if ne > 0 {
+            events.eval(self.t, &self.y, &mut self.g_prev);
+            for i in 0..ne {
+                let just_fired = matches!(self.fired, Some((j, tf)) if j == i && tf == self.t);
+                self.zero_start[i] = just_fired || self.g_prev[i].abs() <= EVENT_ZERO_TOL;
+            }
+        }
+        ne
+    }
+
+    /// The first step of this call: RK4's fixed step, the last call's proposal, the user's, or
+    /// the automatic initial step.
+    fn first_step_size(&mut self, sys: &mut impl OdeSystem) -> Result<f64, SolveError> {
+        Ok(match self.method {
+            Method::Rk4 { step } => step,
+            _ if self.h_next > 0.0 => self.h_next,
+            _ => match self.opts.h_init {
+                Some(h0) => h0,
+                None => self.initial_step(sys)?,
+            },
+        })
+    }
+
+    /// The step-size control of the adaptive methods (Hairer's, with Lund stabilisation for
+    /// DOPRI5) on a step of size `h` with scaled error `err`.
+    fn control_step(&mut self, err: f64, h: f64) -> StepControl {
+        let (expo, beta, fac_min, fac_max): (f64, f64, f64, f64) = match self.method {
+            Method::Dop853 => (1.0 / 8.0, 0.0, 0.333, 6.0),
+            _ => (0.2 - 0.04 * 0.75, 0.04, 0.2, 10.0),
+        };
+        let safe = 0.9;
+        let fac11 = err.powf(expo);
+        if err > 1.0 {
+            self.stats.rejected += 1;
+            self.last_rejected = true;
+            return StepControl::Rejected {
+                retry: h / (1.0 / fac_min).min(fac11 / safe),
+            };
+        }
+        let fac = fac11 / self.facold.powf(beta);
+        let fac = (1.0 / fac_max).max((1.0 / fac_min).min(fac / safe));
+        let mut next = (h / fac).min(self.opts.h_max);
+        if self.last_rejected {
+            next = next.min(h);
+        }
+        self.facold = err.max(1e-4);
+        self.last_rejected = false;
+        StepControl::Accepted { next }
+    }
+
+    /// The earliest event of the step [t, t1] of size `h` (its index and located time): a sign
+    /// change in its direction between the step's start (or, for an event starting at zero, the
+    /// probe at `ZERO_START_PROBE`·h) and its end.
+    fn first_event(
+        &mut self,
+        events: &mut impl EventFunctions,
+        t1: f64,
+        h: f64,
+    ) -> Option<(usize, f64)> {
+        let ne = events.count();
+        let mut found: Option<(usize, f64)> = None;
+        events.eval(t1, &self.y_new, &mut self.g_new);
+        let any_zero = self.zero_start.iter().any(|&z| z);
+        let t_probe = self.t + ZERO_START_PROBE * h;
+        if any_zero {
+            dense_eval(&self.dense, self.dim, self.t, h, t_probe, &mut self.y_tmp);
+            events.eval(t_probe, &self.y_tmp, &mut self.g_ref);
+        }
+        for i in 0..ne {
+            let gb = self.g_new[i];
+            let (ta, ga) = if self.zero_start[i] {
+                if self.g_ref[i].abs() > EVENT_ZERO_TOL {
+                    (t_probe, self.g_ref[i])
+                } else {
+                    continue;
+                }
+            } else {
+                (self.t, self.g_prev[i])
+            };
+            if !crosses(ga, gb, events.direction(i)) {
+                continue;
+            }
+            let tb = match found {
+                Some((_, tf)) => tf.min(t1),
+                None => t1,
+            };
+            let root = self.locate(events, i, ta, ga, t1, gb, tb, h);
+            if let Some(tr) = root
+                && found.is_none_or(|(_, tf)| tr < tf)
+            {
+                found = Some((i, tr));
+            }
+        }
+        found
+    }
+
+    /// Lands on the event time t* with a genuine step from the step start. The root was located
+    /// on the interpolant of a step (size `h`) whose stages may have missed a narrow feature (a
+    /// regularised δ zone inside the step): then the landing step fails the error control or
+    /// disagrees with the interpolant, and its state may lie past other roots that would never
+    /// fire (formerly sub-steps carried the state on to t* without event detection). The long
+    /// step is then rejected and the size to redo it with is returned, so events are located
+    /// only on steps that resolve them; `None` when the landing step is accepted and finished.
+    fn land_on_event(
+        &mut self,
+        sys: &mut impl OdeSystem,
+        h: f64,
+        t_star: f64,
+        adaptive: bool,
+    ) -> Result<Option<f64>, SolveError> {
+        let h_land = t_star - self.t;
+        if adaptive {
+            dense_eval(&self.dense, self.dim, self.t, h, t_star, &mut self.y_event);
+        }
+        let err = self.rk_step(sys, h_land, t_star)?;
+        self.stats.steps += 1;
+        if !err.is_finite() || self.y_new.iter().any(|v| !v.is_finite()) {
+            return Err(SolveError::NonFinite {
+                t: self.t,
+                h: h_land,
+            });
+        }
+        if adaptive {
+            let mismatch = self.scaled_distance(&self.y_new, &self.y_event);
+            if err > 1.0 || mismatch > DENSE_TRUST {
+                self.stats.accepted -= 1;
+                self.stats.rejected += 1;
+                self.last_rejected = true;
+                return Ok(Some(if err > 1.0 {
+                    h_land * (0.9 * err.powf(-0.2)).clamp(0.1, 0.9)
+                } else {
+                    h_land
+                }));
+            }
+        }
+        self.finish_step(sys, h_land, t_star)?;
+        Ok(None)
+    }
+
+    /// After an accepted step without an event: the step end's event values become the next
+    /// step's start (re-evaluated when the projection moved the state); an event that started at
+    /// zero stays so while it is still zero.
+    fn carry_events(&mut self, events: &mut impl EventFunctions, projected: bool) {
+        std::mem::swap(&mut self.g_prev, &mut self.g_new);
+        if projected {
+            events.eval(self.t, &self.y, &mut self.g_prev);
+        }
+        for i in 0..self.zero_start.len() {
+            self.zero_start[i] = self.zero_start[i] && self.g_prev[i].abs() <= EVENT_ZERO_TOL;
         }
     }
 

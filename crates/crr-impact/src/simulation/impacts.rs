@@ -321,15 +321,9 @@ impl Simulation<'_> {
         for &s in &record.slots {
             self.last_impact[s] = t;
         }
-        for &s in &record.seated {
-            self.seated[s] = true;
-        }
         // The switch; the pivots before go back to the scratch.
         std::mem::swap(&mut self.dynamics.pivots, &mut after);
-        self.dynamics.seated.clear();
-        self.dynamics
-            .seated
-            .extend((0..model.slot_count).filter(|&s| self.seated[s]));
+        self.set_seated(record.seated.iter().map(|&s| (s, true)));
         // The snap of the impacting angles to exactly 0 changes U by round-off: booked too.
         let u_snap = u_located - u_snapped;
         self.spare.events_kin = Some(kin);

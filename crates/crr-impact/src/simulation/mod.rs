@@ -104,23 +104,11 @@ pub struct Parameters {
 }
 
 impl Default for Parameters {
+    /// The defaults of `[analysis]` ([`crr_dynamics::AnalysisSpec::default`], their one owner)
+    /// with a duration of 10 s.
     fn default() -> Self {
-        Self {
-            duration: 10.0,
-            output_interval: 0.01,
-            method: Method::Dop853,
-            options: Options {
-                rtol: 1e-10,
-                atol: 1e-12,
-                ..Options::default()
-            },
-            seat_rate: 1e-4,
-            min_impact_interval: 1e-6,
-            simultaneity: 1e-8,
-            max_impacts: 1_000_000,
-            friction: None,
-            collapse_drop: 1e-3,
-        }
+        Self::from_analysis(&crr_dynamics::AnalysisSpec::default(), 10.0)
+            .expect("the default analysis settings are valid")
     }
 }
 
@@ -637,6 +625,20 @@ impl<'a> Simulation<'a> {
         std::mem::replace(&mut self.samples, empty)
     }
 
+    /// Seats (`true`) or releases (`false`) slots. The seated set is held twice, as the mask
+    /// the events read and as the list the dynamics solves with; this is the one place either
+    /// changes after the start, and both change together.
+    pub(super) fn set_seated(&mut self, changes: impl IntoIterator<Item = (usize, bool)>) {
+        for (s, seated) in changes {
+            self.seated[s] = seated;
+        }
+        self.dynamics.seated.clear();
+        let seated = &self.seated;
+        self.dynamics
+            .seated
+            .extend((0..self.model.slot_count).filter(|&s| seated[s]));
+    }
+
     fn reset_solver(&mut self) {
         self.solver.reset(self.t, &self.y);
         // Every segment rebuilds its event list: an index from the last one means nothing now.
@@ -739,30 +741,13 @@ impl<'a> Simulation<'a> {
         let lift_off = self.settle_resting_joints()?;
         let model = self.model;
         let n = model.dof();
-        let mut t_stop = self
-            .ground
-            .next_breakpoint(self.t)
-            .map_or(self.params.duration, |b| b.min(self.params.duration));
-        // A joint leaving φ = 0 against its acceleration (every rebound) ends its segment at the
-        // estimated turning point τ/2: every step of the segment is then shorter than the flight, so
-        // the zero-start probe at 10⁻³h lies on the outward half and the return is a plain sign
-        // change at a later step end. No further step cap is needed: within the segment the error
-        // control sets the steps (a cap at τ/8 had doubled the steps of free rocking without
-        // changing any result).
-        if let Some(c) = lift_off {
-            t_stop = t_stop.min(self.t + c);
-        }
-        // A step returns after at most this many output samples, so that a caller streaming
-        // them (Simulation::drain_samples) keeps its memory flat through long quiet segments.
-        let segment_end = self.t + MAX_SAMPLES_PER_STEP as f64 * self.params.output_interval;
-        if segment_end > self.t {
-            t_stop = t_stop.min(segment_end);
-        }
+        let t_stop = self.segment_end(lift_off);
         if lift_off.is_none()
             && let Some(stop) = self.rest_until_uplift(t_stop)?
         {
             return Ok(stop);
         }
+        let h_max = self.step_cap();
         let mut seg = self.spare.segment.take().unwrap_or_default();
         seg.rocking.clear();
         seg.rocking.extend(
@@ -849,38 +834,6 @@ impl<'a> Simulation<'a> {
                 }
             }
         };
-        // Inside a regularised δ zone the step is limited to an eighth of the zone's crossing time,
-        // so that the bump is resolved by the steps and their dense output.
-        let mut h_max = self.params.options.h_max;
-        // While joints are seated the state barely changes and steps would grow up to the next
-        // breakpoint; the uplift test runs at step ends, so a short excursion of the ground motion
-        // above the threshold could be stepped over. Cap the step at `SEATED_MAX_STEP`.
-        if !self.dynamics.seated.is_empty()
-            && !self.ground.is_none()
-            && self.t < self.ground.duration()
-        {
-            h_max = h_max.min(seated_step(self.ground));
-        }
-        if let Some(r) = &self.regularised {
-            let mut angles = vec![0.0; model.slot_count];
-            let (q, qdot) = (self.q(), self.qdot());
-            slot_angles(
-                model,
-                &mut self.out_kin,
-                &q,
-                &self.dynamics.pivots,
-                &mut angles,
-            );
-            crr_kinematics::velocities(model, &mut self.out_kin, &qdot);
-            let mut rates = vec![0.0; model.slot_count];
-            slot_rates(model, &self.out_kin, &qdot, &mut rates);
-            for z in &r.slots {
-                let (s, width) = (z.slot, z.width);
-                if !self.seated[s] && angles[s].abs() < 0.5 * width * (1.0 + 1e-9) {
-                    h_max = h_max.min(width / (8.0 * rates[s].abs().max(1e-12)));
-                }
-            }
-        }
         self.solver.set_h_max(h_max);
         let buffers = std::mem::take(&mut self.spare.system);
         let mut sys =
@@ -926,6 +879,90 @@ impl<'a> Simulation<'a> {
         let stop = stop?;
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());
+        self.stop_reason(
+            stop,
+            event_slot,
+            collapse_index,
+            first_zone_index,
+            rocking_len,
+        )
+    }
+
+    /// Where this segment ends at the latest: the duration, the ground motion's next breakpoint,
+    /// the estimated turning point of a joint leaving its seat, and the samples one step may
+    /// hold.
+    fn segment_end(&self, lift_off: Option<f64>) -> f64 {
+        let mut t_stop = self
+            .ground
+            .next_breakpoint(self.t)
+            .map_or(self.params.duration, |b| b.min(self.params.duration));
+        // A joint leaving φ = 0 against its acceleration (every rebound) ends its segment at the
+        // estimated turning point τ/2: every step of the segment is then shorter than the flight, so
+        // the zero-start probe at 10⁻³h lies on the outward half and the return is a plain sign
+        // change at a later step end. No further step cap is needed: within the segment the error
+        // control sets the steps (a cap at τ/8 had doubled the steps of free rocking without
+        // changing any result).
+        if let Some(c) = lift_off {
+            t_stop = t_stop.min(self.t + c);
+        }
+        // A step returns after at most this many output samples, so that a caller streaming
+        // them (Simulation::drain_samples) keeps its memory flat through long quiet segments.
+        let segment_end = self.t + MAX_SAMPLES_PER_STEP as f64 * self.params.output_interval;
+        if segment_end > self.t {
+            t_stop = t_stop.min(segment_end);
+        }
+        t_stop
+    }
+
+    /// The longest step of this segment: the user's `max_step`, capped while joints are seated
+    /// under a ground motion and inside a regularised δ zone.
+    fn step_cap(&mut self) -> f64 {
+        let model = self.model;
+        // Inside a regularised δ zone the step is limited to an eighth of the zone's crossing time,
+        // so that the bump is resolved by the steps and their dense output.
+        let mut h_max = self.params.options.h_max;
+        // While joints are seated the state barely changes and steps would grow up to the next
+        // breakpoint; the uplift test runs at step ends, so a short excursion of the ground motion
+        // above the threshold could be stepped over. Cap the step at `SEATED_MAX_STEP`.
+        if !self.dynamics.seated.is_empty()
+            && !self.ground.is_none()
+            && self.t < self.ground.duration()
+        {
+            h_max = h_max.min(seated_step(self.ground));
+        }
+        if let Some(r) = &self.regularised {
+            let mut angles = vec![0.0; model.slot_count];
+            let (q, qdot) = (self.q(), self.qdot());
+            slot_angles(
+                model,
+                &mut self.out_kin,
+                &q,
+                &self.dynamics.pivots,
+                &mut angles,
+            );
+            crr_kinematics::velocities(model, &mut self.out_kin, &qdot);
+            let mut rates = vec![0.0; model.slot_count];
+            slot_rates(model, &self.out_kin, &qdot, &mut rates);
+            for z in &r.slots {
+                let (s, width) = (z.slot, z.width);
+                if !self.seated[s] && angles[s].abs() < 0.5 * width * (1.0 + 1e-9) {
+                    h_max = h_max.min(width / (8.0 * rates[s].abs().max(1e-12)));
+                }
+            }
+        }
+        h_max
+    }
+
+    /// What the segment's end means: the end of the run, a breakpoint, an impact, a collapse, a
+    /// δ zone entered or left, or an uplift.
+    fn stop_reason(
+        &mut self,
+        stop: Stop,
+        event_slot: Option<usize>,
+        collapse_index: usize,
+        first_zone_index: usize,
+        rocking_len: usize,
+    ) -> Result<StopReason, SimulationError> {
         match stop {
             Stop::Reached => {
                 if self.t >= self.params.duration {
@@ -1138,5 +1175,28 @@ mod invariant_tests {
             Err(SimulationError::Invariant(m)) => assert!(m.contains("loops are open"), "{m}"),
             other => panic!("{other:?}"),
         }
+    }
+}
+
+#[cfg(test)]
+mod parameter_tests {
+    use super::Parameters;
+    use crr_dynamics::integrator::Method;
+
+    #[test]
+    fn the_default_parameters_are_the_documented_defaults_of_analysis() {
+        // docs/model-format.md, `[analysis]`: each default as the documentation states it.
+        let p = Parameters::default();
+        assert_eq!(p.duration, 10.0);
+        assert_eq!(p.output_interval, 0.01);
+        assert!(matches!(p.method, Method::Dop853));
+        assert_eq!((p.options.rtol, p.options.atol), (1e-10, 1e-12));
+        assert_eq!(p.options.h_max, f64::INFINITY);
+        assert_eq!(p.seat_rate, 1e-4);
+        assert_eq!(p.min_impact_interval, 1e-6);
+        assert_eq!(p.simultaneity, 1e-8);
+        assert_eq!(p.max_impacts, 1_000_000);
+        assert_eq!(p.friction, None);
+        assert_eq!(p.collapse_drop, 1e-3);
     }
 }

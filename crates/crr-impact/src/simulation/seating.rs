@@ -724,12 +724,9 @@ impl Simulation<'_> {
             // angles).
             let from_rest = self.seated.iter().all(|&s| s);
             for &(s, side) in mode {
-                self.seated[s] = false;
                 self.dynamics.pivots.sides[s] = side;
             }
-            self.dynamics.seated = (0..self.model.slot_count)
-                .filter(|&s| self.seated[s])
-                .collect();
+            self.set_seated(mode.iter().map(|&(s, _)| (s, false)));
             if from_rest {
                 self.uplift_time.get_or_insert(self.t);
             }
@@ -940,7 +937,6 @@ impl Simulation<'_> {
         let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * qdot));
         let u_before = potential_energy(model, &d.kin);
         for &s in &closing {
-            self.seated[s] = true;
             if s < model.dof() {
                 self.y[s] = 0.0;
             }
@@ -955,7 +951,7 @@ impl Simulation<'_> {
         self.dissipated_at_impacts += before - kinetic + u_before - u_after;
         let n = model.dof();
         self.y[n..2 * n].copy_from_slice(qd.as_slice());
-        self.dynamics.seated = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        self.set_seated(closing.iter().map(|&s| (s, true)));
         self.reset_solver();
         self.release_if_opening()?;
         Ok(None)
