@@ -149,6 +149,74 @@ fn opening_mode_local(
     {
         return mode;
     }
+    // The current sides: one evaluation of the state (M, h …) serves every solve, unless the
+    // articulated-body algorithm solves (it does not use M, and its solve is as cheap as the
+    // evaluation).
+    trial.pivots.clone_from(&template.pivots);
+    trial.seated.clone_from(&seated);
+    let evaluated = !trial.articulated_body_applies(model);
+    if evaluated {
+        trial.evaluate(model, ground, t, q, qdot);
+    }
+    // Releases that cannot open are known from one solve with every seated slot locked.
+    let may_open = releases_that_may_open(model, ground, template, trial, t, q, qdot);
+    // Every seated slot held on both of its pivots: no release opens, and no set of releases
+    // either. The power of the held structure's constraint forces on any opening motion is
+    // Σ αₖσₖrₖ(sₖ) over the slots it opens (αₖ ≥ 0), positive when every σₖrₖ(sₖ) is, so the
+    // held motion is the minimum of the Gauss function over the cone of openings (convex), and
+    // the active set below could only end where it starts.
+    if model.constraint_rows > 0 && may_open.as_ref().is_some_and(|m| m.iter().all(|&o| !o)) {
+        return None;
+    }
+    let opening = single_release_openings(
+        model,
+        ground,
+        template,
+        trial,
+        &seated,
+        slot_part,
+        may_open.as_deref(),
+        evaluated,
+        t,
+        q,
+        qdot,
+    );
+    if let Some((k, side)) = strongest_opening(&seated, &opening, tol) {
+        return Some(vec![(k, side)]);
+    }
+    if model.constraint_rows == 0 || seated.len() < 2 {
+        return None;
+    }
+    active_set_opening(model, ground, template, trial, &seated, t, q, qdot, tol)
+}
+
+/// Release (slot, side) is indexed 2i on the positive side of slot `seated[i]`, 2i + 1 on the
+/// negative.
+fn side_index(side: Side) -> usize {
+    usize::from(side == Side::Negative)
+}
+
+/// The opening acceleration of every single release of the seated slots that may open (see
+/// [`side_index`]; None: not tried, or its solve failed). The releases on the slots' current
+/// sides share the template's chain (evaluated once in `trial` when `evaluated`); a release on
+/// the other side changes the chain and is evaluated anew. Releases are batched in rounds: on
+/// open chains slot i goes to round (its rank among the seated slots of its part); with loops
+/// every release is a round of its own (the rank threshold of the closed-chain solve is taken
+/// over the whole Jacobian, which couples the parts' round-off).
+#[allow(clippy::too_many_arguments)]
+fn single_release_openings(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    seated: &[usize],
+    slot_part: &[usize],
+    may_open: Option<&[bool]>,
+    evaluated: bool,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Vec<Option<f64>> {
     let mut row = DVector::zeros(model.dof());
     let n = model.dof();
     // The opening acceleration of slot k in the last solve (a tree coordinate's is q̈ₖ).
@@ -160,14 +228,7 @@ fn opening_mode_local(
             row.dot(&trial.qddot) + bias
         }
     };
-    // Opening acceleration of each single release (slot, side), indexed 2i (positive side) and
-    // 2i + 1 (negative). The releases on the slots' current sides share the template's chain,
-    // evaluated once; a release on the other side changes the chain and is evaluated anew.
     let mut opening: Vec<Option<f64>> = vec![None; 2 * seated.len()];
-    let side_index = |side: Side| usize::from(side == Side::Negative);
-    // Rounds of releases: on open chains slot i goes to round (its rank among the seated slots
-    // of its part); with loops every release is a round of its own (the rank threshold of the
-    // closed-chain solve is taken over the whole Jacobian, which couples the parts' round-off).
     let mut round = vec![0; seated.len()];
     let rounds = if model.constraint_rows == 0 {
         let mut count = vec![0usize; slot_part.iter().max().map_or(0, |&p| p + 1)];
@@ -227,25 +288,6 @@ fn opening_mode_local(
                 .collect::<Vec<_>>()
         })
     };
-    // The current sides: one evaluation of the state (M, h …) serves every solve, unless the
-    // articulated-body algorithm solves (it does not use M, and its solve is as cheap as the
-    // evaluation).
-    trial.pivots.clone_from(&template.pivots);
-    trial.seated.clone_from(&seated);
-    let evaluated = !trial.articulated_body_applies(model);
-    if evaluated {
-        trial.evaluate(model, ground, t, q, qdot);
-    }
-    // Releases that cannot open are known from one solve with every seated slot locked.
-    let may_open = releases_that_may_open(model, ground, template, trial, t, q, qdot);
-    // Every seated slot held on both of its pivots: no release opens, and no set of releases
-    // either. The power of the held structure's constraint forces on any opening motion is
-    // Σ αₖσₖrₖ(sₖ) over the slots it opens (αₖ ≥ 0), positive when every σₖrₖ(sₖ) is, so the
-    // held motion is the minimum of the Gauss function over the cone of openings (convex), and
-    // the active set below could only end where it starts.
-    if model.constraint_rows > 0 && may_open.as_ref().is_some_and(|m| m.iter().all(|&o| !o)) {
-        return None;
-    }
     let mut batch = Vec::with_capacity(seated.len());
     for flip in [false, true] {
         for r in 0..rounds {
@@ -256,10 +298,7 @@ fn opening_mode_local(
                 } else {
                     template.pivots.sides[seated[i]]
                 };
-                round[i] == r
-                    && may_open
-                        .as_ref()
-                        .is_none_or(|m| m[2 * i + side_index(side)])
+                round[i] == r && may_open.is_none_or(|m| m[2 * i + side_index(side)])
             }));
             if batch.is_empty() {
                 continue;
@@ -278,6 +317,11 @@ fn opening_mode_local(
             }
         }
     }
+    opening
+}
+
+/// The single release that opens fastest, above `tol`.
+fn strongest_opening(seated: &[usize], opening: &[Option<f64>], tol: f64) -> Option<(usize, Side)> {
     let mut best: Option<(usize, Side, f64)> = None;
     for (i, &k) in seated.iter().enumerate() {
         for side in [Side::Positive, Side::Negative] {
@@ -289,12 +333,24 @@ fn opening_mode_local(
             }
         }
     }
-    if let Some((k, side, _)) = best {
-        return Some(vec![(k, side)]);
-    }
-    if model.constraint_rows == 0 || seated.len() < 2 {
-        return None;
-    }
+    best.map(|(k, side, _)| (k, side))
+}
+
+/// The active set over the seated slots released together (loops with several seated slots,
+/// when no single release opens).
+#[allow(clippy::too_many_arguments)]
+fn active_set_opening(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    seated: &[usize],
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    tol: f64,
+) -> Option<Vec<(usize, Side)>> {
+    let mut row = DVector::zeros(model.dof());
     // Active set over the seated slots released together: a slot closing on its side is tried
     // once on the other side; closing on both, it stays seated (the tilts of a loop of rocking
     // bases that the excitation does not drive: under x only, the y tilts). Whenever a slot
