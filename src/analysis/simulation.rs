@@ -216,6 +216,28 @@ fn ground_motion(
 }
 
 impl Prepared {
+    /// The history's expected size: its rows (one per output interval, the impacts' two extra
+    /// rows left out) and the bytes of `history.csv` they make.
+    pub fn history_estimate(&self) -> (f64, f64) {
+        let rows = (self.params.duration / self.params.output_interval).floor() + 1.0;
+        (rows, rows * history_row_bytes(&self.model))
+    }
+
+    /// The warning to give before the run when its history will be larger than
+    /// [`HISTORY_SIZE_WARNING`]: what makes it so and how to shrink it.
+    pub fn history_size_warning(&self) -> Option<String> {
+        let (rows, bytes) = self.history_estimate();
+        (bytes > HISTORY_SIZE_WARNING).then(|| {
+            format!(
+                "the history will hold about {rows:.3e} rows ({:.1} GB): the duration {} s over \
+                 output_interval = {} s; raise output_interval to shrink it",
+                bytes / 1e9,
+                self.params.duration,
+                num(self.params.output_interval)
+            )
+        })
+    }
+
     /// Runs the simulation and keeps the samples in the trajectory.
     pub fn run(&self) -> Run {
         self.run_with(|_| Ok(()), false)
@@ -357,6 +379,17 @@ pub const RK4_STEP_WARNING: f64 = 0.05;
 
 /// A simultaneity tolerance larger than this fraction of the smallest slenderness α is a warning.
 pub const SIMULTANEITY_WARNING: f64 = 1e-2;
+
+/// A history expected to exceed this size (bytes of `history.csv`, or of memory held by a run
+/// that keeps its samples: both are about the same) is a warning, given before the run starts.
+pub const HISTORY_SIZE_WARNING: f64 = 1e9;
+
+/// Bytes of one history row: t, q, q̇ and the four energies as `{:e}` (at most about 23
+/// characters with the comma), and each interface's state (`seated`, `+`, `-`, one per slot).
+fn history_row_bytes(model: &Model) -> f64 {
+    let numbers = 1 + 2 * model.dof() + 4;
+    (23 * numbers + 7 * model.slot_count + 1) as f64
+}
 
 /// The event-driven simulation of `model` under `ground` from `initial`, step by step to the end,
 /// a collapse or an error: the one loop every run goes through (`crr::run`, `crr simulate`, the
@@ -611,6 +644,7 @@ fn warnings(
             v.t, v.interface
         ));
     }
+    out.extend(p.history_size_warning());
     out.extend(p.ground.record_warnings());
     out
 }
@@ -677,6 +711,24 @@ mod tests {
             let e = prepare(&model, &options).unwrap_err().to_string();
             assert!(e.contains("duration must be a positive number"), "{e}");
         }
+    }
+
+    #[test]
+    fn a_history_larger_than_the_limit_is_a_warning_before_the_run() {
+        let mut p = prepare(&single_block(), &RunOptions::default()).unwrap();
+        // 10 s at 0.01 s: 1 001 rows of about 0.3 kB: no warning.
+        assert_eq!(p.history_estimate().0, 1001.0);
+        assert!(p.history_size_warning().is_none());
+        // output_interval = 1e-9 s: 1e10 rows, terabytes.
+        p.params.output_interval = 1e-9;
+        let w = p.history_size_warning().expect("a warning");
+        assert!(
+            w.contains("1.000e10 rows") && w.contains("output_interval = 1e-9 s"),
+            "{w}"
+        );
+        let t = Trajectory::empty(&p.model);
+        let all = warnings(&p, &t, &SampleStats::default(), &[]);
+        assert!(all.contains(&w), "{all:?}");
     }
 
     #[test]

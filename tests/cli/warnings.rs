@@ -236,3 +236,46 @@ fn settings_beyond_the_physics_are_refused_and_a_loose_rtol_warns() {
         warnings(&s)
     );
 }
+
+#[test]
+fn a_history_of_gigabytes_is_announced_before_the_run() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    // output_interval = 1e-9 s over 10 s: 1e10 rows of about 0.3 kB. The warning must come
+    // before the run writes them, so the user can stop it; the run is killed after it.
+    let dir = scratch("gigabytes");
+    let model = dir.join("model.toml");
+    std::fs::write(&model, single_block_with("output_interval = 1e-9")).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args(["simulate", model.to_str().unwrap(), "--quiet", "--out"])
+        .arg(dir.join("out"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stderr.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        line.starts_with("crr: warning: the history will hold about 1.000e10 rows")
+            && line.contains("raise output_interval"),
+        "{line}"
+    );
+    // The size is that of the file such a run writes: the bundled block's history at 0.01 s.
+    let (summary, err) = run("history_size", &single_block_with(""), &["--quiet"]);
+    assert!(!err.contains("the history will hold"), "{err}");
+    // (`run` wrote into the scratch folder `warnings_history_size`.)
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("warnings_history_size/out");
+    let bytes = std::fs::metadata(out.join("history.csv")).unwrap().len() as f64;
+    let rows = summary["samples"].as_f64().unwrap();
+    // One coordinate: 1 + 2 + 4 numbers of at most 23 bytes and one state of at most 7.
+    let per_row_estimate = 23.0 * 7.0 + 7.0 + 1.0;
+    let per_row = bytes / rows;
+    assert!(
+        per_row <= per_row_estimate && per_row > 0.5 * per_row_estimate,
+        "{per_row} bytes per row against the estimate {per_row_estimate}"
+    );
+}

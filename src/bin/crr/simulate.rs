@@ -3,10 +3,12 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
+use crr::analysis::simulation::prepare;
 use crr::dynamics::ground_motion::{Axis, RecordFormat, Units};
 use crr::output::plot::plot_results;
-use crr::output::simulate::{FolderOptions, SimulateResult, simulate};
-use crr::{Error, RecordFile, RunOptions};
+use crr::output::results_folder::check_out_dir;
+use crr::output::simulate::{FolderOptions, SimulateResult, out_dir, write_run};
+use crr::{Error, ModelInput, RecordFile, RunOptions};
 
 use crate::failure::Failure;
 
@@ -119,7 +121,16 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         ..Default::default()
     };
     let folder = FolderOptions { out, force };
-    let result = simulate(&model, &options, &folder)?;
+    let input = ModelInput::read(&model)?;
+    let prepared = prepare(&input, &options)?;
+    let out = out_dir(&input, &folder);
+    check_out_dir(&out, folder.force)?;
+    // Before the run, so that a user who did not mean it can stop it at once.
+    let early = prepared.history_size_warning();
+    if let Some(w) = &early {
+        eprintln!("crr: warning: {w}");
+    }
+    let result = write_run(&prepared, &out)?;
     if plot {
         let dir = match &result {
             SimulateResult::Done(dir, _) | SimulateResult::Failed(dir, _) => dir,
@@ -157,7 +168,7 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
                 );
             }
             let warnings = &summary.warnings;
-            for w in warnings {
+            for w in warnings.iter().filter(|w| Some(*w) != early.as_ref()) {
                 eprintln!("crr: warning: {w}");
             }
             if !warnings.is_empty() {
