@@ -17,8 +17,9 @@
 //!   both before and after it (the angle goes on from the negative side to the positive one). The
 //!   first M crossings are dropped, the next N kept.
 //!
-//! The samples are drained after every step ([`Simulation::drain_samples`]) and the impact log
-//! cleared, so memory stays flat however many periods are run.
+//! A section runs through the loop of every run ([`simulate_observed`]), whose observer drains
+//! the samples after every step ([`Simulation::drain_samples`]) and clears the impact log, so
+//! memory stays flat however many periods are run.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -30,11 +31,12 @@ use crr_dynamics::ground_motion::{
 };
 use crr_dynamics::{InitialSpec, InitialState, solve_initial};
 use crr_impact::simulation::{
-    Collapse, Parameters, Simulation, SlotState, StopReason, check_initial_state,
+    Collapse, Parameters, Simulation, SimulationError, SlotState, StopReason, check_initial_state,
 };
 use crr_kinematics::Model;
 
 use crate::Error;
+use crate::analysis::simulation::{Flow, simulate_observed};
 use crate::input::model_file::{ModelFile, load_model};
 
 /// Two section points are the same point when every angle differs by at most this fraction of the
@@ -188,18 +190,12 @@ pub fn run_section(
         }
     }
     let max_impacts = params.max_impacts;
-    let mut sim = match Simulation::new(model, &ground, initial, params) {
-        Ok(s) => s,
-        Err(e) => {
-            section.error = Some(e.to_string());
-            return section;
-        }
-    };
     let mut next_k = 0usize;
     let mut crossings = 0usize;
     let mut impacts = 0usize;
-    loop {
-        let result = sim.step();
+    // The slot states after the last step (the section is at rest when all are seated).
+    let mut last_states = Vec::new();
+    let mut observe = |sim: &mut Simulation, result: &Result<StopReason, SimulationError>| {
         let samples = sim.drain_samples();
         if settings.kind == SectionKind::Stroboscopic {
             for s in &samples {
@@ -219,16 +215,16 @@ pub fn run_section(
                 }
             }
         }
-        let stop = match result {
-            Ok(StopReason::End(_)) => true,
+        let terminal = match result {
+            Ok(StopReason::End(_)) | Err(_) => true,
             Ok(StopReason::Collapse(c)) => {
-                section.collapse = Some(c);
+                section.collapse = Some(c.clone());
                 true
             }
             Ok(StopReason::Impact(i)) => {
                 impacts += 1;
                 if let SectionKind::Crossing(c) = settings.kind
-                    && let Some(record) = sim.impacts.get(i)
+                    && let Some(record) = sim.impacts.get(*i)
                     && let Some(j) = record.slots.iter().position(|&s| s == c)
                 {
                     let qdot = sim.qdot();
@@ -249,43 +245,52 @@ pub fn run_section(
                 false
             }
             Ok(_) => false,
-            Err(e) => {
-                section.error = Some(e.to_string());
-                true
-            }
         };
         // The log is not needed here: cleared so that memory stays flat.
         sim.impacts.clear();
         sim.peaks.clear();
-        if stop {
-            break;
+        last_states = sim.states();
+        if terminal {
+            return Flow::Continue;
         }
         if impacts > max_impacts {
             section.error = Some(format!(
                 "more than {max_impacts} impacts: raise analysis.max_impacts or check the \
                  seating parameters"
             ));
-            break;
+            return Flow::Stop;
         }
         if let SectionKind::Crossing(_) = settings.kind {
             if crossings >= last_k {
-                break;
+                return Flow::Stop;
             }
             // Seated with no ground motion: nothing moves again.
-            if ground.is_none() && sim.states().iter().all(|s| *s == SlotState::Seated) {
-                break;
+            if ground.is_none() && last_states.iter().all(|s| *s == SlotState::Seated) {
+                return Flow::Stop;
             }
         }
+        Flow::Continue
+    };
+    let (trajectory, error) =
+        match simulate_observed(model, &ground, initial, &params, false, &mut observe) {
+            Ok(run) => run,
+            Err(e) => {
+                section.error = Some(e.to_string());
+                return section;
+            }
+        };
+    if let Some(e) = error {
+        section.error = Some(e.to_string());
     }
     // A start beyond the point of no return is a collapse at t = 0 that `step` never reports.
     if section.collapse.is_none() {
-        section.collapse = sim.collapse.clone();
+        section.collapse = trajectory.collapse.clone();
     }
-    section.violation = sim.violation.clone();
-    section.end_time = sim.time();
+    section.violation = trajectory.violation.clone();
+    section.end_time = trajectory.end_time;
     // At rest: seated at the end and, for a stroboscopic section, at every kept point (a forced
     // orbit with seated phases may end in one of them without being at rest).
-    section.at_rest = sim.states().iter().all(|s| *s == SlotState::Seated)
+    section.at_rest = last_states.iter().all(|s| *s == SlotState::Seated)
         && (settings.kind != SectionKind::Stroboscopic
             || section
                 .points

@@ -391,6 +391,17 @@ fn history_row_bytes(model: &Model) -> f64 {
     (23 * numbers + 7 * model.slot_count + 1) as f64
 }
 
+/// What an observer of [`simulate_observed`] tells the loop after a step.
+#[derive(Debug)]
+pub enum Flow {
+    /// Go on.
+    Continue,
+    /// Stop here: the run is complete as far as the observer is concerned.
+    Stop,
+    /// Stop with this error (a sink that cannot write).
+    Fail(SimulationError),
+}
+
 /// The event-driven simulation of `model` under `ground` from `initial`, step by step to the end,
 /// a collapse or an error: the one loop every run goes through (`crr::run`, `crr simulate`, the
 /// cases of a study). The samples are drained into `sink` after every step when `stream` (a sink
@@ -406,27 +417,45 @@ pub fn simulate(
     stream: bool,
     progress: bool,
 ) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
+    let mut drain = |sim: &mut Simulation, _: &Result<StopReason, SimulationError>| {
+        if !stream {
+            return Flow::Continue;
+        }
+        match sink(&sim.drain_samples()) {
+            Ok(()) => Flow::Continue,
+            Err(e) => Flow::Fail(SimulationError::Parameter(format!(
+                "cannot write the history: {e}"
+            ))),
+        }
+    };
+    simulate_observed(model, ground, initial, params, progress, &mut drain)
+}
+
+/// [`simulate`] with an observer called after every step with the simulation and the step's
+/// result: it may drain the samples, read the impacts, and stop the run ([`Flow`]) — Poincaré
+/// sections keep their points and stop after enough crossings this way. The run ends at its
+/// duration, a collapse, an error, or when the observer says so; an observer's error comes
+/// first.
+pub fn simulate_observed(
+    model: &Model,
+    ground: &GroundMotion,
+    initial: &InitialState,
+    params: &Parameters,
+    progress: bool,
+    observe: &mut dyn FnMut(&mut Simulation, &Result<StopReason, SimulationError>) -> Flow,
+) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
     let mut sim = Simulation::new(model, ground, initial, params.clone())?;
     let total = params.duration;
     let mut shown = -1i64;
-    let mut flush = |sim: &mut Simulation| -> Result<(), SimulationError> {
-        if stream {
-            sink(&sim.drain_samples()).map_err(|e| {
-                SimulationError::Parameter(format!("cannot write the history: {e}"))
-            })?;
-        }
-        Ok(())
-    };
     let error = loop {
-        match sim.step() {
-            Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)) => {
-                break flush(&mut sim).err();
-            }
-            Ok(_) => {}
-            Err(e) => break flush(&mut sim).err().or(Some(e)),
-        }
-        if let Err(e) = flush(&mut sim) {
-            break Some(e);
+        let result = sim.step();
+        let flow = observe(&mut sim, &result);
+        match (result, flow) {
+            (_, Flow::Fail(e)) => break Some(e),
+            (Ok(StopReason::End(_)) | Ok(StopReason::Collapse(_)), _) => break None,
+            (Err(e), _) => break Some(e),
+            (Ok(_), Flow::Stop) => break None,
+            (Ok(_), Flow::Continue) => {}
         }
         if progress {
             let pct = (100.0 * sim.time() / total).floor() as i64;
