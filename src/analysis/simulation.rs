@@ -94,7 +94,7 @@ pub struct Prepared {
 }
 
 /// The results of a run: complete, or partial with the reason it stopped.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Run {
     /// The structure that ran (coordinate and interface names, mass properties).
     pub model: Model,
@@ -103,6 +103,9 @@ pub struct Run {
     pub trajectory: Trajectory,
     /// What `summary.json` holds, warnings included.
     pub summary: Summary,
+    /// Why the run stopped early, typed (too many impacts, a solver failure, a sink that could
+    /// not write, …); `summary.error` is its message.
+    pub failure: Option<SimulationError>,
 }
 
 impl Run {
@@ -255,15 +258,17 @@ impl Prepared {
             stats.add(samples);
             sink(samples)
         };
-        let (trajectory, error) = self.integrate(&mut counted, stream);
+        let (trajectory, failure) = self.integrate(&mut counted, stream);
         if !stream {
             stats.add(&trajectory.samples);
         }
+        let error = failure.as_ref().map(|e| e.to_string());
         let summary = self.summary(&trajectory, &stats, error.as_deref());
         Run {
             model: self.model.clone(),
             trajectory,
             summary,
+            failure,
         }
     }
 
@@ -273,10 +278,10 @@ impl Prepared {
         &self,
         sink: &mut dyn FnMut(&Samples) -> std::io::Result<()>,
         stream: bool,
-    ) -> (Trajectory, Option<String>) {
+    ) -> (Trajectory, Option<SimulationError>) {
         match self.simulate(sink, stream) {
-            Ok((t, e)) => (t, e.map(|e| e.to_string())),
-            Err(e) => (Trajectory::empty(&self.model), Some(e.to_string())),
+            Ok((t, e)) => (t, e),
+            Err(e) => (Trajectory::empty(&self.model), Some(e)),
         }
     }
 

@@ -21,7 +21,10 @@ pub struct Summary {
     pub error: Option<String>,
     /// The model's path (or label) as given.
     pub model_file: String,
-    /// The model as run: the file with its tables as overridden, gravity filled in.
+    /// The model file as run: its `[ground_motion]`, `[initial]` and `[analysis]` as replaced
+    /// by the run's options, gravity filled in. Records given in memory
+    /// (`RunOptions::records`) replace components after this table and are not written into it;
+    /// a record file is echoed in `record`.
     pub model: ModelFile,
     /// The record file that replaced one component (`--record`), if any.
     pub record: Option<RecordSummary>,

@@ -18,19 +18,47 @@ fn sources(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// The code lines of `file` (comments dropped) that name any of `higher`.
+/// The code lines of `file` (comments dropped) that name any of `higher` as a path
+/// (`crate::output::…`, `super::super::output`), and the grouped imports
+/// (`use crate::{Error, output::plot};`, over several lines) that name one of them.
 fn upward_references(file: &Path, higher: &[&str]) -> Vec<String> {
     let text = std::fs::read_to_string(file).unwrap();
-    text.lines()
+    let code: Vec<(usize, &str)> = text
+        .lines()
         .enumerate()
-        .filter_map(|(k, line)| {
-            let code = line.split("//").next().unwrap_or("");
-            higher
-                .iter()
-                .any(|h| code.contains(h))
-                .then(|| format!("{}:{}: {}", file.display(), k + 1, line.trim()))
-        })
-        .collect()
+        .map(|(k, line)| (k + 1, line.split("//").next().unwrap_or("")))
+        .collect();
+    let mut found: Vec<String> = code
+        .iter()
+        .filter(|(_, c)| higher.iter().any(|h| c.contains(h)))
+        .map(|(k, c)| format!("{}:{k}: {}", file.display(), c.trim()))
+        .collect();
+    // Grouped imports: `crate::{` … `;`, the layer's name as one of the words inside.
+    let layer_names: Vec<&str> = higher
+        .iter()
+        .filter_map(|h| h.rsplit("::").next())
+        .filter(|n| n.chars().all(|c| c.is_ascii_lowercase()))
+        .collect();
+    for (i, (k, c)) in code.iter().enumerate() {
+        let Some(start) = c.find("crate::{").or_else(|| c.find("crr::{")) else {
+            continue;
+        };
+        let mut group = c[start..].to_string();
+        for (_, next) in &code[i + 1..] {
+            if group.contains(';') {
+                break;
+            }
+            group.push_str(next);
+        }
+        let group = &group[..group.find(';').unwrap_or(group.len())];
+        let words: Vec<&str> = group
+            .split(|ch: char| !(ch.is_ascii_alphanumeric() || ch == '_'))
+            .collect();
+        if layer_names.iter().any(|n| words.contains(n)) {
+            found.push(format!("{}:{k}: {}", file.display(), group.trim()));
+        }
+    }
+    found
 }
 
 #[test]

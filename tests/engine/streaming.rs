@@ -62,6 +62,12 @@ fn a_sink_that_fails_stops_the_run_with_an_error_and_keeps_the_results() {
     })
     .unwrap();
     assert!(!o.completed());
+    // Typed for a program: the sink's failure, and its message in the summary.
+    assert!(
+        matches!(&o.failure, Some(crr::impact::SimulationError::Parameter(m)) if m.contains("disk full")),
+        "{:?}",
+        o.failure
+    );
     let e = o.summary.error.expect("the sink's error stops the run");
     assert!(e.contains("cannot write the history: disk full"), "{e}");
     assert!(o.trajectory.end_time > 0.0 && o.trajectory.end_time < 100.0);

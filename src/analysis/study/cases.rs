@@ -319,21 +319,6 @@ impl Study {
                             .into(),
                     ));
                 }
-                study.records = files
-                    .iter()
-                    .map(|f| StudyRecord {
-                        file: f.clone(),
-                        record: match r.format {
-                            Some(format) => read_record(&base.join(f), format, r.units)
-                                .map_err(|e| e.to_string()),
-                            None => Err("no format".into()),
-                        },
-                    })
-                    .collect();
-                study.records.extend(seeds.iter().map(|&seed| StudyRecord {
-                    file: PathBuf::from(format!("synthetic:{seed}")),
-                    record: synthetic_record(seed),
-                }));
                 study.read_records(r, base, &files, &seeds);
                 let (measure, levels) = intensity_levels(&spec, path)?;
                 study.record_cases(measure, &levels);

@@ -107,13 +107,6 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         plot,
         animate,
     } = a;
-    if let Some(d) = duration
-        && !(d.is_finite() && d > 0.0)
-    {
-        return Err(Failure::Input(Error::Argument(format!(
-            "--duration must be a positive number of seconds, got {d}"
-        ))));
-    }
     let options = RunOptions {
         duration,
         record_file: record_arg(record, format, units, &component, scale)?,
@@ -122,6 +115,14 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
     };
     let folder = FolderOptions { out, force };
     let input = ModelInput::read(&model)?;
+    // Worded for the command line (the library says "duration"), after the model is read.
+    if let Some(d) = duration
+        && !(d.is_finite() && d > 0.0)
+    {
+        return Err(Failure::Input(Error::Argument(format!(
+            "--duration must be a positive number of seconds, got {d}"
+        ))));
+    }
     let prepared = prepare(&input, &options)?;
     let out = out_dir(&input, &folder);
     check_out_dir(&out, folder.force)?;
