@@ -125,7 +125,7 @@ pub enum ShapeError {
     /// More points than the convex hull's brute force handles in reasonable time.
     #[error(
         "polyhedron has {found} vertices, more than the {limit} its convex hull is computed for (by \
-         brute force, O(n³): 0.6 s for 500 points, 4.5 s for 1 000, minutes for 3 000); give the \
+         brute force, O(n³) to O(n⁴): 1 s for 500 points, 15 s for 1 000, minutes for 3 000); give the \
          hull's own vertices, or a decimated point cloud"
     )]
     TooManyPoints {

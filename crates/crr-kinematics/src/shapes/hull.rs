@@ -10,9 +10,9 @@ use super::{MassProperties, ShapeError, any_perpendicular, bbox_diagonal};
 /// below which points are merged and distances to a plane are treated as zero.
 pub const HULL_REL_TOL: f64 = 1e-9;
 
-/// The most points a polyhedron may have: the brute-force hull below takes 4.5 s for 1 000 points
-/// on a sphere (release build; `crr inspect`), and grows as n³ (a 3 000-point cloud took more than
-/// two minutes).
+/// The most points a polyhedron may have: the brute-force hull below takes 15 s for 1 000 points
+/// spread on a sphere (`cargo bench --bench kinematics -- convex_hull`), and grows as n³ to n⁴
+/// (a 3 000-point cloud took more than two minutes).
 pub const MAX_HULL_POINTS: usize = 1000;
 
 /// Outward-oriented triangles of the 3D convex hull of `points`.
@@ -25,9 +25,9 @@ pub const MAX_HULL_POINTS: usize = 1000;
 /// surface (counter-clockwise seen from outside).
 ///
 /// Brute force over point triples with early rejection: O(n³) to O(n⁴),
-/// intended for up to a few hundred points (0.04 s for 200 points on a sphere,
-/// 0.55 s for 500, 4.5 s for 1 000, in an optimised build: `crr inspect`);
-/// more than `MAX_HULL_POINTS` (1 000) are refused.
+/// intended for up to a few hundred points (38 ms for 200 points spread on a
+/// sphere, 1.05 s for 500, 15 s for 1 000: `cargo bench --bench kinematics --
+/// convex_hull`); more than `MAX_HULL_POINTS` (1 000) are refused.
 ///
 /// Errors: fewer than 4 points, non-finite coordinates, or all points
 /// coplanar (within the tolerance).
