@@ -21,6 +21,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -28,13 +29,14 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _crr
-from ._errors import CrrError, FileError, InputError, SimulationError
+from ._errors import CrrError, CrrWarning, FileError, InputError, SimulationError
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas
 
 __all__ = [
     "CrrError",
+    "CrrWarning",
     "FileError",
     "InputError",
     "Model",
@@ -377,6 +379,10 @@ def simulate(
         **analysis: keys of the ``[analysis]`` table that override the model's (``rtol``,
             ``atol``, ``method``, ``output_interval`` s, ``max_step`` s, ``friction``, …).
 
+    Warns:
+        CrrWarning: one per string of ``summary["warnings"]`` (a loose tolerance, an energy
+            balance off, the rigid-contact hypotheses failing, a history of gigabytes, …).
+
     Raises:
         InputError: invalid model tables, records or arguments (the command line's message).
         FileError: a record file that cannot be read.
@@ -433,6 +439,8 @@ def simulate(
         duration=None if duration is None else float(duration),
     )
     result = Result(run, model.coordinates, model.interfaces)
+    for message in result.summary.get("warnings") or []:
+        warnings.warn(CrrWarning(message), stacklevel=2)
     if run.error is not None:
         raise SimulationError(f"{model.source}: the simulation failed: {run.error}", result)
     return result

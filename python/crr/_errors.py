@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-__all__ = ["CrrError", "InputError", "FileError", "SimulationError"]
+__all__ = ["CrrError", "InputError", "FileError", "SimulationError", "CrrWarning"]
 
 
 class CrrError(Exception):
@@ -32,6 +32,12 @@ class SimulationError(CrrError, RuntimeError):
         self.result = result
 
 
+class CrrWarning(UserWarning):
+    """What a user must know before trusting a run's results: each string of
+    ``summary["warnings"]`` (the lines the command line prints after ``crr: warning:``) is
+    raised as one, so that ``warnings.simplefilter("error", crr.CrrWarning)`` makes them fatal."""
+
+
 # Shown and pickled as crr.CrrError, crr.InputError, … (the names the package exports).
-for _cls in (CrrError, InputError, FileError, SimulationError):
+for _cls in (CrrError, InputError, FileError, SimulationError, CrrWarning):
     _cls.__module__ = "crr"

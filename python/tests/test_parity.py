@@ -258,3 +258,26 @@ def test_the_exceptions_are_the_packages_and_pickle():
     assert str(e.value).startswith("<string>: ")
     copy = pickle.loads(pickle.dumps(e.value))
     assert type(copy) is crr.InputError and str(copy) == str(e.value)
+
+
+def test_summary_warnings_are_python_warnings_with_the_command_lines_text(cli, in_root, tmp_path):
+    import warnings
+
+    # rtol = 1e-3 is loose: the command line warns, and so does Python, with the same text.
+    model = "examples/models/single_block.toml"
+    d = crr.Model.from_file(model).to_dict()
+    d["analysis"] = dict(d.get("analysis") or {}, rtol=1e-3)
+    path = tmp_path / "loose.json"
+    path.write_text(json.dumps(d))
+    p = run_cli(cli, ["simulate", str(path), "--out", str(tmp_path / "o"), "--quiet", "--duration", "2"])
+    printed = [line[len("crr: warning: ") :] for line in p.stderr.splitlines() if line.startswith("crr: warning: ")]
+    assert printed and any("rtol" in w for w in printed), p.stderr
+    with pytest.warns(crr.CrrWarning) as caught:
+        result = crr.simulate(model, duration=2.0, rtol=1e-3)
+    assert [str(w.message) for w in caught] == printed == result.summary["warnings"]
+    # A clean run warns nothing; warnings can be made errors.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", crr.CrrWarning)
+        crr.simulate(model, duration=2.0)
+        with pytest.raises(crr.CrrWarning, match="rtol"):
+            crr.simulate(model, duration=2.0, rtol=1e-3)
