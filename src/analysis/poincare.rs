@@ -249,8 +249,9 @@ pub fn run_section(
         // The log is not needed here: cleared so that memory stays flat.
         sim.impacts.clear();
         sim.peaks.clear();
-        last_states = sim.states();
+        // The states are read only where the run ends (no allocation per step).
         if terminal {
+            last_states = sim.states();
             return Flow::Continue;
         }
         if impacts > max_impacts {
@@ -258,15 +259,21 @@ pub fn run_section(
                 "more than {max_impacts} impacts: raise analysis.max_impacts or check the \
                  seating parameters"
             ));
+            last_states = sim.states();
             return Flow::Stop;
         }
         if let SectionKind::Crossing(_) = settings.kind {
             if crossings >= last_k {
+                last_states = sim.states();
                 return Flow::Stop;
             }
             // Seated with no ground motion: nothing moves again.
-            if ground.is_none() && last_states.iter().all(|s| *s == SlotState::Seated) {
-                return Flow::Stop;
+            if ground.is_none() {
+                let states = sim.states();
+                if states.iter().all(|s| *s == SlotState::Seated) {
+                    last_states = states;
+                    return Flow::Stop;
+                }
             }
         }
         Flow::Continue

@@ -253,12 +253,19 @@ fn a_history_of_gigabytes_is_announced_before_the_run() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stderr.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
+    // Read on a thread: without the warning the run would write for ever, so the wait is
+    // bounded by the hang guard and the run killed either way.
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = BufReader::new(stderr).read_line(&mut line);
+        let _ = tx.send(line);
+    });
+    let line = rx.recv_timeout(std::time::Duration::from_secs(common::HANG_GUARD_S));
     child.kill().unwrap();
     child.wait().unwrap();
+    let line = line.expect("crr printed nothing on stderr within the hang guard");
     assert!(
         line.starts_with("crr: warning: the history will hold about 1.000e10 rows")
             && line.contains("raise output_interval"),

@@ -101,8 +101,7 @@ fn code_constants() -> BTreeMap<String, f64> {
 fn stated_values(text: &str) -> Vec<(String, Option<f64>, String)> {
     let text = text.replace('\n', " ");
     let mut out = Vec::new();
-    let bytes: Vec<char> = text.chars().collect();
-    let s: String = bytes.iter().collect();
+    let s = text;
     let mut at = 0;
     while let Some(k) = s[at..].find('`') {
         let start = at + k + 1;
