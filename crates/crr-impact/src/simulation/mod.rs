@@ -44,6 +44,7 @@ use crate::laws::{
 
 mod events;
 mod impacts;
+mod opening_qp;
 mod output;
 mod samples;
 mod seating;
@@ -52,6 +53,9 @@ mod uplift_from_rest;
 
 use events::*;
 use impacts::*;
+pub use opening_qp::{
+    OpeningDecision, OpeningQpError, QP_OPENING_TOLERANCE, offers_both_pivots, opening_qp,
+};
 pub use samples::{Iter as SampleIter, Sample, Samples};
 pub use seating::opening_mode;
 use seating::opening_mode_in;
@@ -245,10 +249,11 @@ pub enum SimulationError {
     /// which angle, when, and what to change.
     #[error("{0}")]
     Invariant(String),
-    /// The structure at rest cannot hold, and the mechanism the load opens lifts blocks off a
-    /// support, which the CRR chain (every interface on a pivot) cannot follow.
+    /// The contact program finds that blocks lift off a support (at rest: the mechanism the load
+    /// opens; in motion: the motion of least Gauss function), which the CRR chain (every
+    /// interface on a pivot) cannot follow.
     #[error(
-        "at t = {t} s the ground acceleration exceeds the structure's collapse multiplier in a mechanism where {} lift(s) off a support (a block leaves one of its supports): outside the CRR model, which keeps every interface on a pivot; see `crr check` for the mechanism",
+        "at t = {t} s the contact faces' program finds a motion in which {} lift(s) off a support (a block leaves one of its supports; at rest, when the ground acceleration exceeds the collapse multiplier in such a mechanism): outside the CRR model, which keeps every interface on a pivot; see `crr check` for the mechanism",
         interfaces.join(", ")
     )]
     LiftOff {

@@ -168,6 +168,17 @@ fn opening_mode_local(
     if model.constraint_rows > 0 && may_open.as_ref().is_some_and(|m| m.iter().all(|&o| !o)) {
         return None;
     }
+    // With loops, one convex program over the seated faces decides (opening_qp.rs); the single
+    // releases and the active set below remain for open chains (where single releases are
+    // exact) and for a program that fails.
+    if model.constraint_rows > 0 {
+        if may_open.is_none() {
+            trial.evaluate(model, ground, t, q, qdot);
+        }
+        if let Some(mode) = loop_opening(model, ground, template, trial, rest, t, q, qdot, tol) {
+            return mode;
+        }
+    }
     let opening = single_release_openings(
         model,
         ground,
@@ -188,6 +199,70 @@ fn opening_mode_local(
         return None;
     }
     active_set_opening(model, ground, template, trial, &seated, t, q, qdot, tol)
+}
+
+/// The contact program's decision on a structure with loops (`trial` evaluated at the state
+/// with the template's pivots and seated slots), checked by the chain's exact solve: the
+/// releases it names are solved together and every one must open on its side by more than
+/// `tol`; one that does not (the program's round-off near a threshold) goes back to its seat and
+/// the rest are solved again. Faces that lift off are recorded in `rest.lift_off` when every
+/// seated slot was offered both pivots ([`OpeningDecision::complete`]). None when the program
+/// fails or finds a lift-off in a restricted program (the caller falls back to single releases
+/// and the active set); Some(None) when nothing opens.
+#[allow(clippy::too_many_arguments)]
+fn loop_opening(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    rest: &mut RestCache,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    tol: f64,
+) -> Option<Option<Vec<(usize, Side)>>> {
+    // A program with some slot held to its current side (a twisting base's tilt) is not the
+    // whole problem: the local test decides then, as before the program.
+    if !offers_both_pivots(model, trial) {
+        return None;
+    }
+    let decision = opening_qp(model, trial).ok()?;
+    if !decision.lifting_off.is_empty() {
+        rest.lift_off = Some(
+            decision
+                .lifting_off
+                .iter()
+                .map(|&i| model.interfaces[i].name.clone())
+                .collect(),
+        );
+        return Some(Some(decision.releases));
+    }
+    let mut releases = decision.releases;
+    let mut row = DVector::zeros(model.dof());
+    while !releases.is_empty() {
+        trial.pivots.clone_from(&template.pivots);
+        for &(k, side) in &releases {
+            trial.pivots.sides[k] = side;
+        }
+        trial.seated.clear();
+        trial.seated.extend(
+            template
+                .seated
+                .iter()
+                .copied()
+                .filter(|s| !releases.iter().any(|r| r.0 == *s)),
+        );
+        trial.accelerations(model, ground, t, q, qdot).ok()?;
+        let before = releases.len();
+        releases.retain(|&(k, side)| {
+            let bias = slot_row(model, &trial.kin, k, &mut row);
+            side.sign() * (row.dot(&trial.qddot) + bias) > tol
+        });
+        if releases.len() == before {
+            return Some(Some(releases));
+        }
+    }
+    Some(None)
 }
 
 /// Release (slot, side) is indexed 2i on the positive side of slot `seated[i]`, 2i + 1 on the
@@ -620,7 +695,7 @@ pub(super) fn closure_other_side_reaction(
 
 /// The rest position (in the coordinates of the frame that carries it) of interface `iface`'s
 /// pivot with its slot `k` on the other side, its other slots as in `pivots`.
-fn other_pivot_rest(iface: &Interface, pivots: &ActivePivots, k: usize) -> Vector3<f64> {
+pub(super) fn other_pivot_rest(iface: &Interface, pivots: &ActivePivots, k: usize) -> Vector3<f64> {
     // An interface has one slot (a hinge) or two (a rocking base's tilts).
     let current = &pivots.sides[iface.slots.clone()];
     let mut sides = [Side::Positive; 2];

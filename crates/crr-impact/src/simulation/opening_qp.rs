@@ -1,0 +1,546 @@
+//! Which seated joints open, to which side, or lift off: Gauss' principle over the contact
+//! faces of the seated joints as one convex quadratic program, at any state (in motion too).
+//!
+//! **Variables.** q̈ (every tree coordinate on the current pivot sides, seated ones included) and,
+//! for each seated slot k whose other pivot can be offered, a lift ℓₖ ≥ 0. A seated slot k on
+//! side σₖ with axis w through its pivot P, other pivot P′, opens by a rotation about P at the
+//! rate αₖ⁺ ≥ 0 (in its sense σₖ) and about P′ at αₖ⁻ ≥ 0 (in the sense −σₖ). At the seat
+//! (ψₖ = ψ̇ₖ = 0) a rotation about P′ is the rotation about P plus the translation w × (P − P′)
+//! of everything beyond the joint, so the two read
+//!
+//!   ψ̈ₖ = σₖ(αₖ⁺ − αₖ⁻),  ℓₖ = αₖ⁻,  with the translation τₖℓₖ, τₖ = σₖ w × (P′ − P)
+//!
+//! (τₖ lies along the face normal, into the child). The constraints αₖ⁺ = σₖψ̈ₖ + ℓₖ ≥ 0 and
+//! ℓₖ ≥ 0 are the face's unilateral contacts: on a hinge the cone of its two pivot lines, on a
+//! rocking base (two tilts, two lifts) the cone of rotations about its four edges, and every
+//! positive combination of both pivots of one slot lifts its face off (both corners open).
+//!
+//! **Objective.** Gauss' function of the bodies' accelerations (Gibbs–Appell): with the tree's
+//! part ½q̈ᵀMq̈ − q̈ᵀ(Q − h), plus the lifts' translations of the bodies beyond each seated tree
+//! coordinate: Σ_b m_b(a_b − g_eff)·Σ_{k∋b} τₖℓₖ + ½Σ_b m_b |Σ_{k∋b} τₖℓₖ|². A lift of a seated
+//! closure angle moves no body: it only relaxes its loop's point rows.
+//!
+//! **Equalities.** The loops' rows Φ_q q̈ + Φ̇_q q̇ = 0, whose point rows x_A(P) − x_B(P) see each
+//! lift: +τₖℓₖ when the closure's parent side is beyond a seated tree coordinate k, −τₖℓₖ for its
+//! child side, +τₖℓₖ for the closure's own seated angle (the child turning about P′).
+//!
+//! The program is convex (a positive semidefinite metric over a polyhedral cone), so its minimum
+//! is global and does not depend on how the model is written: no search over sides, and the
+//! mechanisms of hyperstatic loops (where held reactions are one split among many) come out of
+//! one solve. It is solved by `clarabel`'s interior point; the decision it gives is checked with
+//! the chain's own exact solve before it is used ([`super::seating`]).
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+
+use crr_dynamics::eom::{Dynamics, slot_row};
+use crr_kinematics::kinematics::frame_point;
+use crr_kinematics::velocity::point_bias_acceleration;
+use crr_kinematics::{InterfaceKind, Model, Side};
+
+use super::seating::other_pivot_rest;
+
+/// Relative size (of g / size) below which an opening rate counts as zero in the program's
+/// answer: above the interior point's accuracy (1e-10 of the scaled problem), so that round-off
+/// of the solver is never read as an opening; a true opening below it grows with the load and is
+/// found a moment later, and the answer is checked by the chain's exact solve anyway.
+pub const QP_OPENING_TOLERANCE: f64 = 1e-7;
+
+/// What the contact program decides at a state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OpeningDecision {
+    /// Seated slots that open, with the side of the pivot they turn on.
+    pub releases: Vec<(usize, Side)>,
+    /// Interfaces whose face opens entirely (every corner leaves its seat): a block lifting off a
+    /// support, outside the CRR chain.
+    pub lifting_off: Vec<usize>,
+    /// The opening rates (αₖ⁺, αₖ⁻) of every seated slot, in the order of `Dynamics::seated`
+    /// (rad/s²; αₖ⁻ = 0 where the other pivot is not offered).
+    pub rates: Vec<(f64, f64)>,
+    /// q̈ of the program's minimum (rad/s²).
+    pub qddot: DVector<f64>,
+    /// Every seated slot was offered both pivots. When false (a twisting base's tilt, or a flip
+    /// that would move a free slot's axis) the program is the exact one restricted to the
+    /// current side of those slots: its "holds" and its releases stand (checked by the chain),
+    /// but a lift-off it finds may be an artefact of the restriction.
+    pub complete: bool,
+}
+
+/// Why the program gave no answer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OpeningQpError(pub String);
+
+/// The lift of one seated slot: its translation τₖ and what it moves.
+struct Lift {
+    /// Index into `Dynamics::seated`.
+    seated_index: usize,
+    /// τₖ = σₖ w × (P′ − P) (m per rad/s² of ℓₖ).
+    tau: Vector3<f64>,
+    /// A tree coordinate (its subtree translates) or a closure (its point rows relax).
+    moves: LiftMoves,
+}
+
+enum LiftMoves {
+    Subtree(usize),
+    Closure(usize),
+}
+
+/// Whether the program at the state evaluated in `d` offers every seated slot both of its
+/// pivots ([`OpeningDecision::complete`]), known before it is solved.
+pub fn offers_both_pivots(model: &Model, d: &Dynamics) -> bool {
+    let mut is_seated = vec![false; model.slot_count];
+    for &k in &d.seated {
+        is_seated[k] = true;
+    }
+    lifts(model, d, &is_seated).len() == d.seated.len()
+}
+
+/// Solves the contact program at the state evaluated in `d` ([`Dynamics::evaluate`] with the
+/// current pivots and seated slots: M, h, Q, Φ_q, Φ̇_q q̇, the frames and velocities).
+pub fn opening_qp(model: &Model, d: &Dynamics) -> Result<OpeningDecision, OpeningQpError> {
+    let n = model.dof();
+    let kin = &d.kin;
+    let mut is_seated = vec![false; model.slot_count];
+    for &k in &d.seated {
+        is_seated[k] = true;
+    }
+    let lifts = lifts(model, d, &is_seated);
+    let nv = n + lifts.len();
+    let scale = Scale::of(model);
+
+    // Objective ½xᵀPx + cᵀx (upper triangle of P).
+    let mut p = DMatrix::<f64>::zeros(nv, nv);
+    let mut c = DVector::<f64>::zeros(nv);
+    for i in 0..n {
+        for j in i..n {
+            p[(i, j)] = kin.mass_matrix[(i, j)];
+        }
+        c[i] = kin.velocity_product[i] - d.load[i];
+    }
+    add_lift_metric(model, d, &lifts, &mut p, &mut c);
+
+    // Rows: Ax + s = b, s in the zero cone (loops) then the non-negative cone (openings).
+    let rows = model.constraint_rows;
+    let mut a = DMatrix::<f64>::zeros(rows + d.seated.len() + lifts.len(), nv);
+    let mut b = DVector::<f64>::zeros(a.nrows());
+    let row_scale = d.row_scale();
+    for r in 0..rows {
+        for j in 0..n {
+            a[(r, j)] = row_scale[r] * kin.phi_q[(r, j)];
+        }
+        b[r] = -row_scale[r] * kin.phi_bias[r];
+    }
+    for (l, lift) in lifts.iter().enumerate() {
+        for cl in &model.closures {
+            let share = match lift.moves {
+                LiftMoves::Subtree(k) => {
+                    let closing = &model.interfaces[cl.interface];
+                    let beyond = |f: Option<usize>| f64::from(u8::from(in_subtree(model, f, k)));
+                    beyond(model.frame_of(closing.parent))
+                        - beyond(Some(model.body_coord[closing.child]))
+                }
+                LiftMoves::Closure(i) => f64::from(u8::from(i == cl.interface)),
+            };
+            for r in 0..3 {
+                a[(cl.first_row + r, n + l)] = row_scale[cl.first_row + r] * share * lift.tau[r];
+            }
+        }
+    }
+    // αₖ⁺ = σₖ(rowₖ·q̈ + biasₖ) + ℓₖ ≥ 0, then ℓₖ ≥ 0.
+    let mut slot = DVector::zeros(n);
+    let mut rate_rows = Vec::with_capacity(d.seated.len());
+    for (i, &k) in d.seated.iter().enumerate() {
+        let bias = slot_row(model, kin, k, &mut slot);
+        let sigma = d.pivots.sides[k].sign();
+        let r = rows + i;
+        for j in 0..n {
+            a[(r, j)] = -sigma * slot[j];
+        }
+        b[r] = sigma * bias;
+        rate_rows.push((slot.clone(), bias));
+    }
+    for (l, lift) in lifts.iter().enumerate() {
+        a[(rows + lift.seated_index, n + l)] = -1.0;
+        a[(rows + d.seated.len() + l, n + l)] = -1.0;
+    }
+
+    let x = solve(
+        &scale.apply(p, c, a, b),
+        rows,
+        d.seated.len() + lifts.len(),
+        &scale,
+    )?;
+    Ok(decide(model, d, &lifts, &rate_rows, &x, &scale))
+}
+
+/// The units of the program: rates in g / size, Gauss' function in m_total g² size⁰.
+struct Scale {
+    /// g / size (rad/s²).
+    rate: f64,
+    /// Σ m size² (kg m²).
+    inertia: f64,
+}
+
+/// The scaled program's matrices.
+struct Scaled {
+    p: DMatrix<f64>,
+    c: DVector<f64>,
+    a: DMatrix<f64>,
+    b: DVector<f64>,
+}
+
+impl Scale {
+    fn of(model: &Model) -> Self {
+        let mass: f64 = model.bodies.iter().map(|b| b.mass).sum();
+        Self {
+            rate: model.gravity / model.size,
+            inertia: mass * model.size * model.size,
+        }
+    }
+
+    /// x = rate·x̂: ½x̂ᵀ(P/I)x̂ + (c/(I·rate))ᵀx̂ over Ax̂ + ŝ = b/rate.
+    fn apply(&self, p: DMatrix<f64>, c: DVector<f64>, a: DMatrix<f64>, b: DVector<f64>) -> Scaled {
+        Scaled {
+            p: p / self.inertia,
+            c: c / (self.inertia * self.rate),
+            a,
+            b: b / self.rate,
+        }
+    }
+}
+
+/// The lifts offered: every seated slot at its seat whose other pivot turns no free
+/// coordinate's axis (a rocking base's other tilt moves its corner along that tilt's axis,
+/// which is fine) and is not a twisting base's tilt.
+fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
+    let kin = &d.kin;
+    let n = model.dof();
+    let mut lifts = Vec::new();
+    for (i, &k) in d.seated.iter().enumerate() {
+        let Some(index) = model.interfaces.iter().position(|f| f.slots.contains(&k)) else {
+            continue;
+        };
+        let iface = &model.interfaces[index];
+        let sigma = d.pivots.sides[k].sign();
+        let parent = model.frame_of(iface.parent);
+        let rot = |f: Option<usize>| f.map_or_else(Matrix3::identity, |f| kin.rot_ops[f]);
+        let (w, moves) = if k < n {
+            (kin.axis[k], LiftMoves::Subtree(k))
+        } else {
+            let Some(closure) = model.closures.iter().position(|c| c.interface == index) else {
+                continue;
+            };
+            let w = match &iface.kind {
+                InterfaceKind::Hinge { axis, .. } => rot(parent) * axis,
+                InterfaceKind::RockingBase { twist: true, .. } => continue,
+                InterfaceKind::RockingBase { e1, e2, .. } => {
+                    if k == iface.slots.start {
+                        rot(parent) * e1
+                    } else {
+                        rot(Some(model.body_coord[iface.child])) * e2
+                    }
+                }
+            };
+            (w, LiftMoves::Closure(model.closures[closure].interface))
+        };
+        let pivot = frame_point(
+            kin,
+            parent,
+            &iface.kind.pivot(d.pivots.of_interface(model, index)),
+        );
+        let other = frame_point(kin, parent, &other_pivot_rest(iface, &d.pivots, k));
+        // The other pivot must lie on the axis line of every free slot of the interface (a
+        // rocking base's other tilt: flipping one tilt moves the corner along the other's
+        // axis), or the flip would change that slot's motion too.
+        let moves_free = iface.slots.clone().any(|j| {
+            j != k
+                && !is_seated[j]
+                && world_axis(model, d, index, j)
+                    .cross(&(other - pivot))
+                    .norm()
+                    > 1e-12 * model.size
+        });
+        if moves_free {
+            continue;
+        }
+        lifts.push(Lift {
+            seated_index: i,
+            tau: sigma * w.cross(&(other - pivot)),
+            moves,
+        });
+    }
+    lifts
+}
+
+/// Whether frame `f` is carried by coordinate k (k on its path to the ground).
+fn in_subtree(model: &Model, f: Option<usize>, k: usize) -> bool {
+    let mut j = f;
+    while let Some(jj) = j {
+        if jj == k {
+            return true;
+        }
+        j = model.coords[jj].parent;
+    }
+    false
+}
+
+/// Adds the lifts' terms of Gauss' function: per body b, a_b = Σⱼ (wⱼ × (c_b − pⱼ)) q̈ⱼ + bias_b
+/// plus the translations τₖℓₖ of the seated tree coordinates k that carry it.
+fn add_lift_metric(
+    model: &Model,
+    d: &Dynamics,
+    lifts: &[Lift],
+    p: &mut DMatrix<f64>,
+    c: &mut DVector<f64>,
+) {
+    let kin = &d.kin;
+    let n = model.dof();
+    let g_eff = d.effective_gravity();
+    let mut carrying = Vec::with_capacity(lifts.len());
+    for (b, body) in model.bodies.iter().enumerate() {
+        let frame = model.body_coord[b];
+        carrying.clear();
+        carrying.extend(
+            lifts
+                .iter()
+                .enumerate()
+                .filter_map(|(l, lift)| match lift.moves {
+                    LiftMoves::Subtree(k) if in_subtree(model, Some(frame), k) => Some(l),
+                    _ => None,
+                }),
+        );
+        if carrying.is_empty() {
+            continue;
+        }
+        let m = body.mass;
+        let com = kin.com[b];
+        let free = g_eff - point_bias_acceleration(kin, Some(frame), &com);
+        for (x, &l) in carrying.iter().enumerate() {
+            let tau = lifts[l].tau;
+            c[n + l] -= m * tau.dot(&free);
+            for &l2 in &carrying[x..] {
+                let (lo, hi) = (l.min(l2), l.max(l2));
+                p[(n + lo, n + hi)] += m * tau.dot(&lifts[l2].tau);
+            }
+            let mut j = Some(frame);
+            while let Some(jj) = j {
+                p[(jj, n + l)] += m * tau.dot(&kin.axis[jj].cross(&(com - kin.pivot[jj])));
+                j = model.coords[jj].parent;
+            }
+        }
+    }
+}
+
+/// The interior point on the scaled program; returns x (unscaled, rad/s²).
+fn solve(
+    s: &Scaled,
+    equalities: usize,
+    inequalities: usize,
+    scale: &Scale,
+) -> Result<DVector<f64>, OpeningQpError> {
+    let nv = s.p.ncols();
+    let p = dense_to_csc(&s.p, true);
+    let a = dense_to_csc(&s.a, false);
+    let mut cones = Vec::with_capacity(2);
+    if equalities > 0 {
+        cones.push(SupportedConeT::ZeroConeT(equalities));
+    }
+    if inequalities > 0 {
+        cones.push(SupportedConeT::NonnegativeConeT(inequalities));
+    }
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .tol_gap_abs(1e-9)
+        .tol_gap_rel(1e-9)
+        .tol_feas(1e-9)
+        .tol_ktratio(1e-7)
+        .max_iter(200)
+        .build()
+        .map_err(|e| OpeningQpError(format!("{e:?}")))?;
+    let b: Vec<f64> = s.b.iter().copied().collect();
+    let c: Vec<f64> = s.c.iter().copied().collect();
+    let mut solver = DefaultSolver::new(&p, &c, &a, &b, &cones, settings)
+        .map_err(|e| OpeningQpError(format!("{e:?}")))?;
+    solver.solve();
+    match solver.solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(DVector::from_iterator(
+            nv,
+            solver.solution.x.iter().map(|x| x * scale.rate),
+        )),
+        other => Err(OpeningQpError(format!("{other:?}"))),
+    }
+}
+
+/// A dense matrix as clarabel's compressed columns (its upper triangle when `upper`).
+fn dense_to_csc(m: &DMatrix<f64>, upper: bool) -> CscMatrix<f64> {
+    let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..m.ncols() {
+        let last = if upper { j + 1 } else { m.nrows() };
+        for i in 0..last {
+            if m[(i, j)] != 0.0 {
+                rows.push(i);
+                cols.push(j);
+                vals.push(m[(i, j)]);
+            }
+        }
+    }
+    CscMatrix::new_from_triplets(m.nrows(), m.ncols(), rows, cols, vals)
+}
+
+/// Reads the program's minimum: each seated slot's (αₖ⁺, αₖ⁻), and from them, interface by
+/// interface, what opens. A face with one seated slot opens on the side whose rate is positive,
+/// and lifts off when both are; a rocking base with both tilts seated is read from the normal
+/// accelerations of its four pivot corners (its two lifts are parallel translations, so their
+/// split is not unique): the corners that stay down name the pivot (two: an edge, the tilt
+/// across it turns; one: both tilts; none: the base lifts off).
+fn decide(
+    model: &Model,
+    d: &Dynamics,
+    lifts: &[Lift],
+    rate_rows: &[(DVector<f64>, f64)],
+    x: &DVector<f64>,
+    scale: &Scale,
+) -> OpeningDecision {
+    let n = model.dof();
+    let qddot = x.rows(0, n).into_owned();
+    let mut lift_of = vec![0.0; d.seated.len()];
+    for (l, lift) in lifts.iter().enumerate() {
+        lift_of[lift.seated_index] = x[n + l].max(0.0);
+    }
+    let rates: Vec<(f64, f64)> = d
+        .seated
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| {
+            let (row, bias) = &rate_rows[i];
+            let psi = row.dot(&qddot) + bias;
+            (d.pivots.sides[k].sign() * psi + lift_of[i], lift_of[i])
+        })
+        .collect();
+    let tol = QP_OPENING_TOLERANCE * scale.rate;
+    let mut decision = OpeningDecision {
+        rates: rates.clone(),
+        qddot,
+        complete: lifts.len() == d.seated.len(),
+        ..OpeningDecision::default()
+    };
+    for (index, iface) in model.interfaces.iter().enumerate() {
+        let seated: Vec<usize> = d
+            .seated
+            .iter()
+            .enumerate()
+            .filter(|(_, k)| iface.slots.contains(k))
+            .map(|(i, _)| i)
+            .collect();
+        match seated[..] {
+            [] => {}
+            [i] => {
+                let k = d.seated[i];
+                let side = d.pivots.sides[k];
+                match (rates[i].0 > tol, rates[i].1 > tol) {
+                    (true, true) => decision.lifting_off.push(index),
+                    (true, false) => decision.releases.push((k, side)),
+                    (false, true) => decision.releases.push((k, side.flipped())),
+                    (false, false) => {}
+                }
+            }
+            _ => base_decision(model, d, index, &seated, &decision.qddot, &lift_of, tol)
+                .apply(index, &mut decision),
+        }
+    }
+    decision
+}
+
+/// What a rocking base with both tilts seated does.
+enum BaseMotion {
+    Holds,
+    Turns(Vec<(usize, Side)>),
+    LiftsOff,
+}
+
+impl BaseMotion {
+    fn apply(self, index: usize, decision: &mut OpeningDecision) {
+        match self {
+            BaseMotion::Holds => {}
+            BaseMotion::Turns(r) => decision.releases.extend(r),
+            BaseMotion::LiftsOff => decision.lifting_off.push(index),
+        }
+    }
+}
+
+/// The normal accelerations of a seated base's four pivot corners under the program's motion
+/// (the child's relative to the parent: Σ ψ̈ⱼ wⱼ × (C − P) + Σ τₗℓₗ, along the face normal), and the
+/// corners that stay down.
+fn base_decision(
+    model: &Model,
+    d: &Dynamics,
+    index: usize,
+    seated: &[usize],
+    qddot: &DVector<f64>,
+    lift_of: &[f64],
+    tol: f64,
+) -> BaseMotion {
+    let kin = &d.kin;
+    let iface = &model.interfaces[index];
+    let InterfaceKind::RockingBase { normal, .. } = &iface.kind else {
+        return BaseMotion::Holds;
+    };
+    let parent = model.frame_of(iface.parent);
+    let rot = parent.map_or_else(Matrix3::identity, |f| kin.rot_ops[f]);
+    let n_world = rot * normal;
+    let current = d.pivots.of_interface(model, index).to_vec();
+    let pivot = frame_point(kin, parent, &iface.kind.pivot(&current));
+    let mut slot = DVector::zeros(model.dof());
+    let mut turn = Vector3::zeros();
+    let mut lift = Vector3::zeros();
+    for &i in seated {
+        let k = d.seated[i];
+        let psi = slot_row(model, kin, k, &mut slot) + slot.dot(qddot);
+        let sigma = d.pivots.sides[k].sign();
+        let w = world_axis(model, d, index, k);
+        turn += w * psi;
+        let other = frame_point(kin, parent, &other_pivot_rest(iface, &d.pivots, k));
+        lift += sigma * w.cross(&(other - pivot)) * lift_of[i];
+    }
+    let down: Vec<[Side; 2]> = [Side::Positive, Side::Negative]
+        .into_iter()
+        .flat_map(|a| [Side::Positive, Side::Negative].map(|b| [a, b]))
+        .filter(|sides| {
+            let corner = frame_point(kin, parent, &iface.kind.pivot(sides));
+            n_world.dot(&(turn.cross(&(corner - pivot)) + lift)) <= tol * model.size
+        })
+        .collect();
+    let (k1, k2) = (iface.slots.start, iface.slots.start + 1);
+    match down[..] {
+        [] => BaseMotion::LiftsOff,
+        [[s1, s2]] => BaseMotion::Turns(vec![(k1, s1), (k2, s2)]),
+        // An edge: the corners share one tilt's side, and the other tilt's axis runs along it.
+        [[a1, a2], [b1, b2]] if a2 == b2 && a1 != b1 => BaseMotion::Turns(vec![(k2, a2)]),
+        [[a1, a2], [b1, b2]] if a1 == b1 && a2 != b2 => BaseMotion::Turns(vec![(k1, a1)]),
+        _ => BaseMotion::Holds,
+    }
+}
+
+/// The world axis of slot k of interface `index` (as in `slot_row`: on the parent, a rocking
+/// base's second tilt on the child).
+fn world_axis(model: &Model, d: &Dynamics, index: usize, k: usize) -> Vector3<f64> {
+    let kin = &d.kin;
+    if k < model.dof() {
+        return kin.axis[k];
+    }
+    let iface = &model.interfaces[index];
+    let rot = |f: Option<usize>| f.map_or_else(Matrix3::identity, |f| kin.rot_ops[f]);
+    match &iface.kind {
+        InterfaceKind::Hinge { axis, .. } => rot(model.frame_of(iface.parent)) * axis,
+        InterfaceKind::RockingBase { e1, e2, .. } => {
+            if k == iface.slots.start {
+                rot(model.frame_of(iface.parent)) * e1
+            } else {
+                rot(Some(model.body_coord[iface.child])) * e2
+            }
+        }
+    }
+}
