@@ -11,6 +11,7 @@ mod impact_laws_on_chains;
 mod initial_state_paths;
 mod invariant;
 mod opening_program;
+mod order_invariance;
 mod streaming;
 mod temple;
 mod twist_closure;
