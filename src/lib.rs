@@ -32,7 +32,9 @@ pub mod fuzzing;
 pub mod input;
 pub mod output;
 
-pub use analysis::simulation::{RecordFile, RecordSamples, Run, RunOptions, run, run_streaming};
+pub use analysis::simulation::{
+    Cancel, RecordFile, RecordSamples, Run, RunOptions, run, run_streaming,
+};
 pub use analysis::summary::Summary;
 pub use error::{Error, PlotError};
 pub use input::model_file::load_model;
@@ -42,8 +44,8 @@ pub use input::model_file::{ModelFile, ModelInput};
 pub mod prelude {
     pub use crate::dynamics::ground_motion::{Axis, Record, RecordFormat, Units};
     pub use crate::{
-        Error, ModelFile, ModelInput, RecordFile, RecordSamples, Run, RunOptions, Summary, run,
-        run_streaming,
+        Cancel, Error, ModelFile, ModelInput, RecordFile, RecordSamples, Run, RunOptions, Summary,
+        run, run_streaming,
     };
 }
 

@@ -387,6 +387,9 @@ def simulate(
         InputError: invalid model tables, records or arguments (the command line's message).
         FileError: a record file that cannot be read.
         SimulationError: the run failed part-way; its ``result`` holds the partial results.
+        KeyboardInterrupt: Ctrl-C (SIGINT) during the run stops it after its current step,
+            within a few hundredths of a second; the exception's ``result`` holds the results
+            until then (``result.summary["error"]`` says it was interrupted).
     """
     if not isinstance(model, Model):
         model = Model.from_file(model)
@@ -429,15 +432,22 @@ def simulate(
         table = dict(model.to_dict().get("analysis") or {})
         table.update(analysis)
         analysis_json = json.dumps(table)
-    run = _crr.simulate(
-        native,
-        ground_motion=gm_json,
-        initial=init_json,
-        analysis=analysis_json,
-        record_file=record_file,
-        records=arrays,
-        duration=None if duration is None else float(duration),
-    )
+    try:
+        run = _crr.simulate(
+            native,
+            ground_motion=gm_json,
+            initial=init_json,
+            analysis=analysis_json,
+            record_file=record_file,
+            records=arrays,
+            duration=None if duration is None else float(duration),
+        )
+    except KeyboardInterrupt as interrupt:
+        # Ctrl-C stops the run after its current step; what it computed rides on the exception.
+        partial = getattr(interrupt, "run", None)
+        if partial is not None:
+            interrupt.result = Result(partial, model.coordinates, model.interfaces)  # type: ignore[attr-defined]
+        raise
     result = Result(run, model.coordinates, model.interfaces)
     for message in result.summary.get("warnings") or []:
         warnings.warn(CrrWarning(message), stacklevel=2)

@@ -5,6 +5,8 @@
 //! results folder is [`crate::output::simulate`]'s.
 
 use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::Vector3;
 
@@ -70,6 +72,31 @@ pub struct RunOptions {
     pub duration: Option<f64>,
     /// Print the percentage done on stderr while running.
     pub progress: bool,
+    /// A flag the run polls after every step: once set, it stops with
+    /// [`SimulationError::Cancelled`] and keeps what it computed.
+    pub cancel: Option<Cancel>,
+}
+
+/// A request to stop a run, shared between the run and whoever may interrupt it (a signal
+/// handler, another thread): cloning it shares the flag.
+#[derive(Clone, Debug, Default)]
+pub struct Cancel(Arc<AtomicBool>);
+
+impl Cancel {
+    /// A flag not set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Asks every run holding this flag to stop after its current step.
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`Self::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
 }
 
 /// Everything a run needs, read and checked from the inputs.
@@ -91,6 +118,8 @@ pub struct Prepared {
     pub record_file: Option<RecordFile>,
     /// Print progress on stderr.
     pub progress: bool,
+    /// The cancellation flag of the options.
+    pub cancel: Option<Cancel>,
 }
 
 /// The results of a run: complete, or partial with the reason it stopped.
@@ -188,6 +217,7 @@ pub fn prepare(input: &ModelInput, options: &RunOptions) -> Result<Prepared, Err
         params,
         record_file: options.record_file.clone(),
         progress: options.progress,
+        cancel: options.cancel.clone(),
     })
 }
 
@@ -299,6 +329,7 @@ impl Prepared {
             sink,
             stream,
             self.progress,
+            self.cancel.as_ref(),
         )
     }
 }
@@ -411,8 +442,10 @@ pub enum Flow {
 /// a collapse or an error: the one loop every run goes through (`crr::run`, `crr simulate`, the
 /// cases of a study). The samples are drained into `sink` after every step when `stream` (a sink
 /// error stops the run), else kept in the trajectory; a percentage goes to stderr when
-/// `progress`. An error before the first step is `Err`; one later comes back with the
-/// trajectory computed until then.
+/// `progress`; a set `cancel` flag stops the run after the step in which it was set
+/// ([`SimulationError::Cancelled`]). An error before the first step is `Err`; one later comes
+/// back with the trajectory computed until then.
+#[allow(clippy::too_many_arguments)]
 pub fn simulate(
     model: &Model,
     ground: &GroundMotion,
@@ -421,10 +454,28 @@ pub fn simulate(
     sink: &mut dyn FnMut(&Samples) -> std::io::Result<()>,
     stream: bool,
     progress: bool,
+    cancel: Option<&Cancel>,
 ) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
     let mut drain = |sim: &mut Simulation, _: &Result<StopReason, SimulationError>| {
+        let cancelled = cancel.is_some_and(Cancel::is_cancelled);
+        if cancelled {
+            sim.record_final_sample();
+        }
         if !stream {
-            return Flow::Continue;
+            return if cancelled {
+                Flow::Fail(SimulationError::Cancelled { t: sim.time() })
+            } else {
+                Flow::Continue
+            };
+        }
+        if cancelled {
+            // The samples of the last step go out before the run stops.
+            if let Err(e) = sink(&sim.drain_samples()) {
+                return Flow::Fail(SimulationError::Parameter(format!(
+                    "cannot write the history: {e}"
+                )));
+            }
+            return Flow::Fail(SimulationError::Cancelled { t: sim.time() });
         }
         match sink(&sim.drain_samples()) {
             Ok(()) => Flow::Continue,

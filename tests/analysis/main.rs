@@ -5,6 +5,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod cancel;
 mod levels;
 mod overturning_map;
 mod poincare;

@@ -11,6 +11,7 @@ mod fuzz_corpus;
 mod hostile_inputs;
 mod input_checks;
 mod inspect;
+mod interrupt;
 mod outputs;
 mod plot;
 mod poincare_limits;

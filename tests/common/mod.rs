@@ -45,6 +45,11 @@ pub fn scratch(name: &str) -> PathBuf {
 }
 
 /// The text of the bundled model `examples/models/<name>.toml`.
+pub fn bundled_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/models/{name}.toml"))
+}
+
+/// The text of the bundled model `examples/models/<name>.toml`.
 pub fn bundled_text(name: &str) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     std::fs::read_to_string(root.join(format!("examples/models/{name}.toml"))).unwrap()

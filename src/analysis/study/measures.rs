@@ -48,6 +48,7 @@ pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
         &mut keep_last,
         true,
         false,
+        None,
     )
     .map_err(|e| e.to_string())?;
     if let Some(e) = error {

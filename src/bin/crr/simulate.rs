@@ -8,7 +8,7 @@ use crr::dynamics::ground_motion::{Axis, RecordFormat, Units};
 use crr::output::plot::plot_results;
 use crr::output::results_folder::check_out_dir;
 use crr::output::simulate::{FolderOptions, SimulateResult, out_dir, write_run};
-use crr::{Error, ModelInput, RecordFile, RunOptions};
+use crr::{Cancel, Error, ModelInput, RecordFile, RunOptions};
 
 use crate::failure::Failure;
 
@@ -107,10 +107,12 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         plot,
         animate,
     } = a;
+    let cancel = interrupt_flag();
     let options = RunOptions {
         duration,
         record_file: record_arg(record, format, units, &component, scale)?,
         progress: !quiet && std::io::stderr().is_terminal(),
+        cancel: Some(cancel.clone()),
         ..Default::default()
     };
     let folder = FolderOptions { out, force };
@@ -132,6 +134,11 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         eprintln!("crr: warning: {w}");
     }
     let result = write_run(&prepared, &out)?;
+    // An interrupted run writes its partial results and nothing more.
+    let (plot, animate) = (
+        plot && !cancel.is_cancelled(),
+        animate && !cancel.is_cancelled(),
+    );
     if plot {
         let dir = match &result {
             SimulateResult::Done(dir, _) | SimulateResult::Failed(dir, _) => dir,
@@ -189,6 +196,22 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// A flag set by the first SIGINT (Ctrl-C) or SIGTERM: the run stops after its current step and
+/// writes what it computed. A second signal ends the process at once (exit 130), for a run that
+/// does not come back.
+fn interrupt_flag() -> Cancel {
+    let cancel = Cancel::new();
+    let flag = cancel.clone();
+    // Without a handler (one is already installed) the signals keep their default action.
+    let _ = ctrlc::set_handler(move || {
+        if flag.is_cancelled() {
+            std::process::exit(130);
+        }
+        flag.cancel();
+    });
+    cancel
 }
 
 /// A value as summary.json writes it (the printed line has always shown the JSON values).

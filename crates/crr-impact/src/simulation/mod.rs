@@ -242,6 +242,12 @@ pub enum SimulationError {
     /// Too many impacts.
     #[error("more than {0} impacts: raise analysis.max_impacts or check the seating parameters")]
     TooManyImpacts(usize),
+    /// The caller asked the run to stop (Ctrl-C, SIGTERM, a cancellation flag).
+    #[error("interrupted at t = {t} s: the results until then are kept")]
+    Cancelled {
+        /// Time reached (s).
+        t: f64,
+    },
     /// A bad parameter.
     #[error("{0}")]
     Parameter(String),

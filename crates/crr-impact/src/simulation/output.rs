@@ -92,6 +92,15 @@ impl Simulation<'_> {
         taken
     }
 
+    /// Records the current state as the last sample when it is later than the last one: a run
+    /// that its caller stops between output samples keeps the state it reached (the end of a
+    /// run records it the same way).
+    pub fn record_final_sample(&mut self) {
+        if self.last_sample_t < self.t {
+            self.record_current_sample(self.t);
+        }
+    }
+
     /// Takes and records the sample of the current state at `t`.
     pub(super) fn record_current_sample(&mut self, t: f64) {
         let y = std::mem::take(&mut self.y);
