@@ -44,6 +44,7 @@ fn run(study: &Study, file: &Path, out: &Path, jobs: usize) -> usize {
             jobs: Some(jobs),
             shard: Shard::ALL,
             quiet: true,
+            cancel: None,
         },
     )
     .expect("the study runs");

@@ -23,7 +23,7 @@ use crr::input::model_file::{ModelFile, build_model, load_model, parse_model_tex
 use crr::kinematics::Model as Structure;
 use crr::output::history::{history_csv, impacts_csv};
 use crr::output::study::folder::header;
-use crr::output::study::{StudyOptions, case_rows, cases_csv, run_study};
+use crr::output::study::{StudyOptions, case_rows_cancellable, cases_csv, run_study};
 use crr::{ModelInput, RecordFile, RecordSamples, RunOptions};
 
 /// An exception of `crr._errors` (`kind` is the class name) carrying `message`.
@@ -396,32 +396,52 @@ fn simulate(
             trajectory: run.trajectory,
         }
     };
-    // The run goes on a thread of its own, without the GIL; this thread waits for it in slices
-    // of POLL and checks for signals between them, so that Ctrl-C stops the run after its
-    // current step: KeyboardInterrupt is raised with the partial run as its `run` attribute.
-    let waiter = std::thread::current();
-    let worker = std::thread::spawn(move || {
-        let run = crr::run(&input, &options);
-        waiter.unpark();
-        run
-    });
-    while !worker.is_finished() {
-        py.detach(|| std::thread::park_timeout(POLL));
-        if let Err(interrupt) = py.check_signals() {
-            cancel.cancel();
-            let joined = py.detach(|| worker.join());
-            if let Ok(Ok(run)) = joined {
+    match interruptible(py, &cancel, move || crr::run(&input, &options)) {
+        Ok(run) => run.map(to_py).map_err(|e| input_error(py, e)),
+        Err((interrupt, partial)) => {
+            // Ctrl-C: KeyboardInterrupt, with the partial run as its `run` attribute.
+            if let Some(Ok(run)) = partial {
                 interrupt
                     .value(py)
                     .setattr("run", Py::new(py, to_py(run))?)?;
             }
-            return Err(interrupt);
+            Err(interrupt)
         }
     }
-    let run = py
-        .detach(|| worker.join())
-        .map_err(|_| PyRuntimeError::new_err("the simulation thread panicked"))?;
-    run.map(to_py).map_err(|e| input_error(py, e))
+}
+
+/// Runs `work` on a thread of its own, without the GIL, while this thread waits for it in slices
+/// of [`POLL`] and checks for signals between them: Ctrl-C sets `cancel` (the work stops after
+/// its current step) and, once the work has returned, comes back as the `KeyboardInterrupt`
+/// with what the work returned.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    cancel: &crr::Cancel,
+    work: impl FnOnce() -> T + Send,
+) -> Result<T, (PyErr, Option<T>)> {
+    let waiter = std::thread::current();
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(move || {
+            let result = work();
+            waiter.unpark();
+            result
+        });
+        let mut interrupt = None;
+        while !worker.is_finished() {
+            py.detach(|| std::thread::park_timeout(POLL));
+            if interrupt.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                cancel.cancel();
+                interrupt = Some(e);
+            }
+        }
+        match (interrupt, worker.join()) {
+            (None, Ok(result)) => Ok(result),
+            (Some(e), result) => Err((e, result.ok())),
+            (None, Err(_)) => Err((PyRuntimeError::new_err("the run's thread panicked"), None)),
+        }
+    })
 }
 
 /// How often a run waiting in Python checks for signals (Ctrl-C): well under the 0.2 s a user
@@ -533,8 +553,14 @@ impl PyStudy {
         jobs: Option<usize>,
     ) -> PyResult<Vec<String>> {
         let cases = self.cases(py, ids)?;
-        py.detach(|| case_rows(&self.study, &cases, jobs))
-            .map_err(|e| input_error(py, e))
+        let cancel = crr::Cancel::new();
+        let work = || case_rows_cancellable(&self.study, &cases, jobs, Some(&cancel));
+        match interruptible(py, &cancel, work) {
+            Ok(Ok(Some(rows))) => Ok(rows),
+            Ok(Ok(None)) => Err(PyRuntimeError::new_err("the study was cancelled")),
+            Ok(Err(e)) => Err(input_error(py, e)),
+            Err((interrupt, _)) => Err(interrupt),
+        }
     }
 
     /// The text of cases.csv from rows in any order (in case-id order, as `crr study` writes it).
@@ -554,16 +580,21 @@ impl PyStudy {
         if jobs == Some(0) {
             return Err(argument(py, "--jobs must be at least 1".into()));
         }
+        let cancel = crr::Cancel::new();
         let opts = StudyOptions {
             out,
             jobs,
             shard: crr::output::study::Shard::ALL,
             quiet: true,
+            cancel: Some(cancel.clone()),
         };
-        let o = py
-            .detach(|| run_study(&self.study, &self.label, &opts))
-            .map_err(|e| input_error(py, e))?;
-        Ok((o.cases, o.skipped, o.ran, o.failed))
+        // Ctrl-C: the cases under way stop without a row, the folder keeps the others (running
+        // into it again resumes), and KeyboardInterrupt is raised.
+        match interruptible(py, &cancel, || run_study(&self.study, &self.label, &opts)) {
+            Ok(Ok(o)) => Ok((o.cases, o.skipped, o.ran, o.failed)),
+            Ok(Err(e)) => Err(input_error(py, e)),
+            Err((interrupt, _)) => Err(interrupt),
+        }
     }
 
     fn __repr__(&self) -> String {

@@ -49,3 +49,28 @@ def test_ctrl_c_stops_a_long_simulation_and_keeps_its_partial_result() -> None:
     # Python is usable afterwards.
     again = crr.simulate(BLOCK, ground_motion=SINE, initial=AT_REST, duration=2.0)
     assert again.summary["completed"] is True
+
+
+def test_ctrl_c_stops_a_study_whose_folder_then_resumes(tmp_path: Path) -> None:
+    study = ROOT / "examples" / "studies" / "housner_map.toml"
+    out = tmp_path / "map"
+    sent = {}
+
+    def interrupt() -> None:
+        sent["t"] = time.monotonic()
+        _thread.interrupt_main()
+
+    timer = threading.Timer(0.3, interrupt)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        crr.study(study, jobs=2, out=out)
+    caught = time.monotonic()
+    timer.join()
+    assert caught - sent["t"] < 0.2, f"KeyboardInterrupt {caught - sent['t']:.3f} s after the signal"
+    rows = (out / "cases.csv").read_text().splitlines()
+    assert 1 <= len(rows) < 3601  # the header and the cases that ended
+    assert not (out / "study.json").exists()
+    # The same call resumes: every case once.
+    frame = crr.study(study, jobs=2, out=out)
+    assert len(frame) == 3600
+    assert frame["id"].is_unique

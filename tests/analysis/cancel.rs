@@ -79,3 +79,51 @@ fn a_flag_set_from_another_thread_stops_a_long_run() {
     let last = run.trajectory.samples.iter().next_back().unwrap();
     assert_eq!(last.t, t, "the last sample is where the run stopped");
 }
+
+/// A study cancelled while it runs writes the rows of the cases that ended, none for the cases
+/// under way, and no study.json; running it again into the same folder runs only the missing
+/// cases and ends with the cases.csv of an uninterrupted run, byte for byte.
+#[test]
+fn a_cancelled_study_keeps_its_rows_and_resumes_to_the_same_cases_csv() {
+    use crr::analysis::study::Study;
+    use crr::output::study::{Shard, StudyOptions, run_study};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/studies/drum_fragility.toml");
+    let study = Study::load(&path).unwrap();
+    // 50 of its 200 cases.
+    let shard = Shard { index: 1, count: 4 };
+    let dir = common::scratch("cancelled_study");
+    let opts = |out: &str, cancel: Option<Cancel>| StudyOptions {
+        out: dir.join(out),
+        jobs: Some(2),
+        shard,
+        quiet: true,
+        cancel,
+    };
+    let full = run_study(&study, &path, &opts("full", None)).unwrap();
+    assert!(!full.interrupted);
+    assert_eq!(full.ran, 50);
+
+    // Cancelled as soon as the first row is in cases.csv.
+    let cancel = Cancel::new();
+    let remote = cancel.clone();
+    let csv = dir.join("resumed/cases.csv");
+    let timer = std::thread::spawn(move || {
+        while std::fs::read_to_string(&csv).map_or(0, |t| t.lines().count()) < 2 {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        remote.cancel();
+    });
+    let first = run_study(&study, &path, &opts("resumed", Some(cancel))).unwrap();
+    timer.join().unwrap();
+    assert!(first.interrupted);
+    assert!(first.ran < first.cases, "{first:?}");
+    assert!(!dir.join("resumed/study.json").exists());
+
+    let second = run_study(&study, &path, &opts("resumed", None)).unwrap();
+    assert!(!second.interrupted);
+    assert_eq!(second.skipped, first.ran);
+    assert_eq!(second.skipped + second.ran, second.cases);
+    let read = |d: &str| std::fs::read_to_string(dir.join(d).join("cases.csv")).unwrap();
+    assert_eq!(read("full"), read("resumed"));
+}

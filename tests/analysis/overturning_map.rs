@@ -32,6 +32,7 @@ fn the_map_boundary_follows_zhang_and_makris() {
             jobs: Some(2),
             shard: Shard::ALL,
             quiet: true,
+            cancel: None,
         },
     )
     .expect("runs");

@@ -79,3 +79,56 @@ fn sigint_stops_a_run_with_its_partial_results() {
 fn sigterm_stops_a_run_with_its_partial_results() {
     interrupted_by("TERM");
 }
+
+#[test]
+fn sigint_stops_a_study_that_the_same_command_resumes() {
+    let dir = common::scratch("interrupt_study");
+    let out = dir.join("map");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let args = |out: &std::path::Path| {
+        vec![
+            "study".to_string(),
+            "examples/studies/housner_map.toml".to_string(),
+            "--quiet".to_string(),
+            "--jobs".to_string(),
+            "2".to_string(),
+            "--out".to_string(),
+            out.display().to_string(),
+        ]
+    };
+    let child = Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args(args(&out))
+        .current_dir(root)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("crr runs");
+    let csv = out.join("cases.csv");
+    let started = Instant::now();
+    while std::fs::read_to_string(&csv).map_or(0, |t| t.lines().count()) < 2 {
+        assert!(started.elapsed() < Duration::from_secs(common::HANG_GUARD_S));
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted: "), "{stderr}");
+    assert!(stderr.contains("the same command resumes it"), "{stderr}");
+    assert!(!out.join("study.json").exists());
+    let written = std::fs::read_to_string(&csv).unwrap().lines().count() - 1;
+    assert!(written < 3600, "{written} rows");
+    // The same command resumes and finishes.
+    let args = args(&out);
+    let again = common::crr(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        again.status.success(),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), 3601);
+    assert!(out.join("study.json").exists());
+}

@@ -3,7 +3,8 @@
 
 use crr_impact::Samples;
 
-use crate::analysis::simulation::simulate;
+use crate::analysis::simulation::{Cancel, simulate};
+use crr_impact::simulation::SimulationError;
 
 use super::cases::{Case, Study};
 
@@ -28,7 +29,35 @@ pub struct Measures {
 /// measures: the samples are drained after every step, so memory does not grow with the
 /// duration.
 pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
-    let ground = study.ground_motion(case)?;
+    run_case_cancellable(study, case, None).expect("a run without a flag is not cancelled")
+}
+
+/// [`run_case`] that stops when `cancel` is set: None when it was set before the case ended (its
+/// measures would be those of a partial run, so it has none).
+pub fn run_case_cancellable(
+    study: &Study,
+    case: &Case,
+    cancel: Option<&Cancel>,
+) -> Option<Result<Measures, String>> {
+    if cancel.is_some_and(Cancel::is_cancelled) {
+        return None;
+    }
+    match measure(study, case, cancel) {
+        Err(CaseStop::Cancelled) => None,
+        Err(CaseStop::Failed(e)) => Some(Err(e)),
+        Ok(m) => Some(Ok(m)),
+    }
+}
+
+/// Why a case has no measures.
+enum CaseStop {
+    Failed(String),
+    Cancelled,
+}
+
+fn measure(study: &Study, case: &Case, cancel: Option<&Cancel>) -> Result<Measures, CaseStop> {
+    let failed = |e: String| CaseStop::Failed(e);
+    let ground = study.ground_motion(case).map_err(failed)?;
     let mut params = study.params.clone();
     params.duration = study.duration(&ground);
     let variant = &study.variants[case.variant];
@@ -48,11 +77,13 @@ pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
         &mut keep_last,
         true,
         false,
-        None,
+        cancel,
     )
-    .map_err(|e| e.to_string())?;
-    if let Some(e) = error {
-        return Err(e.to_string());
+    .map_err(|e| failed(e.to_string()))?;
+    match error {
+        Some(SimulationError::Cancelled { .. }) => return Err(CaseStop::Cancelled),
+        Some(e) => return Err(failed(e.to_string())),
+        None => {}
     }
     let (residual, dissipated) = last.unwrap_or((0.0, 0.0));
     Ok(Measures {

@@ -6,6 +6,7 @@ mod animate;
 mod check;
 mod failure;
 mod inspect;
+mod interrupt;
 mod plot;
 mod poincare;
 mod simulate;

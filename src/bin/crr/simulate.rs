@@ -8,7 +8,7 @@ use crr::dynamics::ground_motion::{Axis, RecordFormat, Units};
 use crr::output::plot::plot_results;
 use crr::output::results_folder::check_out_dir;
 use crr::output::simulate::{FolderOptions, SimulateResult, out_dir, write_run};
-use crr::{Cancel, Error, ModelInput, RecordFile, RunOptions};
+use crr::{Error, ModelInput, RecordFile, RunOptions};
 
 use crate::failure::Failure;
 
@@ -107,7 +107,7 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         plot,
         animate,
     } = a;
-    let cancel = interrupt_flag();
+    let cancel = crate::interrupt::interrupt_flag();
     let options = RunOptions {
         duration,
         record_file: record_arg(record, format, units, &component, scale)?,
@@ -196,22 +196,6 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         }
     }
     Ok(())
-}
-
-/// A flag set by the first SIGINT (Ctrl-C) or SIGTERM: the run stops after its current step and
-/// writes what it computed. A second signal ends the process at once (exit 130), for a run that
-/// does not come back.
-fn interrupt_flag() -> Cancel {
-    let cancel = Cancel::new();
-    let flag = cancel.clone();
-    // Without a handler (one is already installed) the signals keep their default action.
-    let _ = ctrlc::set_handler(move || {
-        if flag.is_cancelled() {
-            std::process::exit(130);
-        }
-        flag.cancel();
-    });
-    cancel
 }
 
 /// A value as summary.json writes it (the printed line has always shown the JSON values).

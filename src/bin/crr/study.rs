@@ -90,8 +90,18 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
             jobs,
             shard,
             quiet,
+            cancel: Some(crate::interrupt::interrupt_flag()),
         },
     )?;
+    if outcome.interrupted {
+        return Err(Failure::Simulation(format!(
+            "{}: interrupted: {} case(s) of this part in {}, {} to go; the same command resumes it",
+            path.display(),
+            outcome.skipped + outcome.ran,
+            out.join("cases.csv").display(),
+            outcome.cases - outcome.skipped - outcome.ran
+        )));
+    }
     if !quiet {
         println!(
             "{}: {} case(s) in this part, {} already done, {} run, {} with an error; results in {}",

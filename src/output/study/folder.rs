@@ -15,8 +15,9 @@ use rayon::prelude::*;
 
 use super::info::{MergedStudyInfo, ScaleInfo, StudyInfo, to_json};
 use crate::Error;
+use crate::analysis::simulation::Cancel;
 use crate::analysis::simulation::coordinate_alpha;
-use crate::analysis::study::{Case, Measures, Motion, Study, run_case};
+use crate::analysis::study::{Case, Measures, Motion, Study, run_case_cancellable};
 
 /// `i/n`: the i-th (1-based) of n disjoint parts of a study; case k belongs to part k mod n + 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,6 +67,10 @@ pub struct StudyOptions {
     pub shard: Shard,
     /// No progress bar.
     pub quiet: bool,
+    /// A flag polled by every case: once set, no case starts, the running ones stop without a
+    /// row, and the run returns with [`StudyOutcome::interrupted`] (the rows written stay, and
+    /// running the study again into the same folder resumes it).
+    pub cancel: Option<Cancel>,
 }
 
 /// What a run did.
@@ -79,6 +84,9 @@ pub struct StudyOutcome {
     pub ran: usize,
     /// Cases whose row holds an error.
     pub failed: usize,
+    /// The run was cancelled ([`StudyOptions::cancel`]): `ran` counts the rows written before,
+    /// cases.csv is left in the order they ended and study.json is not written.
+    pub interrupted: bool,
 }
 
 /// Shortest text that reads back as the same f64.
@@ -221,6 +229,18 @@ pub fn case_rows(
     cases: &[&Case],
     jobs: Option<usize>,
 ) -> Result<Vec<String>, Error> {
+    case_rows_cancellable(study, cases, jobs, None)
+        .map(|rows| rows.expect("a run without a flag is not cancelled"))
+}
+
+/// [`case_rows`] that stops when `cancel` is set: Ok(None) then (the rows of a cancelled run
+/// would miss cases).
+pub fn case_rows_cancellable(
+    study: &Study,
+    cases: &[&Case],
+    jobs: Option<usize>,
+    cancel: Option<&Cancel>,
+) -> Result<Option<Vec<String>>, Error> {
     if jobs == Some(0) {
         return Err(Error::Argument("--jobs must be at least 1".into()));
     }
@@ -231,7 +251,9 @@ pub fn case_rows(
     Ok(pool.install(|| {
         cases
             .par_iter()
-            .map(|case| row(study, case, &run_case(study, case)))
+            .map(|case| {
+                run_case_cancellable(study, case, cancel).map(|result| row(study, case, &result))
+            })
             .collect()
     }))
 }
@@ -489,9 +511,13 @@ pub fn run_study(
         .num_threads(opts.jobs.unwrap_or(0))
         .build()
         .map_err(|e| Error::Argument(format!("--jobs: {e}")))?;
+    let cancel = opts.cancel.as_ref();
     let write_result: Result<(), std::io::Error> = pool.install(|| {
         todo.par_iter().try_for_each(|case| {
-            let result = run_case(study, case);
+            // A cancelled case writes nothing: the folder resumes it next time.
+            let Some(result) = run_case_cancellable(study, case, cancel) else {
+                return Ok(());
+            };
             let line = row(study, case, &result);
             {
                 let mut f = sink.lock().expect("the cases file");
@@ -507,6 +533,16 @@ pub fn run_study(
     write_result.map_err(out_err)?;
     let wall = started.elapsed().as_secs_f64();
     drop(sink);
+    if cancel.is_some_and(Cancel::is_cancelled) {
+        let (rows, _) = done_rows(&csv, &header)?;
+        return Ok(StudyOutcome {
+            cases: mine.len(),
+            skipped: done.len(),
+            ran: rows.len() - done.len(),
+            failed: rows.values().filter(|r| r.contains(",error,")).count(),
+            interrupted: true,
+        });
+    }
     // Every case of the shard is done: rewrite in id order.
     let (rows, _) = done_rows(&csv, &header)?;
     let text = cases_csv(&header, rows.values().map(String::as_str));
@@ -552,6 +588,7 @@ pub fn run_study(
         skipped: done.len(),
         ran: todo.len(),
         failed,
+        interrupted: false,
     })
 }
 

@@ -6,5 +6,8 @@ pub mod folder;
 pub mod info;
 pub mod products;
 
-pub use folder::{Shard, StudyOptions, StudyOutcome, case_rows, cases_csv, merge, run_study};
+pub use folder::{
+    Shard, StudyOptions, StudyOutcome, case_rows, case_rows_cancellable, cases_csv, merge,
+    run_study,
+};
 pub use info::{MergedStudyInfo, StudyInfo};
