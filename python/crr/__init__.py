@@ -348,12 +348,41 @@ class Result:
             with open(d / name, "w", newline="", encoding="utf-8") as f:
                 f.write(text)
 
+    def __getstate__(self) -> Dict[str, Any]:
+        # The native run does not pickle: its arrays do, and its two CSV texts go as strings
+        # (history_csv and impacts_csv give the same bytes after a round trip).
+        state = {k: v for k, v in self.__dict__.items() if k != "_run"}
+        state["_csv"] = (self._run.history_csv(), self._run.impacts_csv())
+        return state
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        history, impacts = state.pop("_csv")
+        self.__dict__.update(state)
+        self._run = _CsvTexts(history, impacts)
+
     def __repr__(self) -> str:
         s = self.summary
         return (
             f"<crr.Result {len(self.t)} samples to t = {s['end_time']} s, {s['impacts']} "
             f"impact(s), collapsed: {s['collapse']['collapsed']}>"
         )
+
+
+class _CsvTexts:
+    """What an unpickled :class:`Result` keeps of its native run: the texts of its two CSV
+    files."""
+
+    __slots__ = ("_history", "_impacts")
+
+    def __init__(self, history: str, impacts: str) -> None:
+        self._history = history
+        self._impacts = impacts
+
+    def history_csv(self) -> str:
+        return self._history
+
+    def impacts_csv(self) -> str:
+        return self._impacts
 
 
 def simulate(
@@ -528,6 +557,11 @@ class Study:
         else:
             text = self.csv(self.run_rows(None, jobs))
         return cases_frame(text)
+
+    def __reduce__(self) -> Tuple[Any, Tuple[Tuple[str, ...]]]:
+        # Rebuilt from its description (file path, or text and folder): what a Dask worker or a
+        # process pool receives.
+        return (_load_study, (self._source,))
 
     def __repr__(self) -> str:
         return repr(self._native)
