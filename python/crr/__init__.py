@@ -62,6 +62,29 @@ def _fspath(p: PathLike) -> str:
     return os.fspath(p)
 
 
+def _json(value: Any) -> str:
+    """JSON of a model, study or table given as Python values, numpy scalars and arrays
+    included (as the numbers and lists they hold)."""
+
+    def plain(o: Any) -> Any:
+        if isinstance(o, np.generic):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        raise TypeError(f"{type(o).__name__} is not a number, string, list or mapping")
+
+    return json.dumps(value, default=plain)
+
+
+def _jobs(jobs: Optional[int]) -> Optional[int]:
+    """Worker threads: None or -1 mean one per core."""
+    if jobs is None or jobs == -1:
+        return None
+    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
+        raise InputError(f"jobs must be a positive integer, or -1 for one per core, got {jobs!r}")
+    return int(jobs)
+
+
 class Model:
     """A structure read and validated as the command line reads a model file
     (``docs/model-format.md``): bodies, interfaces and the optional ``[ground_motion]``,
@@ -73,6 +96,11 @@ class Model:
     __slots__ = ("_native",)
 
     def __init__(self, native: _crr.Model) -> None:
+        if not isinstance(native, _crr.Model):
+            raise TypeError(
+                "crr.Model is built with crr.Model.from_file(path), crr.Model.from_toml(text) "
+                f"or crr.Model.from_dict(mapping), not from {type(native).__name__}"
+            )
         self._native = native
 
     @classmethod
@@ -99,7 +127,7 @@ class Model:
         """A model from a mapping with the keys of a model file (``name``, ``body``,
         ``interface``, ``ground_motion``, …), e.g. the output of :meth:`to_dict`."""
         base = _fspath(base_dir) if base_dir is not None else "."
-        return cls(_crr.Model.parse(json.dumps(d), True, label, base))
+        return cls(_crr.Model.parse(_json(d), True, label, base))
 
     @property
     def name(self) -> str:
@@ -285,12 +313,29 @@ class Result:
         self.potential: np.ndarray = h[:, e + 1]
         self.work_in: np.ndarray = h[:, e + 2]
         self.dissipated: np.ndarray = h[:, e + 3]
-        states = run.states()
-        self.states: np.ndarray = (
-            np.array(states, dtype=str) if n else np.empty((0, len(interfaces)), dtype=str)
-        )
-        self.impacts: List[Dict[str, Any]] = run.impacts()
+        # Built on first use: one Python object per sample and per impact, the costly part.
+        self._states: Optional[np.ndarray] = None
+        self._impacts: Optional[List[Dict[str, Any]]] = None
         self.summary: Dict[str, Any] = json.loads(run.summary_json)
+
+    @property
+    def states(self) -> np.ndarray:
+        """State of every interface per sample, shape (n, interfaces), dtype str."""
+        if self._states is None:
+            states = self._run.states()
+            self._states = (
+                np.array(states, dtype=str)
+                if len(self.t)
+                else np.empty((0, len(self.interfaces)), dtype=str)
+            )
+        return self._states
+
+    @property
+    def impacts(self) -> List[Dict[str, Any]]:
+        """The impact log, one dict per impact."""
+        if self._impacts is None:
+            self._impacts = self._run.impacts()
+        return self._impacts
 
     @property
     def completed(self) -> bool:
@@ -351,6 +396,7 @@ class Result:
     def __getstate__(self) -> Dict[str, Any]:
         # The native run does not pickle: its arrays do, and its two CSV texts go as strings
         # (history_csv and impacts_csv give the same bytes after a round trip).
+        _ = (self.states, self.impacts)  # built now: the native run that builds them does not pickle
         state = {k: v for k, v in self.__dict__.items() if k != "_run"}
         state["_csv"] = (self._run.history_csv(), self._run.impacts_csv())
         return state
@@ -429,7 +475,7 @@ def simulate(
     if ground_motion is None:
         pass
     elif isinstance(ground_motion, Mapping):
-        gm_json = json.dumps(ground_motion)
+        gm_json = _json(ground_motion)
     else:
         if isinstance(ground_motion, Record):
             records: List[Record] = [ground_motion]
@@ -455,12 +501,24 @@ def simulate(
                 arrays.append(
                     (r.component, r.t.tolist(), r.a.tolist(), r.units or "m/s2", r.scale)
                 )
-    init_json = json.dumps(initial) if initial is not None else None
+    init_json = _json(initial) if initial is not None else None
+    unknown = sorted(set(analysis) - set(_crr.ANALYSIS_KEYS))
+    if unknown:
+        raise TypeError(
+            f"simulate() got an unexpected keyword argument {unknown[0]!r} (besides model, "
+            "ground_motion, initial and duration it takes the keys of [analysis]: "
+            + ", ".join(_crr.ANALYSIS_KEYS)
+            + ")"
+        )
+    if duration is not None:
+        d = float(duration)
+        if not (np.isfinite(d) and d > 0.0):
+            raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
     analysis_json: Optional[str] = None
     if analysis:
         table = dict(model.to_dict().get("analysis") or {})
         table.update(analysis)
-        analysis_json = json.dumps(table)
+        analysis_json = _json(table)
     try:
         run = _crr.simulate(
             native,
@@ -516,7 +574,7 @@ class Study:
     def from_dict(cls, d: Mapping[str, Any], base_dir: Optional[PathLike] = None) -> "Study":
         """A study from a mapping with the keys of a study file, read as :meth:`from_toml`."""
         label = os.path.join(_fspath(base_dir) if base_dir is not None else ".", "study.toml")
-        text = json.dumps(d)
+        text = _json(d)
         return cls(_crr.Study.parse(text, True, label), ("json", text, label))
 
     @property
@@ -542,7 +600,7 @@ class Study:
     ) -> List[str]:
         """Runs the cases ``ids`` (default all) on ``jobs`` threads (default one per core) and
         returns their lines of ``cases.csv`` (without newlines), in the order of ``ids``."""
-        return self._native.run_rows(None if ids is None else list(ids), jobs)
+        return self._native.run_rows(None if ids is None else list(ids), _jobs(jobs))
 
     def csv(self, rows: Sequence[str]) -> str:
         """The text of ``cases.csv`` from rows given in any order, as ``crr study`` writes it
@@ -552,7 +610,7 @@ class Study:
     def run(self, jobs: Optional[int] = None, out: Optional[PathLike] = None) -> "pandas.DataFrame":
         """Runs every case and returns the DataFrame of ``cases.csv``; see :func:`study`."""
         if out is not None:
-            self._native.run_into(_fspath(out), jobs)
+            self._native.run_into(_fspath(out), _jobs(jobs))
             text = (Path(out) / "cases.csv").read_text()
         else:
             text = self.csv(self.run_rows(None, jobs))

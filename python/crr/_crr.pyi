@@ -6,6 +6,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 _Path = Union[str, PathLike[str]]
 
 __version__: str
+ANALYSIS_KEYS: List[str]
 
 class Model:
     @staticmethod

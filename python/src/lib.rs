@@ -617,5 +617,18 @@ fn _crr(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyStudy>()?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add("__version__", VERSION)?;
+    m.add("ANALYSIS_KEYS", analysis_keys())?;
     Ok(())
+}
+
+/// The keys of the `[analysis]` table (every field of its spec serialises, defaults included):
+/// the keyword arguments `crr.simulate` accepts besides its own.
+fn analysis_keys() -> Vec<String> {
+    let spec = serde_json::to_value(crr::dynamics::AnalysisSpec::default())
+        .expect("the analysis spec serialises");
+    spec.as_object()
+        .expect("the analysis spec is a table")
+        .keys()
+        .cloned()
+        .collect()
 }

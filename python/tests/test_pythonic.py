@@ -1,0 +1,51 @@
+"""Python-worded arguments: numpy values wherever numbers or lists go, ``jobs=-1`` for one
+thread per core, direct construction of a Model refused with the constructors named, and every
+key of ``[analysis]`` accepted as a keyword (the list comes from the engine's own table)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import crr
+
+ROOT = Path(__file__).resolve().parents[2]
+BLOCK = ROOT / "examples" / "models" / "single_block.toml"
+
+
+def test_numpy_values_in_a_dict_model_and_tables() -> None:
+    d = crr.Model.from_file(BLOCK).to_dict()
+    d["body"][0]["density"] = np.float64(2500.0)
+    d["body"][0]["box"]["size"] = np.array([0.4, 0.4, 2.0])
+    model = crr.Model.from_dict(d)
+    plain = crr.Model.from_file(BLOCK)
+    assert model.to_dict() == plain.to_dict()
+    a = crr.simulate(model, initial={"angles": {"base": np.float64(0.1)}}, duration=np.float64(2.0),
+                     rtol=np.float64(1e-10))
+    b = crr.simulate(plain, initial={"angles": {"base": 0.1}}, duration=2.0, rtol=1e-10)
+    np.testing.assert_array_equal(a.q, b.q)
+
+
+def test_jobs_minus_one_is_one_thread_per_core() -> None:
+    study = crr.Study.from_file(ROOT / "examples" / "studies" / "block_spectrum.toml")
+    ids = study.case_ids[:4]
+    assert study.run_rows(ids, jobs=-1) == study.run_rows(ids, jobs=1)
+    for bad in (0, -2, 1.5, True):
+        with pytest.raises(crr.InputError, match="jobs must be a positive integer, or -1"):
+            study.run_rows(ids, jobs=bad)
+
+
+def test_a_model_is_built_by_its_constructors() -> None:
+    with pytest.raises(TypeError, match="crr.Model.from_file"):
+        crr.Model("examples/models/single_block.toml")  # type: ignore[arg-type]
+
+
+def test_every_analysis_key_is_a_keyword() -> None:
+    defaults = {"output_interval": 0.01, "rtol": 1e-10, "method": "dop853", "max_impacts": 1000}
+    for key in crr._crr.ANALYSIS_KEYS:
+        if key in defaults:
+            crr.simulate(BLOCK, duration=0.5, **{key: defaults[key]})
+    assert set(defaults) <= set(crr._crr.ANALYSIS_KEYS)
+    assert "duration" in crr._crr.ANALYSIS_KEYS
