@@ -29,7 +29,14 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _crr
-from ._errors import CrrError, CrrWarning, FileError, InputError, SimulationError
+from ._errors import (
+    CrrError,
+    CrrWarning,
+    FileError,
+    InputError,
+    MissingFileError,
+    SimulationError,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas
@@ -39,6 +46,7 @@ __all__ = [
     "CrrWarning",
     "FileError",
     "InputError",
+    "MissingFileError",
     "Model",
     "Record",
     "Result",

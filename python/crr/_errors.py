@@ -4,7 +4,14 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-__all__ = ["CrrError", "InputError", "FileError", "SimulationError", "CrrWarning"]
+__all__ = [
+    "CrrError",
+    "InputError",
+    "FileError",
+    "MissingFileError",
+    "SimulationError",
+    "CrrWarning",
+]
 
 
 class CrrError(Exception):
@@ -17,7 +24,28 @@ class InputError(CrrError, ValueError):
 
 class FileError(CrrError, OSError):
     """A file that cannot be read or a folder that cannot be written (the command line exits
-    with 2)."""
+    with 2). ``errno`` and ``filename`` are those of the operating system's error (None when
+    unknown); the message is the command line's."""
+
+    def __init__(
+        self, message: str, errno: Optional[int] = None, filename: Optional[Any] = None
+    ) -> None:
+        if errno is None:
+            super().__init__(message)
+        else:
+            super().__init__(errno, message, str(filename) if filename is not None else None)
+        self._message = message
+
+    def __str__(self) -> str:
+        return self._message
+
+    def __reduce__(self) -> Any:
+        return (type(self), (self._message, self.errno, self.filename))
+
+
+class MissingFileError(FileError, FileNotFoundError):
+    """A file that does not exist: a :class:`FileError` that ``except FileNotFoundError``
+    catches too."""
 
 
 class SimulationError(CrrError, RuntimeError):
@@ -39,5 +67,5 @@ class CrrWarning(UserWarning):
 
 
 # Shown and pickled as crr.CrrError, crr.InputError, … (the names the package exports).
-for _cls in (CrrError, InputError, FileError, SimulationError, CrrWarning):
+for _cls in (CrrError, InputError, FileError, MissingFileError, SimulationError, CrrWarning):
     _cls.__module__ = "crr"

@@ -42,11 +42,27 @@ fn raise(py: Python<'_>, kind: &str, message: String) -> PyErr {
 /// read or written are `crr.FileError` (an `OSError`), everything else `crr.InputError` (a
 /// `ValueError`).
 fn input_error(py: Python<'_>, e: Error) -> PyErr {
-    let kind = match e {
-        Error::Io { .. } | Error::Output { .. } => "FileError",
-        _ => "InputError",
+    let message = e.to_string();
+    let (file, source) = match &e {
+        Error::Io { file, source } => (file, source),
+        Error::Output { dir, source } => (dir, source),
+        _ => return raise(py, "InputError", message),
     };
-    raise(py, kind, e.to_string())
+    // With the OS error number and the path, as OSError has them; a missing file is also a
+    // FileNotFoundError.
+    let kind = if source.kind() == std::io::ErrorKind::NotFound {
+        "MissingFileError"
+    } else {
+        "FileError"
+    };
+    let made = py
+        .import("crr._errors")
+        .and_then(|m| m.getattr(kind))
+        .and_then(|cls| cls.call1((message, source.raw_os_error(), file.clone())));
+    match made {
+        Ok(exc) => PyErr::from_value(exc),
+        Err(e) => e,
+    }
 }
 
 fn argument(py: Python<'_>, message: String) -> PyErr {

@@ -49,3 +49,23 @@ def test_every_analysis_key_is_a_keyword() -> None:
             crr.simulate(BLOCK, duration=0.5, **{key: defaults[key]})
     assert set(defaults) <= set(crr._crr.ANALYSIS_KEYS)
     assert "duration" in crr._crr.ANALYSIS_KEYS
+
+
+def test_a_missing_file_is_a_file_not_found_error_with_its_name() -> None:
+    import errno
+    import pickle
+
+    record = crr.Record.from_file("no/such.AT2", format="peer-at2")
+    with pytest.raises(FileNotFoundError) as info:
+        crr.simulate(BLOCK, ground_motion=record)
+    e = info.value
+    assert isinstance(e, crr.FileError) and isinstance(e, crr.MissingFileError)
+    assert e.errno == errno.ENOENT
+    assert e.filename == "no/such.AT2"
+    assert str(e).startswith("no/such.AT2: cannot read the file")
+    back = pickle.loads(pickle.dumps(e))
+    assert type(back) is type(e) and str(back) == str(e)
+    assert (back.errno, back.filename) == (e.errno, e.filename)
+    with pytest.raises(FileNotFoundError) as model:
+        crr.Model.from_file("no/such.toml")
+    assert model.value.filename == "no/such.toml"

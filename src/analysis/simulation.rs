@@ -11,7 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use nalgebra::Vector3;
 
 use crr_dynamics::ground_motion::{
-    Axis, GroundMotion, GroundMotionSpec, Record, RecordFormat, Units, read_record,
+    Axis, GroundMotion, GroundMotionError, GroundMotionSpec, Record, RecordFormat, Units,
+    read_record,
 };
 use crr_dynamics::{AnalysisSpec, InitialSpec, InitialState, solve_initial};
 use crr_impact::simulation::{
@@ -234,8 +235,14 @@ fn ground_motion(
         None => GroundMotion::none(),
     };
     if let Some(r) = &options.record_file {
-        let record = read_record(&r.file, r.format, r.units)
-            .map_err(|e| Error::Argument(format!("record file: {e}")))?;
+        let record = read_record(&r.file, r.format, r.units).map_err(|e| match e {
+            // A file that cannot be read is a file error (Python: crr.FileError with errno).
+            GroundMotionError::Io { error, .. } => Error::Io {
+                file: r.file.clone(),
+                source: error,
+            },
+            e => Error::Argument(format!("record file: {e}")),
+        })?;
         ground = ground
             .with_record(r.component, record, r.scale)
             .map_err(|e| Error::Argument(format!("record scale: {e}")))?;
