@@ -35,6 +35,7 @@ from ._errors import (
     FileError,
     InputError,
     MissingFileError,
+    OutOfMemoryError,
     SimulationError,
 )
 
@@ -48,6 +49,7 @@ __all__ = [
     "InputError",
     "MissingFileError",
     "Model",
+    "OutOfMemoryError",
     "Record",
     "Result",
     "SimulationError",
@@ -82,6 +84,37 @@ def _json(value: Any) -> str:
         raise TypeError(f"{type(o).__name__} is not a number, string, list or mapping")
 
     return json.dumps(value, default=plain)
+
+
+def _memory_available() -> Optional[float]:
+    """Bytes this process can still allocate, where the system tells: the memory available
+    (``MemAvailable`` of ``/proc/meminfo``), and below the address-space limit (``RLIMIT_AS``)
+    what the process has not mapped yet; None when neither is known."""
+    known: List[float] = []
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    known.append(float(line.split()[1]) * 1024.0)
+    except OSError:
+        pass
+    try:
+        import resource
+
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+        if soft != resource.RLIM_INFINITY:
+            with open("/proc/self/status") as f:
+                mapped = next(float(l.split()[1]) * 1024.0 for l in f if l.startswith("VmSize:"))
+            known.append(max(float(soft) - mapped, 0.0))
+    except (ImportError, OSError, StopIteration, ValueError):
+        pass
+    return min(known) if known else None
+
+
+def _positive_count(name: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InputError(f"{name} must be a positive integer, got {value!r}")
+    return int(value)
 
 
 def _jobs(jobs: Optional[int]) -> Optional[int]:
@@ -444,6 +477,7 @@ def simulate(
     ground_motion: GroundMotion = None,
     initial: Optional[Mapping[str, Any]] = None,
     duration: Optional[float] = None,
+    max_samples: Optional[int] = None,
     **analysis: Any,
 ) -> Result:
     """Runs a model as ``crr simulate`` does and returns its results (nothing is written).
@@ -459,6 +493,10 @@ def simulate(
             {name: rad/s}}``.
         duration: simulated time (s), as ``--duration``; default the ``[analysis]`` duration,
             else the ground motion's duration + 5 s, else 10 s.
+        max_samples: most output samples kept in memory; past them the run stops (a
+            :class:`SimulationError` with the results until then). By default, what fits in
+            80 % of the memory this process can still take, and a run whose samples alone would
+            not fit raises :class:`OutOfMemoryError` (a ``MemoryError``) before it starts.
         **analysis: keys of the ``[analysis]`` table that override the model's (``rtol``,
             ``atol``, ``method``, ``output_interval`` s, ``max_step`` s, ``friction``, …).
 
@@ -536,6 +574,8 @@ def simulate(
             record_file=record_file,
             records=arrays,
             duration=None if duration is None else float(duration),
+            max_samples=None if max_samples is None else _positive_count("max_samples", max_samples),
+            memory=_memory_available() if max_samples is None else None,
         )
     except KeyboardInterrupt as interrupt:
         # Ctrl-C stops the run after its current step; what it computed rides on the exception.

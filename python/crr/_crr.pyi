@@ -52,6 +52,8 @@ def simulate(
     record_file: Optional[Tuple[_Path, str, Optional[str], str, float]] = None,
     records: Sequence[Tuple[str, Sequence[float], Sequence[float], str, float]] = ...,
     duration: Optional[float] = None,
+    max_samples: Optional[int] = None,
+    memory: Optional[float] = None,
 ) -> Run: ...
 
 class Study:

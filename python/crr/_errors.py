@@ -9,6 +9,7 @@ __all__ = [
     "InputError",
     "FileError",
     "MissingFileError",
+    "OutOfMemoryError",
     "SimulationError",
     "CrrWarning",
 ]
@@ -60,6 +61,11 @@ class SimulationError(CrrError, RuntimeError):
         self.result = result
 
 
+class OutOfMemoryError(CrrError, MemoryError):
+    """A run whose output samples would not fit in the memory this process can still take,
+    refused before it starts (the message gives the estimate and what to change)."""
+
+
 class CrrWarning(UserWarning):
     """What a user must know before trusting a run's results: each string of
     ``summary["warnings"]`` (the lines the command line prints after ``crr: warning:``) is
@@ -67,5 +73,13 @@ class CrrWarning(UserWarning):
 
 
 # Shown and pickled as crr.CrrError, crr.InputError, … (the names the package exports).
-for _cls in (CrrError, InputError, FileError, MissingFileError, SimulationError, CrrWarning):
+for _cls in (
+    CrrError,
+    InputError,
+    FileError,
+    MissingFileError,
+    OutOfMemoryError,
+    SimulationError,
+    CrrWarning,
+):
     _cls.__module__ = "crr"

@@ -320,7 +320,7 @@ fn parse_axis(what: &str, axis: &str) -> Result<Axis, String> {
 /// motion, initial state, analysis), a record file (as `--record`) and record arrays overriding
 /// components, and `duration` (as `--duration`).
 #[pyfunction]
-#[pyo3(signature = (model, ground_motion=None, initial=None, analysis=None, record_file=None, records=Vec::new(), duration=None))]
+#[pyo3(signature = (model, ground_motion=None, initial=None, analysis=None, record_file=None, records=Vec::new(), duration=None, max_samples=None, memory=None))]
 fn simulate(
     py: Python<'_>,
     model: &PyModel,
@@ -330,6 +330,8 @@ fn simulate(
     record_file: Option<FileRecord>,
     records: Vec<ArrayRecord>,
     duration: Option<f64>,
+    max_samples: Option<usize>,
+    memory: Option<f64>,
 ) -> PyResult<PyRun> {
     let mut options = RunOptions::default();
     let table =
@@ -412,7 +414,11 @@ fn simulate(
             trajectory: run.trajectory,
         }
     };
-    match interruptible(py, &cancel, move || crr::run(&input, &options)) {
+    let prepared = py
+        .detach(|| crr::analysis::simulation::prepare(&input, &options))
+        .map_err(|e| input_error(py, e))?;
+    let prepared = limit_samples(py, prepared, max_samples, memory)?;
+    match interruptible(py, &cancel, move || Ok::<_, Error>(prepared.run())) {
         Ok(run) => run.map(to_py).map_err(|e| input_error(py, e)),
         Err((interrupt, partial)) => {
             // Ctrl-C: KeyboardInterrupt, with the partial run as its `run` attribute.
@@ -424,6 +430,54 @@ fn simulate(
             Err(interrupt)
         }
     }
+}
+
+/// Bytes a run keeps in memory per output sample, both copies counted: the engine's columns
+/// (t, q, q̇ and four energies as f64, one byte per slot state; grown by doubling, so up to twice
+/// that) and the history the Python `Result` copies once.
+fn memory_per_sample(model: &Structure) -> f64 {
+    let numbers = (5 + 2 * model.dof()) as f64 * 8.0 + model.slot_count as f64;
+    3.0 * numbers
+}
+
+/// The sample limit of a run: `max_samples` when given; otherwise, when the memory `memory`
+/// (bytes) the caller can give is known, what fits in 80 % of it, and a run whose output samples
+/// alone would not fit is refused before it starts (crr.OutOfMemoryError, a MemoryError).
+fn limit_samples(
+    py: Python<'_>,
+    mut prepared: crr::analysis::simulation::Prepared,
+    max_samples: Option<usize>,
+    memory: Option<f64>,
+) -> PyResult<crr::analysis::simulation::Prepared> {
+    if let Some(max) = max_samples {
+        prepared.max_samples = Some(max);
+        return Ok(prepared);
+    }
+    let Some(memory) = memory.filter(|m| m.is_finite() && *m > 0.0) else {
+        return Ok(prepared);
+    };
+    let per_sample = memory_per_sample(&prepared.model);
+    let fits = (0.8 * memory / per_sample).floor();
+    let (rows, _) = prepared.history_estimate();
+    if rows > fits {
+        return Err(raise(
+            py,
+            "OutOfMemoryError",
+            format!(
+                "{}: the history would need about {:.1} GB in memory ({rows:.3e} samples: the \
+                 duration {} s over output_interval = {} s), more than 80 % of the {:.1} GB this process \
+                 can still take: raise output_interval, shorten the duration, or use `crr \
+                 simulate`, which streams the history to a file",
+                prepared.path.display(),
+                rows * per_sample / 1e9,
+                prepared.params.duration,
+                prepared.params.output_interval,
+                memory / 1e9
+            ),
+        ));
+    }
+    prepared.max_samples = Some(fits as usize);
+    Ok(prepared)
 }
 
 /// Runs `work` on a thread of its own, without the GIL, while this thread waits for it in slices

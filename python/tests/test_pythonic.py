@@ -69,3 +69,35 @@ def test_a_missing_file_is_a_file_not_found_error_with_its_name() -> None:
     with pytest.raises(FileNotFoundError) as model:
         crr.Model.from_file("no/such.toml")
     assert model.value.filename == "no/such.toml"
+
+
+def test_a_run_that_cannot_fit_in_memory_is_refused_before_it_starts() -> None:
+    # Under a 3 GB address-space limit, 2e5 s at 0.01 s would need some 3.4 GB of samples: the
+    # interpreter used to die in an allocation (exit 134); now a MemoryError says why, at once.
+    import subprocess
+    import sys
+
+    code = (
+        "import resource, crr\n"
+        "resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))\n"
+        "try:\n"
+        f"    crr.simulate({str(BLOCK)!r}, duration=2e5)\n"
+        "except MemoryError as e:\n"
+        "    print(type(e).__name__, e)\n"
+    )
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.startswith("OutOfMemoryError "), p.stdout
+    assert "output_interval" in p.stdout
+
+
+def test_a_sample_limit_stops_the_run_with_its_results() -> None:
+    with pytest.raises(crr.SimulationError, match="more than 100 output samples") as info:
+        crr.simulate(BLOCK, duration=20.0, max_samples=100)
+    partial = info.value.result
+    assert 100 < len(partial.t) <= 100 + 4096 + 2 * len(partial.impacts)
+    full = crr.simulate(BLOCK, duration=20.0)
+    n = len(partial.t) - 1
+    np.testing.assert_array_equal(partial.q[:n], full.q[:n])
+    with pytest.raises(crr.InputError, match="max_samples must be a positive integer"):
+        crr.simulate(BLOCK, duration=1.0, max_samples=0)

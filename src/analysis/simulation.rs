@@ -76,6 +76,10 @@ pub struct RunOptions {
     /// A flag the run polls after every step: once set, it stops with
     /// [`SimulationError::Cancelled`] and keeps what it computed.
     pub cancel: Option<Cancel>,
+    /// Most output samples a run keeps in memory (not streamed): the run stops with
+    /// [`SimulationError::TooManySamples`] after the step that passes it (a step records at
+    /// most 4 096 samples plus two per impact), keeping what it computed.
+    pub max_samples: Option<usize>,
 }
 
 /// A request to stop a run, shared between the run and whoever may interrupt it (a signal
@@ -121,6 +125,8 @@ pub struct Prepared {
     pub progress: bool,
     /// The cancellation flag of the options.
     pub cancel: Option<Cancel>,
+    /// The sample limit of the options.
+    pub max_samples: Option<usize>,
 }
 
 /// The results of a run: complete, or partial with the reason it stopped.
@@ -219,6 +225,7 @@ pub fn prepare(input: &ModelInput, options: &RunOptions) -> Result<Prepared, Err
         record_file: options.record_file.clone(),
         progress: options.progress,
         cancel: options.cancel.clone(),
+        max_samples: options.max_samples,
     })
 }
 
@@ -337,6 +344,7 @@ impl Prepared {
             stream,
             self.progress,
             self.cancel.as_ref(),
+            self.max_samples,
         )
     }
 }
@@ -450,7 +458,8 @@ pub enum Flow {
 /// cases of a study). The samples are drained into `sink` after every step when `stream` (a sink
 /// error stops the run), else kept in the trajectory; a percentage goes to stderr when
 /// `progress`; a set `cancel` flag stops the run after the step in which it was set
-/// ([`SimulationError::Cancelled`]). An error before the first step is `Err`; one later comes
+/// ([`SimulationError::Cancelled`]), and so do more than `max_samples` samples kept in memory
+/// ([`SimulationError::TooManySamples`]). An error before the first step is `Err`; one later comes
 /// back with the trajectory computed until then.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
@@ -462,6 +471,7 @@ pub fn simulate(
     stream: bool,
     progress: bool,
     cancel: Option<&Cancel>,
+    max_samples: Option<usize>,
 ) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
     let mut drain = |sim: &mut Simulation, _: &Result<StopReason, SimulationError>| {
         let cancelled = cancel.is_some_and(Cancel::is_cancelled);
@@ -471,6 +481,8 @@ pub fn simulate(
         if !stream {
             return if cancelled {
                 Flow::Fail(SimulationError::Cancelled { t: sim.time() })
+            } else if let Some(max) = max_samples.filter(|&m| sim.samples.len() > m) {
+                Flow::Fail(SimulationError::TooManySamples { max, t: sim.time() })
             } else {
                 Flow::Continue
             };

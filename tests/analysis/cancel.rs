@@ -1,7 +1,9 @@
-//! A run's cancellation flag (`RunOptions::cancel`): set before the run, the run stops after its
-//! first step; set from another thread while it runs, it stops soon after, in both cases as a
-//! partial run (`SimulationError::Cancelled`, "completed": false) that keeps every sample and
-//! impact computed until then, identical to those of the uncancelled run.
+//! Stopping a run early, keeping what it computed. Its cancellation flag (`RunOptions::cancel`):
+//! set before the run, the run stops after its first step; set from another thread while it runs,
+//! it stops soon after; a study stops and resumes. Its sample limit (`RunOptions::max_samples`)
+//! stops it after the step that passes the limit. In every case the run is partial
+//! (`"completed": false`) and keeps every sample and impact computed until then, identical to
+//! those of the run not stopped.
 
 use crr::impact::simulation::SimulationError;
 use crr::{Cancel, RunOptions};
@@ -126,4 +128,35 @@ fn a_cancelled_study_keeps_its_rows_and_resumes_to_the_same_cases_csv() {
     assert_eq!(second.skipped + second.ran, second.cases);
     let read = |d: &str| std::fs::read_to_string(dir.join(d).join("cases.csv")).unwrap();
     assert_eq!(read("full"), read("resumed"));
+}
+
+/// A sample limit stops an in-memory run after the step that passes it, keeping what it computed:
+/// the samples until then are those of the unlimited run.
+#[test]
+fn a_sample_limit_stops_a_run_in_memory() {
+    let model = crr::ModelInput::read(common::bundled_path("block_record")).unwrap();
+    let limited = RunOptions {
+        duration: Some(20.0),
+        max_samples: Some(300),
+        ..Default::default()
+    };
+    let run = crr::run(&model, &limited).unwrap();
+    let Some(SimulationError::TooManySamples { max: 300, t }) = run.failure else {
+        panic!("{:?}", run.failure);
+    };
+    assert!(t < 20.0);
+    let samples = &run.trajectory.samples;
+    // Past the limit by at most one step's samples (4 096, two per impact).
+    assert!(samples.len() > 300 && samples.len() <= 300 + 4096 + 2 * run.trajectory.impacts.len());
+    assert!(
+        run.summary
+            .error
+            .as_deref()
+            .unwrap()
+            .starts_with("more than 300 output samples")
+    );
+    let full = crr::run(&model, &options(20.0, &Cancel::new())).unwrap();
+    for (x, y) in samples.iter().zip(full.trajectory.samples.iter()) {
+        assert_eq!((x.t, x.q, x.qdot), (y.t, y.q, y.qdot));
+    }
 }

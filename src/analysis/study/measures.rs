@@ -78,6 +78,7 @@ fn measure(study: &Study, case: &Case, cancel: Option<&Cancel>) -> Result<Measur
         true,
         false,
         cancel,
+        None,
     )
     .map_err(|e| failed(e.to_string()))?;
     match error {

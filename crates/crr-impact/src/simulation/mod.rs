@@ -242,6 +242,18 @@ pub enum SimulationError {
     /// Too many impacts.
     #[error("more than {0} impacts: raise analysis.max_impacts or check the seating parameters")]
     TooManyImpacts(usize),
+    /// More output samples in memory than the caller allows.
+    #[error(
+        "more than {max} output samples in memory at t = {t} s: raise output_interval, or the \
+         sample limit if the memory allows, or stream the history to a file (crr simulate); \
+         the results until then are kept"
+    )]
+    TooManySamples {
+        /// The limit.
+        max: usize,
+        /// Time reached (s).
+        t: f64,
+    },
     /// The caller asked the run to stop (Ctrl-C, SIGTERM, a cancellation flag).
     #[error("interrupted at t = {t} s: the results until then are kept")]
     Cancelled {
