@@ -111,6 +111,17 @@ def _memory_available() -> Optional[float]:
     return min(known) if known else None
 
 
+def _samples(name: str, values: npt.ArrayLike) -> np.ndarray:
+    """A column of samples as a flat float array: a column or row vector of shape (n, 1) or
+    (1, n) is one series; any other 2-D shape is refused with its shape named."""
+    array = np.asarray(values, dtype=float)
+    if array.ndim == 2 and 1 in array.shape:
+        array = array.reshape(-1)
+    if array.ndim != 1:
+        raise InputError(f"{name} must be one series of samples, got an array of shape {array.shape}")
+    return np.ascontiguousarray(array)
+
+
 def _positive_count(name: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise InputError(f"{name} must be a positive integer, got {value!r}")
@@ -296,8 +307,8 @@ class Record:
         (``m/s2``, ``g`` = 9.80665 m/s² or ``cm/s2``), linear between samples and 0 outside
         them, as a ``csv`` record of the same numbers."""
         return cls(
-            t=np.ascontiguousarray(t, dtype=float),
-            a=np.ascontiguousarray(a, dtype=float),
+            t=_samples("t", t),
+            a=_samples("a", a),
             units=units,
             component=component,
             scale=scale,

@@ -13,6 +13,7 @@ import crr
 
 ROOT = Path(__file__).resolve().parents[2]
 BLOCK = ROOT / "examples" / "models" / "single_block.toml"
+AT_REST = {"angles": {"base": 0.0}}
 
 
 def test_numpy_values_in_a_dict_model_and_tables() -> None:
@@ -101,3 +102,22 @@ def test_a_sample_limit_stops_the_run_with_its_results() -> None:
     np.testing.assert_array_equal(partial.q[:n], full.q[:n])
     with pytest.raises(crr.InputError, match="max_samples must be a positive integer"):
         crr.simulate(BLOCK, duration=1.0, max_samples=0)
+
+
+def test_a_dict_model_error_names_the_key_path() -> None:
+    d = crr.Model.from_file(BLOCK).to_dict()
+    d["body"][0]["densty"] = d["body"][0].pop("density")
+    with pytest.raises(crr.InputError, match=r"body\[0\]\.densty: unknown field `densty`"):
+        crr.Model.from_dict(d)
+
+
+def test_a_record_column_vector_is_one_series() -> None:
+    t = np.linspace(0.0, 0.5, 101)
+    a = 4.0 * np.sin(4.0 * np.pi * t)
+    flat = crr.simulate(BLOCK, ground_motion=(t, a), initial=AT_REST, duration=2.0)
+    column = crr.simulate(
+        BLOCK, ground_motion=(t.reshape(-1, 1), a.reshape(-1, 1)), initial=AT_REST, duration=2.0
+    )
+    np.testing.assert_array_equal(flat.q, column.q)
+    with pytest.raises(crr.InputError, match=r"a must be one series of samples, got an array of shape \(101, 2\)"):
+        crr.Record.from_arrays(t, np.stack([a, a], axis=1))

@@ -74,7 +74,18 @@ pub fn parse_model_file(path: &Path, text: &str) -> Result<ModelFile, Error> {
 pub fn parse_model_text(label: &Path, text: &str, is_json: bool) -> Result<ModelFile, Error> {
     let path = label;
     let parsed = if is_json {
-        serde_json::from_str(text).map_err(|e| e.to_string())
+        // With the key path of the error: a model given as a dict in Python has no lines to
+        // point at (its JSON is one line).
+        let mut de = serde_json::Deserializer::from_str(text);
+        serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            if path == "." {
+                inner.to_string()
+            } else {
+                format!("{path}: {inner}")
+            }
+        })
     } else {
         toml::from_str(text).map_err(|e| e.to_string().trim_end().to_string())
     };
