@@ -21,6 +21,8 @@ from __future__ import annotations
 import io
 import json
 import os
+import sys
+import time
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
@@ -666,14 +668,39 @@ class Study:
         (header, then the rows in case-id order)."""
         return self._native.csv(list(rows))
 
-    def run(self, jobs: Optional[int] = None, out: Optional[PathLike] = None) -> "pandas.DataFrame":
+    def run(
+        self, jobs: Optional[int] = None, out: Optional[PathLike] = None, progress: bool = False
+    ) -> "pandas.DataFrame":
         """Runs every case and returns the DataFrame of ``cases.csv``; see :func:`study`."""
         if out is not None:
-            self._native.run_into(_fspath(out), _jobs(jobs))
+            self._native.run_into(_fspath(out), _jobs(jobs), progress)
             text = (Path(out) / "cases.csv").read_text()
+        elif progress:
+            text = self.csv(self._rows_with_progress(_jobs(jobs)))
         else:
             text = self.csv(self.run_rows(None, jobs))
         return cases_frame(text)
+
+    def _rows_with_progress(self, jobs: Optional[int]) -> List[str]:
+        """Every case's row, run in batches of a few cases per thread, with a tqdm bar when tqdm
+        is installed, else a line on stderr updated in place."""
+        ids = self.case_ids
+        batch = 8 * (jobs or os.cpu_count() or 1)
+        try:
+            from tqdm import tqdm  # type: ignore[import-untyped]
+
+            bar: Any = tqdm(total=len(ids), unit="case", desc=self.name)
+        except ImportError:
+            bar = _ProgressLine(self.name, len(ids))
+        rows: List[str] = []
+        try:
+            for start in range(0, len(ids), batch):
+                chunk = ids[start : start + batch]
+                rows.extend(self.run_rows(chunk, jobs))
+                bar.update(len(chunk))
+        finally:
+            bar.close()
+        return rows
 
     def __reduce__(self) -> Tuple[Any, Tuple[Tuple[str, ...]]]:
         # Rebuilt from its description (file path, or text and folder): what a Dask worker or a
@@ -682,6 +709,27 @@ class Study:
 
     def __repr__(self) -> str:
         return repr(self._native)
+
+
+class _ProgressLine:
+    """A progress line on stderr, rewritten in place (what a study shows without tqdm)."""
+
+    def __init__(self, name: str, total: int) -> None:
+        self._name, self._total, self._done = name, total, 0
+        self._start = time.monotonic()
+
+    def update(self, n: int) -> None:
+        self._done += n
+        pct = 100.0 * self._done / max(self._total, 1)
+        elapsed = time.monotonic() - self._start
+        sys.stderr.write(
+            f"\rcrr: {self._name}: {self._done}/{self._total} cases ({pct:.0f} %), {elapsed:.1f} s"
+        )
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        sys.stderr.write("\n")
+        sys.stderr.flush()
 
 
 def _load_study(source: Tuple[str, ...]) -> Study:
@@ -711,6 +759,7 @@ def study(
     study: Union[Study, PathLike, Mapping[str, Any]],
     jobs: Optional[int] = None,
     out: Optional[PathLike] = None,
+    progress: bool = False,
 ) -> "pandas.DataFrame":
     """Runs every case of a study, as ``crr study``, and returns ``cases.csv`` as a pandas
     DataFrame (same columns; ``frame.attrs["cases_csv"]`` holds the file's exact text).
@@ -721,8 +770,11 @@ def study(
         jobs: worker threads (default one per core); the results do not depend on it.
         out: when given, the study is run into this folder exactly as
             ``crr study FILE --out OUT`` (``cases.csv``, ``study.json``; a rerun resumes).
+        progress: show progress on stderr: with ``out``, the command line's progress line;
+            otherwise a tqdm bar when tqdm is installed, else a line updated in place. The rows
+            are the same either way.
     """
-    return _as_study(study).run(jobs=jobs, out=out)
+    return _as_study(study).run(jobs=jobs, out=out, progress=progress)
 
 
 def _as_study(study: Union[Study, PathLike, Mapping[str, Any]]) -> Study:

@@ -638,14 +638,16 @@ impl PyStudy {
         cases_csv(&header(&self.study), rows.iter().map(String::as_str))
     }
 
-    /// `crr study FILE --out OUT --jobs JOBS --quiet`: runs (or resumes) the study into `out`
-    /// (cases.csv, study.json) and returns (cases, skipped, ran, failed).
-    #[pyo3(signature = (out, jobs=None))]
+    /// `crr study FILE --out OUT --jobs JOBS [--quiet]`: runs (or resumes) the study into `out`
+    /// (cases.csv, study.json) and returns (cases, skipped, ran, failed); `progress` shows the
+    /// command line's progress line on stderr.
+    #[pyo3(signature = (out, jobs=None, progress=false))]
     fn run_into(
         &self,
         py: Python<'_>,
         out: PathBuf,
         jobs: Option<usize>,
+        progress: bool,
     ) -> PyResult<(usize, usize, usize, usize)> {
         if jobs == Some(0) {
             return Err(argument(py, "--jobs must be at least 1".into()));
@@ -655,7 +657,7 @@ impl PyStudy {
             out,
             jobs,
             shard: crr::output::study::Shard::ALL,
-            quiet: true,
+            quiet: !progress,
             cancel: Some(cancel.clone()),
         };
         // Ctrl-C: the cases under way stop without a row, the folder keeps the others (running

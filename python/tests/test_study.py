@@ -115,3 +115,18 @@ def test_a_dask_local_cluster_reproduces_the_study(cli, tmp_path):
     assert (tmp_path / "dask" / "cases.csv").read_text() == expected
     assert len(frame) == 36
     assert by_dict.attrs["cases_csv"] == crr.study(records_study()).attrs["cases_csv"]
+
+
+def test_progress_shows_on_stderr_and_changes_no_row(tmp_path, capfd):
+    spec = Path(__file__).resolve().parents[2] / "examples" / "studies" / "block_spectrum.toml"
+    study = crr.Study.from_file(spec)
+    plain = crr.study(study, jobs=2)
+    capfd.readouterr()
+    shown = crr.study(study, jobs=2, progress=True)
+    err = capfd.readouterr().err
+    assert shown.attrs["cases_csv"] == plain.attrs["cases_csv"]
+    assert "100/100" in err, err
+    folder = crr.study(study, jobs=2, out=tmp_path / "s", progress=True)
+    err = capfd.readouterr().err
+    assert "crr: study [" in err and "100/100 cases" in err, err
+    assert folder.attrs["cases_csv"] == plain.attrs["cases_csv"]
