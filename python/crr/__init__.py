@@ -551,9 +551,9 @@ def simulate(
                 raise TypeError(f"ground_motion: expected crr.Record items, got {type(r).__name__}")
             if r.path is not None:
                 if record_file is not None:
-                    raise InputError("ground_motion: at most one record file per run (as --record)")
+                    raise InputError("ground_motion: at most one record file per run")
                 if r.format is None:
-                    raise InputError("--record needs --format peer-at2, csv or text")
+                    raise InputError("Record.from_file needs format='peer-at2', 'csv' or 'text'")
                 record_file = (r.path, r.format, r.units, r.component, r.scale)
             else:
                 assert r.t is not None and r.a is not None

@@ -353,13 +353,20 @@ fn simulate(
         Some((path, format, units, component, scale)) => {
             let format: RecordFormat = format
                 .parse()
-                .map_err(|e| argument(py, format!("--format: {e}")))?;
+                .map_err(|e| argument(py, format!("record format: {e}")))?;
             let units: Option<Units> = units
-                .map(|u| u.parse().map_err(|e| argument(py, format!("--units: {e}"))))
+                .map(|u| {
+                    u.parse()
+                        .map_err(|e| argument(py, format!("record units: {e}")))
+                })
                 .transpose()?;
-            let component = parse_axis("--component", &component).map_err(|e| argument(py, e))?;
+            let component =
+                parse_axis("record component", &component).map_err(|e| argument(py, e))?;
             if !scale.is_finite() {
-                return Err(argument(py, format!("--scale must be finite, got {scale}")));
+                return Err(argument(
+                    py,
+                    format!("record scale must be finite, got {scale}"),
+                ));
             }
             Some(RecordFile {
                 file: path,
@@ -387,13 +394,13 @@ fn simulate(
         });
     }
     options.records = arrays;
-    // The command line's wording, which the tests compare (issue: Python-worded errors).
+    // Also checked in Python (crr.simulate), with the same wording: the argument is `duration`.
     if let Some(d) = duration
         && !(d.is_finite() && d > 0.0)
     {
         return Err(argument(
             py,
-            format!("--duration must be a positive number of seconds, got {d}"),
+            format!("duration must be a positive number of seconds, got {d}"),
         ));
     }
     options.duration = duration;
@@ -650,7 +657,7 @@ impl PyStudy {
         progress: bool,
     ) -> PyResult<(usize, usize, usize, usize)> {
         if jobs == Some(0) {
-            return Err(argument(py, "--jobs must be at least 1".into()));
+            return Err(argument(py, "jobs must be at least 1".into()));
         }
         let cancel = crr::Cancel::new();
         let opts = StudyOptions {

@@ -121,3 +121,19 @@ def test_a_record_column_vector_is_one_series() -> None:
     np.testing.assert_array_equal(flat.q, column.q)
     with pytest.raises(crr.InputError, match=r"a must be one series of samples, got an array of shape \(101, 2\)"):
         crr.Record.from_arrays(t, np.stack([a, a], axis=1))
+
+
+def test_record_argument_errors_name_the_python_arguments() -> None:
+    at2 = str(ROOT / "examples" / "records" / "synthetic.AT2")
+    cases = [
+        (crr.Record.from_file(at2, format="xyz"), r"^record format: "),
+        (crr.Record.from_file(at2, format="peer-at2", component="w"), r"^record component: "),
+        (crr.Record.from_file(at2, format="peer-at2", scale=float("nan")), r"^record scale must be finite"),
+        (
+            crr.Record.from_file(at2, format=None),  # type: ignore[arg-type]
+            r"^Record\.from_file needs format='peer-at2', 'csv' or 'text'$",
+        ),
+    ]
+    for record, message in cases:
+        with pytest.raises(crr.InputError, match=message):
+            crr.simulate(BLOCK, ground_motion=record, duration=1.0)
