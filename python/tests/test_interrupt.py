@@ -1,9 +1,11 @@
 """Ctrl-C during ``crr.simulate`` stops the run after its current step: ``KeyboardInterrupt`` is
-raised within 0.2 s of the signal (the waiting thread checks for signals every 20 ms; a step of
-this run takes well under a millisecond in a release build), carries the partial results as
-``result`` (every sample until the interruption, the summary saying so), and Python goes on:
-another run afterwards completes. The signal comes from a timer thread (``_thread.interrupt_main``,
-what Ctrl-C does to the main thread)."""
+raised soon after the signal (the waiting thread checks for signals every 20 ms; a step of this
+run takes well under a millisecond in a release build: 11–22 ms were measured with CI running
+beside it, python/README.md), carries the partial results as ``result`` (every sample until the
+interruption, the summary saying so), and Python goes on: another run afterwards completes. The
+signal comes from a timer thread (``_thread.interrupt_main``, what Ctrl-C does to the main
+thread). The assertion on the delay is only that the run stopped instead of going on: it would
+take minutes, and a loaded machine may be slow to schedule the waiting thread."""
 
 from __future__ import annotations
 
@@ -24,20 +26,31 @@ SINE = {"x": {"sine": {"amplitude": 4.0, "frequency": 2.0}}}
 AT_REST = {"angles": {"base": 0.0}}
 
 
-def test_ctrl_c_stops_a_long_simulation_and_keeps_its_partial_result() -> None:
-    sent = {}
+# Far below the minutes these runs would take, far above any scheduling delay.
+STOPPED_WITHIN_S = 10.0
+
+
+def _interrupt_after(seconds: float) -> "tuple[threading.Timer, dict]":
+    """A started timer that sends Ctrl-C to the main thread after `seconds`, and where it notes
+    when it did."""
+    sent: dict = {}
 
     def interrupt() -> None:
         sent["t"] = time.monotonic()
         _thread.interrupt_main()
 
-    timer = threading.Timer(0.5, interrupt)
+    timer = threading.Timer(seconds, interrupt)
     timer.start()
+    return timer, sent
+
+
+def test_ctrl_c_stops_a_long_simulation_and_keeps_its_partial_result() -> None:
+    timer, sent = _interrupt_after(0.5)
     with pytest.raises(KeyboardInterrupt) as info:
         crr.simulate(BLOCK, ground_motion=SINE, initial=AT_REST, duration=1e6, output_interval=0.5)
     caught = time.monotonic()
     timer.join()
-    assert caught - sent["t"] < 0.2, f"KeyboardInterrupt {caught - sent['t']:.3f} s after the signal"
+    assert caught - sent["t"] < STOPPED_WITHIN_S, f"{caught - sent['t']:.3f} s after the signal"
     result = info.value.result  # type: ignore[attr-defined]
     assert result.summary["completed"] is False
     assert result.summary["error"].startswith("interrupted at t = ")
@@ -54,19 +67,12 @@ def test_ctrl_c_stops_a_long_simulation_and_keeps_its_partial_result() -> None:
 def test_ctrl_c_stops_a_study_whose_folder_then_resumes(tmp_path: Path) -> None:
     study = ROOT / "examples" / "studies" / "housner_map.toml"
     out = tmp_path / "map"
-    sent = {}
-
-    def interrupt() -> None:
-        sent["t"] = time.monotonic()
-        _thread.interrupt_main()
-
-    timer = threading.Timer(0.3, interrupt)
-    timer.start()
+    timer, sent = _interrupt_after(0.3)
     with pytest.raises(KeyboardInterrupt):
         crr.study(study, jobs=2, out=out)
     caught = time.monotonic()
     timer.join()
-    assert caught - sent["t"] < 0.2, f"KeyboardInterrupt {caught - sent['t']:.3f} s after the signal"
+    assert caught - sent["t"] < STOPPED_WITHIN_S, f"{caught - sent['t']:.3f} s after the signal"
     rows = (out / "cases.csv").read_text().splitlines()
     assert 1 <= len(rows) < 3601  # the header and the cases that ended
     assert not (out / "study.json").exists()

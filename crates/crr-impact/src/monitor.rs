@@ -235,16 +235,7 @@ fn interface_forces(
         closure_on.push((model.frame_of(iface.parent), lam));
         closure_on.push((Some(model.body_coord[iface.child]), -lam));
     }
-    let in_subtree = |frame: Option<usize>, root: usize| -> bool {
-        let mut j = frame;
-        while let Some(jj) = j {
-            if jj == root {
-                return true;
-            }
-            j = model.coords[jj].parent;
-        }
-        false
-    };
+    let in_subtree = |frame: Option<usize>, root: usize| model.carries(root, frame);
     out.clear();
     out.extend(model.interfaces.iter().map(|iface| {
         let n_rest = rest_normal(&iface.kind, model.size)?;

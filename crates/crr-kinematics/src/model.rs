@@ -665,6 +665,19 @@ impl Model {
         }
     }
 
+    /// Whether coordinate `coordinate` carries frame `frame`: it lies on the frame's path to the
+    /// ground (a frame carries itself; the ground, None, is carried by nothing).
+    pub fn carries(&self, coordinate: usize, frame: Option<usize>) -> bool {
+        let mut j = frame;
+        while let Some(jj) = j {
+            if jj == coordinate {
+                return true;
+            }
+            j = self.coords[jj].parent;
+        }
+        false
+    }
+
     /// The partition of the structure into its connected parts: the coordinates joined by
     /// parent links (one tree rooted at the ground each), by loop closures between bodies
     /// (a closure to the ground joins nothing) and by symmetry rows. The equations of motion of

@@ -84,7 +84,9 @@ struct Lift {
 }
 
 enum LiftMoves {
+    /// The subtree of this tree coordinate translates.
     Subtree(usize),
+    /// The point rows of this closure interface relax.
     Closure(usize),
 }
 
@@ -138,7 +140,7 @@ pub fn opening_qp(model: &Model, d: &Dynamics) -> Result<OpeningDecision, Openin
             let share = match lift.moves {
                 LiftMoves::Subtree(k) => {
                     let closing = &model.interfaces[cl.interface];
-                    let beyond = |f: Option<usize>| f64::from(u8::from(in_subtree(model, f, k)));
+                    let beyond = |f: Option<usize>| f64::from(u8::from(model.carries(k, f)));
                     beyond(model.frame_of(closing.parent))
                         - beyond(Some(model.body_coord[closing.child]))
                 }
@@ -226,26 +228,16 @@ fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
         let iface = &model.interfaces[index];
         let sigma = d.pivots.sides[k].sign();
         let parent = model.frame_of(iface.parent);
-        let rot = |f: Option<usize>| f.map_or_else(Matrix3::identity, |f| kin.rot_ops[f]);
-        let (w, moves) = if k < n {
-            (kin.axis[k], LiftMoves::Subtree(k))
+        let moves = if k < n {
+            LiftMoves::Subtree(k)
+        } else if model.closures.iter().any(|c| c.interface == index)
+            && !matches!(iface.kind, InterfaceKind::RockingBase { twist: true, .. })
+        {
+            LiftMoves::Closure(index)
         } else {
-            let Some(closure) = model.closures.iter().position(|c| c.interface == index) else {
-                continue;
-            };
-            let w = match &iface.kind {
-                InterfaceKind::Hinge { axis, .. } => rot(parent) * axis,
-                InterfaceKind::RockingBase { twist: true, .. } => continue,
-                InterfaceKind::RockingBase { e1, e2, .. } => {
-                    if k == iface.slots.start {
-                        rot(parent) * e1
-                    } else {
-                        rot(Some(model.body_coord[iface.child])) * e2
-                    }
-                }
-            };
-            (w, LiftMoves::Closure(model.closures[closure].interface))
+            continue;
         };
+        let w = world_axis(model, d, index, k);
         let pivot = frame_point(
             kin,
             parent,
@@ -275,18 +267,6 @@ fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
     lifts
 }
 
-/// Whether frame `f` is carried by coordinate k (k on its path to the ground).
-fn in_subtree(model: &Model, f: Option<usize>, k: usize) -> bool {
-    let mut j = f;
-    while let Some(jj) = j {
-        if jj == k {
-            return true;
-        }
-        j = model.coords[jj].parent;
-    }
-    false
-}
-
 /// Adds the lifts' terms of Gauss' function: per body b, a_b = Σⱼ (wⱼ × (c_b − pⱼ)) q̈ⱼ + bias_b
 /// plus the translations τₖℓₖ of the seated tree coordinates k that carry it.
 fn add_lift_metric(
@@ -308,7 +288,7 @@ fn add_lift_metric(
                 .iter()
                 .enumerate()
                 .filter_map(|(l, lift)| match lift.moves {
-                    LiftMoves::Subtree(k) if in_subtree(model, Some(frame), k) => Some(l),
+                    LiftMoves::Subtree(k) if model.carries(k, Some(frame)) => Some(l),
                     _ => None,
                 }),
         );

@@ -778,16 +778,7 @@ impl SubtreeLoads {
         r: f64,
     ) -> (f64, f64) {
         let kin = &trial.kin;
-        let in_subtree = |frame: Option<usize>| {
-            let mut j = frame;
-            while let Some(jj) = j {
-                if jj == k {
-                    return true;
-                }
-                j = model.coords[jj].parent;
-            }
-            false
-        };
+        let in_subtree = |frame: Option<usize>| model.carries(k, frame);
         let mut force = Vector3::zeros();
         for (b, f) in self.body_force.iter().enumerate() {
             if in_subtree(Some(model.body_coord[b])) {
