@@ -16,7 +16,7 @@ use crr::dynamics::{mobility, mobility_after_step};
 use crr::kinematics::{ActivePivots, InterfaceKind, Model, Side, closure_angles, relative_angles};
 
 /// The bundled baldachin's text with its three loop-closing tops allowed to twist.
-fn twisting_text() -> String {
+pub(crate) fn twisting_text() -> String {
     let text = common::bundled_text("baldachin");
     let mut out = String::new();
     let mut in_closing_top = false;
