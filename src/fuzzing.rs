@@ -53,5 +53,10 @@ pub fn results(data: &[u8]) {
         parts.next().unwrap_or_default(),
         parts.next().unwrap_or_default(),
     );
-    let _ = crate::output::plot::parse_results(Path::new("fuzz"), &summary, &history, &impacts);
+    let _ = crate::output::plot::parse_results(
+        Path::new("fuzz"),
+        &summary,
+        std::io::Cursor::new(history.as_bytes()),
+        &impacts,
+    );
 }

@@ -11,3 +11,4 @@ pub mod poincare_plot;
 pub mod results_folder;
 pub mod simulate;
 pub mod study;
+pub mod text_lines;

@@ -21,7 +21,9 @@ use crr_kinematics::{ActivePivots, Model, Side};
 use crate::analysis::check::{CheckReport, housner_frequency};
 use crate::analysis::levels::{DEFAULT_STEP, MechanismLevels, mechanism_levels};
 use crate::input::model_file::ModelFile;
+use crate::output::text_lines::TextLines;
 
+pub mod decimate;
 mod figures;
 mod study;
 pub use figures::{
@@ -86,7 +88,10 @@ pub struct Results {
     pub model_name: String,
     /// Coordinate names, in the order of q.
     pub coordinates: Vec<String>,
-    /// Sample times (s).
+    /// Rows of history.csv.
+    pub history_rows: usize,
+    /// Sample times (s) of the rows drawn: all of them, or for a long history those that keep
+    /// every series' envelope at the figures' width ([`decimate`]).
     pub t: Vec<f64>,
     /// Angles (rad), one vector per coordinate.
     pub q: Vec<Vec<f64>>,
@@ -161,21 +166,31 @@ fn mechanism_levels_of(summary: &Value) -> Option<MechanismLevels> {
     mechanism_levels(&model, DEFAULT_STEP).ok()
 }
 
-/// Reads `history.csv`, `impacts.csv` and `summary.json` of a results folder.
+/// Reads `history.csv`, `impacts.csv` and `summary.json` of a results folder; history.csv is read
+/// line by line (only its numbers are kept, not its text).
 pub fn read_results(dir: &Path) -> Result<Results, PlotError> {
     if !dir.is_dir() {
         return Err(PlotError::MissingDir(dir.to_path_buf()));
     }
-    let [summary, history, impacts] =
-        ["summary.json", "history.csv", "impacts.csv"].map(|f| read_text(&dir.join(f)));
-    parse_results(dir, &summary?, &history?, &impacts?)
+    let history_file = dir.join("history.csv");
+    let history =
+        crr_dynamics::input::open_regular_file(&history_file).map_err(|e| PlotError::Read {
+            file: history_file.clone(),
+            message: format!("cannot read the file: {e}"),
+        });
+    let [summary, impacts] = ["summary.json", "impacts.csv"].map(|f| read_text(&dir.join(f)));
+    let (summary, history, impacts) = (summary?, history?, impacts?);
+    parse_results(dir, &summary, std::io::BufReader::new(history), &impacts)
 }
 
-/// Parses the texts of the three files of a results folder (`dir` names them in messages).
+/// Parses the three files of a results folder, history.csv from a reader, read twice: once to
+/// check every row, once to keep the rows drawn (every row of a history of at most
+/// [`decimate::ROWS_KEPT_WHOLE`], else those of [`decimate::Decimator`]). `dir` names the files in
+/// messages.
 pub fn parse_results(
     dir: &Path,
     summary_text: &str,
-    history_text: &str,
+    history: impl std::io::BufRead + std::io::Seek,
     impacts_text: &str,
 ) -> Result<Results, PlotError> {
     let summary_file = dir.join("summary.json");
@@ -198,21 +213,23 @@ pub fn parse_results(
         .to_string();
 
     let history_file = dir.join("history.csv");
-    let text = history_text;
     let bad = |message: String| PlotError::Read {
         file: history_file.clone(),
         message,
     };
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
+    let mut lines = TextLines::new(history);
+    let header: Vec<String> = lines
+        .next_line()
+        .map_err(&bad)?
         .ok_or_else(|| bad("empty file".into()))?
+        .text
         .split(',')
+        .map(str::to_string)
         .collect();
     let column = |name: &str| {
         header
             .iter()
-            .position(|h| *h == name)
+            .position(|h| h == name)
             .ok_or_else(|| bad(format!("no column `{name}`")))
     };
     let t_col = column("t")?;
@@ -232,6 +249,7 @@ pub fn parse_results(
     let mut r = Results {
         model_name,
         coordinates,
+        history_rows: 0,
         t: Vec::new(),
         q: vec![Vec::new(); n],
         qdot: vec![Vec::new(); n],
@@ -246,42 +264,93 @@ pub fn parse_results(
     if r.free_rocking.is_none() {
         r.levels = mechanism_levels_of(&summary);
     }
-    for (row, line) in lines.enumerate() {
-        if line.trim().is_empty() {
+    // The numbers of a row in the order [t, q…, q̇…, T, U, W, D].
+    let columns: Vec<usize> = std::iter::once(t_col)
+        .chain(q_cols.iter().copied())
+        .chain(rate_cols.iter().copied())
+        .chain(energy_cols.iter().copied())
+        .collect();
+    let parse_row = |line: &str, line_no: usize| -> Result<Vec<f64>, PlotError> {
+        let fields: Vec<&str> = line.split(',').collect();
+        columns
+            .iter()
+            .map(|&c| {
+                fields
+                    .get(c)
+                    .and_then(|f| f.trim().parse::<f64>().ok())
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| {
+                        bad(format!(
+                            "line {line_no}: column `{}` is not a finite number",
+                            header[c]
+                        ))
+                    })
+            })
+            .collect()
+    };
+    // First pass: every row checked, its count and time span kept.
+    let mut rows = 0usize;
+    let mut span = (0.0, 0.0);
+    while let Some(line) = lines.next_line().map_err(&bad)? {
+        if line.text.trim().is_empty() {
             continue;
         }
-        let fields: Vec<&str> = line.split(',').collect();
-        let value = |c: usize| -> Result<f64, PlotError> {
-            fields
-                .get(c)
-                .and_then(|f| f.trim().parse::<f64>().ok())
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    bad(format!(
-                        "line {}: column `{}` is not a finite number",
-                        row + 2,
-                        header[c]
-                    ))
-                })
-        };
-        let t = value(t_col)?;
-        if r.t.last().is_some_and(|&last| t < last) {
-            return Err(bad(format!("line {}: time {t} goes backwards", row + 2)));
+        let line_no = line.number;
+        let t = parse_row(line.text, line_no)?[0];
+        if rows > 0 && t < span.1 {
+            return Err(bad(format!("line {line_no}: time {t} goes backwards")));
         }
-        r.t.push(t);
-        for k in 0..n {
-            r.q[k].push(value(q_cols[k])?);
-            r.qdot[k].push(value(rate_cols[k])?);
+        if rows == 0 {
+            span.0 = t;
         }
-        r.kinetic.push(value(energy_cols[0])?);
-        r.potential.push(value(energy_cols[1])?);
-        r.work_in.push(value(energy_cols[2])?);
-        r.dissipated.push(value(energy_cols[3])?);
+        span.1 = t;
+        rows += 1;
     }
-
-    if r.t.is_empty() {
+    if rows == 0 {
         return Err(bad("no data rows after the header".into()));
     }
+    // Second pass: the rows drawn, every one or those a figure's width can show.
+    let mut reader = lines.into_inner();
+    reader
+        .seek(std::io::SeekFrom::Start(0))
+        .map_err(|e| bad(format!("cannot read the file again: {e}")))?;
+    let mut lines = TextLines::new(reader);
+    lines.next_line().map_err(&bad)?;
+    let mut kept = Vec::with_capacity(rows.min(decimate::ROWS_KEPT_WHOLE));
+    let mut decimator =
+        (rows > decimate::ROWS_KEPT_WHOLE).then(|| decimate::Decimator::new(span.0, span.1));
+    let mut index = 0;
+    while let Some(line) = lines.next_line().map_err(&bad)? {
+        if line.text.trim().is_empty() {
+            continue;
+        }
+        let mut row = parse_row(line.text, line.number)?;
+        match decimator.as_mut() {
+            Some(d) => {
+                // The energy balance T + U − W + D is drawn too: its envelope is kept as well.
+                let e = row[1 + 2 * n] + row[2 + 2 * n] - row[3 + 2 * n] + row[4 + 2 * n];
+                row.push(e);
+                d.push(index, row)
+            }
+            None => kept.push(row),
+        }
+        index += 1;
+    }
+    if let Some(d) = decimator {
+        kept = d.finish();
+    }
+    for row in kept {
+        r.t.push(row[0]);
+        for k in 0..n {
+            r.q[k].push(row[1 + k]);
+            r.qdot[k].push(row[1 + n + k]);
+        }
+        r.kinetic.push(row[1 + 2 * n]);
+        r.potential.push(row[2 + 2 * n]);
+        r.work_in.push(row[3 + 2 * n]);
+        r.dissipated.push(row[4 + 2 * n]);
+    }
+    r.history_rows = rows;
 
     let impacts_file = dir.join("impacts.csv");
     let text = impacts_text;

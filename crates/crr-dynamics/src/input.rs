@@ -35,6 +35,18 @@ pub fn read_regular_file(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// Opens the file at `path` for reading in pieces if it is a regular file (no size limit: the
+/// caller reads it in constant memory).
+pub fn open_regular_file(path: &Path) -> std::io::Result<std::fs::File> {
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a folder, a pipe or a device)",
+        ));
+    }
+    std::fs::File::open(path)
+}
+
 /// [`read_regular_file`] as UTF-8 text (invalid sequences are an error naming the byte offset).
 pub fn read_regular_text(path: &Path, limit: u64) -> std::io::Result<String> {
     String::from_utf8(read_regular_file(path, limit)?).map_err(|e| {
@@ -70,9 +82,14 @@ mod tests {
         assert!(e.to_string().contains("over the limit of 4"), "{e}");
         let e = read_regular_file(&dir, 100).unwrap_err();
         assert!(e.to_string().contains("not a regular file"), "{e}");
+        let e = open_regular_file(&dir).unwrap_err();
+        assert!(e.to_string().contains("not a regular file"), "{e}");
+        assert!(open_regular_file(&f).is_ok());
         #[cfg(unix)]
         {
             let e = read_regular_file(Path::new("/dev/zero"), 100).unwrap_err();
+            assert!(e.to_string().contains("not a regular file"), "{e}");
+            let e = open_regular_file(Path::new("/dev/zero")).unwrap_err();
             assert!(e.to_string().contains("not a regular file"), "{e}");
         }
         std::fs::write(&f, [0x66, 0xff, 0x66]).unwrap();

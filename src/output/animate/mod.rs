@@ -9,6 +9,8 @@
 //! body's [`Surface`]. Everything is shown in the frame of the ground (the ground motion moves
 //! the whole picture, which is not drawn).
 
+use std::fs::File;
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use nalgebra::{DVector, Vector3};
@@ -19,6 +21,7 @@ use crr_kinematics::{ActivePivots, Data, Model, Side, body_points, forward_kinem
 
 use crate::Error;
 use crate::input::model_file::ModelFile;
+use crate::output::text_lines::TextLines;
 
 pub mod gif;
 pub mod render;
@@ -114,22 +117,36 @@ pub struct State {
     pub row: usize,
 }
 
-/// A results folder read back for animation.
+/// A results folder read back for animation: the model, and the extent of its history, whose
+/// states are read again, one at a time, when the frames are drawn ([`Run::states`]), so that a
+/// history of any length is animated in memory proportional to the frames kept.
 #[derive(Clone, Debug)]
 pub struct Run {
     /// The model rebuilt from summary.json.
     pub model: Model,
-    /// Every state of history.csv, the two rows of an impact merged (the later one kept).
-    pub states: Vec<State>,
+    /// The run's history.csv.
+    pub history: PathBuf,
+    /// The states of history.csv (the two rows of an impact merged into one).
+    pub count: usize,
+    /// Time of the first and of the last state (s).
+    pub span: (f64, f64),
+}
+
+impl Run {
+    /// The states of history.csv, read again from the file.
+    pub fn states(&self) -> Result<HistoryStates<'_, BufReader<File>>, Error> {
+        HistoryStates::open(&self.model, &self.history)
+    }
 }
 
 fn read_error(file: &Path, message: impl std::fmt::Display) -> Error {
     Error::Argument(format!("{}: {message}", file.display()))
 }
 
-/// Reads `summary.json` (for the model) and `history.csv` of a results folder. A missing
-/// folder or file, a run still being written (its hidden `.partial.NAME` files), a summary
-/// without the model, or a history that does not fit the model is an error naming the file.
+/// Reads `summary.json` (for the model) and `history.csv` of a results folder, checking every row
+/// of the history once (nothing is kept but its count and time span). A missing folder or file, a
+/// run still being written (its hidden `.partial.NAME` files), a summary without the model, or a
+/// history that does not fit the model is an error naming the file.
 pub fn read_run(dir: &Path) -> Result<Run, Error> {
     if !dir.is_dir() {
         return Err(Error::Argument(format!(
@@ -157,10 +174,25 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
     let summary: Value = serde_json::from_str(&summary_text)
         .map_err(|e| read_error(&summary_path, format!("not valid JSON: {e}")))?;
     let model = model_of(&summary, &summary_path)?;
-    let history = std::fs::read_to_string(&history_path)
-        .map_err(|e| read_error(&history_path, format!("cannot read the file: {e}")))?;
-    let states = parse_history(&model, &history, &history_path)?;
-    Ok(Run { model, states })
+    let mut count = 0;
+    let mut span = (0.0, 0.0);
+    for state in HistoryStates::open(&model, &history_path)? {
+        let state = state?;
+        if count == 0 {
+            span.0 = state.t;
+        }
+        span.1 = state.t;
+        count += 1;
+    }
+    if count == 0 {
+        return Err(read_error(&history_path, "holds no data rows"));
+    }
+    Ok(Run {
+        model,
+        history: history_path,
+        count,
+        span,
+    })
 }
 
 /// The model echoed in summary.json's `model`, validated.
@@ -180,52 +212,100 @@ fn model_of(summary: &Value, path: &Path) -> Result<Model, Error> {
     Model::from_spec(&file.structure()).map_err(|e| read_error(path, format!("`model`: {e}")))
 }
 
-/// Parses history.csv: the angle and `_state` columns of every row.
-pub fn parse_history(model: &Model, text: &str, path: &Path) -> Result<Vec<State>, Error> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines
-        .next()
-        .ok_or_else(|| read_error(path, "empty file"))?
-        .split(',')
-        .collect();
-    let column = |name: &str| {
-        header
-            .iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| read_error(path, format!("no column `{name}`")))
-    };
-    let t_col = column("t")?;
-    let q_cols = model
-        .coords
-        .iter()
-        .map(|c| column(&c.name))
-        .collect::<Result<Vec<_>, _>>()?;
-    let state_cols = model
-        .interfaces
-        .iter()
-        .map(|i| column(&format!("{}_state", i.name)))
-        .collect::<Result<Vec<_>, _>>()?;
-    if !text.ends_with('\n') {
-        return Err(read_error(
-            path,
-            "the last line is not complete (no line end): a half-written file",
-        ));
+/// The states of history.csv (its angle and `_state` columns) one at a time, the two rows of an
+/// impact (rates before, then after) merged into one state, the later: a history of any length
+/// is read in constant memory. A row that does not fit the model is an error naming the file and
+/// the line, after which the iterator ends.
+pub struct HistoryStates<'m, R> {
+    model: &'m Model,
+    path: PathBuf,
+    lines: TextLines<R>,
+    header: Vec<String>,
+    t_col: usize,
+    q_cols: Vec<usize>,
+    state_cols: Vec<usize>,
+    peak: f64,
+    pending: Option<State>,
+    done: bool,
+}
+
+impl<'m> HistoryStates<'m, BufReader<File>> {
+    /// Opens `path` and reads its header.
+    pub fn open(model: &'m Model, path: &Path) -> Result<Self, Error> {
+        let file = crr_dynamics::input::open_regular_file(path)
+            .map_err(|e| read_error(path, format!("cannot read the file: {e}")))?;
+        HistoryStates::new(model, BufReader::new(file), path)
     }
-    let mut states: Vec<State> = Vec::new();
-    let mut peak = 0.0f64;
-    for (i, line) in lines.enumerate() {
-        let row = i + 1;
-        let line_no = i + 2;
+}
+
+impl<'m, R: BufRead> HistoryStates<'m, R> {
+    /// Reads the header of a history read from `reader` (`path` names it in messages).
+    pub fn new(model: &'m Model, reader: R, path: &Path) -> Result<Self, Error> {
+        let mut states = HistoryStates {
+            model,
+            path: path.to_path_buf(),
+            lines: TextLines::new(reader),
+            header: Vec::new(),
+            t_col: 0,
+            q_cols: Vec::new(),
+            state_cols: Vec::new(),
+            peak: 0.0,
+            pending: None,
+            done: false,
+        };
+        let header = states
+            .next_line()?
+            .ok_or_else(|| read_error(path, "empty file"))?;
+        let header: Vec<String> = header.split(',').map(str::to_string).collect();
+        let column = |name: &str| {
+            header
+                .iter()
+                .position(|h| h == name)
+                .ok_or_else(|| read_error(path, format!("no column `{name}`")))
+        };
+        states.t_col = column("t")?;
+        states.q_cols = model
+            .coords
+            .iter()
+            .map(|c| column(&c.name))
+            .collect::<Result<Vec<_>, _>>()?;
+        states.state_cols = model
+            .interfaces
+            .iter()
+            .map(|i| column(&format!("{}_state", i.name)))
+            .collect::<Result<Vec<_>, _>>()?;
+        states.header = header;
+        Ok(states)
+    }
+
+    fn error(&self, message: impl std::fmt::Display) -> Error {
+        read_error(&self.path, message)
+    }
+
+    /// The next line without its line end; None at the end of the file. A last line without
+    /// its line end is a half-written file.
+    fn next_line(&mut self) -> Result<Option<&str>, Error> {
+        match self.lines.next_line() {
+            Ok(Some(line)) if !line.ended => Err(read_error(
+                &self.path,
+                "the last line is not complete (no line end): a half-written file",
+            )),
+            Ok(line) => Ok(line.map(|l| l.text)),
+            Err(message) => Err(read_error(&self.path, message)),
+        }
+    }
+
+    /// Parses one data row into a state.
+    fn parse_row(&self, line: &str) -> Result<State, Error> {
+        let line_no = self.lines.number();
+        let header = &self.header;
         let fields: Vec<&str> = line.split(',').collect();
         if fields.len() != header.len() {
-            return Err(read_error(
-                path,
-                format!(
-                    "line {line_no}: {} fields, {} expected (a damaged or half-written file)",
-                    fields.len(),
-                    header.len()
-                ),
-            ));
+            return Err(self.error(format!(
+                "line {line_no}: {} fields, {} expected (a damaged or half-written file)",
+                fields.len(),
+                header.len()
+            )));
         }
         let number = |c: usize| -> Result<f64, Error> {
             fields[c]
@@ -234,36 +314,31 @@ pub fn parse_history(model: &Model, text: &str, path: &Path) -> Result<Vec<State
                 .ok()
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
-                    read_error(
-                        path,
-                        format!(
-                            "line {line_no}: column `{}` is not a finite number",
-                            header[c]
-                        ),
-                    )
+                    self.error(format!(
+                        "line {line_no}: column `{}` is not a finite number",
+                        header[c]
+                    ))
                 })
         };
-        let t = number(t_col)?;
+        let t = number(self.t_col)?;
         let q = DVector::from_iterator(
-            q_cols.len(),
-            q_cols
+            self.q_cols.len(),
+            self.q_cols
                 .iter()
                 .map(|&c| number(c))
                 .collect::<Result<Vec<_>, _>>()?,
         );
+        let model = self.model;
         let mut pivots = ActivePivots::uniform(model, Side::Positive);
-        for (iface, &c) in model.interfaces.iter().zip(&state_cols) {
+        for (iface, &c) in model.interfaces.iter().zip(&self.state_cols) {
             let codes: Vec<&str> = fields[c].split('/').collect();
             if codes.len() != iface.slots.len() {
-                return Err(read_error(
-                    path,
-                    format!(
-                        "line {line_no}: column `{}` is `{}`, {} code(s) expected",
-                        header[c],
-                        fields[c],
-                        iface.slots.len()
-                    ),
-                ));
+                return Err(self.error(format!(
+                    "line {line_no}: column `{}` is `{}`, {} code(s) expected",
+                    header[c],
+                    fields[c],
+                    iface.slots.len()
+                )));
             }
             for (k, (slot, code)) in iface.slots.clone().zip(codes).enumerate() {
                 pivots.sides[slot] = match code {
@@ -278,56 +353,84 @@ pub fn parse_history(model: &Model, text: &str, path: &Path) -> Result<Vec<State
                         Side::of(angle, Side::Positive)
                     }
                     other => {
-                        return Err(read_error(
-                            path,
-                            format!(
-                                "line {line_no}: column `{}` holds `{other}`, not +, - or seated",
-                                header[c]
-                            ),
-                        ));
+                        return Err(self.error(format!(
+                            "line {line_no}: column `{}` holds `{other}`, not +, - or seated",
+                            header[c]
+                        )));
                     }
                 };
             }
         }
-        peak = q.iter().fold(peak, |m, v| m.max(v.abs()));
-        let state = State {
+        Ok(State {
             t,
             q,
             pivots,
-            peak_so_far: peak,
-            row,
-        };
-        match states.last_mut() {
-            Some(last) if t < last.t => {
-                return Err(read_error(
-                    path,
-                    format!("line {line_no}: time {t} goes backwards"),
-                ));
+            peak_so_far: 0.0,
+            row: line_no - 1,
+        })
+    }
+
+    /// The next merged state: rows are read until one has a later time than the pending state.
+    fn advance(&mut self) -> Result<Option<State>, Error> {
+        loop {
+            let Some(line) = self.next_line()? else {
+                return Ok(self.pending.take());
+            };
+            let line = line.to_string();
+            let mut state = self.parse_row(&line)?;
+            self.peak = state.q.iter().fold(self.peak, |m, v| m.max(v.abs()));
+            state.peak_so_far = self.peak;
+            match self.pending.take() {
+                Some(last) if state.t < last.t => {
+                    return Err(self.error(format!(
+                        "line {}: time {} goes backwards",
+                        self.lines.number(),
+                        state.t
+                    )));
+                }
+                // The two rows of an impact (rates before, then after): one state, the later.
+                Some(last) if state.t == last.t => self.pending = Some(state),
+                Some(last) => {
+                    self.pending = Some(state);
+                    return Ok(Some(last));
+                }
+                None => self.pending = Some(state),
             }
-            // The two rows of an impact (rates before, then after): one state, the later.
-            Some(last) if t == last.t => *last = state,
-            _ => states.push(state),
         }
     }
-    if states.is_empty() {
-        return Err(read_error(path, "holds no data rows"));
+}
+
+impl<R: BufRead> Iterator for HistoryStates<'_, R> {
+    type Item = Result<State, Error>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        let next = self.advance().transpose();
+        if !matches!(next, Some(Ok(_))) {
+            self.done = true;
+        }
+        next
     }
-    Ok(states)
 }
 
 /// The step K between frames: `every` when given (at least 1), else about
 /// [`DEFAULT_FRAME_INTERVAL`] of simulated time between frames and at most
-/// [`DEFAULT_MAX_FRAMES`] frames.
-pub fn frame_step(states: &[State], every: Option<usize>) -> Result<usize, Error> {
+/// [`DEFAULT_MAX_FRAMES`] frames, for `count` states spanning `span` (s).
+pub fn frame_step(count: usize, span: (f64, f64), every: Option<usize>) -> Result<usize, Error> {
     match every {
         Some(0) => Err(Error::Argument(
             "--every must be at least 1 (keep every K-th state)".into(),
         )),
         Some(k) => Ok(k),
         None => {
-            let n = states.len();
-            let span = states[n - 1].t - states[0].t;
-            let dt = if n > 1 { span / (n - 1) as f64 } else { 1.0 };
+            let n = count.max(1);
+            let dt = if n > 1 {
+                (span.1 - span.0) / (n - 1) as f64
+            } else {
+                1.0
+            };
             let by_time = if dt > 0.0 {
                 (DEFAULT_FRAME_INTERVAL / dt).round().max(1.0) as usize
             } else {
@@ -338,9 +441,17 @@ pub fn frame_step(states: &[State], every: Option<usize>) -> Result<usize, Error
     }
 }
 
-/// The states kept as frames: the first and every K-th after it.
-pub fn frame_states(states: &[State], k: usize) -> Vec<&State> {
-    states.iter().step_by(k.max(1)).collect()
+/// The states kept as frames: the first and every K-th after it, read from the history again.
+/// Every row is read (an error anywhere stops it), only the frames are kept.
+pub fn frame_states(run: &Run, k: usize) -> Result<Vec<State>, Error> {
+    let mut frames = Vec::with_capacity(run.count.div_ceil(k.max(1)));
+    for (i, state) in run.states()?.enumerate() {
+        let state = state?;
+        if i % k.max(1) == 0 {
+            frames.push(state);
+        }
+    }
+    Ok(frames)
 }
 
 /// The bodies' surfaces at rest (the frame of the mass properties), in body order.
@@ -501,8 +612,8 @@ pub fn animate(dir: &Path, opts: &AnimateOptions) -> Result<AnimateReport, Error
         )));
     }
     let run = read_run(dir)?;
-    let k = frame_step(&run.states, opts.every)?;
-    let frames = frame_states(&run.states, k);
+    let k = frame_step(run.count, run.span, opts.every)?;
+    let frames = frame_states(&run, k)?;
     let surfaces = body_surfaces(&run.model)?;
     let ground = Ground::of(&run.model, &surfaces);
     let model = &run.model;
