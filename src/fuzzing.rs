@@ -28,6 +28,11 @@ pub fn model_file(data: &[u8]) {
         let q = nalgebra::DVector::zeros(model.dof());
         let _ = crate::analysis::inspect::inspect(&model, &q);
         let _ = crate::analysis::check::check(&model);
+        // What `crr simulate` checks before it runs: the ground motion, the initial state (the
+        // continuation from rest on closed chains) and every analysis setting's bounds.
+        if let Ok(input) = crate::ModelInput::from_file(Path::new(name), file) {
+            let _ = crate::analysis::simulation::prepare(&input, &crate::RunOptions::default());
+        }
     }
 }
 
