@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::{InitialSpec, solve_initial};
-use crr_impact::{Parameters, Simulation, SlotState, Trajectory};
+use crr_impact::{Parameters, Simulation, SimulationError, SlotState, Trajectory};
 use crr_kinematics::fixtures::single_block;
 use crr_kinematics::{ImpactLaw, Model};
 
@@ -275,4 +275,62 @@ fn regularised_dirac_switches_at_every_crossing_whatever_the_width() {
         / lx.iter().map(|x| (x - mx).powi(2)).sum::<f64>();
     eprintln!("observed order {slope:.4}");
     assert!((slope - 1.0).abs() < 0.02, "observed order {slope}");
+}
+
+/// A zone narrower than the run's angle tolerance is refused when the model is built, naming the
+/// interface, the bound and the impulsive law to use instead; forced past that check, such a zone
+/// is stepped over and the run stops on its pivot-side invariant with no collapse claimed (the
+/// block's fall past its pivot had been reported as an overturning).
+#[test]
+fn a_zone_narrower_than_the_angle_tolerance_is_refused_and_never_reported_as_a_collapse() {
+    let mut spec = single_block(0.2, 1.0, 2500.0);
+    for width in [1e-13, 9.9e-6, f64::NAN] {
+        spec.interface[0].impact = ImpactLaw::DiracRegularised {
+            r: 0.9,
+            c: 1.0,
+            width,
+        };
+        let e = Model::from_spec(&spec).unwrap_err().to_string();
+        assert!(
+            e.contains("base") && e.contains("at least 1e-5 rad") && e.contains("dirac = {"),
+            "{e}"
+        );
+    }
+    spec.interface[0].impact = ImpactLaw::DiracRegularised {
+        r: 0.9,
+        c: 1.0,
+        width: crr_kinematics::MIN_DIRAC_WIDTH,
+    };
+    let mut model = Model::from_spec(&spec).unwrap();
+    model.interfaces[0].impact = ImpactLaw::DiracRegularised {
+        r: 0.9,
+        c: 1.0,
+        width: 1e-12,
+    };
+    let init = solve_initial(
+        &model,
+        &InitialSpec {
+            angles: BTreeMap::from([("base".into(), 0.1)]),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let params = Parameters {
+        duration: 2.0,
+        ..Parameters::default()
+    };
+    let stopped = Simulation::new(&model, &GroundMotion::none(), &init, params)
+        .unwrap()
+        .run()
+        .expect_err("the zone is stepped over");
+    assert!(
+        matches!(stopped.error, SimulationError::Invariant(_)),
+        "{}",
+        stopped.error
+    );
+    assert!(
+        stopped.partial.collapse.is_none(),
+        "{:?}",
+        stopped.partial.collapse
+    );
 }

@@ -676,7 +676,14 @@ impl<'a> Simulation<'a> {
     /// state.
     pub fn step(&mut self) -> Result<StopReason, SimulationError> {
         let stop = self.step_unchecked()?;
-        self.check_invariant()?;
+        if let Err(e) = self.check_invariant() {
+            // A collapse declared from a state outside the model is no collapse: the run stops
+            // with the error alone.
+            if matches!(stop, StopReason::Collapse(_)) {
+                self.collapse = None;
+            }
+            return Err(e);
+        }
         Ok(stop)
     }
 
