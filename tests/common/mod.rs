@@ -119,3 +119,45 @@ pub fn bundled_model(name: &str) -> crr::kinematics::Model {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/models/{name}.toml"));
     crr::load_model(&path).expect("bundled model loads").1
 }
+
+/// The structure mirrored by x → −x (bodies that are boxes; hinges and rocking bases). A
+/// reflection R reverses orientation: a hinge's axis becomes −R u with its pivots R P⁺, R P⁻ (so
+/// that u × (P⁻ − P⁺), the face normal, maps to R n), a rocking base's corners are listed in the
+/// reverse order (so that their normal still points into the child).
+pub fn mirrored_x(
+    spec: &crr::kinematics::spec::StructureSpec,
+) -> crr::kinematics::spec::StructureSpec {
+    let r = nalgebra::Matrix3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+    let map = |p: [f64; 3]| -> [f64; 3] { (r * nalgebra::Vector3::from(p)).into() };
+    let mut out = spec.clone();
+    for body in &mut out.body {
+        let b = body.box_shape.as_mut().expect("a box");
+        assert!(b.rotation.is_none(), "axis-aligned boxes only");
+        b.center = map(b.center);
+    }
+    for interface in &mut out.interface {
+        if let Some(axis) = interface.axis {
+            interface.axis = Some(map(axis).map(|x| -x));
+            for pivot in [&mut interface.pivot_positive, &mut interface.pivot_negative]
+                .into_iter()
+                .flatten()
+            {
+                *pivot = match *pivot {
+                    crr::kinematics::spec::PivotSpec::Point(p) => {
+                        crr::kinematics::spec::PivotSpec::Point(map(p))
+                    }
+                    crr::kinematics::spec::PivotSpec::Segment([a, b]) => {
+                        crr::kinematics::spec::PivotSpec::Segment([map(a), map(b)])
+                    }
+                };
+            }
+        }
+        if let Some(base) = &mut interface.rocking_base {
+            for c in &mut base.corners {
+                *c = map(*c);
+            }
+            base.corners.reverse();
+        }
+    }
+    out
+}

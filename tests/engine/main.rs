@@ -10,6 +10,7 @@ mod collapse;
 mod impact_laws_on_chains;
 mod initial_state_paths;
 mod invariant;
+mod mirror_invariance;
 mod opening_program;
 mod order_invariance;
 mod streaming;

@@ -8,12 +8,14 @@
 //!
 //! Tolerance 1e-9 relative: the interior-point solver stops at a duality gap of 1e-12 of the
 //! structure's weight (the multipliers agree to a few 1e-12 in practice).
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
 use crr::kinematics::Model;
 use crr::kinematics::fixtures::{SplitMix, running_bond_wall, running_bond_wall_3d, voussoir_arch};
-use crr::kinematics::spec::{PivotSpec, StructureSpec};
+use crr::kinematics::spec::StructureSpec;
+
+use crate::common::mirrored_x;
 
 fn bundled_spec(name: &str) -> StructureSpec {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -57,42 +59,6 @@ fn shuffled(spec: &StructureSpec, seed: u64, interfaces: bool) -> StructureSpec 
         if let Some(base) = &mut interface.rocking_base {
             let k = rng.below(4);
             base.corners.rotate_left(k);
-        }
-    }
-    out
-}
-
-/// The structure mirrored by x → −x (bodies that are boxes; hinges and rocking bases). A
-/// reflection R reverses orientation: a hinge's axis becomes −R u with its pivots R P⁺, R P⁻ (so
-/// that u × (P⁻ − P⁺), the face normal, maps to R n), a rocking base's corners are listed in the
-/// reverse order (so that their normal still points into the child).
-fn mirrored_x(spec: &StructureSpec) -> StructureSpec {
-    let r = Matrix3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-    let map = |p: [f64; 3]| -> [f64; 3] { (r * Vector3::from(p)).into() };
-    let mut out = spec.clone();
-    for body in &mut out.body {
-        let b = body.box_shape.as_mut().expect("a box");
-        assert!(b.rotation.is_none(), "axis-aligned boxes only");
-        b.center = map(b.center);
-    }
-    for interface in &mut out.interface {
-        if let Some(axis) = interface.axis {
-            interface.axis = Some(map(axis).map(|x| -x));
-            for pivot in [&mut interface.pivot_positive, &mut interface.pivot_negative]
-                .into_iter()
-                .flatten()
-            {
-                *pivot = match *pivot {
-                    PivotSpec::Point(p) => PivotSpec::Point(map(p)),
-                    PivotSpec::Segment([a, b]) => PivotSpec::Segment([map(a), map(b)]),
-                };
-            }
-        }
-        if let Some(base) = &mut interface.rocking_base {
-            for c in &mut base.corners {
-                *c = map(*c);
-            }
-            base.corners.reverse();
         }
     }
     out
