@@ -358,16 +358,19 @@ class Result:
         self.coordinates = coordinates
         self.interfaces = interfaces
         n, dof = run.samples, len(coordinates)
-        h = np.frombuffer(run.history_bytes(), dtype=np.float64).reshape(n, run.width)
-        self.t: np.ndarray = h[:, 0]
-        self.q: np.ndarray = h[:, 1 : 1 + dof]
-        self.qdot: np.ndarray = h[:, 1 + dof : 1 + 2 * dof]
-        e = 1 + 2 * dof
-        self.kinetic: np.ndarray = h[:, e]
-        self.potential: np.ndarray = h[:, e + 1]
-        self.work_in: np.ndarray = h[:, e + 2]
-        self.dissipated: np.ndarray = h[:, e + 3]
-        # Built on first use: one Python object per sample and per impact, the costly part.
+        # Each column crosses as one bytes object that numpy reads in place (no per-sample
+        # Python object).
+        t, q, qdot, kinetic, potential, work_in, dissipated = (
+            np.frombuffer(b, dtype=np.float64) for b in run.history_columns()
+        )
+        self.t: np.ndarray = t
+        self.q: np.ndarray = q.reshape(n, dof)
+        self.qdot: np.ndarray = qdot.reshape(n, dof)
+        self.kinetic: np.ndarray = kinetic
+        self.potential: np.ndarray = potential
+        self.work_in: np.ndarray = work_in
+        self.dissipated: np.ndarray = dissipated
+        # Built on first use: the states from coded columns, the impacts one dict each.
         self._states: Optional[np.ndarray] = None
         self._impacts: Optional[List[Dict[str, Any]]] = None
         self.summary: Dict[str, Any] = json.loads(run.summary_json)
@@ -376,12 +379,9 @@ class Result:
     def states(self) -> np.ndarray:
         """State of every interface per sample, shape (n, interfaces), dtype str."""
         if self._states is None:
-            states = self._run.states()
-            self._states = (
-                np.array(states, dtype=str)
-                if len(self.t)
-                else np.empty((0, len(self.interfaces)), dtype=str)
-            )
+            labels, codes = self._run.state_codes()
+            index = np.frombuffer(codes, dtype=np.uint32).reshape(len(self.t), len(self.interfaces))
+            self._states = np.array(labels or [""], dtype=str)[index]
         return self._states
 
     @property

@@ -8,6 +8,7 @@
 //! `crr` prints after `crr: error: `). Simulations and studies run with the interpreter
 //! detached (`Python::detach`, the GIL released), so that Python threads run them in parallel.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use pyo3::exceptions::PyRuntimeError;
@@ -18,7 +19,7 @@ use crr::Error;
 use crr::analysis::inspect;
 use crr::analysis::study::{Case, StudySpec};
 use crr::dynamics::ground_motion::{Axis, Record, RecordFormat, Units};
-use crr::impact::Trajectory;
+use crr::impact::{SlotState, Trajectory};
 use crr::input::model_file::{ModelFile, build_model, load_model, parse_model_text};
 use crr::kinematics::Model as Structure;
 use crr::output::history::{history_csv, impacts_csv};
@@ -223,48 +224,86 @@ impl PyRun {
         self.trajectory.samples.len()
     }
 
-    /// Width of a history row of numbers: t, q, q̇, T, U, W, D.
-    #[getter]
-    fn width(&self) -> usize {
-        1 + 2 * self.structure.dof() + 4
-    }
-
-    /// The numbers of history.csv (t, q, q̇, kinetic, potential, work_in, dissipated) row by row,
-    /// as native-endian f64 bytes.
-    fn history_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        let mut bytes = Vec::with_capacity(8 * self.samples() * self.width());
-        for s in &self.trajectory.samples {
-            let row = std::iter::once(s.t)
-                .chain(s.q.iter().copied())
-                .chain(s.qdot.iter().copied())
-                .chain([s.kinetic, s.potential, s.work_in, s.dissipated]);
-            for v in row {
-                bytes.extend_from_slice(&v.to_ne_bytes());
-            }
-        }
-        PyBytes::new(py, &bytes)
+    /// The numbers of history.csv as columns of native-endian f64 bytes, each written straight
+    /// into its Python object: t, q (row-major, samples × dof), q̇ (the same), kinetic,
+    /// potential, work_in, dissipated. numpy reads each without a copy.
+    fn history_columns<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyBytes>>> {
+        let s = &self.trajectory.samples;
+        [
+            s.times(),
+            s.q(),
+            s.qdot(),
+            s.kinetic(),
+            s.potential(),
+            s.work_in(),
+            s.dissipated(),
+        ]
+        .into_iter()
+        .map(|column| {
+            PyBytes::new_with(py, 8 * column.len(), |buf| {
+                for (bytes, v) in buf.chunks_exact_mut(8).zip(column) {
+                    bytes.copy_from_slice(&v.to_ne_bytes());
+                }
+                Ok(())
+            })
+        })
+        .collect()
     }
 
     /// The state column of every interface per sample, as in history.csv (`seated`, `+`, `-`,
-    /// slots joined by `/`).
-    fn states(&self) -> Vec<Vec<String>> {
-        self.trajectory
-            .samples
-            .iter()
-            .map(|s| {
-                self.structure
-                    .interfaces
-                    .iter()
-                    .map(|i| {
-                        i.slots
-                            .clone()
-                            .map(|k| s.states.get(k).map_or("?", |st| st.code()))
-                            .collect::<Vec<_>>()
-                            .join("/")
+    /// slots joined by `/`), coded: the distinct labels, and for every sample and interface (row
+    /// by row) the index of its label as native-endian u32 bytes. Python indexes the labels with
+    /// them (one numpy operation) instead of building a string per sample.
+    fn state_codes<'py>(&self, py: Python<'py>) -> PyResult<(Vec<String>, Bound<'py, PyBytes>)> {
+        let interfaces = &self.structure.interfaces;
+        let mut labels: Vec<String> = Vec::new();
+        let mut by_label: HashMap<String, u32> = HashMap::new();
+        // (interface, its slots' states as a base-4 number) → label index: a label is built once.
+        let mut by_key: HashMap<(usize, u64), u32> = HashMap::new();
+        let mut codes = Vec::with_capacity(self.samples() * interfaces.len());
+        // Each interface's last key and code: states change only at events, so most samples
+        // repeat the previous one's and skip the map.
+        let mut last: Vec<Option<(u64, u32)>> = vec![None; interfaces.len()];
+        for s in &self.trajectory.samples {
+            for (i, iface) in interfaces.iter().enumerate() {
+                let key = iface.slots.clone().fold(0u64, |key, k| {
+                    let digit = match s.states.get(k) {
+                        Some(SlotState::Seated) => 0,
+                        Some(SlotState::Positive) => 1,
+                        Some(SlotState::Negative) => 2,
+                        None => 3,
+                    };
+                    key.wrapping_mul(4).wrapping_add(digit)
+                });
+                if let Some((k, code)) = last[i]
+                    && k == key
+                {
+                    codes.push(code);
+                    continue;
+                }
+                let code = *by_key.entry((i, key)).or_insert_with(|| {
+                    let label = iface
+                        .slots
+                        .clone()
+                        .map(|k| s.states.get(k).map_or("?", |st| st.code()))
+                        .collect::<Vec<_>>()
+                        .join("/");
+                    *by_label.entry(label.clone()).or_insert_with(|| {
+                        labels.push(label);
+                        (labels.len() - 1) as u32
                     })
-                    .collect()
-            })
-            .collect()
+                });
+                last[i] = Some((key, code));
+                codes.push(code);
+            }
+        }
+        let bytes = PyBytes::new_with(py, 4 * codes.len(), |buf| {
+            for (chunk, c) in buf.chunks_exact_mut(4).zip(&codes) {
+                chunk.copy_from_slice(&c.to_ne_bytes());
+            }
+            Ok(())
+        })?;
+        Ok((labels, bytes))
     }
 
     /// The impact log: one dict per impact (t in s, interfaces, rates before and after in

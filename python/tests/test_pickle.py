@@ -66,3 +66,23 @@ def test_a_simulation_error_pickles_with_its_partial_result() -> None:
     assert str(back) == str(info.value)
     assert isinstance(back, crr.SimulationError)
     _same_result(info.value.result, back.result)
+
+
+def test_history_columns_are_contiguous_numpy_arrays_equal_to_history_csv(in_root) -> None:
+    # The columns cross as bytes read in place: contiguous, float64, equal to the CSV's numbers
+    # (printed in the shortest form that reads back to the same f64).
+    r = crr.simulate(crr.Model.from_file("examples/models/baldachin.toml"), duration=1.0)
+    lines = r.history_csv().splitlines()
+    rows = [line.split(",") for line in lines[1:]]
+    dof = len(r.coordinates)
+    numbers = np.array([[float(v) for v in row[: 1 + 2 * dof + 4]] for row in rows])
+    for name, column in (("t", r.t), ("q", r.q), ("qdot", r.qdot), ("kinetic", r.kinetic)):
+        assert column.dtype == np.float64 and column.flags.c_contiguous, name
+    np.testing.assert_array_equal(r.t, numbers[:, 0])
+    np.testing.assert_array_equal(r.q, numbers[:, 1 : 1 + dof])
+    np.testing.assert_array_equal(r.qdot, numbers[:, 1 + dof : 1 + 2 * dof])
+    np.testing.assert_array_equal(r.dissipated, numbers[:, 1 + 2 * dof + 3])
+    # Rocking bases: two slots per interface, joined by "/" (e.g. "seated/+").
+    states = [row[1 + 2 * dof + 4 :] for row in rows]
+    assert r.states.tolist() == states
+    assert any("/" in s for s in r.states[:, 0])
