@@ -411,7 +411,7 @@ class Result:
 
     def history_frame(self) -> "pandas.DataFrame":
         """The history as a pandas DataFrame with the columns of ``history.csv``."""
-        import pandas as pd
+        pd = _pandas("Result.history_frame")
 
         cols: Dict[str, Any] = {"t": self.t}
         for k, c in enumerate(self.coordinates):
@@ -427,7 +427,7 @@ class Result:
         """The impact log as a pandas DataFrame (columns ``t``, ``interfaces``,
         ``rates_before``, ``rates_after``, ``energy_lost``; the list-valued columns hold
         lists)."""
-        import pandas as pd
+        pd = _pandas("Result.impacts_frame")
 
         return pd.DataFrame(
             self.impacts,
@@ -740,10 +740,22 @@ def _load_study(source: Tuple[str, ...]) -> Study:
     return Study(_crr.Study.parse(source[1], kind == "json", source[2]), source)
 
 
+def _pandas(what: str) -> Any:
+    """pandas, or an ImportError saying what needs it and which extra installs it."""
+    try:
+        import pandas
+    except ImportError as e:
+        raise ImportError(
+            f"{what} needs pandas, which is not installed: pip install 'crr-rocking[pandas]' "
+            "(or 'crr-rocking[dask]' for crr.dask)"
+        ) from e
+    return pandas
+
+
 def cases_frame(text: str) -> "pandas.DataFrame":
     """The text of a ``cases.csv`` as a pandas DataFrame, every number read back exactly; the
     empty cells are NaN."""
-    import pandas as pd
+    pd = _pandas("a study's DataFrame")
 
     # pandas < 3 reads floats exactly only with the round-trip converter; pandas 3 always does
     # (and deprecates the option).

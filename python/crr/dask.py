@@ -18,7 +18,7 @@ import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, List, Mapping, Optional, Sequence, Tuple, Union
 
-from . import Study, _as_study, _load_study, cases_frame
+from . import Study, _as_study, _load_study, _pandas, cases_frame
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas
@@ -45,6 +45,7 @@ def run_study(
     chunk_size: int = 64,
     jobs: Optional[int] = 1,
     out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    progress: bool = False,
 ) -> "pandas.DataFrame":
     """Runs every case of ``study`` on the cluster of ``client`` and returns ``cases.csv`` as a
     pandas DataFrame (``frame.attrs["cases_csv"]`` holds the exact text).
@@ -57,7 +58,11 @@ def run_study(
             seconds (a long record on an arch): aim for tasks of a second or more.
         jobs: threads per task (default 1; each Dask worker thread runs one task).
         out: when given, ``cases.csv`` is also written into this folder (created if needed).
+        progress: show the tasks' progress with ``distributed.progress`` (a bar in a terminal,
+            a widget in a notebook) while the cluster works.
     """
+    # Before the cluster works: a missing pandas must not cost the computed rows.
+    _pandas("crr.dask.run_study")
     if chunk_size < 1:
         raise ValueError(f"chunk_size must be at least 1, got {chunk_size}")
     s = _as_study(study)
@@ -71,6 +76,10 @@ def run_study(
         jobs=jobs,
         key=[f"crr-{s.name}-{token}-{c[0]}" for c in chunks],
     )
+    if progress:
+        from distributed import progress as show_progress
+
+        show_progress(futures)
     rows = [r for chunk in client.gather(futures) for r in chunk]
     text = s.csv(rows)
     if out is not None:

@@ -111,6 +111,9 @@ def test_a_dask_local_cluster_reproduces_the_study(cli, tmp_path):
         workers = client.run(lambda: __import__("os").getpid())
         assert len(set(workers.values())) == 2
         by_dict = crr.dask.run_study(records_study(), client, chunk_size=2)
+        # distributed.progress draws its bar while the tasks run and changes no row.
+        shown = crr.dask.run_study(study, client, chunk_size=5, progress=True)
+    assert shown.attrs["cases_csv"] == expected
     assert frame.attrs["cases_csv"] == expected
     assert (tmp_path / "dask" / "cases.csv").read_text() == expected
     assert len(frame) == 36
@@ -130,3 +133,32 @@ def test_progress_shows_on_stderr_and_changes_no_row(tmp_path, capfd):
     err = capfd.readouterr().err
     assert "crr: study [" in err and "100/100 cases" in err, err
     assert folder.attrs["cases_csv"] == plain.attrs["cases_csv"]
+
+
+def test_without_pandas_the_frames_say_which_extra_installs_it(monkeypatch, tmp_path):
+    # pandas made unimportable: every DataFrame says so, naming the extra, and crr.dask.run_study
+    # says it before any case runs (no client is needed to get there).
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_pandas(name, *args, **kwargs):
+        if name == "pandas" or name.startswith("pandas."):
+            raise ImportError("No module named 'pandas'")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_pandas)
+    import crr.dask
+
+    result = crr.simulate(
+        crr.Model.from_file(Path(__file__).resolve().parents[2] / "examples/models/single_block.toml"),
+        duration=0.1,
+    )
+    for call, what in (
+        (result.history_frame, "Result.history_frame"),
+        (result.impacts_frame, "Result.impacts_frame"),
+        (lambda: crr.dask.run_study(small_map(tmp_path), client=None), "crr.dask.run_study"),
+        (lambda: crr.cases_frame("id\n"), "a study's DataFrame"),
+    ):
+        with pytest.raises(ImportError, match=f"{what} needs pandas.*crr-rocking\\[pandas\\]"):
+            call()
