@@ -43,6 +43,7 @@ from ._errors import (
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas
+    import xarray
 
 __all__ = [
     "CrrError",
@@ -422,6 +423,64 @@ class Result:
         for k, i in enumerate(self.interfaces):
             cols[f"{i}_state"] = self.states[:, k]
         return pd.DataFrame(cols)
+
+    def to_xarray(self) -> "xarray.Dataset":
+        """The history as an ``xarray.Dataset`` on the time index ``t`` (s).
+
+        Variables: ``q`` (rad) and ``qdot`` (rad/s) over (``t``, ``coordinate``); ``kinetic``,
+        ``potential``, ``work_in``, ``dissipated`` (J) over ``t``; ``state`` over (``t``,
+        ``interface``). Every variable and ``t`` carry ``units`` and ``long_name`` attributes; the
+        dataset's attributes hold the model's name, the number of impacts, whether the run
+        completed or collapsed, and ``summary_json`` (the whole summary as text: netCDF
+        attributes are flat).
+
+        ``t`` is not unique: at an impact the history has two rows at the same time, the rates
+        before and then after it (as ``history.csv``). Select those by position (``isel``), or
+        keep the after-impact rows for a unique index with
+        ``ds.isel(t=~ds.indexes["t"].duplicated(keep="last"))``.
+        """
+        try:
+            import xarray as xr
+        except ImportError as e:
+            raise ImportError(
+                "Result.to_xarray needs xarray, which is not installed: pip install xarray"
+            ) from e
+
+        def energy(v: np.ndarray, name: str) -> Any:
+            return ("t", v, {"units": "J", "long_name": name})
+
+        ds = xr.Dataset(
+            {
+                "q": (("t", "coordinate"), self.q, {"units": "rad", "long_name": "angle"}),
+                "qdot": (
+                    ("t", "coordinate"),
+                    self.qdot,
+                    {"units": "rad/s", "long_name": "angular rate"},
+                ),
+                "kinetic": energy(self.kinetic, "kinetic energy T"),
+                "potential": energy(self.potential, "potential energy U - U(rest)"),
+                "work_in": energy(self.work_in, "work of the ground motion W"),
+                "dissipated": energy(self.dissipated, "energy dissipated at impacts D"),
+                "state": (
+                    ("t", "interface"),
+                    self.states,
+                    {"long_name": "active pivot (seated, +, -; slots joined by /)"},
+                ),
+            },
+            coords={
+                "t": ("t", self.t, {"units": "s", "long_name": "time"}),
+                "coordinate": list(self.coordinates),
+                "interface": list(self.interfaces),
+            },
+            attrs={
+                "model": str(self.summary.get("model", {}).get("name", "")),
+                "impacts": int(self.summary["impacts"]),
+                "completed": int(self.completed),
+                "collapsed": int(self.summary["collapse"]["collapsed"]),
+                "summary_json": json.dumps(self.summary, ensure_ascii=False),
+            },
+        )
+        return ds
 
     def impacts_frame(self) -> "pandas.DataFrame":
         """The impact log as a pandas DataFrame (columns ``t``, ``interfaces``,
