@@ -3,6 +3,7 @@
 //! sweeps, Poincaré sections and studies. Nothing here writes a results folder or draws a plot;
 //! those are the output layer's.
 
+pub mod assemble;
 pub mod check;
 pub mod inspect;
 pub mod levels;

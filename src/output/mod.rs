@@ -3,6 +3,7 @@
 //! animations. It calls the analysis layer; nothing below calls it.
 
 pub mod animate;
+pub mod assemble;
 pub mod folder_lock;
 pub mod history;
 pub mod plot;

@@ -6,6 +6,7 @@
 mod common;
 
 mod animate;
+mod assemble;
 mod check;
 mod fuzz_corpus;
 mod hostile_inputs;

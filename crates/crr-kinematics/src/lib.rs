@@ -31,6 +31,7 @@
 //! assert!((data.mass_matrix[(0, 0)] - i0).abs() < 1e-9 * i0);
 //! ```
 
+pub mod assembly;
 pub mod closure;
 pub mod contact_face;
 pub mod contact_kinematics;

@@ -3,6 +3,7 @@
 //! layers).
 
 mod animate;
+mod assemble;
 mod check;
 mod failure;
 mod inspect;
@@ -50,6 +51,9 @@ enum Command {
     /// t = kT (T = 1/F), or where a coordinate crosses 0 upward (--section, or --amplitude 0);
     /// sweeps give a bifurcation diagram or basins (docs/poincare.md).
     Poincare(poincare::Args),
+    /// From geometry to hinges: the contact faces of an assembly of blocks (bodies only) and the
+    /// model whose rocking interfaces they are (docs/assembly.md).
+    Assemble(assemble::Args),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Check(a) => check::run(a),
         Command::Study(a) => study::run(a),
         Command::Poincare(a) => poincare::run(a),
+        Command::Assemble(a) => assemble::run(a),
     };
     failure::exit_code(result)
 }

@@ -1,0 +1,454 @@
+//! From geometry to hinges: the contact faces of blocks placed in contact, found from their
+//! shapes alone, and the CRR structure whose rocking interfaces they are (documented in
+//! `docs/assembly.md`).
+//!
+//! Two faces touch when they face each other (outward normals opposite, to 1e-9) in one plane
+//! (their distance at most the tolerance); the contact face is the overlap of the two convex
+//! polygons (clipped in the plane, Sutherland–Hodgman). The ground is the plane z = 0: a face
+//! lying on it with its outward normal down rests on the ground whole. A contact whose normal
+//! leans less than 45° from the vertical is a **bed** (the lower body supports the upper one: a
+//! rocking interface); a steeper one is a **side** contact (a head joint, a block against a
+//! neighbour), reported but not made an interface, since a CRR interface is a support rocking
+//! under gravity.
+
+use nalgebra::Vector3;
+
+use crate::shapes::Shape;
+use crate::shapes::Surface;
+use crate::spec::{BodySpec, InterfaceSpec, PivotSpec, RockingBaseSpec, StructureSpec};
+
+/// A contact face between two bodies (or a body and the ground).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactFace {
+    /// The supporting body (None: the ground) of a bed; of a side contact, the first body.
+    pub lower: Option<usize>,
+    /// The supported body of a bed; of a side contact, the second body.
+    pub upper: usize,
+    /// Unit normal from `lower` into `upper`.
+    pub normal: Vector3<f64>,
+    /// The overlap polygon's corners, counter-clockwise about `normal` (convex).
+    pub corners: Vec<Vector3<f64>>,
+    /// Its area (m²).
+    pub area: f64,
+    /// Whether it is a bed (normal within 45° of the vertical) or a side contact.
+    pub bed: bool,
+}
+
+/// Why an assembly cannot be turned into a structure.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{item}: {message}")]
+pub struct AssemblyError {
+    /// The body or contact concerned.
+    pub item: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn error(item: impl Into<String>, message: impl Into<String>) -> AssemblyError {
+    AssemblyError {
+        item: item.into(),
+        message: message.into(),
+    }
+}
+
+/// The shape of a body of an assembly (exactly one is given).
+fn shape_of(body: &BodySpec) -> Result<Shape, AssemblyError> {
+    let shapes: Vec<Shape> = [
+        body.box_shape.clone().map(Shape::Box),
+        body.polyhedron.clone().map(Shape::Polyhedron),
+        body.prism.clone().map(Shape::Prism),
+        body.annular_sector.clone().map(Shape::AnnularSector),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    match <[Shape; 1]>::try_from(shapes) {
+        Ok([shape]) => Ok(shape),
+        Err(s) => Err(error(
+            format!("body \"{}\"", body.name),
+            format!("has {} shapes: give exactly one", s.len()),
+        )),
+    }
+}
+
+/// The closed surface of a body's shape, in world coordinates.
+pub fn body_surface(body: &BodySpec) -> Result<Surface, AssemblyError> {
+    let surface = match shape_of(body)? {
+        Shape::Box(s) => s.surface(),
+        Shape::Polyhedron(s) => s.surface(),
+        Shape::Prism(s) => s.surface(),
+        Shape::AnnularSector(s) => s.surface(),
+    };
+    surface.map_err(|e| error(format!("body \"{}\"", body.name), e.to_string()))
+}
+
+/// One face of a surface: its polygon, unit outward normal and plane offset n·x.
+struct Face {
+    polygon: Vec<Vector3<f64>>,
+    normal: Vector3<f64>,
+    offset: f64,
+}
+
+fn faces_of(surface: &Surface) -> Vec<Face> {
+    surface
+        .faces
+        .iter()
+        .filter_map(|f| {
+            let polygon: Vec<Vector3<f64>> = f.iter().map(|&i| surface.vertices[i]).collect();
+            let m = polygon.len();
+            let area = (0..m).fold(Vector3::zeros(), |a, i| {
+                a + polygon[i].cross(&polygon[(i + 1) % m]) * 0.5
+            });
+            let norm = area.norm();
+            (norm > 0.0).then(|| {
+                let normal = area / norm;
+                Face {
+                    offset: normal.dot(&polygon[0]),
+                    polygon,
+                    normal,
+                }
+            })
+        })
+        .collect()
+}
+
+/// A unit vector perpendicular to the unit vector `n`.
+fn perpendicular(n: &Vector3<f64>) -> Vector3<f64> {
+    let trial = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    (trial - n * n.dot(&trial)).normalize()
+}
+
+/// Signed area of a 2D polygon (positive counter-clockwise).
+fn area_2d(p: &[[f64; 2]]) -> f64 {
+    let m = p.len();
+    (0..m)
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % m]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum::<f64>()
+        * 0.5
+}
+
+/// The part of the convex polygon `subject` inside the convex polygon `clip` (both
+/// counter-clockwise), by Sutherland–Hodgman: clipped by each edge's half-plane in turn.
+fn clip_convex(subject: &[[f64; 2]], clip: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let mut out = subject.to_vec();
+    let m = clip.len();
+    for i in 0..m {
+        if out.is_empty() {
+            break;
+        }
+        let (a, b) = (clip[i], clip[(i + 1) % m]);
+        // Inside: left of the edge a → b.
+        let side = |p: [f64; 2]| (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+        let input = std::mem::take(&mut out);
+        let k = input.len();
+        for j in 0..k {
+            let (p, q) = (input[j], input[(j + 1) % k]);
+            let (sp, sq) = (side(p), side(q));
+            if sp >= 0.0 {
+                out.push(p);
+            }
+            if (sp >= 0.0) != (sq >= 0.0) {
+                let s = sp / (sp - sq);
+                out.push([p[0] + s * (q[0] - p[0]), p[1] + s * (q[1] - p[1])]);
+            }
+        }
+    }
+    out
+}
+
+/// The polygon without repeated points (within `tol`) and collinear middle points.
+fn simplified(p: Vec<[f64; 2]>, tol: f64) -> Vec<[f64; 2]> {
+    let mut q: Vec<[f64; 2]> = Vec::with_capacity(p.len());
+    for v in p {
+        if q.last()
+            .is_none_or(|l| (l[0] - v[0]).hypot(l[1] - v[1]) > tol)
+        {
+            q.push(v);
+        }
+    }
+    while q.len() > 1 {
+        let (f, l) = (q[0], q[q.len() - 1]);
+        if (f[0] - l[0]).hypot(f[1] - l[1]) > tol {
+            break;
+        }
+        q.pop();
+    }
+    let mut changed = true;
+    while changed && q.len() >= 3 {
+        changed = false;
+        let m = q.len();
+        for i in 0..m {
+            let (a, b, c) = (q[(i + m - 1) % m], q[i], q[(i + 1) % m]);
+            let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            let len = (c[0] - a[0]).hypot(c[1] - a[1]);
+            if cross.abs() <= tol * len {
+                q.remove(i);
+                changed = true;
+                break;
+            }
+        }
+    }
+    q
+}
+
+/// The contact faces of `bodies` resting on the ground (z = 0) and on each other: faces facing
+/// each other in one plane (distance at most `tolerance`, m) whose overlap has an area above
+/// tolerance × the model size. Every body must have a bed under it (else it floats: an error
+/// naming it).
+pub fn detect_contacts(
+    bodies: &[BodySpec],
+    tolerance: f64,
+) -> Result<Vec<ContactFace>, AssemblyError> {
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(error(
+            "tolerance",
+            format!("must be a positive length (m), got {tolerance}"),
+        ));
+    }
+    let surfaces = bodies
+        .iter()
+        .map(body_surface)
+        .collect::<Result<Vec<_>, _>>()?;
+    let faces: Vec<Vec<Face>> = surfaces.iter().map(faces_of).collect();
+    let boxes: Vec<(Vector3<f64>, Vector3<f64>)> = surfaces
+        .iter()
+        .map(|s| {
+            s.vertices.iter().fold(
+                (
+                    Vector3::repeat(f64::INFINITY),
+                    Vector3::repeat(f64::NEG_INFINITY),
+                ),
+                |(lo, hi), v| (lo.inf(v), hi.sup(v)),
+            )
+        })
+        .collect();
+    let size = boxes
+        .iter()
+        .fold(0.0f64, |m, (lo, hi)| m.max((hi - lo).norm()));
+    let min_area = tolerance * size;
+    let facing = 1.0 - 1e-9;
+    let mut contacts = Vec::new();
+    // On the ground: a face on z = 0 whose outward normal is −z rests whole.
+    for (b, fs) in faces.iter().enumerate() {
+        for f in fs {
+            if f.normal.z < -facing && f.polygon.iter().all(|v| v.z.abs() <= tolerance) {
+                let (corners, area) = overlap(&f.polygon, &f.polygon, &-f.normal, tolerance);
+                if area > min_area {
+                    contacts.push(ContactFace {
+                        lower: None,
+                        upper: b,
+                        normal: Vector3::z(),
+                        corners,
+                        area,
+                        bed: true,
+                    });
+                }
+            }
+        }
+    }
+    for i in 0..bodies.len() {
+        for j in i + 1..bodies.len() {
+            let (lo_i, hi_i) = boxes[i];
+            let (lo_j, hi_j) = boxes[j];
+            let apart =
+                (0..3).any(|k| lo_i[k] > hi_j[k] + tolerance || lo_j[k] > hi_i[k] + tolerance);
+            if apart {
+                continue;
+            }
+            for fa in &faces[i] {
+                for fb in &faces[j] {
+                    if fa.normal.dot(&fb.normal) > -facing
+                        || (fa.offset + fb.offset).abs() > tolerance
+                    {
+                        continue;
+                    }
+                    // The normal from the lower body into the upper one; a side contact keeps
+                    // the order of the file.
+                    let bed = fa.normal.z.abs() > std::f64::consts::FRAC_1_SQRT_2;
+                    let (lower, upper, normal) = if !bed || fa.normal.z > 0.0 {
+                        (i, j, fa.normal)
+                    } else {
+                        (j, i, fb.normal)
+                    };
+                    let (corners, area) = overlap(&fa.polygon, &fb.polygon, &normal, tolerance);
+                    if area > min_area {
+                        contacts.push(ContactFace {
+                            lower: Some(lower),
+                            upper,
+                            normal,
+                            corners,
+                            area,
+                            bed,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    for (b, body) in bodies.iter().enumerate() {
+        if !contacts.iter().any(|c| c.bed && c.upper == b) {
+            return Err(error(
+                format!("body \"{}\"", body.name),
+                format!(
+                    "rests on nothing: no face of it lies on the ground (z = 0) or on a block \
+                     below within the tolerance of {tolerance} m"
+                ),
+            ));
+        }
+    }
+    Ok(contacts)
+}
+
+/// The overlap of two facing planar polygons, expressed in the plane of `a`: its corners
+/// counter-clockwise about `normal` and its area.
+fn overlap(
+    a: &[Vector3<f64>],
+    b: &[Vector3<f64>],
+    normal: &Vector3<f64>,
+    tolerance: f64,
+) -> (Vec<Vector3<f64>>, f64) {
+    let e1 = perpendicular(normal);
+    let e2 = normal.cross(&e1);
+    let origin = a[0];
+    let to_2d = |p: &Vector3<f64>| [(p - origin).dot(&e1), (p - origin).dot(&e2)];
+    let ccw = |pts: &[Vector3<f64>]| {
+        let mut p: Vec<[f64; 2]> = pts.iter().map(to_2d).collect();
+        if area_2d(&p) < 0.0 {
+            p.reverse();
+        }
+        p
+    };
+    let clipped = simplified(clip_convex(&ccw(a), &ccw(b)), tolerance);
+    if clipped.len() < 3 {
+        return (Vec::new(), 0.0);
+    }
+    let area = area_2d(&clipped);
+    let corners = clipped
+        .iter()
+        .map(|p| origin + e1 * p[0] + e2 * p[1])
+        .collect();
+    (corners, area)
+}
+
+/// How the bed contacts become interfaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InterfaceStyle {
+    /// A rocking base per bed (3D rocking on the face's edges).
+    RockingBase,
+    /// A hinge about y per bed, its pivots the overlap's lines of least and greatest x (a planar
+    /// layout in the x–z plane: every bed horizontal and spanning the same depth along y).
+    PlanarHinge,
+}
+
+/// The structure whose interfaces are every bed contact (named `UPPER_on_LOWER`, the lower body
+/// the parent; `ground` for the ground), listed from the ground up so that the spanning tree
+/// reaches each body through its first support and the other supports close loops.
+pub fn structure_of(
+    name: &str,
+    gravity: f64,
+    bodies: &[BodySpec],
+    contacts: &[ContactFace],
+    style: InterfaceStyle,
+    tolerance: f64,
+) -> Result<StructureSpec, AssemblyError> {
+    let name_of = |b: Option<usize>| b.map_or("ground", |b| bodies[b].name.as_str());
+    let mut beds: Vec<&ContactFace> = contacts.iter().filter(|c| c.bed).collect();
+    // From the ground up: by the contact's height, then by the bodies' order.
+    beds.sort_by(|a, b| {
+        let za = a.corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
+        let zb = b.corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
+        za.total_cmp(&zb)
+            .then(a.upper.cmp(&b.upper))
+            .then(a.lower.cmp(&b.lower))
+    });
+    let mut interfaces = Vec::with_capacity(beds.len());
+    for c in beds {
+        let iname = format!("{}_on_{}", name_of(Some(c.upper)), name_of(c.lower));
+        let item = || format!("contact \"{iname}\"");
+        let mut spec = InterfaceSpec {
+            name: iname.clone(),
+            parent: name_of(c.lower).to_string(),
+            child: name_of(Some(c.upper)).to_string(),
+            axis: None,
+            pivot_positive: None,
+            pivot_negative: None,
+            rocking_base: None,
+            impact: Default::default(),
+        };
+        match style {
+            InterfaceStyle::RockingBase => {
+                spec.rocking_base = Some(RockingBaseSpec {
+                    corners: c.corners.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                    twist: false,
+                });
+            }
+            InterfaceStyle::PlanarHinge => {
+                if c.normal.z < 1.0 - 1e-9 {
+                    return Err(error(
+                        item(),
+                        "is not horizontal: a planar layout (--planar) needs horizontal beds",
+                    ));
+                }
+                let (x0, x1) = c
+                    .corners
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                        (lo.min(p.x), hi.max(p.x))
+                    });
+                let (y0, y1) = c
+                    .corners
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                        (lo.min(p.y), hi.max(p.y))
+                    });
+                let rectangle = (x1 - x0) * (y1 - y0);
+                if (rectangle - c.area).abs() > tolerance * (x1 - x0 + y1 - y0) {
+                    return Err(error(
+                        item(),
+                        "is not a rectangle aligned with x and y: a planar layout (--planar) \
+                         needs beds spanning the blocks' depth along y",
+                    ));
+                }
+                let z = c.corners[0].z;
+                spec.axis = Some([0.0, 1.0, 0.0]);
+                // A positive angle about +y lowers +x points: the block pivots on its +x line.
+                spec.pivot_positive = Some(PivotSpec::Segment([[x1, y0, z], [x1, y1, z]]));
+                spec.pivot_negative = Some(PivotSpec::Segment([[x0, y0, z], [x0, y1, z]]));
+            }
+        }
+        interfaces.push(spec);
+    }
+    Ok(StructureSpec {
+        name: name.to_string(),
+        gravity,
+        body: bodies.to_vec(),
+        interface: interfaces,
+        symmetry: Vec::new(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clipping_two_squares_gives_their_overlap() {
+        let a = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
+        let b = [[1.0, 1.0], [3.0, 1.0], [3.0, 3.0], [1.0, 3.0]];
+        let o = simplified(clip_convex(&a, &b), 1e-12);
+        assert_eq!(o.len(), 4);
+        assert!((area_2d(&o) - 1.0).abs() < 1e-15);
+        let far = [[5.0, 5.0], [6.0, 5.0], [6.0, 6.0]];
+        assert!(clip_convex(&a, &far).is_empty());
+        // Touching along an edge only: no area.
+        let edge = [[2.0, 0.0], [3.0, 0.0], [3.0, 2.0], [2.0, 2.0]];
+        assert!(simplified(clip_convex(&a, &edge), 1e-12).len() < 3);
+    }
+}

@@ -1,0 +1,88 @@
+//! `crr assemble`: blocks in contact in, a CRR model out (docs/assembly.md). The assembly file is
+//! a model file with bodies only; the contact faces are found from the bodies' shapes
+//! ([`crr_kinematics::assembly`]) and every bed contact becomes a rocking interface, the spanning
+//! tree and the loops chosen as for any model file.
+
+use std::path::Path;
+
+use crr_kinematics::assembly::{ContactFace, InterfaceStyle, detect_contacts, structure_of};
+use crr_kinematics::{Model, StructureSpec};
+
+use crate::Error;
+use crate::input::model_file::{ModelFile, parse_model_file};
+
+/// The default contact tolerance (m): two faces closer than this touch.
+pub const DEFAULT_TOLERANCE: f64 = 1e-6;
+
+/// Reads an assembly file: a model file (TOML, or JSON when it ends in .json) with bodies and
+/// no interfaces.
+pub fn read_assembly(path: &Path) -> Result<ModelFile, Error> {
+    let limit = crr_dynamics::input::MODEL_FILE_LIMIT;
+    let text = crr_dynamics::input::read_regular_text(path, limit).map_err(|source| Error::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    let file = parse_model_file(path, &text)?;
+    let here = |m: &str| Error::Argument(format!("{}: {m}", path.display()));
+    if !file.interface.is_empty() {
+        return Err(here(
+            "an assembly lists bodies only: `crr assemble` finds the interfaces (remove the \
+             [[interface]] tables, or simulate the file as a model)",
+        ));
+    }
+    if file.body.is_empty() {
+        return Err(here("the assembly has no [[body]]"));
+    }
+    Ok(file)
+}
+
+/// An assembly turned into a model.
+#[derive(Clone, Debug)]
+pub struct Assembled {
+    /// Every contact face found (beds and side contacts).
+    pub contacts: Vec<ContactFace>,
+    /// The model file written: the assembly's tables with the interfaces added.
+    pub file: ModelFile,
+    /// The model it builds.
+    pub model: Model,
+}
+
+/// Finds the contacts of the assembly `file` (read from `path`) and builds the model whose
+/// interfaces are every bed contact: rocking bases, or hinges about y with `planar`.
+pub fn assemble(
+    path: &Path,
+    file: &ModelFile,
+    planar: bool,
+    tolerance: f64,
+) -> Result<Assembled, Error> {
+    let here = |e: &dyn std::fmt::Display| Error::Argument(format!("{}: {e}", path.display()));
+    let contacts = detect_contacts(&file.body, tolerance).map_err(|e| here(&e))?;
+    let style = if planar {
+        InterfaceStyle::PlanarHinge
+    } else {
+        InterfaceStyle::RockingBase
+    };
+    let spec: StructureSpec = structure_of(
+        &file.name,
+        file.gravity,
+        &file.body,
+        &contacts,
+        style,
+        tolerance,
+    )
+    .map_err(|e| here(&e))?;
+    let out = ModelFile {
+        body: spec.body.clone(),
+        interface: spec.interface.clone(),
+        ..file.clone()
+    };
+    let model = Model::from_spec(&spec).map_err(|source| Error::Model {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    Ok(Assembled {
+        contacts,
+        file: out,
+        model,
+    })
+}

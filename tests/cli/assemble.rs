@@ -1,0 +1,151 @@
+//! `crr assemble`: an assembly of blocks (bodies only) in, the model whose rocking interfaces are
+//! its bed contacts out. Checked against what is known without the code under test: the bundled
+//! running-bond wall was written by hand from the same bodies (the generated model must have the
+//! same bed joints and pivots, and its multiplier is 7/11 by the virtual work of the corner
+//! wedge); a panel cut into courses rocks whole on its base edge, λ = b/h.
+
+use std::collections::BTreeSet;
+
+use nalgebra::Vector3;
+
+use crr::analysis::assemble::{DEFAULT_TOLERANCE, assemble, read_assembly};
+use crr::impact::statics::{StaticsOptions, collapse_multiplier};
+use crr::kinematics::spec::PivotSpec;
+
+use crate::common;
+
+/// The bodies of a model file (its text up to the first interface) written as an assembly.
+fn assembly_of(model: &str, tag: &str) -> std::path::PathBuf {
+    let text = common::bundled_text(model);
+    let head = &text[..text.find("[[interface]]").unwrap()];
+    common::write_model(tag, head)
+}
+
+fn lambda(model: &crr::kinematics::Model, d: Vector3<f64>) -> f64 {
+    collapse_multiplier(model, d, &StaticsOptions::default())
+        .unwrap()
+        .lambda
+        .unwrap()
+}
+
+/// A bed joint as (parent, child, axis, the x and z of its two pivot lines along y): a point
+/// pivot (the hand-written wall) and a segment along y (the assembled one) are the same line.
+fn joints(spec_interfaces: &[crr::kinematics::spec::InterfaceSpec]) -> BTreeSet<String> {
+    let seg = |p: &Option<PivotSpec>| {
+        let (a, b) = match p.as_ref().expect("a pivot") {
+            PivotSpec::Point(a) => (*a, *a),
+            PivotSpec::Segment([a, b]) => (*a, *b),
+        };
+        assert!(
+            (a[0] - b[0]).abs() < 1e-12 && (a[2] - b[2]).abs() < 1e-12,
+            "along y"
+        );
+        format!("x {:.9} z {:.9}", a[0], a[2])
+    };
+    spec_interfaces
+        .iter()
+        .map(|i| {
+            format!(
+                "{} -> {}: {:?} + {} - {}",
+                i.parent,
+                i.child,
+                i.axis,
+                seg(&i.pivot_positive),
+                seg(&i.pivot_negative)
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_wall_assembled_from_its_blocks_is_the_hand_written_wall() {
+    let path = assembly_of("wall", "wall_assembly");
+    let file = read_assembly(&path).unwrap();
+    let planar = assemble(&path, &file, true, DEFAULT_TOLERANCE).unwrap();
+    let (hand, _) = crr::load_model(&common::bundled_path("wall")).unwrap();
+    assert_eq!(joints(&planar.file.interface), joints(&hand.interface));
+    // 4 courses of 3 blocks (half blocks at the ends of the odd ones): 3 on the ground, and the
+    // other 9 + 9 (one or two supports each) bed joints; 10 head joints touch but are no interface.
+    let beds = planar.contacts.iter().filter(|c| c.bed).count();
+    let sides = planar.contacts.len() - beds;
+    assert_eq!((beds, sides), (21, 10));
+    let bed_area: f64 = planar
+        .contacts
+        .iter()
+        .filter(|c| c.bed)
+        .map(|c| c.area)
+        .sum();
+    // Every block's base is in contact with what lies below: 12 + 1 (half blocks) blocks of
+    // 0.5 m depth on 3 m of length per course, 4 courses.
+    assert!((bed_area - 4.0 * 3.0 * 0.5).abs() < 1e-12, "{bed_area}");
+    let seven_elevenths = 7.0 / 11.0;
+    for m in [
+        &planar.model,
+        &assemble(&path, &file, false, DEFAULT_TOLERANCE)
+            .unwrap()
+            .model,
+    ] {
+        for d in [Vector3::x(), -Vector3::x()] {
+            let l = lambda(m, d);
+            assert!((l - seven_elevenths).abs() < 1e-9, "{l}");
+        }
+    }
+}
+
+#[test]
+fn a_panel_cut_into_courses_rocks_whole_on_its_base_edge() {
+    // 5 courses of 0.4 × 0.3 × 0.5 m, 2.5 m in all: the whole panel rocks on a base edge when
+    // λ = b/h, b the half-width and h = 1.25 m the centre's height: 0.2/1.25 = 0.16 along ±x and
+    // 0.15/1.25 = 0.12 along ±y for rocking bases; 0.16 for the planar hinges.
+    let mut text = String::from("name = \"panel\"\n");
+    for k in 0..5 {
+        text += &format!(
+            "[[body]]\nname = \"course_{k}\"\ndensity = 2000.0\nbox = {{ center = [0.0, 0.0, {}], size = [0.4, 0.3, 0.5] }}\n",
+            0.25 + 0.5 * k as f64
+        );
+    }
+    let path = common::write_model("panel_assembly", &text);
+    let file = read_assembly(&path).unwrap();
+    let bases = assemble(&path, &file, false, DEFAULT_TOLERANCE).unwrap();
+    assert_eq!(bases.model.dof(), 10);
+    assert!(bases.model.closures.is_empty());
+    for (d, expected) in [
+        (Vector3::x(), 0.16),
+        (-Vector3::x(), 0.16),
+        (Vector3::y(), 0.12),
+        (-Vector3::y(), 0.12),
+    ] {
+        let l = lambda(&bases.model, d);
+        assert!((l - expected).abs() < 1e-9, "{d:?}: {l}");
+    }
+    let hinges = assemble(&path, &file, true, DEFAULT_TOLERANCE).unwrap();
+    assert!((lambda(&hinges.model, Vector3::x()) - 0.16).abs() < 1e-9);
+    // The model file written loads back into the same model.
+    let out = common::scratch("panel_model").join("panel.toml");
+    let o = common::crr(&[
+        "assemble",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (_, back) = crr::load_model(&out).unwrap();
+    assert_eq!(back.dof(), 10);
+    assert!((lambda(&back, Vector3::y()) - 0.12).abs() < 1e-9);
+}
+
+#[test]
+fn a_floating_block_and_an_assembly_with_interfaces_are_refused_naming_them() {
+    let text = "name = \"gap\"\n[[body]]\nname = \"low\"\ndensity = 2000.0\nbox = { center = [0.0, 0.0, 0.5], size = [1.0, 1.0, 1.0] }\n[[body]]\nname = \"high\"\ndensity = 2000.0\nbox = { center = [0.0, 0.0, 1.51], size = [1.0, 1.0, 1.0] }\n";
+    let path = common::write_model("gap_assembly", text);
+    let o = common::crr(&["assemble", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("body \"high\": rests on nothing"), "{err}");
+    let model = common::bundled_path("trilithon");
+    let o = common::crr(&["assemble", model.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("an assembly lists bodies only"), "{err}");
+}
