@@ -185,6 +185,34 @@ fn a_merge_needs_every_shard_finished_and_of_one_study() {
         ],
         "2 fields",
     );
+    // A row whose id is not a case of the study, replacing the last row (the count stays
+    // right: this was merged with exit 0, the case it replaced lost) or added.
+    let last = cut[cut.len() - 1];
+    let foreign = format!("c999999{}", &last[last.find(',').unwrap()..]);
+    for (tag, edited) in [
+        (
+            "m3r",
+            cut[..cut.len() - 1].join("\n") + "\n" + &foreign + "\n",
+        ),
+        ("m3a", text.clone() + &foreign + "\n"),
+    ] {
+        std::fs::write(two.join("cases.csv"), edited).unwrap();
+        refused(
+            &[
+                "study",
+                "merge",
+                o1,
+                o2,
+                "--out",
+                dir.join(tag).to_str().unwrap(),
+            ],
+            "case c999999 is not one of the study's 6 cases (c000000 to c000005)",
+        );
+        assert!(
+            !dir.join(tag).join("cases.csv").exists(),
+            "{tag}: nothing merged"
+        );
+    }
     std::fs::write(two.join("cases.csv"), &text).unwrap();
     // The second shard run again after the study was edited.
     map(&dir, 4.0);

@@ -433,7 +433,7 @@ impl Study {
         let index = self.cases.len();
         self.cases.push(Case {
             index,
-            id: format!("c{index:06}"),
+            id: case_id(index),
             variant,
             motion,
         });
@@ -750,4 +750,9 @@ fn study_axis(spec: &StudySpec, path: &Path) -> Result<Axis, Error> {
         ));
     }
     Ok(axis)
+}
+
+/// The id of case `index` of a study: `c` and the index on six digits (more past 999 999).
+pub fn case_id(index: usize) -> String {
+    format!("c{index:06}")
 }

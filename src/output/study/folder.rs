@@ -17,6 +17,7 @@ use super::info::{MergedStudyInfo, ScaleInfo, StudyInfo, to_json};
 use crate::Error;
 use crate::analysis::simulation::Cancel;
 use crate::analysis::simulation::coordinate_alpha;
+use crate::analysis::study::cases::case_id;
 use crate::analysis::study::{Case, Measures, Motion, Study, run_case_cancellable};
 
 /// `i/n`: the i-th (1-based) of n disjoint parts of a study; case k belongs to part k mod n + 1.
@@ -592,6 +593,13 @@ pub fn run_study(
     })
 }
 
+/// Whether `id` names one of the `total` cases of a study.
+fn is_case_id(id: &str, total: usize) -> bool {
+    id.strip_prefix('c')
+        .and_then(|d| d.parse::<usize>().ok())
+        .is_some_and(|i| i < total && id == case_id(i))
+}
+
 /// `crr study merge`: joins the `cases.csv` of shard folders into `out` (rows by id; the same id
 /// twice must be the same row), checking that they come from the same study.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
@@ -663,9 +671,22 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
             }
             _ => {}
         }
+        let in_study = json["cases_in_study"].as_u64().map(|n| n as usize);
         let mut in_file = std::collections::BTreeSet::new();
         for (number, line) in lines.enumerate() {
             let id = checked_row(&csv, number + 2, line, fields, |id| in_file.contains(id))?;
+            if let Some(total) = in_study
+                && !is_case_id(id, total)
+            {
+                return Err(Error::Argument(format!(
+                    "{}: line {}: case {id} is not one of the study's {total} cases ({} to {}): \
+                     the file is damaged or comes from another study",
+                    csv.display(),
+                    number + 2,
+                    case_id(0),
+                    case_id(total.saturating_sub(1))
+                )));
+            }
             in_file.insert(id.to_string());
             if let Some(prev) = rows.get(id)
                 && prev != line
