@@ -13,3 +13,19 @@ pub mod size_sweep;
 pub mod static_multiplier;
 pub mod study;
 pub mod summary;
+
+/// The most worker threads `--jobs` starts (studies, Poincaré sweeps): past the cores, threads
+/// only wait, and a hundred thousand of them stalled a study that runs in 0.5 s.
+pub const MAX_JOBS: usize = 1024;
+
+/// Refuses `--jobs N` above [`MAX_JOBS`] (0 is refused where it is read).
+pub fn check_max_jobs(jobs: Option<usize>) -> Result<(), crate::Error> {
+    match jobs {
+        Some(n) if n > MAX_JOBS => Err(crate::Error::Argument(format!(
+            "--jobs must be at most {MAX_JOBS}, got {n} (this machine has {} core(s): more \
+             threads than cores only wait)",
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        ))),
+        _ => Ok(()),
+    }
+}

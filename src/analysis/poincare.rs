@@ -651,6 +651,7 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, Error> {
     if opts.jobs == Some(0) {
         return Err(arg("--jobs must be at least 1, got 0".into()));
     }
+    crate::analysis::check_max_jobs(opts.jobs)?;
     if let Some(d) = opts.duration
         && !(d.is_finite() && d > 0.0)
     {

@@ -135,3 +135,46 @@ fn a_range_count_below_one_is_named() {
         );
     }
 }
+
+/// A study too large is refused before its cases are listed (issue: a 100 000 × 100 000 grid
+/// filled 18 GB within 30 s, and `count = 10000000000000` aborted on an 80 TB allocation): an
+/// axis holds at most `MAX_AXIS_VALUES` values, a study at most `MAX_STUDY_CASES` cases.
+#[test]
+fn a_study_too_large_is_refused_before_anything_is_allocated() {
+    use crr::analysis::study::cases::MAX_STUDY_CASES;
+    use crr::analysis::study::spec::MAX_AXIS_VALUES;
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("study_too_large");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/single_block.toml");
+    let grid = |a: u64, f: u64| {
+        format!(
+            "name = \"big\"\nmodel = \"{}\"\nduration = 1.0\n\n[pulses]\nkind = \"one_sine_pulse\"\n\
+             amplitude_ratios = {{ from = 1.0, to = 2.0, count = {a} }}\n\
+             frequency_ratios = {{ from = 1.0, to = 2.0, count = {f} }}\n",
+            model.display()
+        )
+    };
+    for (a, f, needle) in [
+        (
+            10_000_000_000_000,
+            20,
+            format!("count must be at most {MAX_AXIS_VALUES}, got 10000000000000"),
+        ),
+        (
+            100_000,
+            100_000,
+            format!("make 10000000000 cases, more than the {MAX_STUDY_CASES} a study may hold"),
+        ),
+        (
+            1001,
+            1000,
+            format!("make 1001000 cases, more than the {MAX_STUDY_CASES}"),
+        ),
+    ] {
+        let bad = write(&dir, "big.toml", &grid(a, f));
+        let err = Study::load(&bad).unwrap_err().to_string();
+        assert!(err.contains(&needle), "{a} × {f}: {err}");
+    }
+    // At the limit it loads.
+    let ok = write(&dir, "ok.toml", &grid(1000, 1000));
+    assert_eq!(Study::load(&ok).unwrap().cases.len(), MAX_STUDY_CASES);
+}

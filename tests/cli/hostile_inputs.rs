@@ -96,3 +96,50 @@ fn devices_pipes_and_folders_are_not_read() {
         );
     }
 }
+
+/// `--jobs` is bounded (issue: `crr study … --jobs 100000` started about 1 200 threads in 16 s
+/// and finished none of 400 cases in a minute): above `MAX_JOBS` it is refused before any
+/// thread starts or any file is written.
+#[test]
+fn jobs_beyond_the_bound_are_refused_before_anything_runs() {
+    let dir = scratch("jobs_bound");
+    let study = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/studies/block_spectrum.toml");
+    let out = dir.join("study");
+    let too_many = (crr::analysis::MAX_JOBS + 1).to_string();
+    let needle = format!(
+        "--jobs must be at most {}, got {too_many}",
+        crr::analysis::MAX_JOBS
+    );
+    common::refused(
+        &[
+            "study",
+            study.to_str().unwrap(),
+            "--jobs",
+            &too_many,
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &needle,
+    );
+    assert!(!out.join("cases.csv").exists(), "nothing written");
+    let block = common::bundled_path("single_block");
+    let pc = dir.join("poincare");
+    common::refused(
+        &[
+            "poincare",
+            block.to_str().unwrap(),
+            "--frequency",
+            "2",
+            "--amplitudes",
+            "1:3:4",
+            "--jobs",
+            &too_many,
+            "--out",
+            pc.to_str().unwrap(),
+        ],
+        &needle,
+    );
+    assert!(!pc.exists(), "nothing written");
+}

@@ -225,6 +225,30 @@ pub fn spectral_acceleration(record: &Record, period: f64, damping: f64) -> Opti
     Some(w * w * peak)
 }
 
+/// The most cases a study holds: refused above it before the cases are listed.
+pub const MAX_STUDY_CASES: usize = 1_000_000;
+
+/// Refuses a study whose `so_far` cases and `more` new ones exceed [`MAX_STUDY_CASES`] (None: the
+/// product overflowed).
+fn check_case_count(
+    path: &Path,
+    so_far: usize,
+    more: Option<usize>,
+    what: &str,
+) -> Result<(), Error> {
+    match more.and_then(|m| m.checked_add(so_far)) {
+        Some(n) if n <= MAX_STUDY_CASES => Ok(()),
+        n => Err(bad(
+            path,
+            format!(
+                "{what} make {} cases, more than the {MAX_STUDY_CASES} a study may hold: split \
+                 it into several studies (or shards of a coarser grid)",
+                n.map_or_else(|| "more than 2⁶⁴".to_string(), |n| n.to_string())
+            ),
+        )),
+    }
+}
+
 fn bad(path: &Path, msg: String) -> Error {
     Error::Argument(format!("{}: {msg}", path.display()))
 }
@@ -321,6 +345,16 @@ impl Study {
                 }
                 study.read_records(r, base, &files, &seeds);
                 let (measure, levels) = intensity_levels(&spec, path)?;
+                check_case_count(
+                    path,
+                    0,
+                    study
+                        .variants
+                        .len()
+                        .checked_mul(study.records.len())
+                        .and_then(|n| n.checked_mul(levels.len())),
+                    "records × intensity levels × scales",
+                )?;
                 study.record_cases(measure, &levels);
             }
         }
@@ -359,6 +393,12 @@ impl Study {
                     format!("pulses: a period must be > 0, got {t} s"),
                 ));
             }
+            check_case_count(
+                path,
+                study.cases.len(),
+                amplitudes.len().checked_mul(periods.len()),
+                "pulses: amplitudes × periods",
+            )?;
             for (i, &a) in amplitudes.iter().enumerate() {
                 for (j, &t) in periods.iter().enumerate() {
                     study.push(

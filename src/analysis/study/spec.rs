@@ -59,6 +59,10 @@ impl TryFrom<RawValues> for Values {
     }
 }
 
+/// The most values one axis of a study takes (`{ from, to, count }`): refused above it before
+/// anything is allocated.
+pub const MAX_AXIS_VALUES: usize = 100_000;
+
 impl Values {
     /// The values, or an error naming `what` when a value is not finite or the list is empty.
     pub fn expand(&self, what: &str) -> Result<Vec<f64>, String> {
@@ -67,6 +71,12 @@ impl Values {
             Values::Range { from, to, count } => {
                 if *count == 0 {
                     return Err(format!("{what}: count must be at least 1"));
+                }
+                if *count > MAX_AXIS_VALUES {
+                    return Err(format!(
+                        "{what}: count must be at most {MAX_AXIS_VALUES}, got {count} (the values \
+                         of one axis of a study)"
+                    ));
                 }
                 if *count == 1 {
                     vec![*from]

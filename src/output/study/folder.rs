@@ -245,6 +245,7 @@ pub fn case_rows_cancellable(
     if jobs == Some(0) {
         return Err(Error::Argument("--jobs must be at least 1".into()));
     }
+    crate::analysis::check_max_jobs(jobs)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs.unwrap_or(0))
         .build()
@@ -455,6 +456,7 @@ pub fn run_study(
     study_file: &Path,
     opts: &StudyOptions,
 ) -> Result<StudyOutcome, Error> {
+    crate::analysis::check_max_jobs(opts.jobs)?;
     let out_err = |source: std::io::Error| Error::Output {
         dir: opts.out.clone(),
         source,
