@@ -64,7 +64,7 @@ pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> 
             out.display()
         )));
     }
-    std::fs::write(out, model_toml(a)).map_err(|source| Error::Output {
+    crate::output::replace_file::replace_file(out, model_toml(a)).map_err(|source| Error::Output {
         dir: out.to_path_buf(),
         source,
     })

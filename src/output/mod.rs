@@ -9,6 +9,7 @@ pub mod history;
 pub mod plot;
 pub mod poincare;
 pub mod poincare_plot;
+pub mod replace_file;
 pub mod results_folder;
 pub mod simulate;
 pub mod study;

@@ -21,6 +21,7 @@ use crr_kinematics::{ActivePivots, Model, Side};
 use crate::analysis::check::{CheckReport, housner_frequency};
 use crate::analysis::levels::{DEFAULT_STEP, MechanismLevels, mechanism_levels};
 use crate::input::model_file::ModelFile;
+use crate::output::replace_file::replace_file_with;
 use crate::output::text_lines::TextLines;
 
 pub mod decimate;
@@ -937,10 +938,17 @@ pub fn write_png(
         root.present().map_err(|e| fail(e.to_string()))?;
     }
     let small = downsample(&big, w, h, k);
-    let mut out = BitMapBackend::new(file, SIZE);
-    out.blit_bitmap((0, 0), SIZE, &small)
-        .map_err(|e| fail(e.to_string()))?;
-    out.present().map_err(|e| fail(e.to_string()))
+    // Through a temporary file renamed over `file` (a FIFO there would block the writer).
+    replace_file_with(
+        file,
+        |tmp| {
+            let mut out = BitMapBackend::new(tmp, SIZE);
+            out.blit_bitmap((0, 0), SIZE, &small)
+                .map_err(|e| fail(e.to_string()))?;
+            out.present().map_err(|e| fail(e.to_string()))
+        },
+        |e| fail(format!("cannot write the file: {e}")),
+    )
 }
 
 /// Writes one SVG of [`SIZE`].
@@ -952,9 +960,15 @@ pub fn write_svg(
         file: file.to_path_buf(),
         message,
     };
-    let root = SVGBackend::new(file, SIZE).into_drawing_area();
-    draw(&root, 1).map_err(fail)?;
-    root.present().map_err(|e| fail(e.to_string()))
+    replace_file_with(
+        file,
+        |tmp| {
+            let root = SVGBackend::new(tmp, SIZE).into_drawing_area();
+            draw(&root, 1).map_err(fail)?;
+            root.present().map_err(|e| fail(e.to_string()))
+        },
+        |e| fail(format!("cannot write the file: {e}")),
+    )
 }
 
 /// Draws one plot into `DIR/STEM.png` and `DIR/STEM.svg`; evaluates to the two paths.

@@ -143,3 +143,69 @@ fn jobs_beyond_the_bound_are_refused_before_anything_runs() {
     );
     assert!(!pc.exists(), "nothing written");
 }
+
+/// A FIFO where an output file goes is replaced, never opened for writing (issue: a FIFO named
+/// `study.json` in a study's folder, or `energy.png` in a results folder, blocked `crr study` and
+/// `crr plot` for ever, deaf to SIGTERM). Each command must finish within the hang guard.
+#[test]
+#[cfg(unix)]
+fn a_fifo_in_place_of_an_output_file_is_replaced() {
+    use std::time::{Duration, Instant};
+    let dir = scratch("fifo_outputs");
+    let mkfifo = |p: &std::path::Path| {
+        assert!(Command::new("mkfifo").arg(p).status().unwrap().success());
+    };
+    // Generous for a debug build on a loaded machine; a hang would last for ever.
+    let guard = Duration::from_secs(300);
+    let run = |args: &[&str]| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_crr"))
+            .args(args)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                return status;
+            }
+            if start.elapsed() > guard {
+                let _ = child.kill();
+                panic!("{args:?} hangs on a FIFO");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    };
+    let study = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/studies/block_spectrum.toml");
+    let out = dir.join("study");
+    std::fs::create_dir_all(&out).unwrap();
+    mkfifo(&out.join("study.json"));
+    let status = run(&[
+        "study",
+        study.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(status.success());
+    let json = std::fs::read_to_string(out.join("study.json")).unwrap();
+    assert!(json.contains("\"fingerprint\""), "{json}");
+
+    let results = dir.join("results");
+    let block = common::bundled_path("single_block");
+    assert!(
+        crr(&[
+            "simulate",
+            block.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            results.to_str().unwrap()
+        ])
+        .status
+        .success()
+    );
+    mkfifo(&results.join("energy.png"));
+    assert!(run(&["plot", results.to_str().unwrap()]).success());
+    assert!(std::fs::metadata(results.join("energy.png")).unwrap().len() > 10_000);
+}

@@ -311,9 +311,11 @@ pub fn plot_levels(
     let data = (model_name.to_string(), levels.clone());
     let mut files: Vec<PathBuf> = both_named!(dir, &format!("{prefix}levels"), draw_levels, &data);
     let csv = dir.join(format!("{prefix}levels.csv"));
-    std::fs::write(&csv, levels.to_csv()).map_err(|e| PlotError::Draw {
-        file: csv.clone(),
-        message: format!("cannot write the file: {e}"),
+    crate::output::replace_file::replace_file(&csv, levels.to_csv()).map_err(|e| {
+        PlotError::Draw {
+            file: csv.clone(),
+            message: format!("cannot write the file: {e}"),
+        }
     })?;
     files.push(csv);
     Ok(files)

@@ -325,7 +325,7 @@ pub fn draw_fragility<DB: DrawingBackend>(
 }
 
 fn write_text(file: &Path, text: &str) -> Result<(), PlotError> {
-    std::fs::write(file, text).map_err(|e| PlotError::Draw {
+    crate::output::replace_file::replace_file(file, text).map_err(|e| PlotError::Draw {
         file: file.to_path_buf(),
         message: format!("cannot write the file: {e}"),
     })

@@ -5,7 +5,7 @@
 //! depend on the number of threads, and merged shards equal a single run byte for byte.
 
 use std::collections::BTreeMap;
-use std::fs::{File, OpenOptions};
+use std::fs::OpenOptions;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -19,6 +19,7 @@ use crate::analysis::simulation::Cancel;
 use crate::analysis::simulation::coordinate_alpha;
 use crate::analysis::study::cases::case_id;
 use crate::analysis::study::{Case, Measures, Motion, Study, run_case_cancellable};
+use crate::output::replace_file::replace_file;
 
 /// `i/n`: the i-th (1-based) of n disjoint parts of a study; case k belongs to part k mod n + 1.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -471,7 +472,7 @@ pub fn run_study(
     if complete_len > 0 {
         same_study(&csv, &print_path, &print, done.len())?;
     }
-    std::fs::write(&print_path, format!("{print}\n")).map_err(out_err)?;
+    replace_file(&print_path, format!("{print}\n")).map_err(out_err)?;
     let mine: Vec<&Case> = study
         .cases
         .iter()
@@ -582,9 +583,9 @@ pub fn run_study(
             })
             .collect(),
     };
-    std::fs::write(opts.out.join("study.json"), to_json(&info)).map_err(out_err)?;
+    replace_file(&opts.out.join("study.json"), to_json(&info)).map_err(out_err)?;
     if let Some(text) = boundary_csv(study) {
-        std::fs::write(opts.out.join(BOUNDARY_FILE), text).map_err(out_err)?;
+        replace_file(&opts.out.join(BOUNDARY_FILE), text).map_err(out_err)?;
     }
     Ok(StudyOutcome {
         cases: mine.len(),
@@ -722,11 +723,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
     };
     std::fs::create_dir_all(out).map_err(out_err)?;
     let _lock = crate::output::folder_lock::FolderLock::acquire(out)?;
-    let mut f = File::create(out.join("cases.csv")).map_err(out_err)?;
-    writeln!(f, "{}", header.unwrap_or_default()).map_err(out_err)?;
+    let mut text = header.unwrap_or_default() + "\n";
     for r in rows.values() {
-        writeln!(f, "{r}").map_err(out_err)?;
+        text.push_str(r);
+        text.push('\n');
     }
+    replace_file(&out.join("cases.csv"), text).map_err(out_err)?;
     let info = MergedStudyInfo {
         study,
         name: first_json.as_ref().map(|j| j["name"].clone()),
@@ -736,9 +738,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
         cases: rows.len(),
         crr_version: env!("CARGO_PKG_VERSION").to_string(),
     };
-    std::fs::write(out.join("study.json"), to_json(&info)).map_err(out_err)?;
+    replace_file(&out.join("study.json"), to_json(&info)).map_err(out_err)?;
     if let Ok(text) = std::fs::read_to_string(dirs[0].join(BOUNDARY_FILE)) {
-        std::fs::write(out.join(BOUNDARY_FILE), text).map_err(out_err)?;
+        replace_file(&out.join(BOUNDARY_FILE), text).map_err(out_err)?;
     }
     Ok(rows.len())
 }
