@@ -215,6 +215,10 @@ pub fn prepare(input: &ModelInput, options: &RunOptions) -> Result<Prepared, Err
         }
         params.duration = d;
     }
+    // Settings that would change the physics are input errors, found before anything runs or
+    // is written (not a failed run with partial results).
+    crr_impact::simulation::check_physical_bounds(&input.model, &params)
+        .map_err(|e| here(e.to_string()))?;
     Ok(Prepared {
         path: path.clone(),
         file,

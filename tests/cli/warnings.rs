@@ -204,7 +204,8 @@ fn the_bundled_models_run_without_warnings_but_the_flights_of_the_drum_column_an
 /// (issue: each of these was accepted and turned a collapse into survival or let a block pass
 /// through the ground): a seat rate or a minimum impact interval as large as the structure's own
 /// rate and time scales √(g/L), √(L/g), a collapse drop beyond a fall, an rtol that keeps no
-/// digit. A loose but admissible rtol is a warning.
+/// digit; each is an input error (exit 2) found before the run, with nothing written. A loose but
+/// admissible rtol is a warning.
 #[test]
 fn settings_beyond_the_physics_are_refused_and_a_loose_rtol_warns() {
     for (setting, word) in [
@@ -213,13 +214,30 @@ fn settings_beyond_the_physics_are_refused_and_a_loose_rtol_warns() {
         ("collapse_drop = 2.0", "collapse_drop"),
         ("rtol = 1.0", "rtol"),
     ] {
-        let (err, _) = common::simulate_failing(
+        // An input error (exit 2), found before the run: nothing is written.
+        let path = common::write_model(
             &format!("bounds_{word}"),
             &single_block_with(&format!("duration = 1.0\n{setting}")),
         );
+        let out = scratch(&format!("bounds_{word}_out"));
+        let o = common::crr(&[
+            "simulate",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+            "--force",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{setting}: {err}");
         assert!(
             err.contains(word) && err.contains("default"),
             "{setting}: {err}"
+        );
+        assert!(!err.contains("partial results"), "{setting}: {err}");
+        assert!(
+            !out.join("history.csv").exists(),
+            "{setting}: nothing written"
         );
     }
     let (s, err) = run(

@@ -422,7 +422,7 @@ pub const COLLAPSE_DROP_MAX: f64 = 0.5;
 /// a seat rate or impact interval as large as the motion's own scales seats joints that rock
 /// (turning a collapse into survival), a collapse drop beyond a fall lets a block pass through the
 /// ground unreported.
-fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), SimulationError> {
+pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), SimulationError> {
     let rate_scale = (model.gravity / model.size).sqrt();
     let time_scale = 1.0 / rate_scale;
     if params.seat_rate > SEAT_RATE_MAX * rate_scale {
