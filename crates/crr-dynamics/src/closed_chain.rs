@@ -476,6 +476,41 @@ fn continuation_step(
     Err("the pivot sides do not settle".into())
 }
 
+/// The solved configuration `q_end` with the free angles that only drifted (below 1e-6 rad: the
+/// continuation's and Newton's steps leave such drift along a mechanism that the given angles do
+/// not move, and it broke the symmetry of symmetric structures) set to exactly 0 and the loops closed again by
+/// the other free angles, when that closes them (row-scaled |Φ| ≤ 1e-12) within 1e-6 rad of the
+/// end; else the end as it is.
+fn without_drift(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    q_end: DVector<f64>,
+    free: &[usize],
+) -> DVector<f64> {
+    let drifted: Vec<usize> = free
+        .iter()
+        .copied()
+        .filter(|&k| q_end[k] != 0.0 && q_end[k].abs() < 1e-6)
+        .collect();
+    if drifted.is_empty() {
+        return q_end;
+    }
+    let others: Vec<usize> = free
+        .iter()
+        .copied()
+        .filter(|k| !drifted.contains(k))
+        .collect();
+    let mut q = q_end.clone();
+    for &k in &drifted {
+        q[k] = 0.0;
+    }
+    let closed = project_positions(model, kin, pivots, &mut q, Some(&others)).is_ok()
+        && scaled(model, kin, &q, pivots).0.amax() <= 1e-12
+        && (&q - &q_end).amax() <= 1e-6;
+    if closed { q } else { q_end }
+}
+
 /// Solves the initial state: the given angles and rates are kept, the other coordinates are found
 /// so that Φ = 0 and Φ_q q̇ = 0, on the branch connected to rest (a continuation from 0); Newton from
 /// the rest configuration (minimum-norm steps, the pivots following the signs of the solution
@@ -562,6 +597,7 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
             pivots = pivots_path;
             settled = true;
         }
+        q = without_drift(model, &mut kin, &pivots, q, &free);
         let (phi, _) = scaled(model, &mut kin, &q, &pivots);
         if phi.amax() > 1e-9 {
             return Err(explain(&format!(": residual {:.3e}", phi.amax())));
