@@ -447,6 +447,9 @@ pub const MAX_GRID_CASES: usize = 1_000_000;
 /// section point.
 pub const MAX_PERIODS: usize = 10_000_000;
 
+/// The most section points a run keeps over all its cases (a sweep's cases × `--periods`).
+pub const MAX_KEPT_POINTS: usize = 10_000_000;
+
 /// Longest simulated time of one run, (transient + periods)/F (s).
 pub const MAX_SECTION_TIME: f64 = 1e7;
 
@@ -646,6 +649,21 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, Error> {
         return Err(arg(format!(
             "--grid asks for {} × {} cases, more than {MAX_GRID_CASES}",
             angle.count, rate.count
+        )));
+    }
+    // Every case keeps its section's points until the end (about 240 bytes each for one
+    // coordinate): the total is bounded, not only each section.
+    let cases = match &opts.sweep {
+        Sweep::None => 1,
+        Sweep::Amplitudes(r) | Sweep::Frequencies(r) => r.count,
+        Sweep::Grid { angle, rate } => angle.count.saturating_mul(rate.count),
+    };
+    if cases.saturating_mul(opts.periods) > MAX_KEPT_POINTS {
+        return Err(arg(format!(
+            "{cases} case(s) × --periods {} would keep {} section points, more than \
+             {MAX_KEPT_POINTS} (about 240 bytes each): fewer cases or periods",
+            opts.periods,
+            cases.saturating_mul(opts.periods)
         )));
     }
     if opts.jobs == Some(0) {

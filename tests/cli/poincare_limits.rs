@@ -37,6 +37,18 @@ fn sizes_beyond_the_limits_are_refused_before_running() {
             ],
             ["--periods", "10000000"],
         ),
+        (
+            // Each case keeps its points: 10⁵ amplitudes × 1 000 periods would hold about 24 GB.
+            vec![
+                "--amplitudes",
+                "0:4:100000",
+                "--periods",
+                "1000",
+                "--frequency",
+                "2",
+            ],
+            ["100000 case(s) × --periods 1000", "10000000"],
+        ),
     ] {
         let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("poincare_limits");
         let mut a = vec!["poincare", "examples/models/single_block.toml", "--out"];
