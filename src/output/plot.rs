@@ -89,8 +89,6 @@ pub struct Results {
     pub model_name: String,
     /// Coordinate names, in the order of q.
     pub coordinates: Vec<String>,
-    /// Rows of history.csv.
-    pub history_rows: usize,
     /// Sample times (s) of the rows drawn: all of them, or for a long history those that keep
     /// every series' envelope at the figures' width ([`decimate`]).
     pub t: Vec<f64>,
@@ -250,7 +248,6 @@ pub fn parse_results(
     let mut r = Results {
         model_name,
         coordinates,
-        history_rows: 0,
         t: Vec::new(),
         q: vec![Vec::new(); n],
         qdot: vec![Vec::new(); n],
@@ -351,7 +348,6 @@ pub fn parse_results(
         r.work_in.push(row[3 + 2 * n]);
         r.dissipated.push(row[4 + 2 * n]);
     }
-    r.history_rows = rows;
 
     let impacts_file = dir.join("impacts.csv");
     let text = impacts_text;

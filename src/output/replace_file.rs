@@ -29,28 +29,52 @@ fn not_a_folder(path: &Path) -> io::Result<()> {
     }
 }
 
-/// Writes `bytes` to `path` through [`temporary_for`] and a rename.
-pub fn replace_file(path: &Path, bytes: impl AsRef<[u8]>) -> io::Result<()> {
-    not_a_folder(path)?;
+/// A fresh temporary file for `path`: whatever was left at its name (a file of an interrupted
+/// write, a FIFO, a link) is removed first, and the new one is created, never opened.
+fn fresh_temporary(path: &Path) -> io::Result<(PathBuf, std::fs::File)> {
     let tmp = temporary_for(path);
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path)
+    match std::fs::remove_file(&tmp) {
+        Err(e) if e.kind() != io::ErrorKind::NotFound => return Err(e),
+        _ => {}
+    }
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&tmp)?;
+    Ok((tmp, file))
+}
+
+/// Writes `bytes` to `path` through [`temporary_for`] and a rename; the temporary file is
+/// removed when either fails.
+pub fn replace_file(path: &Path, bytes: impl AsRef<[u8]>) -> io::Result<()> {
+    use std::io::Write;
+    not_a_folder(path)?;
+    let (tmp, mut file) = fresh_temporary(path)?;
+    let done = file
+        .write_all(bytes.as_ref())
+        .and_then(|_| file.flush())
+        .and_then(|_| std::fs::rename(&tmp, path));
+    if done.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    done
 }
 
 /// Runs `write` on the temporary file of `path`, then renames it over `path` (for writers that
-/// take a path, such as the plotting backends). The temporary file is removed when `write` fails.
+/// take a path, such as the plotting backends). The temporary file is removed when either fails.
 pub fn replace_file_with<E>(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), E>,
     io_error: impl Fn(io::Error) -> E,
 ) -> Result<(), E> {
     not_a_folder(path).map_err(&io_error)?;
-    let tmp = temporary_for(path);
-    if let Err(e) = write(&tmp) {
+    // Created fresh (and closed) so that the writer opens a regular file of ours.
+    let (tmp, _) = fresh_temporary(path).map_err(&io_error)?;
+    let done = write(&tmp).and_then(|_| std::fs::rename(&tmp, path).map_err(&io_error));
+    if done.is_err() {
         let _ = std::fs::remove_file(&tmp);
-        return Err(e);
     }
-    std::fs::rename(&tmp, path).map_err(io_error)
+    done
 }
 
 #[cfg(test)]
@@ -66,6 +90,12 @@ mod tests {
         let _ = std::fs::remove_file(&fifo);
         let made = std::process::Command::new("mkfifo")
             .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        // A FIFO left at the temporary name as well: removed, not opened.
+        let made = std::process::Command::new("mkfifo")
+            .arg(temporary_for(&fifo))
             .status()
             .unwrap();
         assert!(made.success());

@@ -162,7 +162,9 @@ fn a_study_too_large_is_refused_before_anything_is_allocated() {
         (
             100_000,
             100_000,
-            format!("make 10000000000 cases, more than the {MAX_STUDY_CASES} a study may hold"),
+            format!(
+                "amplitudes × periods × scales make 10000000000 cases, more than the {MAX_STUDY_CASES} a study may hold"
+            ),
         ),
         (
             1001,

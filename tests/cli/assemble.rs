@@ -136,13 +136,27 @@ fn a_panel_cut_into_courses_rocks_whole_on_its_base_edge() {
 }
 
 #[test]
-fn a_floating_block_and_an_assembly_with_interfaces_are_refused_naming_them() {
+fn a_floating_block_a_non_convex_footprint_and_an_assembly_with_interfaces_are_refused_naming_them()
+{
     let text = "name = \"gap\"\n[[body]]\nname = \"low\"\ndensity = 2000.0\nbox = { center = [0.0, 0.0, 0.5], size = [1.0, 1.0, 1.0] }\n[[body]]\nname = \"high\"\ndensity = 2000.0\nbox = { center = [0.0, 0.0, 1.51], size = [1.0, 1.0, 1.0] }\n";
     let path = common::write_model("gap_assembly", text);
     let o = common::crr(&["assemble", path.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("body \"high\": rests on nothing"), "{err}");
+    // An L-shaped block standing on the ground: its footprint is not convex (clipping it would
+    // keep a unit square of its 3 m²), refused by name.
+    let text = "name = \"l\"\n[[body]]\nname = \"ell\"\ndensity = 2000.0\nprism = { polygon = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 2.0, 0.0]], extrude = [0.0, 0.0, 1.0] }\n";
+    let path = common::write_model("ell_assembly", text);
+    let o = common::crr(&["assemble", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(
+            "body \"ell\": touches another body (or the ground) with a face that is not convex"
+        ),
+        "{err}"
+    );
     let model = common::bundled_path("trilithon");
     let o = common::crr(&["assemble", model.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);

@@ -104,6 +104,9 @@ fn mirrored_files_under_the_mirrored_record_move_as_mirror_images() {
                 ta.impacts.len()
             );
             assert!(ta.uplift_time.is_some(), "{name}: it uplifts");
+            // Under these records the three rock and then overturn, in both runs (so the
+            // comparison covers the collapse decision as well).
+            assert!(ta.collapse.is_some(), "{name}: it overturns");
         }
         assert_eq!(
             ta.impacts.len(),

@@ -480,7 +480,7 @@ fn continuation_step(
 /// continuation's and Newton's steps leave such drift along a mechanism that the given angles do
 /// not move, and it broke the symmetry of symmetric structures) set to exactly 0 and the loops closed again by
 /// the other free angles, when that closes them (row-scaled |Φ| ≤ 1e-12) within 1e-6 rad of the
-/// end; else the end as it is.
+/// end with every angle still on the side of its pivot; else the end as it is.
 fn without_drift(
     model: &Model,
     kin: &mut Data,
@@ -507,7 +507,8 @@ fn without_drift(
     }
     let closed = project_positions(model, kin, pivots, &mut q, Some(&others)).is_ok()
         && scaled(model, kin, &q, pivots).0.amax() <= 1e-12
-        && (&q - &q_end).amax() <= 1e-6;
+        && (&q - &q_end).amax() <= 1e-6
+        && signs_agree(model, kin, &q, pivots);
     if closed { q } else { q_end }
 }
 

@@ -284,7 +284,7 @@ fn regularised_dirac_switches_at_every_crossing_whatever_the_width() {
 #[test]
 fn a_zone_narrower_than_the_angle_tolerance_is_refused_and_never_reported_as_a_collapse() {
     let mut spec = single_block(0.2, 1.0, 2500.0);
-    for width in [1e-13, 9.9e-6, f64::NAN] {
+    for width in [1e-13, 9.9e-6, f64::NAN, f64::INFINITY] {
         spec.interface[0].impact = ImpactLaw::DiracRegularised {
             r: 0.9,
             c: 1.0,

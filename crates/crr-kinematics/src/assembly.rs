@@ -87,6 +87,8 @@ struct Face {
     polygon: Vec<Vector3<f64>>,
     normal: Vector3<f64>,
     offset: f64,
+    /// Whether the polygon is convex (every turn the same way about the normal).
+    convex: bool,
 }
 
 fn faces_of(surface: &Surface) -> Vec<Face> {
@@ -102,10 +104,15 @@ fn faces_of(surface: &Surface) -> Vec<Face> {
             let norm = area.norm();
             (norm > 0.0).then(|| {
                 let normal = area / norm;
+                let convex = (0..m).all(|i| {
+                    let (a, b, c) = (polygon[i], polygon[(i + 1) % m], polygon[(i + 2) % m]);
+                    (b - a).cross(&(c - b)).dot(&normal) >= -1e-12 * (b - a).norm() * (c - b).norm()
+                });
                 Face {
                     offset: normal.dot(&polygon[0]),
                     polygon,
                     normal,
+                    convex,
                 }
             })
         })
@@ -239,6 +246,9 @@ pub fn detect_contacts(
     for (b, fs) in faces.iter().enumerate() {
         for f in fs {
             if f.normal.z < -facing && f.polygon.iter().all(|v| v.z.abs() <= tolerance) {
+                if !f.convex {
+                    return Err(non_convex(&bodies[b].name));
+                }
                 let (corners, area) = overlap(&f.polygon, &f.polygon, &-f.normal, tolerance);
                 if area > min_area {
                     contacts.push(ContactFace {
@@ -278,6 +288,10 @@ pub fn detect_contacts(
                         (j, i, fb.normal)
                     };
                     let (corners, area) = overlap(&fa.polygon, &fb.polygon, &normal, tolerance);
+                    if area > min_area && !(fa.convex && fb.convex) {
+                        let b = if fa.convex { j } else { i };
+                        return Err(non_convex(&bodies[b].name));
+                    }
                     if area > min_area {
                         contacts.push(ContactFace {
                             lower: Some(lower),
@@ -292,6 +306,23 @@ pub fn detect_contacts(
             }
         }
     }
+    for (k, c) in contacts.iter().enumerate() {
+        if c.bed
+            && contacts[..k]
+                .iter()
+                .any(|d| d.bed && d.lower == c.lower && d.upper == c.upper)
+        {
+            let lower = c.lower.map_or("the ground", |b| bodies[b].name.as_str());
+            return Err(error(
+                format!("body \"{}\"", bodies[c.upper].name),
+                format!(
+                    "rests on {lower} on more than one face (a face split in pieces, as an \
+                     annular sector's flat side): crr assemble makes one interface per pair of \
+                     bodies and needs one bed face between them"
+                ),
+            ));
+        }
+    }
     for (b, body) in bodies.iter().enumerate() {
         if !contacts.iter().any(|c| c.bed && c.upper == b) {
             return Err(error(
@@ -304,6 +335,14 @@ pub fn detect_contacts(
         }
     }
     Ok(contacts)
+}
+
+fn non_convex(body: &str) -> AssemblyError {
+    error(
+        format!("body \"{body}\""),
+        "touches another body (or the ground) with a face that is not convex: crr assemble \
+         clips convex faces only (cut the block into convex parts)",
+    )
 }
 
 /// The overlap of two facing planar polygons, expressed in the plane of `a`: its corners

@@ -794,11 +794,14 @@ fn check_impact_law(law: &ImpactLaw, item: &str) -> Result<(), ModelError> {
         ImpactLaw::Dirac { c, .. } | ImpactLaw::DiracRegularised { c, .. } if bad_pos(c) => {
             Some(format!("c must be positive, got {c}"))
         }
-        ImpactLaw::DiracRegularised { width, .. } if width.is_nan() || width < MIN_DIRAC_WIDTH => {
+        ImpactLaw::DiracRegularised { width, .. }
+            if !(width.is_finite() && width >= MIN_DIRAC_WIDTH) =>
+        {
             Some(format!(
-                "width must be at least {MIN_DIRAC_WIDTH:e} rad, got {width}: a narrower zone lies \
-             within the angle tolerance of the run's events and pivot checks (1e-5 rad), so the \
-             integrator steps over it; for the impulsive limit give `dirac = {{ r, c }}`"
+                "width must be a finite number of at least {MIN_DIRAC_WIDTH:e} rad, got {width}: \
+                 a narrower zone lies within the angle tolerance of the run's events and pivot \
+                 checks (1e-5 rad), so the integrator steps over it; for the impulsive limit give \
+                 `dirac = {{ r, c }}`"
             ))
         }
         _ => None,

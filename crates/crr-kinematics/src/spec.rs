@@ -131,7 +131,7 @@ pub enum ImpactLaw {
         r: f64,
         /// The coefficient C (> 0).
         c: f64,
-        /// Width ε of the regularised δ (rad, > 0).
+        /// Width ε of the regularised δ (rad, at least `MIN_DIRAC_WIDTH` = 1e-5).
         width: f64,
     },
 }

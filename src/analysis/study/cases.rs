@@ -343,7 +343,7 @@ impl Study {
                             .into(),
                     ));
                 }
-                study.read_records(r, base, &files, &seeds);
+                // Counted before the records are read or generated.
                 let (measure, levels) = intensity_levels(&spec, path)?;
                 check_case_count(
                     path,
@@ -351,10 +351,11 @@ impl Study {
                     study
                         .variants
                         .len()
-                        .checked_mul(study.records.len())
+                        .checked_mul(files.len() + seeds.len())
                         .and_then(|n| n.checked_mul(levels.len())),
                     "records × intensity levels × scales",
                 )?;
+                study.read_records(r, base, &files, &seeds);
                 study.record_cases(measure, &levels);
             }
         }
@@ -397,7 +398,7 @@ impl Study {
                 path,
                 study.cases.len(),
                 amplitudes.len().checked_mul(periods.len()),
-                "pulses: amplitudes × periods",
+                "pulses: amplitudes × periods × scales",
             )?;
             for (i, &a) in amplitudes.iter().enumerate() {
                 for (j, &t) in periods.iter().enumerate() {

@@ -444,7 +444,7 @@ pub fn frame_step(count: usize, span: (f64, f64), every: Option<usize>) -> Resul
 /// The states kept as frames: the first and every K-th after it, read from the history again.
 /// Every row is read (an error anywhere stops it), only the frames are kept.
 pub fn frame_states(run: &Run, k: usize) -> Result<Vec<State>, Error> {
-    let mut frames = Vec::with_capacity(run.count.div_ceil(k.max(1)));
+    let mut frames = Vec::with_capacity(run.count.div_ceil(k.max(1)).min(DEFAULT_MAX_FRAMES));
     for (i, state) in run.states()?.enumerate() {
         let state = state?;
         if i % k.max(1) == 0 {

@@ -98,10 +98,15 @@ impl Decimator {
 mod tests {
     use super::*;
 
-    /// Envelope of series `s` over the span of bucket `b`, from a list of rows.
-    fn envelope(rows: &[Vec<f64>], d: &Decimator, b: usize, s: usize) -> (f64, f64) {
+    /// Least and greatest value of series `s` over the rows whose time lies in span `b` of
+    /// [0, 10] s cut into `BUCKETS` equal spans (the last one closed), from a list of rows.
+    fn envelope(rows: &[Vec<f64>], b: usize, s: usize) -> (f64, f64) {
+        let (lo_t, hi_t) = (
+            10.0 * b as f64 / BUCKETS as f64,
+            10.0 * (b + 1) as f64 / BUCKETS as f64,
+        );
         rows.iter()
-            .filter(|r| (((r[0] - d.start) / d.width) as usize).min(BUCKETS - 1) == b)
+            .filter(|r| r[0] >= lo_t && (r[0] < hi_t || (b == BUCKETS - 1 && r[0] <= hi_t)))
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
                 (lo.min(r[s]), hi.max(r[s]))
             })
@@ -109,30 +114,37 @@ mod tests {
 
     #[test]
     fn every_span_keeps_its_ends_and_the_envelope_of_every_series() {
-        // A million rows of a fast oscillation and a slow ramp, with a jump (two rows at one time).
+        // A million rows of a fast oscillation, a slow ramp and a cosine, on times k/99 999.9 s
+        // (away from the spans' bounds), and an impact: two rows at one time, the second with the
+        // oscillation's value jumped by 1 (rates before and after).
         let n = 1_000_000;
-        let rows: Vec<Vec<f64>> = (0..n)
+        let mut rows: Vec<Vec<f64>> = (0..n)
             .map(|i| {
-                let t = 10.0 * i as f64 / (n - 1) as f64;
-                let jump = if i > n / 2 { 1.0 } else { 0.0 };
-                vec![t, (997.0 * t).sin() + jump, t * t, (31.0 * t).cos()]
+                let t = (i as f64 + 0.5) / 100_000.0;
+                vec![t, (997.0 * t).sin(), t * t, (31.0 * t).cos()]
             })
             .collect();
+        let at = 500_000;
+        let mut after = rows[at].clone();
+        after[1] += 1.0;
+        rows.insert(at + 1, after);
         let mut d = Decimator::new(0.0, 10.0);
         for (i, r) in rows.iter().enumerate() {
             d.push(i, r.clone());
         }
-        let probe = Decimator::new(0.0, 10.0);
         let kept = d.finish();
         assert!(kept.len() < 10 * BUCKETS, "{} rows kept", kept.len());
         assert!(kept.windows(2).all(|w| w[0][0] <= w[1][0]), "in time order");
         assert_eq!(kept.first(), rows.first());
         assert_eq!(kept.last(), rows.last());
-        for b in (0..BUCKETS).step_by(37) {
+        // Both rows of the impact are kept here, so the jump is drawn.
+        assert!(kept.contains(&rows[at]) && kept.contains(&rows[at + 1]));
+        let impact_span = (rows[at][0] * BUCKETS as f64 / 10.0) as usize;
+        for b in (0..BUCKETS).step_by(37).chain([impact_span]) {
             for s in 1..4 {
                 assert_eq!(
-                    envelope(&kept, &probe, b, s),
-                    envelope(&rows, &probe, b, s),
+                    envelope(&kept, b, s),
+                    envelope(&rows, b, s),
                     "span {b}, series {s}"
                 );
             }
