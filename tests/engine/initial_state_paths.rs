@@ -180,8 +180,8 @@ fn every_single_angle_release_of_the_documented_3d_trilithon_is_the_parallel_mot
 
 /// Releasing any one of the baldachin's four columns by the same tilt about x starts the same
 /// parallel motion: the angles the release does not move are exactly 0, not a drift of 1e-7 rad
-/// along the other mechanism (issue: the four releases gave 0, 0, 26 and 53 impacts in 0.3 s,
-/// their free tilts about y at −6e-8 and 3.6e-7 rad), and the four runs are the same motion.
+/// along the other mechanism (the releases of columns 3 and 4 started with their free tilts
+/// about y at −6e-8 and 3.6e-7 rad), and the four runs are the same motion.
 #[test]
 fn releasing_any_column_of_the_baldachin_gives_the_same_motion_without_drift() {
     let (_, model) =
