@@ -9,7 +9,7 @@ use crr_kinematics::assembly::{ContactFace, InterfaceStyle, detect_contacts, str
 use crr_kinematics::{Model, StructureSpec};
 
 use crate::Error;
-use crate::input::model_file::{ModelFile, parse_model_file};
+use crate::input::model_file::{ModelFile, read_model_file};
 
 /// The default contact tolerance (m): two faces closer than this touch.
 pub const DEFAULT_TOLERANCE: f64 = 1e-6;
@@ -17,12 +17,7 @@ pub const DEFAULT_TOLERANCE: f64 = 1e-6;
 /// Reads an assembly file: a model file (TOML, or JSON when it ends in .json) with bodies and
 /// no interfaces.
 pub fn read_assembly(path: &Path) -> Result<ModelFile, Error> {
-    let limit = crr_dynamics::input::MODEL_FILE_LIMIT;
-    let text = crr_dynamics::input::read_regular_text(path, limit).map_err(|source| Error::Io {
-        file: path.to_path_buf(),
-        source,
-    })?;
-    let file = parse_model_file(path, &text)?;
+    let file = read_model_file(path)?;
     let here = |m: &str| Error::Argument(format!("{}: {m}", path.display()));
     if !file.interface.is_empty() {
         return Err(here(

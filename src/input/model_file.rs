@@ -171,16 +171,21 @@ fn array_length_error(v: &serde_json::Value, at: &str) -> Option<String> {
     }
 }
 
-/// Reads, parses and validates a model file (the structure; the other tables are checked where
-/// they are used).
-pub fn load_model(path: &Path) -> Result<(ModelFile, Model), Error> {
+/// Reads and parses a model file (TOML, or JSON when it ends in .json), without validating the
+/// structure.
+pub fn read_model_file(path: &Path) -> Result<ModelFile, Error> {
     let limit = crr_dynamics::input::MODEL_FILE_LIMIT;
     let text = crr_dynamics::input::read_regular_text(path, limit).map_err(|source| Error::Io {
         file: path.to_path_buf(),
         source,
     })?;
-    let file = parse_model_file(path, &text)?;
-    build_model(path, file)
+    parse_model_file(path, &text)
+}
+
+/// Reads, parses and validates a model file (the structure; the other tables are checked where
+/// they are used).
+pub fn load_model(path: &Path) -> Result<(ModelFile, Model), Error> {
+    build_model(path, read_model_file(path)?)
 }
 
 /// Validates the structure of a parsed model file into a model; errors name `path` (the file,

@@ -13,8 +13,8 @@
 
 use nalgebra::Vector3;
 
-use crate::shapes::Shape;
 use crate::shapes::Surface;
+use crate::shapes::{Shape, any_perpendicular};
 use crate::spec::{BodySpec, InterfaceSpec, PivotSpec, RockingBaseSpec, StructureSpec};
 
 /// A contact face between two bodies (or a body and the ground).
@@ -92,18 +92,17 @@ struct Face {
 }
 
 fn faces_of(surface: &Surface) -> Vec<Face> {
-    surface
-        .faces
-        .iter()
+    (0..surface.faces.len())
         .filter_map(|f| {
-            let polygon: Vec<Vector3<f64>> = f.iter().map(|&i| surface.vertices[i]).collect();
-            let m = polygon.len();
-            let area = (0..m).fold(Vector3::zeros(), |a, i| {
-                a + polygon[i].cross(&polygon[(i + 1) % m]) * 0.5
-            });
+            let polygon: Vec<Vector3<f64>> = surface.faces[f]
+                .iter()
+                .map(|&i| surface.vertices[i])
+                .collect();
+            let area = surface.face_area_vector(f);
             let norm = area.norm();
             (norm > 0.0).then(|| {
                 let normal = area / norm;
+                let m = polygon.len();
                 let convex = (0..m).all(|i| {
                     let (a, b, c) = (polygon[i], polygon[(i + 1) % m], polygon[(i + 2) % m]);
                     (b - a).cross(&(c - b)).dot(&normal) >= -1e-12 * (b - a).norm() * (c - b).norm()
@@ -117,16 +116,6 @@ fn faces_of(surface: &Surface) -> Vec<Face> {
             })
         })
         .collect()
-}
-
-/// A unit vector perpendicular to the unit vector `n`.
-fn perpendicular(n: &Vector3<f64>) -> Vector3<f64> {
-    let trial = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    (trial - n * n.dot(&trial)).normalize()
 }
 
 /// Signed area of a 2D polygon (positive counter-clockwise).
@@ -353,7 +342,7 @@ fn overlap(
     normal: &Vector3<f64>,
     tolerance: f64,
 ) -> (Vec<Vector3<f64>>, f64) {
-    let e1 = perpendicular(normal);
+    let e1 = any_perpendicular(normal);
     let e2 = normal.cross(&e1);
     let origin = a[0];
     let to_2d = |p: &Vector3<f64>| [(p - origin).dot(&e1), (p - origin).dot(&e2)];

@@ -676,7 +676,7 @@ fn bbox_diagonal(pts: &[Vector3<f64>]) -> f64 {
 }
 
 /// A unit vector perpendicular to the unit vector `n`.
-fn any_perpendicular(n: &Vector3<f64>) -> Vector3<f64> {
+pub(crate) fn any_perpendicular(n: &Vector3<f64>) -> Vector3<f64> {
     let trial = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
         Vector3::x()
     } else if n.y.abs() <= n.z.abs() {

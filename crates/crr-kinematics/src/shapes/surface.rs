@@ -80,7 +80,12 @@ impl Surface {
 
     /// Unit outward normal of face `f` (Newell's method).
     pub fn face_normal(&self, f: usize) -> Vector3<f64> {
-        newell(&self.faces[f], &self.vertices).normalize()
+        self.face_area_vector(f).normalize()
+    }
+
+    /// Vector area of face `f` (Newell's method): its area times its unit outward normal.
+    pub fn face_area_vector(&self, f: usize) -> Vector3<f64> {
+        newell(&self.faces[f], &self.vertices)
     }
 }
 
