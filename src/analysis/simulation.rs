@@ -740,6 +740,13 @@ fn warnings(
                 "would need tension (N = {:.4e} N): the bodies separate (flight)",
                 v.normal
             )
+        } else if v.kind == "outside_face" {
+            format!(
+                "is held seated with its contact's resultant outside its face (an edge of the \
+                 face would pull with N = {:.4e} N): the joint should be rocking, which the \
+                 engine's choice of the joints that open missed",
+                v.normal
+            )
         } else {
             format!(
                 "needs friction |F_t|/N = {:.4} above μ: it slides",

@@ -56,7 +56,8 @@ pub struct Summary {
     pub collapse: CollapseSummary,
     /// Largest |T + U − W + D − E(0)| over the samples (J).
     pub energy_balance_error: f64,
-    /// The first failure of the rigid-contact hypotheses (flight, sliding), if any.
+    /// The first failure of the rigid-contact hypotheses (flight, a resultant outside its face,
+    /// sliding), if any.
     pub hypothesis_violation: Option<ViolationSummary>,
 }
 
@@ -180,9 +181,9 @@ pub struct ViolationSummary {
     pub time: f64,
     /// The interface.
     pub interface: String,
-    /// `tension` (flight) or `sliding`.
+    /// `tension` (flight), `outside_face` (a seated joint that should be rocking) or `sliding`.
     pub kind: String,
-    /// Its normal force (N).
+    /// Its normal force (N); for `outside_face`, the force of the edge that would pull.
     pub normal_force: f64,
     /// |F_t|/N needed; `None` when undefined.
     pub friction_demand: Option<f64>,

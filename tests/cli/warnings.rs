@@ -151,8 +151,12 @@ fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
     assert!(v["normal_force"].as_f64().unwrap() < 0.0);
 }
 
+/// Every bundled model runs without a warning except three whose monitor reports a failure:
+/// the drum column's flight, and two joints held seated with their contact's resultant outside
+/// the face in the 3D arch and the temple (the decisions in motion on loops are not yet the
+/// face-level program everywhere; docs/simulation.md, the hypotheses monitor).
 #[test]
-fn the_bundled_models_run_without_warnings_but_the_flights_of_the_drum_column_and_the_temple() {
+fn the_bundled_models_run_without_warnings_but_the_three_the_monitor_flags() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
     let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -177,22 +181,21 @@ fn the_bundled_models_run_without_warnings_but_the_flights_of_the_drum_column_an
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
         // The drum column's impact at 0.422 s needs tension under the third drum (the drums
-        // above would jump): the one bundled run outside crr's model, and it says so.
-        if stem == "drum_column" {
+        // above would jump): a run outside crr's model, and it says so.
+        let flagged = match stem.as_str() {
+            "drum_column" => Some("\"bed_3\" would need tension"),
+            // At 2.68 s, as the y tilts of the voussoirs come to rest after a run of impacts,
+            // the right springing's y tilt is seated while an edge of its face would pull.
+            "arch_3d" => Some("\"springing_right\" is held seated with its contact's resultant"),
+            // 25 ms after the temple leaves rest in its y mechanism, a bed of the first column is
+            // held seated with an edge of its face pulling (tests/engine/temple.rs).
+            "temple" => Some("\"c11_bed_3\" is held seated with its contact's resultant"),
+            _ => None,
+        };
+        if let Some(words) = flagged {
             let w = warnings(&s);
-            assert_eq!(w.len(), 1, "{w:?}");
-            assert!(w[0].contains("\"bed_3\" would need tension"), "{w:?}");
-            continue;
-        }
-        // The temple leaves rest in its y mechanism, in which the entablature turns on the back
-        // row's capitals; at 4.24 s a seat of the entablature would need tension (tests/engine/temple.rs).
-        if stem == "temple" {
-            let w = warnings(&s);
-            assert_eq!(w.len(), 1, "{w:?}");
-            assert!(
-                w[0].contains("\"entablature_on_c21\" would need tension"),
-                "{w:?}"
-            );
+            assert_eq!(w.len(), 1, "{stem}: {w:?}");
+            assert!(w[0].contains(words), "{stem}: {w:?}");
             continue;
         }
         assert!(warnings(&s).is_empty(), "{stem}: {s}");

@@ -206,9 +206,9 @@ fn assert_energy_balance(traj: &crr::impact::Trajectory, least: f64) {
 /// exceeds the collapse multiplier along its own direction (mostly along y there: the y
 /// mechanism, 0.162905/|d_y|), found by the global test at rest; the former local search missed
 /// it by 0.26 ms (a load 0.17 % above λ_c). In that mechanism the entablature turns on the back
-/// row's capitals, and the monitor later finds a seat of the entablature in tension (it would
-/// lift off a capital), which the run reports: the results after that instant are outside the
-/// CRR model.
+/// row's capitals; 25 ms later the monitor finds a bed of the first column held seated with an
+/// edge of its face pulling, which the run reports: the results after that instant are not
+/// reliable.
 #[test]
 fn the_bundled_run_leaves_rest_at_the_collapse_multiplier() {
     let (model, traj) = common::run_model_text("temple_bundled", &temple_text(), None);
@@ -243,10 +243,16 @@ fn the_bundled_run_leaves_rest_at_the_collapse_multiplier() {
     assert!((uplift - 1.615273).abs() < 1e-5, "{uplift}");
     assert!(traj.collapse.is_none());
     assert!(traj.impacts.len() > 10, "{} impacts", traj.impacts.len());
+    // The monitor flags a bed of the first column held seated 25 ms after the uplift with an
+    // edge of its face pulling (0.6 % of the weight): the decisions in motion on the twisting
+    // seats are still the local ones (docs/simulation.md, the hypotheses monitor).
     if let Some(v) = &traj.violation {
-        assert_eq!(v.kind, "tension", "{v:?}");
-        assert!(v.interface.starts_with("entablature_on_"), "{v:?}");
-        assert!(v.t > 4.0, "{v:?}");
+        assert_eq!(
+            (v.kind.as_str(), v.interface.as_str()),
+            ("outside_face", "c11_bed_3"),
+            "{v:?}"
+        );
+        assert!(v.t > uplift && v.t < uplift + 0.05, "{v:?}");
     }
     assert_energy_balance(&traj, 100.0);
 }
@@ -293,7 +299,7 @@ fn self_stress_moves_forces_between_columns_only() {
         (on_ground - weight).abs() < 1e-9 * weight,
         "{on_ground} against {weight}"
     );
-    let states = crr::impact::monitor::self_stress_normals(&model, &d).expect("hyperstatic");
+    let states = crr::impact::monitor::self_stress_normals(&model, &d, &[]).expect("hyperstatic");
     assert!(states.ncols() > 0);
     for j in 0..states.ncols() {
         let col = states.column(j);
@@ -443,5 +449,77 @@ fn separate_architraves_rock_as_walls_along_y() {
             "{:?}",
             s.opening
         );
+    }
+}
+
+/// The monitor against the static theorem on the temple at rest, every joint seated, under a
+/// constant ground acceleration κ g along ±x and ±y: an equilibrium with every contact's
+/// resultant within its face exists if and only if κ ≤ λ_c, the collapse multiplier of the
+/// contact faces' linear program (`crr::impact::statics`, corner forces; independent of the
+/// monitor's seat reactions and self-stress states). At κ = 0 the least-norm distribution has
+/// edges pulling, which the self-stress states resolve; at 0.98 λ_c nothing is reported and at
+/// 1.02 λ_c a violation is.
+#[test]
+fn the_monitor_at_rest_agrees_with_the_static_theorem() {
+    use crr::dynamics::eom::Dynamics;
+    use crr::dynamics::ground_motion::{
+        Axis, ComponentSpec, ConstantSpec, GroundMotion, SignalSpec,
+    };
+    use crr::impact::monitor::{ForceWork, check, contact_forces_into, self_stress_normals};
+    use crr::kinematics::{ActivePivots, Side};
+    use nalgebra::{DVector, Vector3};
+    let (_, model) =
+        crr::load_model(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/temple.toml"))
+            .unwrap();
+    let tol = crr::impact::monitor::TENSION_TOLERANCE * model.total_mass() * model.gravity;
+    let zero = DVector::zeros(model.dof());
+    let violation = |a: Vector3<f64>| {
+        let mut ground = GroundMotion::none();
+        for (axis, value) in [(Axis::X, a.x), (Axis::Y, a.y)] {
+            let constant = SignalSpec::Constant(ConstantSpec { value });
+            ground = ground
+                .with_component(axis, &ComponentSpec::new(constant), Path::new("."))
+                .unwrap();
+        }
+        let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+        d.seated = (0..model.slot_count).collect();
+        let mut work = ForceWork::default();
+        contact_forces_into(&model, &mut d, &ground, 0.0, &zero, &zero, &mut work).unwrap();
+        let states = self_stress_normals(&model, &d, &work.edges);
+        let least_norm_pulls = work.edges.iter().any(|e| e.near.min(e.far) < -tol);
+        let v = check(
+            &model,
+            &work.forces,
+            &work.edges,
+            states.as_ref(),
+            0.0,
+            None,
+            tol,
+        );
+        (least_norm_pulls, v)
+    };
+    let (pulls, v) = violation(Vector3::zeros());
+    assert!(
+        pulls,
+        "the least-norm distribution at rest has an edge pulling"
+    );
+    assert_eq!(v, None);
+    for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
+        let lambda = crr::impact::statics::collapse_multiplier(
+            &model,
+            d,
+            &crr::impact::statics::StaticsOptions::default(),
+        )
+        .unwrap()
+        .lambda
+        .expect("collapses");
+        for (factor, fails) in [(0.98, false), (1.02, true)] {
+            let (_, v) = violation(d * factor * lambda * model.gravity);
+            assert_eq!(
+                v.is_some(),
+                fails,
+                "{factor} λ_c = {lambda} along {d:?}: {v:?}"
+            );
+        }
     }
 }

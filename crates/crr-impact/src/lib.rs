@@ -42,6 +42,7 @@
 //! ```
 
 pub mod laws;
+pub mod least_distance;
 pub mod monitor;
 pub mod nnls;
 pub mod simulation;

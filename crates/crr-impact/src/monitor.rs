@@ -8,8 +8,16 @@
 //! multipliers (−λ on the child). N = f·n with n the contact normal (towards the child: for a hinge
 //! with two pivot lines n ∝ u × (P⁻ − P⁺); for a rocking base its normal), rotated with the parent.
 //! Plain hinges (one pivot line) are joints that can hold tension and are not monitored.
+//!
+//! A seated slot also carries a moment about its pivot line: its seat reaction r (the
+//! generalized force holding it, N m). With the normal force N of its face split between the
+//! edge through the current pivot P and the edge through the other pivot P′, the far edge's share
+//! is r/s, s = (w × (P′ − P))·n the moment about P's line (axis w) of a unit normal force on P′'s
+//! line, and the near edge's N − r/s ([`SeatEdges`]). The contact's resultant lies within its face
+//! exactly when both are compressive: a negative far share means the joint should have opened
+//! about P, a negative near share that it should rock about P′.
 
-use nalgebra::{DMatrix, DVector, Vector3, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3, Vector6};
 use serde::Serialize;
 
 use crr_dynamics::DynamicsError;
@@ -50,6 +58,23 @@ impl ContactForce {
     }
 }
 
+/// The normal force of a seated slot's face split between the edges through its two pivots (the
+/// two pivot lines of a hinge; for a rocking base's tilt, the edge through the pivot corner along
+/// the tilt's axis and the parallel edge through the other corner).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SeatEdges {
+    /// Interface index.
+    pub interface: usize,
+    /// The slot (a tree coordinate, or a closure angle).
+    pub slot: usize,
+    /// Normal force on the edge through the current pivot P (N); negative: the joint would need
+    /// tension there, it should rock about the other pivot.
+    pub near: f64,
+    /// Normal force on the edge through the other pivot P′ (N); negative: the joint should have
+    /// opened about P.
+    pub far: f64,
+}
+
 /// The first failure of a hypothesis.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Violation {
@@ -57,9 +82,10 @@ pub struct Violation {
     pub t: f64,
     /// Interface name.
     pub interface: String,
-    /// `"tension"` (N < 0: flight) or `"sliding"` (|F_t| > μN).
+    /// `"tension"` (N < 0: flight), `"outside_face"` (a seated joint's resultant beyond an edge of
+    /// its face: one of its edges would pull, the joint should rock) or `"sliding"` (|F_t| > μN).
     pub kind: String,
-    /// N at that time (N).
+    /// N at that time (N); for `"outside_face"` the normal force of the edge that would pull.
     pub normal: f64,
     /// |F_t|/N at that time.
     pub friction_demand: f64,
@@ -116,6 +142,9 @@ pub struct ForceWork {
     transmitted: Vec<Option<(Vector3<f64>, Vector3<f64>)>>,
     /// The contact forces of the last call, in interface order.
     pub forces: Vec<Option<ContactForce>>,
+    /// The split of the seated slots' normal forces between their edges, in the order of
+    /// `Dynamics::seated` (slots of plain hinges left out).
+    pub edges: Vec<SeatEdges>,
 }
 
 /// [`contact_forces`] into reused buffers: the forces are left in `work.forces`.
@@ -137,6 +166,7 @@ pub fn contact_forces_into(
         solved?;
         let (g_eff, qddot) = (dynamics.effective_gravity(), dynamics.qddot[0]);
         one_body_force(model, &mut dynamics.kin, g_eff, qddot, qdot[0], work);
+        seat_edges(model, dynamics, &work.forces, &mut work.edges);
         return Ok(());
     }
     dynamics.accelerations(model, ground, t, q, qdot)?;
@@ -181,7 +211,93 @@ pub fn contact_forces_into(
             .iter()
             .map(|f| f.map(|(force, normal)| ContactForce::new(force, normal))),
     );
+    seat_edges(model, dynamics, &work.forces, &mut work.edges);
     Ok(())
+}
+
+/// World axis w, current pivot P and other pivot P′ of seated slot `slot` at the state of `kin`,
+/// and its interface's index (the axis of `slot_row`: a hinge's and a first tilt's on the parent,
+/// a second tilt's on the child, a twisting base's tilts of the face normal on the parent).
+fn slot_pivot_lines(
+    model: &Model,
+    kin: &crr_kinematics::Data,
+    pivots: &crr_kinematics::ActivePivots,
+    slot: usize,
+) -> (usize, Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let index = crate::simulation::slot_interface(model, slot);
+    let iface = &model.interfaces[index];
+    let other_rest = crate::simulation::other_pivot_rest(iface, pivots, slot);
+    if slot < model.dof() {
+        let parent = model.coords[slot].parent;
+        let other = crr_kinematics::kinematics::frame_point(kin, parent, &other_rest);
+        return (index, kin.axis[slot], kin.pivot[slot], other);
+    }
+    let parent = model.frame_of(iface.parent);
+    let rot = |k: Option<usize>| k.map_or_else(Matrix3::identity, |k| kin.rot_ops[k]);
+    let component = slot - iface.slots.start;
+    let w = match &iface.kind {
+        InterfaceKind::Hinge { axis, .. } => rot(parent) * axis,
+        InterfaceKind::RockingBase {
+            e1,
+            e2,
+            twist: true,
+            ..
+        } => rot(parent) * if component == 0 { e1 } else { e2 },
+        InterfaceKind::RockingBase { e1, e2, .. } => {
+            if component == 0 {
+                rot(parent) * e1
+            } else {
+                rot(Some(model.body_coord[iface.child])) * e2
+            }
+        }
+    };
+    let current = iface.kind.pivot(pivots.of_interface(model, index));
+    let point = |x: &Vector3<f64>| crr_kinematics::kinematics::frame_point(kin, parent, x);
+    (index, w, point(&current), point(&other_rest))
+}
+
+/// The split of every seated slot's normal force between the edges through its two pivots
+/// ([`SeatEdges`]) from its seat reaction and its interface's contact force, into `edges`.
+fn seat_edges(
+    model: &Model,
+    dynamics: &Dynamics,
+    forces: &[Option<ContactForce>],
+    edges: &mut Vec<SeatEdges>,
+) {
+    edges.clear();
+    if dynamics.seat_reactions.len() != dynamics.seated.len() {
+        return;
+    }
+    for (i, &slot) in dynamics.seated.iter().enumerate() {
+        let Some((interface, arm)) = seat_arm(model, dynamics, slot) else {
+            continue;
+        };
+        let Some(force) = forces[interface] else {
+            continue;
+        };
+        let far = dynamics.seat_reactions[i] / arm;
+        edges.push(SeatEdges {
+            interface,
+            slot,
+            near: force.normal - far,
+            far,
+        });
+    }
+}
+
+/// The interface of seated slot `slot` and its arm s = (w × (P′ − P))·n (m): the moment about
+/// the current pivot's line of a unit normal force on the other pivot's line. None for plain
+/// hinges (no face) and faces of no width.
+fn seat_arm(model: &Model, dynamics: &Dynamics, slot: usize) -> Option<(usize, f64)> {
+    let kin = &dynamics.kin;
+    let (interface, w, p, p_other) = slot_pivot_lines(model, kin, &dynamics.pivots, slot);
+    let iface = &model.interfaces[interface];
+    let n_rest = rest_normal(&iface.kind, model.size)?;
+    let parent_rot = model
+        .frame_of(iface.parent)
+        .map_or_else(Matrix3::identity, |k| kin.rot_ops[k]);
+    let arm = w.cross(&(p_other - p)).dot(&(parent_rot * n_rest));
+    (arm.abs() > 1e-9 * model.size).then_some((interface, arm))
 }
 
 /// [`contact_forces_into`] for a structure of one coordinate with θ̈ solved and the frames of
@@ -264,16 +380,23 @@ fn interface_forces(
     }));
 }
 
-/// How the monitored interfaces' normal forces change along the self-stress states of a
-/// hyperstatic structure (None when it has none, or no loops): column j holds the change of
-/// every normal force (rows in interface order, 0 for plain hinges) under the j-th state.
+/// How the monitored normal forces change along the self-stress states of a hyperstatic
+/// structure (None when it has none, or no loops): column j holds the change of every
+/// interface's normal force (rows in interface order, 0 for plain hinges), then of each seated
+/// slot's edge forces (far, near) in the order of `edges` ([`SeatEdges`], from
+/// [`contact_forces_into`] at the same state), under the j-th state.
 ///
 /// A structure whose loops and seated joints hold it more times than its motion needs (a bay of
-/// columns under one entablature, an arch at rest) has multipliers λ that the motion does not
-/// determine: any λ + K ν with Bᵀ K = 0, B the rows of the closures and the seated slots, gives
-/// the same accelerations. The solver returns the least-norm λ, one distribution among them; a
-/// tension in it is no flight if another distribution is compressive ([`check`]).
-pub fn self_stress_normals(model: &Model, dynamics: &Dynamics) -> Option<DMatrix<f64>> {
+/// columns under one entablature, an arch at rest) has multipliers λ and seat reactions that the
+/// motion does not determine: any (λ, r) + K ν with Bᵀ K = 0, B the rows of the closures and the
+/// seated slots, gives the same accelerations. The solver returns the least-norm set, one
+/// distribution among them; a tension in it is no flight if another distribution is compressive
+/// ([`check`]).
+pub fn self_stress_normals(
+    model: &Model,
+    dynamics: &Dynamics,
+    edges: &[SeatEdges],
+) -> Option<DMatrix<f64>> {
     if model.constraint_rows == 0 {
         return None;
     }
@@ -305,9 +428,15 @@ pub fn self_stress_normals(model: &Model, dynamics: &Dynamics) -> Option<DMatrix
     if states.ncols() == 0 {
         return None;
     }
+    // The arm of every edge split, by slot.
+    let arms: Vec<f64> = edges
+        .iter()
+        .map(|e| seat_arm(model, dynamics, e.slot).map_or(f64::INFINITY, |(_, arm)| arm))
+        .collect();
     let zero = vec![Vector3::zeros(); model.bodies.len()];
     let (mut closure_on, mut transmitted) = (Vec::new(), Vec::new());
-    let mut d = DMatrix::zeros(model.interfaces.len(), states.ncols());
+    let interfaces = model.interfaces.len();
+    let mut d = DMatrix::zeros(interfaces + 2 * edges.len(), states.ncols());
     for j in 0..states.ncols() {
         let lambda = DVector::from_fn(model.constraint_rows, |i, _| states[(i, j)] * scale[i]);
         interface_forces(
@@ -323,6 +452,15 @@ pub fn self_stress_normals(model: &Model, dynamics: &Dynamics) -> Option<DMatrix
                 d[(i, j)] = force.dot(normal);
             }
         }
+        for (e, edge) in edges.iter().enumerate() {
+            let Some(i) = dynamics.seated.iter().position(|&s| s == edge.slot) else {
+                continue;
+            };
+            let r = model.constraint_rows + i;
+            let far = states[(r, j)] * scale[r] / arms[e];
+            d[(interfaces + 2 * e, j)] = far;
+            d[(interfaces + 2 * e + 1, j)] = d[(edge.interface, j)] - far;
+        }
     }
     Some(d)
 }
@@ -334,18 +472,20 @@ pub fn self_stress_normals(model: &Model, dynamics: &Dynamics) -> Option<DMatrix
 /// at its first sample beyond with 1 ms samples, −5e-3 W with 10 ms).
 pub const TENSION_TOLERANCE: f64 = 1e-3;
 
-/// The first violation among the given contact forces at time t (tension first, then sliding
-/// when μ is given). A tension smaller than `tolerance` (N) is round-off, not flight.
+/// The first violation among the given contact forces and seated edges at time t, in interface
+/// order: tension, then a resultant outside the face, then sliding when μ is given. A tension
+/// smaller than `tolerance` (N) is round-off, not flight.
 ///
 /// With `self_stress` ([`self_stress_normals`]) a tension counts only if no distribution of the
 /// hyperstatic forces is compressive: the nearest change ν of the least-norm one with every
-/// normal force N + Dν ≥ −tolerance/2 is sought by least-distance programming, and when it
-/// exists the tests read the normal forces of N + Dν; the sliding test keeps the given tangential
-/// forces (the self-stress states' tangential parts are not sought: their friction demand is an
-/// estimate, only made when the least-norm forces show a tension).
+/// normal force and every edge force N + Dν ≥ −tolerance/2 is sought by least-distance
+/// programming, and when it exists the tests read the forces of N + Dν; the sliding test keeps
+/// the given tangential forces (the self-stress states' tangential parts are not sought: their
+/// friction demand is an estimate, only made when the least-norm forces show a tension).
 pub fn check(
     model: &Model,
     forces: &[Option<ContactForce>],
+    edges: &[SeatEdges],
     self_stress: Option<&DMatrix<f64>>,
     t: f64,
     friction: Option<f64>,
@@ -353,49 +493,59 @@ pub fn check(
 ) -> Option<Violation> {
     let tension = forces
         .iter()
-        .any(|f| f.is_some_and(|f| f.normal < -tolerance));
-    // The normal forces of the compressive distribution, when one is needed and exists (no
-    // buffer when there is no tension: the forces' own normals are read).
-    let mut normals: Vec<f64> = Vec::new();
+        .any(|f| f.is_some_and(|f| f.normal < -tolerance))
+        || edges
+            .iter()
+            .any(|e| e.near < -tolerance || e.far < -tolerance);
+    // The forces of the compressive distribution, when one is needed and exists (no buffer when
+    // there is no tension: the forces' own are read): every interface's normal force, then
+    // (far, near) of each edge split.
+    let mut values: Vec<f64> = Vec::new();
     if tension {
-        normals.extend(forces.iter().map(|f| f.map_or(0.0, |f| f.normal)));
+        values.extend(forces.iter().map(|f| f.map_or(0.0, |f| f.normal)));
+        values.extend(edges.iter().flat_map(|e| [e.far, e.near]));
     }
     if let (Some(d), true) = (self_stress, tension) {
-        let monitored: Vec<usize> = (0..forces.len()).filter(|&i| forces[i].is_some()).collect();
+        let monitored: Vec<usize> = (0..forces.len())
+            .filter(|&i| forces[i].is_some())
+            .chain(forces.len()..values.len())
+            .collect();
         let g = DMatrix::from_fn(monitored.len(), d.ncols(), |r, c| d[(monitored[r], c)]);
         let h = DVector::from_fn(monitored.len(), |r, _| {
-            -0.5 * tolerance - normals[monitored[r]]
+            -0.5 * tolerance - values[monitored[r]]
         });
-        if let Some(nu) = crate::nnls::least_distance(&g, &h) {
-            let dn = &g * nu;
+        if let Some(nu) = crate::least_distance::least_distance(&g, &h) {
+            let dv = &g * nu;
             for (r, &i) in monitored.iter().enumerate() {
-                normals[i] += dn[r];
+                values[i] += dv[r];
             }
         }
     }
-    let normal_of = |i: usize, f: &ContactForce| normals.get(i).copied().unwrap_or(f.normal);
+    let value = |i: usize, given: f64| values.get(i).copied().unwrap_or(given);
+    let violation = |i: usize, kind: &str, normal: f64, f: &ContactForce| Violation {
+        t,
+        interface: model.interfaces[i].name.clone(),
+        kind: kind.into(),
+        normal,
+        friction_demand: f.friction_demand(),
+    };
     for (i, f) in forces.iter().enumerate() {
         let Some(f) = f else { continue };
-        let normal = normal_of(i, f);
+        let normal = value(i, f.normal);
         if normal < -tolerance {
-            return Some(Violation {
-                t,
-                interface: model.interfaces[i].name.clone(),
-                kind: "tension".into(),
-                normal,
-                friction_demand: f.friction_demand(),
-            });
+            return Some(violation(i, "tension", normal, f));
+        }
+        for (e, edge) in edges.iter().enumerate().filter(|(_, e)| e.interface == i) {
+            let far = value(forces.len() + 2 * e, edge.far);
+            let near = value(forces.len() + 2 * e + 1, edge.near);
+            if far.min(near) < -tolerance {
+                return Some(violation(i, "outside_face", far.min(near), f));
+            }
         }
         if let Some(mu) = friction
             && f.tangential > mu * normal.max(0.0) + tolerance
         {
-            return Some(Violation {
-                t,
-                interface: model.interfaces[i].name.clone(),
-                kind: "sliding".into(),
-                normal,
-                friction_demand: f.friction_demand(),
-            });
+            return Some(violation(i, "sliding", normal, f));
         }
     }
     None

@@ -1,7 +1,5 @@
-//! Non-negative least squares (Lawson–Hanson) and least-distance programming on top of it: the
-//! uplift of loops at rest (Gauss' principle over the seated slots, uplift_from_rest.rs) and the
-//! hypotheses monitor (a compressive distribution of a hyperstatic structure's contact forces,
-//! monitor.rs).
+//! Non-negative least squares (Lawson–Hanson): the uplift of loops at rest (Gauss' principle over
+//! the seated slots, uplift_from_rest.rs).
 
 use nalgebra::{DMatrix, DVector};
 
@@ -87,65 +85,12 @@ fn passive_least_squares(
     pinv_solve(&ap, b).0
 }
 
-/// Least-distance programming, min ‖x‖ subject to G x ≥ h (Lawson & Hanson 1974, ch. 23,
-/// algorithm LDP): with E = [Gᵀ; hᵀ] and f = (0, …, 0, 1), the non-negative least-squares
-/// solution u of min ‖E u − f‖ gives the residual r = E u − f; the constraints are consistent
-/// exactly when r ≠ 0, and then x = −r₁..ₙ / rₙ₊₁. Returns None when they are inconsistent.
-pub fn least_distance(g: &DMatrix<f64>, h: &DVector<f64>) -> Option<DVector<f64>> {
-    let (m, n) = (g.nrows(), g.ncols());
-    let mut e = DMatrix::zeros(n + 1, m);
-    for i in 0..m {
-        for j in 0..n {
-            e[(j, i)] = g[(i, j)];
-        }
-        e[(n, i)] = h[i];
-    }
-    let mut f = DVector::zeros(n + 1);
-    f[n] = 1.0;
-    let u = nnls(&e, &f);
-    let r = &e * &u - &f;
-    // r = 0 (to round-off) means f is in the cone of E's columns: no x satisfies G x ≥ h.
-    if r.norm() <= 1e-10 || r[n].abs() <= 1e-12 {
-        return None;
-    }
-    Some(-r.rows(0, n) / r[n])
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// NNLS against the closed form of a 2 × 2 problem with one active bound, and the
     /// Karush–Kuhn–Tucker conditions of a random one.
-    /// LDP on a closed form (the nearest point of a half-plane) and on an inconsistent pair.
-    #[test]
-    fn least_distance_finds_the_nearest_feasible_point() {
-        // x₁ + x₂ ≥ 2: the nearest point to the origin is (1, 1).
-        let g = DMatrix::from_row_slice(1, 2, &[1.0, 1.0]);
-        let h = DVector::from_vec(vec![2.0]);
-        let x = least_distance(&g, &h).expect("consistent");
-        assert!(
-            (x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12,
-            "{x}"
-        );
-        // x₁ ≥ 1 and −x₁ ≥ 0 cannot hold together.
-        let g = DMatrix::from_row_slice(2, 1, &[1.0, -1.0]);
-        let h = DVector::from_vec(vec![1.0, 0.0]);
-        assert!(least_distance(&g, &h).is_none());
-        // Three random-looking constraints in 4 unknowns that hold at some x: the answer
-        // satisfies them, and it is the nearest (KKT: x = Gᵀμ with μ ≥ 0 on the active ones).
-        let g = DMatrix::from_fn(3, 4, |i, j| ((i * 5 + j * 3) % 7) as f64 - 3.0);
-        let h = DVector::from_vec(vec![1.0, 0.5, -2.0]);
-        let x = least_distance(&g, &h).expect("consistent");
-        let slack = &g * &x - &h;
-        assert!(slack.min() >= -1e-12, "{slack}");
-        let active: Vec<usize> = (0..3).filter(|&i| slack[i] < 1e-9).collect();
-        let ga = DMatrix::from_fn(active.len(), 4, |r, c| g[(active[r], c)]);
-        let (mu, _) = crr_dynamics::linalg::pinv_solve(&ga.transpose(), &x);
-        assert!((ga.transpose() * &mu - &x).amax() < 1e-10);
-        assert!(mu.min() >= -1e-12, "{mu}");
-    }
-
     #[test]
     fn nnls_satisfies_the_kkt_conditions() {
         // min (x₁ − 1)² + (x₂ + 1)²: x = (1, 0).

@@ -234,10 +234,10 @@ fn hyperstatic_tension_needs_no_compressive_distribution() {
     d[(1, 0)] = -1.0;
     let tol = 1.0;
     let fixable = forces([-3e3, 5e3, 1e4, 1e4]);
-    assert!(check(&model, &fixable, None, 0.0, None, tol).is_some());
-    assert_eq!(check(&model, &fixable, Some(&d), 0.0, None, tol), None);
+    assert!(check(&model, &fixable, &[], None, 0.0, None, tol).is_some());
+    assert_eq!(check(&model, &fixable, &[], Some(&d), 0.0, None, tol), None);
     let hopeless = forces([-1e4, 5e3, 1e4, 1e4]);
-    let v = check(&model, &hopeless, Some(&d), 0.0, None, tol).expect("tension");
+    let v = check(&model, &hopeless, &[], Some(&d), 0.0, None, tol).expect("tension");
     assert_eq!(
         (v.kind.as_str(), v.interface.as_str()),
         ("tension", model.interfaces[0].name.as_str())
@@ -245,7 +245,7 @@ fn hyperstatic_tension_needs_no_compressive_distribution() {
     assert_eq!(v.normal, -1e4);
     // A state that moves no force at all changes nothing.
     let none = DMatrix::zeros(monitored, 1);
-    assert!(check(&model, &fixable, Some(&none), 0.0, None, tol).is_some());
+    assert!(check(&model, &fixable, &[], Some(&none), 0.0, None, tol).is_some());
 }
 
 /// On one body with one coordinate the monitor takes the contact force in closed form, with θ̈
@@ -312,4 +312,282 @@ fn one_coordinate_forces_match_the_general_solve() {
         }
     }
     assert!(compared > 0, "no force along the hinge axis in any case");
+}
+
+/// The normal forces on the two edges of a seated joint and the check that the contact's
+/// resultant lies within its face, at (q, q̇) = 0 with every slot seated, under a constant ground
+/// acceleration `a` (m/s²) on the pivots of `side`.
+fn seated_edges(
+    model: &Model,
+    a: [f64; 3],
+    side: Side,
+) -> (crr_impact::monitor::ForceWork, Dynamics) {
+    let ground = constant_ground(&[(Axis::X, a[0]), (Axis::Y, a[1]), (Axis::Z, a[2])]);
+    let mut d = Dynamics::new(model, ActivePivots::uniform(model, side));
+    d.seated = (0..model.slot_count).collect();
+    let zero = DVector::zeros(model.dof());
+    let mut work = crr_impact::monitor::ForceWork::default();
+    crr_impact::monitor::contact_forces_into(model, &mut d, &ground, 0.0, &zero, &zero, &mut work)
+        .unwrap();
+    (work, d)
+}
+
+/// Housner's block (half-width b, half-height h) seated under a ground acceleration a_x: moment
+/// balance about the base's centre, m a_x h = b (N⁻ − N⁺), and N⁺ + N⁻ = m g give the edge
+/// forces N^± = (m g ∓ m a_x h/b)/2 (the ground pushing the block with it unloads the +x edge).
+/// The monitor's split matches on both pivot sides to 1e-9 of the weight, and beyond
+/// a_x = g b/h (the uplift threshold) the +x edge would pull: `check` reports the resultant
+/// outside the face with that edge's (negative) force.
+#[test]
+fn seated_block_edges_against_moment_balance() {
+    use crr_impact::monitor::check;
+    let (b, h) = (0.2, 1.0);
+    let model = Model::from_spec(&single_block(b, h, 2500.0)).unwrap();
+    let (m, w) = (model.total_mass(), model.total_mass() * G);
+    for kappa in [0.1, -0.15, 0.25, -0.3] {
+        let ax = kappa * G;
+        let plus = (m * G - m * ax * h / b) / 2.0;
+        let minus = (m * G + m * ax * h / b) / 2.0;
+        for side in [Side::Positive, Side::Negative] {
+            let (work, _) = seated_edges(&model, [ax, 0.0, 0.0], side);
+            let [e] = work.edges[..] else {
+                panic!("one seated slot: {:?}", work.edges)
+            };
+            let (near, far) = match side {
+                Side::Positive => (plus, minus),
+                Side::Negative => (minus, plus),
+            };
+            assert!(
+                (e.near - near).abs() < 1e-9 * w && (e.far - far).abs() < 1e-9 * w,
+                "κ = {kappa}, {side:?}: {e:?} against near {near}, far {far}"
+            );
+            let v = check(&model, &work.forces, &work.edges, None, 0.0, None, 1e-3 * w);
+            if kappa.abs() <= b / h {
+                assert_eq!(v, None, "κ = {kappa}");
+            } else {
+                let v = v.expect("beyond the uplift threshold");
+                assert_eq!(
+                    (v.kind.as_str(), v.interface.as_str()),
+                    ("outside_face", "base")
+                );
+                assert!((v.normal - plus.min(minus)).abs() < 1e-9 * w, "{v:?}");
+            }
+        }
+    }
+}
+
+/// A block of 2a × 2c × 2h on a rocking base under a_x and a_y together: by the moment balances
+/// about the base's centre lines, the edges at x = ±a carry (m g ∓ m a_x h/a)/2 and those at
+/// y = ±c carry (m g ∓ m a_y h/c)/2. The first tilt (about e₁ = x) splits N between the edges
+/// at y = ±c, the second (about e₂ = y) between x = ±a; "near" is the edge through the pivot
+/// corner. Checked on all four pivot corners to 1e-9 of the weight.
+#[test]
+fn rocking_base_edges_against_moment_balance() {
+    let (a, c, h) = (0.3, 0.2, 0.8);
+    let spec = crr_kinematics::spec::StructureSpec {
+        name: "block_on_base".into(),
+        gravity: G,
+        body: vec![box_body(
+            "block",
+            2500.0,
+            [0.0, 0.0, h],
+            [2.0 * a, 2.0 * c, 2.0 * h],
+        )],
+        interface: vec![crr_kinematics::fixtures::rocking_base(
+            "base",
+            "ground",
+            "block",
+            [[-a, -c, 0.0], [a, -c, 0.0], [a, c, 0.0], [-a, c, 0.0]],
+        )],
+        symmetry: Vec::new(),
+    };
+    let model = Model::from_spec(&spec).unwrap();
+    let (m, w) = (model.total_mass(), model.total_mass() * G);
+    let (ax, ay) = (0.12 * G, -0.07 * G);
+    let edge_x = |x: f64| (m * G - x.signum() * m * ax * h / a) / 2.0;
+    let edge_y = |y: f64| (m * G - y.signum() * m * ay * h / c) / 2.0;
+    for sides in [
+        [Side::Positive, Side::Positive],
+        [Side::Positive, Side::Negative],
+        [Side::Negative, Side::Positive],
+        [Side::Negative, Side::Negative],
+    ] {
+        let ground = constant_ground(&[(Axis::X, ax), (Axis::Y, ay)]);
+        let mut pivots = ActivePivots::uniform(&model, Side::Positive);
+        pivots.sides.copy_from_slice(&sides);
+        let mut d = Dynamics::new(&model, pivots);
+        d.seated = vec![0, 1];
+        let zero = DVector::zeros(2);
+        let mut work = crr_impact::monitor::ForceWork::default();
+        crr_impact::monitor::contact_forces_into(
+            &model, &mut d, &ground, 0.0, &zero, &zero, &mut work,
+        )
+        .unwrap();
+        let corner = model.interfaces[0].kind.pivot(&sides);
+        let [tilt1, tilt2] = work.edges[..] else {
+            panic!("two seated tilts: {:?}", work.edges)
+        };
+        let expect = [
+            (edge_y(corner.y), edge_y(-corner.y)),
+            (edge_x(corner.x), edge_x(-corner.x)),
+        ];
+        for (e, (near, far)) in [tilt1, tilt2].iter().zip(expect) {
+            assert!(
+                (e.near - near).abs() < 1e-9 * w && (e.far - far).abs() < 1e-9 * w,
+                "{sides:?}: {e:?} against near {near}, far {far}"
+            );
+        }
+    }
+}
+
+/// In motion the seat reaction r of a seated joint is the moment about its pivot line of the
+/// wrench its parent transmits, which the articulated-body algorithm gives independently
+/// (`Dynamics::joint_force`: [n₀; f] about the world origin). On a stack of two blocks on
+/// rocking bases, the lower one tilted about both axes and turning, the upper seated, the split
+/// of every seated tilt's normal force must equal the one from that wrench: far = (n₀ − P × f)·w
+/// / ((w × (P′ − P))·n) and near = f·n − far, to 1e-9 of the weight.
+#[test]
+fn seated_edges_in_motion_against_articulated_wrench() {
+    use crr_kinematics::kinematics::frame_point;
+    let (a, c) = (0.3, 0.2);
+    let face = |z: f64| [[-a, -c, z], [a, -c, z], [a, c, z], [-a, c, z]];
+    let spec = crr_kinematics::spec::StructureSpec {
+        name: "stack".into(),
+        gravity: G,
+        body: vec![
+            box_body("lower", 2500.0, [0.0, 0.0, 0.6], [2.0 * a, 2.0 * c, 1.2]),
+            box_body("upper", 2500.0, [0.0, 0.0, 1.6], [2.0 * a, 2.0 * c, 0.8]),
+        ],
+        interface: vec![
+            crr_kinematics::fixtures::rocking_base("base", "ground", "lower", face(0.0)),
+            crr_kinematics::fixtures::rocking_base("bed", "lower", "upper", face(1.2)),
+        ],
+        symmetry: Vec::new(),
+    };
+    let model = Model::from_spec(&spec).unwrap();
+    let w_total = model.total_mass() * G;
+    let ground = constant_ground(&[(Axis::X, 0.3 * G), (Axis::Y, -0.2 * G)]);
+    let mut pivots = ActivePivots::uniform(&model, Side::Positive);
+    pivots.sides[1] = Side::Negative;
+    pivots.sides[3] = Side::Negative;
+    let mut d = Dynamics::new(&model, pivots.clone());
+    d.seated = vec![2, 3];
+    let q = DVector::from_column_slice(&[0.04, -0.03, 0.0, 0.0]);
+    let qdot = DVector::from_column_slice(&[0.5, -0.8, 0.0, 0.0]);
+    let mut work = crr_impact::monitor::ForceWork::default();
+    crr_impact::monitor::contact_forces_into(&model, &mut d, &ground, 0.0, &q, &qdot, &mut work)
+        .unwrap();
+    assert!(d.used_articulated_body());
+    assert_eq!(work.edges.len(), 2);
+    let iface = &model.interfaces[1];
+    let crr_kinematics::InterfaceKind::RockingBase { normal, .. } = iface.kind else {
+        unreachable!()
+    };
+    let n = d.kin.rot_ops[1] * normal;
+    for e in &work.edges {
+        let k = e.slot;
+        let wrench = d.joint_force(k).expect("articulated");
+        let (n0, f) = (wrench.fixed_rows::<3>(0), wrench.fixed_rows::<3>(3));
+        let (w, p) = (d.kin.axis[k], d.kin.pivot[k]);
+        let mut sides = pivots.sides[2..4].to_vec();
+        sides[k - 2] = sides[k - 2].flipped();
+        let p_other = frame_point(&d.kin, model.coords[k].parent, &iface.kind.pivot(&sides));
+        let moment = (n0 - p.cross(&f)).dot(&w);
+        let far = moment / w.cross(&(p_other - p)).dot(&n);
+        let near = f.dot(&n) - far;
+        assert!(
+            (e.far - far).abs() < 1e-9 * w_total && (e.near - near).abs() < 1e-9 * w_total,
+            "slot {k}: {e:?} against near {near}, far {far}"
+        );
+    }
+}
+
+/// The hyperstatic check against the static theorem. A structure at rest with every joint
+/// seated under a constant ground acceleration κ g d holds if and only if some equilibrium with
+/// compressive contacts exists (the contacts' resultants within their faces), which is what the
+/// collapse multiplier λ_c of `crr_impact::statics` (a linear program over the corner forces,
+/// independent of the monitor's self-stress family) decides. So the monitor, given the
+/// least-norm forces, their self-stress states and the edges, must report nothing at κ = 0.98 λ_c
+/// and a violation at 1.02 λ_c, along ±x; on the planar trilithon (hinges, one loop) and on a
+/// 3D portal (rocking bases, a twisting loop-closing seat). At rest the least-norm forces alone
+/// show an edge in tension on the portal, which the self-stress states resolve.
+#[test]
+fn hyperstatic_edges_against_the_static_theorem() {
+    use crr_impact::monitor::{check, self_stress_normals};
+    use crr_impact::statics::{StaticsOptions, collapse_multiplier};
+    use nalgebra::Vector3;
+    let (a, c) = (0.2, 0.2);
+    let face = |x: f64, z: f64| [[x - a, -c, z], [x + a, -c, z], [x + a, c, z], [x - a, c, z]];
+    let mut on_b = crr_kinematics::fixtures::rocking_base("on_b", "b", "lintel", face(2.0, 2.0));
+    if let Some(base) = on_b.rocking_base.as_mut() {
+        base.twist = true;
+    }
+    let portal = crr_kinematics::spec::StructureSpec {
+        name: "portal".into(),
+        gravity: G,
+        body: vec![
+            box_body("a", 2500.0, [0.0, 0.0, 1.0], [2.0 * a, 2.0 * c, 2.0]),
+            box_body("b", 2500.0, [2.0, 0.0, 1.0], [2.0 * a, 2.0 * c, 2.0]),
+            box_body("lintel", 2500.0, [1.0, 0.0, 2.25], [2.4, 2.0 * c, 0.5]),
+        ],
+        interface: vec![
+            crr_kinematics::fixtures::rocking_base("base_a", "ground", "a", face(0.0, 0.0)),
+            crr_kinematics::fixtures::rocking_base("base_b", "ground", "b", face(2.0, 0.0)),
+            crr_kinematics::fixtures::rocking_base("on_a", "a", "lintel", face(0.0, 2.0)),
+            on_b,
+        ],
+        symmetry: Vec::new(),
+    };
+    let trilithon = crr_kinematics::fixtures::trilithon(0.25, 1.5, 2.0, 0.5, 1.0);
+    for (spec, least_norm_tension) in [(portal, true), (trilithon, false)] {
+        let model = Model::from_spec(&spec).unwrap();
+        let w = model.total_mass() * G;
+        let tol = 1e-3 * w;
+        let (work, d) = seated_edges(&model, [0.0; 3], Side::Positive);
+        let states = self_stress_normals(&model, &d, &work.edges).expect("hyperstatic");
+        if least_norm_tension {
+            assert!(work.edges.iter().any(|e| e.near.min(e.far) < -tol));
+        }
+        assert_eq!(
+            check(
+                &model,
+                &work.forces,
+                &work.edges,
+                Some(&states),
+                0.0,
+                None,
+                tol
+            ),
+            None,
+            "{} at rest",
+            model.name
+        );
+        for sign in [1.0, -1.0] {
+            let dir = Vector3::new(sign, 0.0, 0.0);
+            let lambda = collapse_multiplier(&model, dir, &StaticsOptions::default())
+                .unwrap()
+                .lambda
+                .expect("collapses");
+            for (factor, fails) in [(0.98, false), (1.02, true)] {
+                let ax = sign * factor * lambda * G;
+                let (work, d) = seated_edges(&model, [ax, 0.0, 0.0], Side::Positive);
+                let states = self_stress_normals(&model, &d, &work.edges);
+                let v = check(
+                    &model,
+                    &work.forces,
+                    &work.edges,
+                    states.as_ref(),
+                    0.0,
+                    None,
+                    tol,
+                );
+                assert_eq!(
+                    v.is_some(),
+                    fails,
+                    "{}: {factor} λ_c = {lambda} along {sign:+}x: {v:?}",
+                    model.name
+                );
+            }
+        }
+    }
 }

@@ -59,7 +59,9 @@ pub use opening_qp::{
 pub use samples::{Iter as SampleIter, Sample, Samples};
 pub use seating::opening_mode;
 use seating::opening_mode_in;
+pub(crate) use seating::other_pivot_rest;
 pub use slots::check_initial_state;
+pub(crate) use slots::slot_interface;
 use slots::*;
 use uplift_from_rest::{RestCache, opening_from_rest};
 

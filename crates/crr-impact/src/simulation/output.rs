@@ -46,22 +46,24 @@ impl Simulation<'_> {
             if crate::monitor::contact_forces_into(self.model, d, self.ground, t, &q, &qdot, work)
                 .is_ok()
             {
-                let forces = &work.forces;
+                let (forces, edges) = (&work.forces, &work.edges);
                 monitor_kin = true;
                 let tol = crate::monitor::TENSION_TOLERANCE
                     * self.model.total_mass()
                     * self.model.gravity;
                 // A tension in a hyperstatic structure: is there a compressive distribution?
                 // (The self-stress states cost a decomposition, made only then.)
-                let tension = forces.iter().any(|f| f.is_some_and(|f| f.normal < -tol));
+                let tension = forces.iter().any(|f| f.is_some_and(|f| f.normal < -tol))
+                    || edges.iter().any(|e| e.near.min(e.far) < -tol);
                 let states = if tension {
-                    crate::monitor::self_stress_normals(self.model, d)
+                    crate::monitor::self_stress_normals(self.model, d, edges)
                 } else {
                     None
                 };
                 self.violation = crate::monitor::check(
                     self.model,
                     forces,
+                    edges,
                     states.as_ref(),
                     t,
                     self.params.friction,

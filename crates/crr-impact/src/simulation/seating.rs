@@ -695,7 +695,7 @@ pub(super) fn closure_other_side_reaction(
 
 /// The rest position (in the coordinates of the frame that carries it) of interface `iface`'s
 /// pivot with its slot `k` on the other side, its other slots as in `pivots`.
-pub(super) fn other_pivot_rest(iface: &Interface, pivots: &ActivePivots, k: usize) -> Vector3<f64> {
+pub(crate) fn other_pivot_rest(iface: &Interface, pivots: &ActivePivots, k: usize) -> Vector3<f64> {
     // An interface has one slot (a hinge) or two (a rocking base's tilts).
     let current = &pivots.sides[iface.slots.clone()];
     let mut sides = [Side::Positive; 2];
@@ -811,10 +811,32 @@ impl Simulation<'_> {
             .unwrap_or_else(|| Box::new(self.dynamics.clone()))
     }
 
-    /// Releases seated slots if the seated state cannot hold now.
+    /// Releases seated slots if the seated state cannot hold now. On open chains a decision
+    /// releases the strongest single opening of each part, and a release changes the loads on
+    /// the joints left seated (a drum column whose third bed opens at an impact can need the
+    /// fourth to open too, on its other pivot), so the test is repeated on what remains until
+    /// it holds (at most once per slot). On loops the decision is taken for all the seated
+    /// slots together (the contact program, or the active set) and is not repeated: releasing
+    /// one slot at a time there cascades through joints that the joint decision keeps seated.
+    /// Returns every slot released, with its side.
     pub(super) fn release_if_opening(
         &mut self,
     ) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
+        let mut released: Option<Vec<(usize, Side)>> = None;
+        for _ in 0..self.model.slot_count {
+            match self.release_once()? {
+                Some(mode) => released.get_or_insert_with(Vec::new).extend(mode),
+                None => break,
+            }
+            if !self.model.closures.is_empty() {
+                break;
+            }
+        }
+        Ok(released)
+    }
+
+    /// One round of [`Self::release_if_opening`].
+    fn release_once(&mut self) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
         if self.dynamics.seated.is_empty() {
             return Ok(None);
         }
@@ -845,8 +867,16 @@ impl Simulation<'_> {
             // uplift of the structure (`uplift_time` stays null for a run released from rest
             // angles).
             let from_rest = self.seated.iter().all(|&s| s);
+            let n = self.model.dof();
             for &(s, side) in mode {
                 self.dynamics.pivots.sides[s] = side;
+                // A seated angle leaves its seat from exactly 0: the state can still carry the
+                // round-off of the step that seated it (−1.9e-9 rad on the drum column), which
+                // on the other pivot would be the wrong side of it.
+                if s < n {
+                    self.y[s] = 0.0;
+                    self.y[n + s] = 0.0;
+                }
             }
             self.set_seated(mode.iter().map(|&(s, _)| (s, false)));
             if from_rest {

@@ -72,7 +72,7 @@ pub(super) fn slot_rates(model: &Model, kin: &Data, qdot: &DVector<f64>, out: &m
     }
 }
 
-pub(super) fn slot_interface(model: &Model, slot: usize) -> usize {
+pub(crate) fn slot_interface(model: &Model, slot: usize) -> usize {
     model
         .interfaces
         .iter()
