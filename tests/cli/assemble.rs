@@ -163,3 +163,52 @@ fn a_floating_block_a_non_convex_footprint_and_an_assembly_with_interfaces_are_r
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("an assembly lists bodies only"), "{err}");
 }
+
+/// Blocks that interpenetrate, or reach below the ground, are errors of the geometry, refused
+/// naming them, with the depth. Two boxes standing 5 cm into each other: the separating-axis
+/// depth is 0.05 m. Two voussoirs of an arch (annular sectors, whose intrados is concave) cut at
+/// 1.0 rad and at π/3 rad overlap by the wedge between: the centroid of one's radial face lies
+/// inside the other at the distance r_mid·sin(π/3 − 1) from its joint plane. A block whose base
+/// is at z = −0.05 m reaches below the ground.
+#[test]
+fn overlapping_blocks_and_a_block_below_the_ground_are_refused_naming_them() {
+    let refusal = |tag: &str, text: &str| {
+        let path = common::write_model(tag, text);
+        let o = common::crr(&["assemble", path.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr).to_string();
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        err
+    };
+    let depth = |err: &str| -> f64 {
+        let from = err.find("interpenetrate by ").expect(err) + "interpenetrate by ".len();
+        err[from..].split(' ').next().unwrap().parse().unwrap()
+    };
+    let boxes = "name = \"pair\"\n[[body]]\nname = \"a\"\ndensity = 2000.0\nbox = { center = [0.0, 0.0, 0.5], size = [1.0, 1.0, 1.0] }\n[[body]]\nname = \"b\"\ndensity = 2000.0\nbox = { center = [0.95, 0.0, 0.5], size = [1.0, 1.0, 1.0] }\n";
+    let err = refusal("overlapping_boxes", boxes);
+    assert!(err.contains("bodies \"a\" and \"b\": overlap"), "{err}");
+    assert!((depth(&err) - 0.05).abs() < 1e-6, "{err}");
+    let sector = |name: &str, from: f64, to: f64| {
+        format!(
+            "[[body]]\nname = \"{name}\"\ndensity = 2200.0\nannular_sector = {{ center = [0.0, 0.0, 0.0], axis = [0.0, -1.0, 0.0], start = [1.0, 0.0, 0.0], inner_radius = 2.0, outer_radius = 2.5, thickness = 1.0, from_angle = {from}, to_angle = {to} }}\n"
+        )
+    };
+    let third = std::f64::consts::FRAC_PI_3;
+    let arch = format!(
+        "name = \"arch\"\n{}{}",
+        sector("v1", 0.0, third),
+        sector("v2", 1.0, 2.0 * third)
+    );
+    let err = refusal("overlapping_voussoirs", &arch);
+    assert!(err.contains("bodies \"v1\" and \"v2\": overlap"), "{err}");
+    let expected = 2.25 * (third - 1.0).sin();
+    assert!(
+        (depth(&err) - expected).abs() < 1e-6,
+        "{err} against {expected}"
+    );
+    let sunk = "name = \"sunk\"\n[[body]]\nname = \"a\"\ndensity = 2000.0\nbox = { center = [0.0, 0.0, 0.45], size = [1.0, 1.0, 1.0] }\n";
+    let err = refusal("sunk_block", sunk);
+    assert!(
+        err.contains("body \"a\": reaches 0.050000 m below the ground"),
+        "{err}"
+    );
+}

@@ -228,6 +228,7 @@ pub fn detect_contacts(
     let size = boxes
         .iter()
         .fold(0.0f64, |m, (lo, hi)| m.max((hi - lo).norm()));
+    refuse_overlaps(bodies, &surfaces, &boxes, tolerance)?;
     let min_area = tolerance * size;
     let facing = 1.0 - 1e-9;
     let mut contacts = Vec::new();
@@ -324,6 +325,51 @@ pub fn detect_contacts(
         }
     }
     Ok(contacts)
+}
+
+/// Blocks below the ground or inside one another are errors of the geometry: each is named, with
+/// the depth and a point of the overlap.
+fn refuse_overlaps(
+    bodies: &[BodySpec],
+    surfaces: &[Surface],
+    boxes: &[(Vector3<f64>, Vector3<f64>)],
+    tolerance: f64,
+) -> Result<(), AssemblyError> {
+    for (b, (lo, _)) in boxes.iter().enumerate() {
+        if lo.z < -tolerance {
+            return Err(error(
+                format!("body \"{}\"", bodies[b].name),
+                format!(
+                    "reaches {:.6} m below the ground (z = 0): a block must stand on or above it",
+                    -lo.z
+                ),
+            ));
+        }
+    }
+    for i in 0..bodies.len() {
+        for j in i + 1..bodies.len() {
+            let ((lo_i, hi_i), (lo_j, hi_j)) = (boxes[i], boxes[j]);
+            // Bounding boxes that overlap by at most the tolerance along some axis: apart or
+            // touching.
+            if (0..3).any(|k| hi_i[k].min(hi_j[k]) - lo_i[k].max(lo_j[k]) <= tolerance) {
+                continue;
+            }
+            if let Some(p) =
+                crate::interpenetration::interpenetration(&surfaces[i], &surfaces[j], tolerance)
+            {
+                return Err(error(
+                    format!("bodies \"{}\" and \"{}\"", bodies[i].name, bodies[j].name),
+                    format!(
+                        "overlap: they interpenetrate by {:.6} m, around ({:.4}, {:.4}, {:.4}) m; \
+                         blocks in contact touch along faces (within the tolerance of {tolerance} \
+                         m)",
+                        p.depth, p.point.x, p.point.y, p.point.z
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn non_convex(body: &str) -> AssemblyError {

@@ -39,6 +39,7 @@ pub mod data;
 pub mod error;
 pub mod fixtures;
 pub mod gamma;
+pub mod interpenetration;
 pub mod kinematics;
 pub mod mass_matrix;
 pub mod model;
