@@ -1,11 +1,13 @@
 //! `crr assemble`: blocks in contact in, a CRR model out (docs/assembly.md). The assembly file is
 //! a model file with bodies only; the contact faces are found from the bodies' shapes
-//! ([`crr_kinematics::assembly`]) and every bed contact becomes a rocking interface, the spanning
-//! tree and the loops chosen as for any model file.
+//! ([`crr_kinematics::assembly`]) and every bed contact (or, on request, every contact) becomes a
+//! rocking interface, the spanning tree and the loops chosen as for any model file.
 
 use std::path::Path;
 
-use crr_kinematics::assembly::{ContactFace, InterfaceStyle, detect_contacts, structure_of};
+use crr_kinematics::assembly::{
+    ContactFace, ContactSet, InterfaceStyle, detect_contacts, structure_of,
+};
 use crr_kinematics::{Model, StructureSpec};
 
 use crate::Error;
@@ -36,22 +38,28 @@ pub fn read_assembly(path: &Path) -> Result<ModelFile, Error> {
 pub struct Assembled {
     /// Every contact face found (beds and side contacts).
     pub contacts: Vec<ContactFace>,
+    /// Which of them are the model's interfaces.
+    pub set: ContactSet,
     /// The model file written: the assembly's tables with the interfaces added.
     pub file: ModelFile,
     /// The model it builds.
     pub model: Model,
+    /// The folder of the assembly file (its relative record paths start there).
+    pub folder: std::path::PathBuf,
 }
 
 /// Finds the contacts of the assembly `file` (read from `path`) and builds the model whose
-/// interfaces are every bed contact: rocking bases, or hinges about y with `planar`.
+/// interfaces are the contacts of `set` (every bed, or every contact): rocking bases, or hinges
+/// about y with `planar`.
 pub fn assemble(
     path: &Path,
     file: &ModelFile,
     planar: bool,
+    set: ContactSet,
     tolerance: f64,
 ) -> Result<Assembled, Error> {
     let here = |e: &dyn std::fmt::Display| Error::Argument(format!("{}: {e}", path.display()));
-    let contacts = detect_contacts(&file.body, tolerance).map_err(|e| here(&e))?;
+    let contacts = detect_contacts(&file.body, tolerance, set).map_err(|e| here(&e))?;
     let style = if planar {
         InterfaceStyle::PlanarHinge
     } else {
@@ -63,6 +71,7 @@ pub fn assemble(
         &file.body,
         &contacts,
         style,
+        set,
         tolerance,
     )
     .map_err(|e| here(&e))?;
@@ -77,7 +86,9 @@ pub fn assemble(
     })?;
     Ok(Assembled {
         contacts,
+        set,
         file: out,
         model,
+        folder: path.parent().map(Path::to_path_buf).unwrap_or_default(),
     })
 }

@@ -1,9 +1,11 @@
 //! The outputs of `crr assemble`: the contacts report and the model file written.
 
 use std::fmt::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crr_kinematics::assembly::ContactFace;
+use crr_dynamics::ground_motion::SignalSpec;
+
+use crr_kinematics::assembly::{ContactFace, ContactSet};
 
 use crate::Error;
 use crate::analysis::assemble::Assembled;
@@ -15,9 +17,13 @@ pub fn contacts_text(a: &Assembled) -> String {
     let name = |b: Option<usize>| b.map_or("ground", |b| bodies[b].name.as_str());
     let mut s = String::new();
     let beds = a.contacts.iter().filter(|c| c.bed).count();
+    let sides = match a.set {
+        ContactSet::Beds => "reported only",
+        ContactSet::All => "rocking interfaces",
+    };
     let _ = writeln!(
         s,
-        "{} contact(s): {beds} bed(s) (rocking interfaces), {} side contact(s) (reported only)",
+        "{} contact(s): {beds} bed(s) (rocking interfaces), {} side contact(s) ({sides})",
         a.contacts.len(),
         a.contacts.len() - beds
     );
@@ -46,9 +52,13 @@ fn contact_line(c: &ContactFace, lower: &str, upper: &str) -> String {
 /// The model file of an assembly as TOML (loads back into the same model).
 pub fn model_toml(a: &Assembled) -> String {
     let header = format!(
-        "# Written by `crr assemble` (crr {}): the assembly's bodies with every bed contact as a\n\
+        "# Written by `crr assemble` (crr {}): the assembly's bodies with every {} as a\n\
          # rocking interface ({} interfaces, DOF(1) = {}, {} loop closure(s)).\n",
         env!("CARGO_PKG_VERSION"),
+        match a.set {
+            ContactSet::Beds => "bed contact",
+            ContactSet::All => "contact",
+        },
         a.file.interface.len(),
         a.model.dof(),
         a.model.closures.len()
@@ -56,7 +66,9 @@ pub fn model_toml(a: &Assembled) -> String {
     header + &toml::to_string(&a.file).expect("a model file serialises to TOML")
 }
 
-/// Writes the model file to `out` (refused when it exists, unless `force`).
+/// Writes the model file to `out` (refused when it exists, unless `force`). A record file given
+/// by a relative path (relative to the assembly's folder) is given relative to the model's folder,
+/// so that the model finds it wherever it is written.
 pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> {
     if out.exists() && !force {
         return Err(Error::Argument(format!(
@@ -64,8 +76,47 @@ pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> 
             out.display()
         )));
     }
-    crate::output::replace_file::replace_file(out, model_toml(a)).map_err(|source| Error::Output {
-        dir: out.to_path_buf(),
-        source,
+    let mut rebased = a.clone();
+    let target = out.parent().unwrap_or(Path::new(""));
+    if let Some(gm) = rebased.file.ground_motion.as_mut() {
+        for component in [&mut gm.x, &mut gm.y, &mut gm.z].into_iter().flatten() {
+            if let SignalSpec::Record(record) = &mut component.signal
+                && record.file.is_relative()
+            {
+                record.file = rebase(&a.folder.join(&record.file), target);
+            }
+        }
+    }
+    crate::output::replace_file::replace_file(out, model_toml(&rebased)).map_err(|source| {
+        Error::Output {
+            dir: out.to_path_buf(),
+            source,
+        }
     })
+}
+
+/// `file` as seen from the folder `to`: relative when both resolve (the common prefix of their
+/// canonical paths dropped, a `..` per remaining folder of `to`), else `file` itself.
+fn rebase(file: &Path, to: &Path) -> PathBuf {
+    let dir = if to.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        to
+    };
+    let (Ok(file_abs), Ok(dir_abs)) = (file.canonicalize(), dir.canonicalize()) else {
+        return file.to_path_buf();
+    };
+    let (f, d): (Vec<_>, Vec<_>) = (
+        file_abs.components().collect(),
+        dir_abs.components().collect(),
+    );
+    let common = f.iter().zip(&d).take_while(|(x, y)| x == y).count();
+    let mut rel = PathBuf::new();
+    for _ in common..d.len() {
+        rel.push("..");
+    }
+    for c in &f[common..] {
+        rel.push(c);
+    }
+    rel
 }

@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 
 use crr::analysis::assemble::{DEFAULT_TOLERANCE, assemble, read_assembly};
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
+use crr::kinematics::assembly::ContactSet;
 use crr::kinematics::spec::PivotSpec;
 
 use crate::common;
@@ -61,7 +62,7 @@ fn joints(spec_interfaces: &[crr::kinematics::spec::InterfaceSpec]) -> BTreeSet<
 fn the_wall_assembled_from_its_blocks_is_the_hand_written_wall() {
     let path = assembly_of("wall", "wall_assembly");
     let file = read_assembly(&path).unwrap();
-    let planar = assemble(&path, &file, true, DEFAULT_TOLERANCE).unwrap();
+    let planar = assemble(&path, &file, true, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
     let (hand, _) = crr::load_model(&common::bundled_path("wall")).unwrap();
     assert_eq!(joints(&planar.file.interface), joints(&hand.interface));
     // 4 courses of 3 blocks (half blocks at the ends of the odd ones): 3 on the ground, and the
@@ -81,7 +82,7 @@ fn the_wall_assembled_from_its_blocks_is_the_hand_written_wall() {
     let seven_elevenths = 7.0 / 11.0;
     for m in [
         &planar.model,
-        &assemble(&path, &file, false, DEFAULT_TOLERANCE)
+        &assemble(&path, &file, false, ContactSet::Beds, DEFAULT_TOLERANCE)
             .unwrap()
             .model,
     ] {
@@ -106,7 +107,7 @@ fn a_panel_cut_into_courses_rocks_whole_on_its_base_edge() {
     }
     let path = common::write_model("panel_assembly", &text);
     let file = read_assembly(&path).unwrap();
-    let bases = assemble(&path, &file, false, DEFAULT_TOLERANCE).unwrap();
+    let bases = assemble(&path, &file, false, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
     assert_eq!(bases.model.dof(), 10);
     assert!(bases.model.closures.is_empty());
     for (d, expected) in [
@@ -118,7 +119,7 @@ fn a_panel_cut_into_courses_rocks_whole_on_its_base_edge() {
         let l = lambda(&bases.model, d);
         assert!((l - expected).abs() < 1e-9, "{d:?}: {l}");
     }
-    let hinges = assemble(&path, &file, true, DEFAULT_TOLERANCE).unwrap();
+    let hinges = assemble(&path, &file, true, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
     assert!((lambda(&hinges.model, Vector3::x()) - 0.16).abs() < 1e-9);
     // The model file written loads back into the same model.
     let out = common::scratch("panel_model").join("panel.toml");
@@ -211,4 +212,80 @@ fn overlapping_blocks_and_a_block_below_the_ground_are_refused_naming_them() {
         err.contains("body \"a\": reaches 0.050000 m below the ground"),
         "{err}"
     );
+}
+
+/// The trilithon bundled as three stones (`examples/assemblies/trilithon.toml`) gives, with
+/// `--planar`, the hand-written trilithon's four joints (`examples/models/trilithon.toml`: the same
+/// parents, children and pivot lines) and its multiplier b/h = 0.5/4 = 0.125 along ±x.
+#[test]
+fn the_trilithon_of_stones_is_the_hand_written_trilithon() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/trilithon.toml");
+    let file = read_assembly(&path).unwrap();
+    let planar = assemble(&path, &file, true, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
+    let (hand, _) = crr::load_model(&common::bundled_path("trilithon")).unwrap();
+    assert_eq!(joints(&planar.file.interface), joints(&hand.interface));
+    for d in [Vector3::x(), -Vector3::x()] {
+        let l = lambda(&planar.model, d);
+        assert!((l - 0.125).abs() < 1e-9, "{l}");
+    }
+}
+
+/// Every bundled assembly goes from stones to a simulation through the command line, as
+/// `examples/assemblies/README.md` shows: `crr assemble` writes a model (the arch with
+/// `--all-contacts`: its ten joints, one loop), `crr check` reports its multipliers and
+/// `crr simulate` runs it; a record given relative to the assembly's folder is found from the
+/// model's folder (here a scratch folder elsewhere).
+#[test]
+fn the_bundled_assemblies_go_from_stones_to_a_simulation() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies");
+    for (name, flags, interfaces, loops) in [
+        ("arch", &["--all-contacts", "--planar"][..], 10, 1),
+        ("wall", &["--planar"][..], 75, 31),
+        ("facade", &["--planar"][..], 86, 34),
+        ("trilithon", &["--planar"][..], 4, 1),
+    ] {
+        let out = common::scratch(&format!("assembled_{name}"));
+        let model = out.join("model.toml");
+        let source = dir.join(format!("{name}.toml"));
+        let mut args = vec!["assemble", source.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        args.extend(["--out", model.to_str().unwrap()]);
+        let o = common::crr(&args);
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(
+            text.contains(&format!("({interfaces} interfaces,"))
+                && text.contains(&format!("{loops} loop closure(s)")),
+            "{name}: {text}"
+        );
+        let o = common::crr(&["check", model.to_str().unwrap()]);
+        let report = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(report.contains("d = +x: λ = "), "{name}: {report}");
+        let results = out.join("run");
+        let o = common::crr(&[
+            "simulate",
+            model.to_str().unwrap(),
+            "--duration",
+            "1.0",
+            "--out",
+            results.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(results.join("summary.json").exists(), "{name}");
+    }
 }

@@ -804,3 +804,127 @@ fn walls_open_earlier_by_a_sliding_corner_wedge() {
     let panel = stacked_panel(3, 0.25, 1.5, 0.3);
     assert_close("panel", engine_default(&panel, 1.0), 0.25 / 1.5, RTOL);
 }
+
+/// The joints where the thrust line of the thrust-line LP's optimum (λ = λ_c) touches the
+/// intrados or the extrados, |M_j| = N_j t/2 (to 1e-7 of the unit total weight): the hinges of
+/// the collapse mechanism, joint j = 0 … n at angle jπ/n.
+fn arch_hinges(n: usize, r_in: f64, r_out: f64, dx: f64) -> Vec<usize> {
+    let half_t = 0.5 * (r_out - r_in);
+    let joints = arch_joints(n, r_in, r_out, dx);
+    let mut lp = Lp::new(4);
+    lp.cost[3] = -1.0;
+    for (nj, mj) in &joints {
+        lp.le.push(nj.scaled(-1.0).nonpositive());
+        lp.le.push(mj.plus(nj.scaled(-half_t)).nonpositive());
+        lp.le
+            .push(mj.scaled(-1.0).plus(nj.scaled(-half_t)).nonpositive());
+    }
+    let x = lp.solve().expect("a thrust line exists").x;
+    let at = |f: &Affine| f.a.iter().zip(&x).map(|(a, v)| a * v).sum::<f64>() + f.c;
+    (0..=n)
+        .filter(|&j| {
+            let (nj, mj) = (at(&joints[j].0), at(&joints[j].1));
+            mj.abs() >= nj * half_t - 1e-7
+        })
+        .collect()
+}
+
+/// The arch of 9 voussoirs bundled as stones (`examples/assemblies/arch.toml`), turned into a
+/// model by `crr assemble --all-contacts` (every joint an interface; hinges about y with
+/// `--planar`, rocking bases without): its multiplier along ±x is the thrust-line LP's (1e-7),
+/// and its collapse mechanism rocks on exactly the four joints where the LP's thrust line
+/// touches the intrados or the extrados, the other joints staying closed.
+#[test]
+fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
+    use crr::analysis::assemble::{assemble, read_assembly};
+    use crr::impact::statics::Motion;
+    use crr::kinematics::assembly::ContactSet;
+    let (n, r_in, r_out) = (9, 2.0, 2.5);
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/arch.toml");
+    let file = read_assembly(&path).unwrap();
+    for planar in [true, false] {
+        let assembled = assemble(&path, &file, planar, ContactSet::All, 1e-6).unwrap();
+        let model = &assembled.model;
+        assert_eq!(model.interfaces.len(), n + 1);
+        for dx in [1.0, -1.0] {
+            let collapse = collapse_multiplier(
+                model,
+                Vector3::new(dx, 0.0, 0.0),
+                &StaticsOptions::default(),
+            )
+            .unwrap();
+            let expected = arch_lambda(n, r_in, r_out, dx).expect("a thrust line exists");
+            assert_close(
+                &format!("assembled arch, planar {planar}, dx = {dx:+}"),
+                collapse.lambda,
+                expected,
+                RTOL,
+            );
+            // Joint j is the ground's under v1 (j = 0) or vₙ (j = n), else between v_j and v_{j+1}.
+            let joint_of = |name: &str| -> usize {
+                let ends: Vec<usize> = name
+                    .split("_on_")
+                    .map(|b| {
+                        if b == "ground" {
+                            0
+                        } else {
+                            b[1..].parse().unwrap()
+                        }
+                    })
+                    .collect();
+                match ends[..] {
+                    [1, 0] => 0,
+                    [v, 0] => {
+                        assert_eq!(v, n);
+                        n
+                    }
+                    [a, b] => a.min(b),
+                    _ => unreachable!(),
+                }
+            };
+            let mut rocking: Vec<usize> = collapse
+                .interfaces
+                .iter()
+                .filter(|i| i.motion == Motion::Rocks)
+                .map(|i| joint_of(&i.name))
+                .collect();
+            rocking.sort_unstable();
+            assert!(
+                collapse
+                    .interfaces
+                    .iter()
+                    .all(|i| matches!(i.motion, Motion::Rocks | Motion::Closed)),
+                "planar {planar}, dx = {dx:+}"
+            );
+            let hinges = arch_hinges(n, r_in, r_out, dx);
+            assert_eq!(rocking, hinges, "planar {planar}, dx = {dx:+}");
+            assert_eq!(hinges.len(), 4);
+        }
+    }
+}
+
+/// The running-bond wall bundled as stones (`examples/assemblies/wall.toml`: 8 courses of 5
+/// blocks 0.6 m × 0.25 m, the geometry of [`wall_blocks`]), turned into a model by
+/// `crr assemble --planar` (its bed joints hinges about y), has the block LP's multiplier along
+/// ±x (1e-7).
+#[test]
+fn the_wall_assembled_from_its_stones_matches_the_block_lp() {
+    use crr::analysis::assemble::{assemble, read_assembly};
+    use crr::kinematics::assembly::ContactSet;
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/wall.toml");
+    let file = read_assembly(&path).unwrap();
+    let assembled = assemble(&path, &file, true, ContactSet::Beds, 1e-6).unwrap();
+    let options = StaticsOptions {
+        sliding_lift_off: false,
+        ..StaticsOptions::default()
+    };
+    for dx in [1.0, -1.0] {
+        let (expected, _) = wall_lp(8, 5, 0.6, 0.25, dx);
+        let got = collapse_multiplier(&assembled.model, Vector3::new(dx, 0.0, 0.0), &options)
+            .unwrap()
+            .lambda;
+        assert_close(&format!("assembled wall, dx = {dx:+}"), got, expected, RTOL);
+    }
+}

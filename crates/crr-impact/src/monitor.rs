@@ -465,6 +465,44 @@ pub fn self_stress_normals(
     Some(d)
 }
 
+/// The self-stress states of the last state the monitor saw, with the seated set, pivots and
+/// q they were found for, and the last least-distance correction: a structure at rest keeps them
+/// from sample to sample (their decomposition is the monitor's main cost on hyperstatic
+/// structures).
+#[derive(Clone, Debug, Default)]
+pub struct SelfStressCache {
+    key: Option<(Vec<usize>, Vec<crr_kinematics::Side>, DVector<f64>)>,
+    states: Option<DMatrix<f64>>,
+    /// The last correction ν of [`check_from`].
+    pub correction: Option<DVector<f64>>,
+}
+
+impl SelfStressCache {
+    /// The states of [`self_stress_normals`] at `q` with `dynamics`' seated slots and pivots
+    /// (computed again only when one of them changed), and the last correction.
+    pub fn states(
+        &mut self,
+        model: &Model,
+        dynamics: &Dynamics,
+        q: &DVector<f64>,
+        edges: &[SeatEdges],
+    ) -> (Option<&DMatrix<f64>>, &mut Option<DVector<f64>>) {
+        let same = self.key.as_ref().is_some_and(|(seated, sides, at)| {
+            seated == &dynamics.seated && sides == &dynamics.pivots.sides && at == q
+        });
+        if !same {
+            self.states = self_stress_normals(model, dynamics, edges);
+            self.key = Some((
+                dynamics.seated.clone(),
+                dynamics.pivots.sides.clone(),
+                q.clone(),
+            ));
+            self.correction = None;
+        }
+        (self.states.as_ref(), &mut self.correction)
+    }
+}
+
 /// A pivot's normal force counts as tension (flight) below −TENSION_TOLERANCE W, W the
 /// structure's weight: a tension of a thousandth of the weight is within what the rigid-contact
 /// idealisation resolves (the drum column's pivots dip to −2e-4 W at impact instants), and the
@@ -491,6 +529,33 @@ pub fn check(
     friction: Option<f64>,
     tolerance: f64,
 ) -> Option<Violation> {
+    check_from(
+        model,
+        forces,
+        edges,
+        self_stress,
+        t,
+        friction,
+        tolerance,
+        &mut None,
+    )
+}
+
+/// [`check`] starting from the self-stress change `correction` of a previous call: when it still
+/// makes every force ≥ −tolerance/2 it is kept (no program is solved: a structure at rest, or
+/// one whose forces barely changed between samples), otherwise the least-distance program gives
+/// the new one, left in `correction` (None when there is none).
+#[allow(clippy::too_many_arguments)]
+pub fn check_from(
+    model: &Model,
+    forces: &[Option<ContactForce>],
+    edges: &[SeatEdges],
+    self_stress: Option<&DMatrix<f64>>,
+    t: f64,
+    friction: Option<f64>,
+    tolerance: f64,
+    correction: &mut Option<DVector<f64>>,
+) -> Option<Violation> {
     let tension = forces
         .iter()
         .any(|f| f.is_some_and(|f| f.normal < -tolerance))
@@ -514,7 +579,11 @@ pub fn check(
         let h = DVector::from_fn(monitored.len(), |r, _| {
             -0.5 * tolerance - values[monitored[r]]
         });
-        if let Some(nu) = crate::least_distance::least_distance(&g, &h) {
+        let holds = |nu: &DVector<f64>| nu.len() == g.ncols() && (&g * nu - &h).min() >= 0.0;
+        if !correction.as_ref().is_some_and(holds) {
+            *correction = crate::least_distance::least_distance(&g, &h);
+        }
+        if let Some(nu) = correction.as_ref() {
             let dv = &g * nu;
             for (r, &i) in monitored.iter().enumerate() {
                 values[i] += dv[r];

@@ -194,13 +194,26 @@ fn simplified(p: Vec<[f64; 2]>, tol: f64) -> Vec<[f64; 2]> {
     q
 }
 
+/// Which contacts become interfaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactSet {
+    /// The beds only (normals within 45° of the vertical: supports rocking under gravity); side
+    /// contacts are reported. Every body needs a bed under it.
+    Beds,
+    /// Every contact face (beds, the inclined joints of an arch, head joints). Every body needs a
+    /// chain of contacts to the ground; each interface's parent is the body nearer the ground
+    /// along the contacts (breadth first).
+    All,
+}
+
 /// The contact faces of `bodies` resting on the ground (z = 0) and on each other: faces facing
 /// each other in one plane (distance at most `tolerance`, m) whose overlap has an area above
-/// tolerance × the model size. Every body must have a bed under it (else it floats: an error
-/// naming it).
+/// tolerance × the model size. Every body must be supported through the contacts of `set`
+/// (else it floats: an error naming it), and two bodies may touch on one face only.
 pub fn detect_contacts(
     bodies: &[BodySpec],
     tolerance: f64,
+    set: ContactSet,
 ) -> Result<Vec<ContactFace>, AssemblyError> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(error(
@@ -296,12 +309,13 @@ pub fn detect_contacts(
             }
         }
     }
+    let counts = |c: &ContactFace| c.bed || set == ContactSet::All;
     for (k, c) in contacts.iter().enumerate() {
-        if c.bed
-            && contacts[..k]
-                .iter()
-                .any(|d| d.bed && d.lower == c.lower && d.upper == c.upper)
-        {
+        let same_pair = |d: &ContactFace| {
+            (d.lower == c.lower && d.upper == c.upper)
+                || (d.lower == Some(c.upper) && c.lower == Some(d.upper))
+        };
+        if counts(c) && contacts[..k].iter().any(|d| counts(d) && same_pair(d)) {
             let lower = c.lower.map_or("the ground", |b| bodies[b].name.as_str());
             return Err(error(
                 format!("body \"{}\"", bodies[c.upper].name),
@@ -313,18 +327,64 @@ pub fn detect_contacts(
             ));
         }
     }
-    for (b, body) in bodies.iter().enumerate() {
-        if !contacts.iter().any(|c| c.bed && c.upper == b) {
-            return Err(error(
-                format!("body \"{}\"", body.name),
-                format!(
-                    "rests on nothing: no face of it lies on the ground (z = 0) or on a block \
-                     below within the tolerance of {tolerance} m"
-                ),
-            ));
+    match set {
+        ContactSet::Beds => {
+            for (b, body) in bodies.iter().enumerate() {
+                if !contacts.iter().any(|c| c.bed && c.upper == b) {
+                    return Err(error(
+                        format!("body \"{}\"", body.name),
+                        format!(
+                            "rests on nothing: no face of it lies on the ground (z = 0) or on a \
+                             block below within the tolerance of {tolerance} m"
+                        ),
+                    ));
+                }
+            }
+        }
+        ContactSet::All => {
+            let depth = ground_depths(bodies.len(), &contacts);
+            if let Some(b) = depth.iter().position(Option::is_none) {
+                return Err(error(
+                    format!("body \"{}\"", bodies[b].name),
+                    format!(
+                        "rests on nothing: no chain of contacts within the tolerance of \
+                         {tolerance} m reaches it from the ground (z = 0)"
+                    ),
+                ));
+            }
         }
     }
     Ok(contacts)
+}
+
+/// The number of contacts between each body and the ground along the shortest chain of
+/// contacts (breadth first; None: not reached).
+fn ground_depths(bodies: usize, contacts: &[ContactFace]) -> Vec<Option<usize>> {
+    let mut depth: Vec<Option<usize>> = vec![None; bodies];
+    let mut frontier: Vec<usize> = contacts
+        .iter()
+        .filter(|c| c.lower.is_none())
+        .map(|c| c.upper)
+        .collect();
+    let mut level = 1;
+    while !frontier.is_empty() {
+        let mut next = Vec::new();
+        for b in frontier {
+            if depth[b].is_none() {
+                depth[b] = Some(level);
+                for c in contacts {
+                    match (c.lower, c.upper) {
+                        (Some(l), u) if l == b && depth[u].is_none() => next.push(u),
+                        (Some(l), u) if u == b && depth[l].is_none() => next.push(l),
+                        _ => {}
+                    }
+                }
+            }
+        }
+        frontier = next;
+        level += 1;
+    }
+    depth
 }
 
 /// Blocks below the ground or inside one another are errors of the geometry: each is named, with
@@ -421,19 +481,41 @@ pub enum InterfaceStyle {
     PlanarHinge,
 }
 
-/// The structure whose interfaces are every bed contact (named `UPPER_on_LOWER`, the lower body
-/// the parent; `ground` for the ground), listed from the ground up so that the spanning tree
-/// reaches each body through its first support and the other supports close loops.
+/// The structure whose interfaces are the contacts of `set` (named `CHILD_on_PARENT`; `ground`
+/// for the ground), listed from the ground up so that the spanning tree reaches each body through
+/// its first support and the other supports close loops. A bed's parent is its lower body; with
+/// [`ContactSet::All`] an interface's parent is the body nearer the ground along the contacts
+/// (the lower one at equal distance), its normal and corners turned to point into the child.
 pub fn structure_of(
     name: &str,
     gravity: f64,
     bodies: &[BodySpec],
     contacts: &[ContactFace],
     style: InterfaceStyle,
+    set: ContactSet,
     tolerance: f64,
 ) -> Result<StructureSpec, AssemblyError> {
     let name_of = |b: Option<usize>| b.map_or("ground", |b| bodies[b].name.as_str());
-    let mut beds: Vec<&ContactFace> = contacts.iter().filter(|c| c.bed).collect();
+    let oriented: Vec<ContactFace> = match set {
+        ContactSet::Beds => contacts.iter().filter(|c| c.bed).cloned().collect(),
+        ContactSet::All => {
+            let depth = ground_depths(bodies.len(), contacts);
+            contacts
+                .iter()
+                .map(|c| match c.lower {
+                    Some(l) if depth[c.upper] < depth[l] => ContactFace {
+                        lower: Some(c.upper),
+                        upper: l,
+                        normal: -c.normal,
+                        corners: c.corners.iter().rev().copied().collect(),
+                        ..c.clone()
+                    },
+                    _ => c.clone(),
+                })
+                .collect()
+        }
+    };
+    let mut beds: Vec<&ContactFace> = oriented.iter().collect();
     // From the ground up: by the contact's height, then by the bodies' order.
     beds.sort_by(|a, b| {
         let za = a.corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
@@ -464,37 +546,18 @@ pub fn structure_of(
                 });
             }
             InterfaceStyle::PlanarHinge => {
-                if c.normal.z < 1.0 - 1e-9 {
-                    return Err(error(
-                        item(),
-                        "is not horizontal: a planar layout (--planar) needs horizontal beds",
-                    ));
-                }
-                let (x0, x1) = c
-                    .corners
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                        (lo.min(p.x), hi.max(p.x))
-                    });
-                let (y0, y1) = c
-                    .corners
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                        (lo.min(p.y), hi.max(p.y))
-                    });
-                let rectangle = (x1 - x0) * (y1 - y0);
-                if (rectangle - c.area).abs() > tolerance * (x1 - x0 + y1 - y0) {
-                    return Err(error(
-                        item(),
-                        "is not a rectangle aligned with x and y: a planar layout (--planar) \
-                         needs beds spanning the blocks' depth along y",
-                    ));
-                }
-                let z = c.corners[0].z;
-                spec.axis = Some([0.0, 1.0, 0.0]);
-                // A positive angle about +y lowers +x points: the block pivots on its +x line.
-                spec.pivot_positive = Some(PivotSpec::Segment([[x1, y0, z], [x1, y1, z]]));
-                spec.pivot_negative = Some(PivotSpec::Segment([[x0, y0, z], [x0, y1, z]]));
+                let (axis, pivot_positive, pivot_negative) = planar_pivots(c, tolerance)
+                    .ok_or_else(|| {
+                        error(
+                            item(),
+                            "is not a rectangle spanning the blocks' depth along y in a plane \
+                             containing y: a planar layout (--planar) needs joints whose \
+                             faces contain the y direction",
+                        )
+                    })?;
+                spec.axis = Some(axis);
+                spec.pivot_positive = Some(PivotSpec::Segment(pivot_positive));
+                spec.pivot_negative = Some(PivotSpec::Segment(pivot_negative));
             }
         }
         interfaces.push(spec);
@@ -506,6 +569,47 @@ pub fn structure_of(
         interface: interfaces,
         symmetry: Vec::new(),
     })
+}
+
+/// The hinge about y of a contact face of a planar layout (in the x–z plane): its plane must
+/// contain y (normal n ⟂ y) and its overlap be a rectangle with edges along y and along
+/// s = y × n (for a horizontal bed, s = x). The pivot lines run along y at the least and greatest
+/// s; a positive angle about +y moves a point at distance d from the line at the greatest s by
+/// y × (−d s) = d n, off the parent: the child pivots on that line (P⁺), as a block on its +x edge.
+#[allow(clippy::type_complexity)]
+fn planar_pivots(
+    c: &ContactFace,
+    tolerance: f64,
+) -> Option<([f64; 3], [[f64; 3]; 2], [[f64; 3]; 2])> {
+    if c.normal.y.abs() > 1e-9 {
+        return None;
+    }
+    let y = Vector3::y();
+    let s = y.cross(&c.normal);
+    let range = |u: &Vector3<f64>| {
+        c.corners
+            .iter()
+            .map(|p| u.dot(p))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            })
+    };
+    let ((s0, s1), (y0, y1)) = (range(&s), range(&y));
+    let rectangle = (s1 - s0) * (y1 - y0);
+    if (rectangle - c.area).abs() > tolerance * (s1 - s0 + y1 - y0) {
+        return None;
+    }
+    // The face's plane: n·x = h; a point of it at (s, y) is s ŝ + y ŷ + h n.
+    let h = c.normal.dot(&c.corners[0]);
+    let at = |sv: f64, yv: f64| {
+        let p = s * sv + y * yv + c.normal * h;
+        [p.x, p.y, p.z]
+    };
+    Some((
+        [0.0, 1.0, 0.0],
+        [at(s1, y0), at(s1, y1)],
+        [at(s0, y0), at(s0, y1)],
+    ))
 }
 
 #[cfg(test)]

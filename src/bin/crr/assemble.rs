@@ -1,8 +1,10 @@
-//! `crr assemble ASSEMBLY [--contacts] [--out MODEL.toml] [--planar] [--tolerance T] [--force]`.
+//! `crr assemble ASSEMBLY [--contacts] [--out MODEL.toml] [--all-contacts] [--planar]
+//! [--tolerance T] [--force]`.
 
 use std::path::PathBuf;
 
 use crr::analysis::assemble::{DEFAULT_TOLERANCE, assemble, read_assembly};
+use crr::kinematics::assembly::ContactSet;
 use crr::output::assemble::{contacts_text, write_model};
 
 use crate::failure::Failure;
@@ -15,9 +17,13 @@ pub(crate) struct Args {
     /// List every contact found (bodies, bed or side, area, normal).
     #[arg(long)]
     pub(crate) contacts: bool,
-    /// Write the model (every bed contact a rocking interface) to this file.
+    /// Write the model (every bed contact, or every contact, a rocking interface) to this file.
     #[arg(long, value_name = "MODEL.toml")]
     pub(crate) out: Option<PathBuf>,
+    /// Every contact face becomes an interface (the inclined joints of an arch, head joints),
+    /// not only the beds; each interface's parent is the body nearer the ground.
+    #[arg(long)]
+    pub(crate) all_contacts: bool,
     /// A planar layout in the x–z plane: hinges about y instead of rocking bases.
     #[arg(long)]
     pub(crate) planar: bool,
@@ -31,7 +37,12 @@ pub(crate) struct Args {
 
 pub(crate) fn run(a: Args) -> Result<(), Failure> {
     let file = read_assembly(&a.assembly)?;
-    let assembled = assemble(&a.assembly, &file, a.planar, a.tolerance)?;
+    let set = if a.all_contacts {
+        ContactSet::All
+    } else {
+        ContactSet::Beds
+    };
+    let assembled = assemble(&a.assembly, &file, a.planar, set, a.tolerance)?;
     if a.contacts || a.out.is_none() {
         print!("{}", contacts_text(&assembled));
     }

@@ -55,19 +55,21 @@ impl Simulation<'_> {
                 // (The self-stress states cost a decomposition, made only then.)
                 let tension = forces.iter().any(|f| f.is_some_and(|f| f.normal < -tol))
                     || edges.iter().any(|e| e.near.min(e.far) < -tol);
-                let states = if tension {
-                    crate::monitor::self_stress_normals(self.model, d, edges)
+                let mut none = None;
+                let (states, correction) = if tension {
+                    self.spare.self_stress.states(self.model, d, &q, edges)
                 } else {
-                    None
+                    (None, &mut none)
                 };
-                self.violation = crate::monitor::check(
+                self.violation = crate::monitor::check_from(
                     self.model,
                     forces,
                     edges,
-                    states.as_ref(),
+                    states,
                     t,
                     self.params.friction,
                     tol,
+                    correction,
                 );
             }
         }
