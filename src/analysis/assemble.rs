@@ -12,14 +12,33 @@ use crr_kinematics::{Model, StructureSpec};
 
 use crate::Error;
 use crate::input::model_file::{ModelFile, read_model_file};
+use crate::input::obj::obj_bodies;
 
 /// The default contact tolerance (m): two faces closer than this touch.
 pub const DEFAULT_TOLERANCE: f64 = 1e-6;
 
-/// Reads an assembly file: a model file (TOML, or JSON when it ends in .json) with bodies and
-/// no interfaces.
+/// Reads an assembly file: a model file (TOML, or JSON when it ends in .json) with bodies (its
+/// `[[body]]` tables, then the blocks of its `[[obj]]` files) and no interfaces.
 pub fn read_assembly(path: &Path) -> Result<ModelFile, Error> {
-    let file = read_model_file(path)?;
+    let mut file = read_model_file(path)?;
+    // The blocks of `[[obj]]` files become bodies after the `[[body]]` ones.
+    let folder = path.parent().unwrap_or(Path::new(""));
+    for spec in std::mem::take(&mut file.obj) {
+        file.body.extend(obj_bodies(&spec, folder)?);
+    }
+    let names: Vec<&str> = file.body.iter().map(|b| b.name.as_str()).collect();
+    if let Some((i, name)) = names
+        .iter()
+        .enumerate()
+        .find(|(i, n)| names[..*i].contains(n))
+    {
+        return Err(Error::Argument(format!(
+            "{}: body \"{name}\" is named twice (body {} of the assembly, with its [[obj]] \
+             blocks after its [[body]] tables)",
+            path.display(),
+            i + 1
+        )));
+    }
     let here = |m: &str| Error::Argument(format!("{}: {m}", path.display()));
     if !file.interface.is_empty() {
         return Err(here(

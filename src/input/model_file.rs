@@ -45,6 +45,9 @@ pub struct ModelFile {
     /// Duration, output interval, integrator settings.
     #[serde(default)]
     pub analysis: Option<AnalysisSpec>,
+    /// Blocks from Wavefront OBJ files (assemblies only: `crr assemble` turns them into bodies).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obj: Vec<crate::input::obj::ObjSpec>,
 }
 
 impl ModelFile {
@@ -191,6 +194,13 @@ pub fn load_model(path: &Path) -> Result<(ModelFile, Model), Error> {
 /// Validates the structure of a parsed model file into a model; errors name `path` (the file,
 /// or the label of a model given as text) and the item.
 pub fn build_model(path: &Path, file: ModelFile) -> Result<(ModelFile, Model), Error> {
+    if !file.obj.is_empty() {
+        return Err(Error::Argument(format!(
+            "{}: [[obj]] lists blocks of an assembly: turn it into a model with `crr assemble` \
+             (docs/assembly.md)",
+            path.display()
+        )));
+    }
     let model = Model::from_spec(&file.structure()).map_err(|source| Error::Model {
         file: path.to_path_buf(),
         source,

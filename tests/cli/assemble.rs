@@ -289,3 +289,137 @@ fn the_bundled_assemblies_go_from_stones_to_a_simulation() {
         assert!(results.join("summary.json").exists(), "{name}");
     }
 }
+
+/// The OBJ text of a box [lo, hi] as object `name`, its vertices numbered from `first` (OBJ
+/// indices are global to the file): six quadrilaterals, counter-clockwise seen from outside;
+/// `skip` leaves one face out.
+fn box_obj(name: &str, lo: [f64; 3], hi: [f64; 3], first: usize, skip: Option<usize>) -> String {
+    let mut s = format!("o {name}\n");
+    for k in 0..8 {
+        let x = if matches!(k % 4, 1 | 2) { hi[0] } else { lo[0] };
+        let y = if matches!(k % 4, 2 | 3) { hi[1] } else { lo[1] };
+        let z = if k >= 4 { hi[2] } else { lo[2] };
+        s += &format!("v {x} {y} {z}\n");
+    }
+    let faces = [
+        [0, 3, 2, 1],
+        [4, 5, 6, 7],
+        [0, 1, 5, 4],
+        [2, 3, 7, 6],
+        [0, 4, 7, 3],
+        [1, 2, 6, 5],
+    ];
+    for (i, f) in faces.iter().enumerate() {
+        if Some(i) != skip {
+            let f: Vec<String> = f.iter().map(|&v| (v + first).to_string()).collect();
+            s += &format!("f {}\n", f.join(" "));
+        }
+    }
+    s
+}
+
+/// An assembly whose blocks come from an OBJ file written beside it.
+fn obj_assembly(tag: &str, obj: &str, table: &str) -> std::path::PathBuf {
+    let dir = common::scratch(tag);
+    std::fs::write(dir.join("blocks.obj"), obj).unwrap();
+    let path = dir.join("assembly.toml");
+    std::fs::write(
+        &path,
+        format!("name = \"{tag}\"\n[[obj]]\nfile = \"blocks.obj\"\ndensity = 2000.0\n{table}"),
+    )
+    .unwrap();
+    path
+}
+
+/// Blocks from a Wavefront OBJ file: a column of two stones 0.4 × 0.4 × 1 m stacked on the
+/// ground rocks whole on a base edge at λ = b/h = 0.2/1.0 along x and y, and weighs
+/// 2 × 0.16 m³ × 2000 kg/m³, whether the file is in metres with z up, in millimetres, or in
+/// metres with y up; an open mesh and a non-convex block are refused naming the object, and
+/// `crr simulate` refuses a file with `[[obj]]` (an assembly, not a model).
+#[test]
+fn blocks_from_an_obj_file() {
+    let column = |k: f64, y_up: bool| {
+        let p = |x: f64, y: f64, z: f64| {
+            if y_up {
+                [k * x, k * z, -k * y]
+            } else {
+                [k * x, k * y, k * z]
+            }
+        };
+        let (a0, a1) = (p(-0.2, -0.2, 0.0), p(0.2, 0.2, 1.0));
+        let (b0, b1) = (p(-0.2, -0.2, 1.0), p(0.2, 0.2, 2.0));
+        let sorted = |u: [f64; 3], v: [f64; 3]| {
+            let lo = [u[0].min(v[0]), u[1].min(v[1]), u[2].min(v[2])];
+            let hi = [u[0].max(v[0]), u[1].max(v[1]), u[2].max(v[2])];
+            (lo, hi)
+        };
+        let ((la, ha), (lb, hb)) = (sorted(a0, a1), sorted(b0, b1));
+        box_obj("lower", la, ha, 1, None) + &box_obj("upper", lb, hb, 9, None)
+    };
+    for (tag, obj, table) in [
+        ("obj_m", column(1.0, false), ""),
+        ("obj_mm", column(1000.0, false), "units = \"mm\"\n"),
+        ("obj_y_up", column(1.0, true), "up = \"y\"\n"),
+    ] {
+        let path = obj_assembly(tag, &obj, table);
+        let file = read_assembly(&path).unwrap();
+        let names: Vec<&str> = file.body.iter().map(|b| b.name.as_str()).collect();
+        assert_eq!(names, ["lower", "upper"], "{tag}");
+        let a = assemble(&path, &file, false, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
+        let mass = a.model.total_mass();
+        assert!(
+            (mass - 2.0 * 0.16 * 2000.0).abs() < 1e-9 * mass,
+            "{tag}: {mass}"
+        );
+        for d in [Vector3::x(), -Vector3::y()] {
+            let l = lambda(&a.model, d);
+            assert!((l - 0.2).abs() < 1e-9, "{tag}: {l}");
+        }
+    }
+    // A model file is not an assembly: its [[obj]] blocks are refused by `crr simulate`.
+    let path = obj_assembly("obj_as_model", &column(1.0, false), "");
+    let o = common::crr(&["simulate", path.to_str().unwrap(), "--quiet"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("[[obj]] lists blocks of an assembly"), "{err}");
+    let open = obj_assembly(
+        "obj_open",
+        &box_obj("a", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0], 1, Some(1)),
+        "",
+    );
+    let o = common::crr(&["assemble", open.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("object \"a\": the mesh is not a closed surface"),
+        "{err}"
+    );
+    // An L-shaped prism (a reflex corner at (1, 1)): not the convex hull of its vertices.
+    let l_shape = [
+        [0.0, 0.0],
+        [2.0, 0.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [1.0, 2.0],
+        [0.0, 2.0],
+    ];
+    let mut obj = String::from("o ell\n");
+    for z in [0.0, 1.0] {
+        for [x, y] in l_shape {
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    obj += "f 6 5 4 3 2 1\nf 7 8 9 10 11 12\n";
+    for i in 0..6 {
+        let j = (i + 1) % 6;
+        obj += &format!("f {} {} {} {}\n", i + 1, j + 1, j + 7, i + 7);
+    }
+    let path = obj_assembly("obj_ell", &obj, "");
+    let o = common::crr(&["assemble", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("object \"ell\": the block is not convex"),
+        "{err}"
+    );
+}

@@ -1,0 +1,265 @@
+//! Blocks from a Wavefront OBJ file (`[[obj]]` of an assembly, docs/assembly.md): one object (or
+//! group) per block, each a closed convex polyhedron, in the file's units, turned into bodies of
+//! the model format (a `polyhedron` with the block's vertices, named after its object).
+//!
+//! The mesh is read by `tobj`. Each object's vertices are welded by position (a CAD export often
+//! repeats them per face), its faces must close it (every edge shared by exactly two faces, met
+//! once in each direction) and it must be convex (every vertex on the inner side of every face),
+//! since a `polyhedron` body is the convex hull of its vertices; a block that is not is refused
+//! by name, with the edge or the face concerned.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crr_kinematics::shapes::PolyhedronShape;
+use crr_kinematics::spec::BodySpec;
+
+use crate::Error;
+
+/// Length unit of an OBJ file's coordinates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ObjUnits {
+    /// Metres (the default).
+    #[default]
+    M,
+    /// Centimetres.
+    Cm,
+    /// Millimetres.
+    Mm,
+}
+
+impl ObjUnits {
+    /// Metres per unit.
+    pub fn metres(self) -> f64 {
+        match self {
+            ObjUnits::M => 1.0,
+            ObjUnits::Cm => 0.01,
+            ObjUnits::Mm => 0.001,
+        }
+    }
+}
+
+/// The vertical axis of an OBJ file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ObjUp {
+    /// z up, as crr (the default).
+    #[default]
+    Z,
+    /// y up (many modelling tools): (x, y, z) is read as (x, −z, y), a rotation of 90° about x.
+    Y,
+}
+
+/// An `[[obj]]` table: the blocks of a Wavefront OBJ file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjSpec {
+    /// The OBJ file; a relative path is resolved against the assembly file's folder.
+    pub file: PathBuf,
+    /// Density of every block (kg/m³).
+    pub density: f64,
+    /// Unit of the coordinates (`m`, `cm` or `mm`; default `m`).
+    #[serde(default)]
+    pub units: ObjUnits,
+    /// The vertical axis (`z` or `y`; default `z`).
+    #[serde(default)]
+    pub up: ObjUp,
+}
+
+/// The bodies of the OBJ file of `spec` (its path relative to `folder`), one per object.
+pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error> {
+    let path = folder.join(&spec.file);
+    let here = |m: String| Error::Argument(format!("{}: {m}", path.display()));
+    if !(spec.density.is_finite() && spec.density > 0.0) {
+        return Err(here(format!(
+            "density must be a positive number (kg/m³), got {}",
+            spec.density
+        )));
+    }
+    let options = tobj::LoadOptions {
+        triangulate: false,
+        single_index: false,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(&path, &options).map_err(|e| here(format!("{e}")))?;
+    if models.is_empty() {
+        return Err(here("no object in the file".into()));
+    }
+    let mut bodies: Vec<BodySpec> = Vec::with_capacity(models.len());
+    for (k, m) in models.iter().enumerate() {
+        let name = if m.name.trim().is_empty() {
+            format!("object_{}", k + 1)
+        } else {
+            m.name.trim().to_string()
+        };
+        if bodies.iter().any(|b| b.name == name) {
+            return Err(here(format!(
+                "object \"{name}\" appears twice: every block needs its own name"
+            )));
+        }
+        let item = |m: String| here(format!("object \"{name}\": {m}"));
+        let block = Block::from_mesh(&m.mesh, spec).map_err(item)?;
+        block.check_closed().map_err(item)?;
+        block.check_convex().map_err(item)?;
+        bodies.push(BodySpec {
+            name,
+            density: Some(spec.density),
+            mass: None,
+            box_shape: None,
+            polyhedron: Some(PolyhedronShape {
+                vertices: block.vertices.iter().map(|v| [v.x, v.y, v.z]).collect(),
+            }),
+            prism: None,
+            annular_sector: None,
+        });
+    }
+    Ok(bodies)
+}
+
+/// One object's mesh with its vertices welded (m, z up).
+struct Block {
+    vertices: Vec<Vector3<f64>>,
+    faces: Vec<Vec<usize>>,
+}
+
+impl Block {
+    fn from_mesh(mesh: &tobj::Mesh, spec: &ObjSpec) -> Result<Block, String> {
+        let scale = spec.units.metres();
+        let point = |i: usize| {
+            let p = &mesh.positions[3 * i..3 * i + 3];
+            let v = Vector3::new(p[0], p[1], p[2]) * scale;
+            match spec.up {
+                ObjUp::Z => v,
+                ObjUp::Y => Vector3::new(v.x, -v.z, v.y),
+            }
+        };
+        // Weld equal positions: the same corner written once per face is one vertex.
+        let mut index: HashMap<[u64; 3], usize> = HashMap::new();
+        let mut vertices = Vec::new();
+        let mut welded = Vec::with_capacity(mesh.positions.len() / 3);
+        for i in 0..mesh.positions.len() / 3 {
+            let v = point(i);
+            if !(v.x.is_finite() && v.y.is_finite() && v.z.is_finite()) {
+                return Err(format!("vertex {} is not finite", i + 1));
+            }
+            let key = [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+            let id = *index.entry(key).or_insert_with(|| {
+                vertices.push(v);
+                vertices.len() - 1
+            });
+            welded.push(id);
+        }
+        let arities: Vec<usize> = if mesh.face_arities.is_empty() {
+            vec![3; mesh.indices.len() / 3]
+        } else {
+            mesh.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        let mut faces = Vec::with_capacity(arities.len());
+        let mut at = 0;
+        for a in arities {
+            let face: Vec<usize> = mesh.indices[at..at + a]
+                .iter()
+                .map(|&i| welded[i as usize])
+                .collect();
+            at += a;
+            faces.push(face);
+        }
+        if vertices.len() < 4 || faces.len() < 4 {
+            return Err(format!(
+                "{} vertices and {} faces do not close a solid",
+                vertices.len(),
+                faces.len()
+            ));
+        }
+        Ok(Block { vertices, faces })
+    }
+
+    fn edges(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.faces.iter().flat_map(|f| {
+            let m = f.len();
+            (0..m).map(move |i| (f[i], f[(i + 1) % m]))
+        })
+    }
+
+    /// Every edge is met once in each direction: two faces share it, oriented alike.
+    fn check_closed(&self) -> Result<(), String> {
+        let mut count: HashMap<(usize, usize), i32> = HashMap::new();
+        for (a, b) in self.edges() {
+            *count.entry((a, b)).or_default() += 1;
+        }
+        for (&(a, b), &n) in &count {
+            let back = count.get(&(b, a)).copied().unwrap_or(0);
+            if n != 1 || back != 1 {
+                let (p, q) = (self.vertices[a], self.vertices[b]);
+                return Err(format!(
+                    "the mesh is not a closed surface: the edge from ({:.6}, {:.6}, {:.6}) to \
+                     ({:.6}, {:.6}, {:.6}) m belongs to {} face(s) (each edge of a closed, \
+                     consistently oriented mesh belongs to two, once each way)",
+                    p.x,
+                    p.y,
+                    p.z,
+                    q.x,
+                    q.y,
+                    q.z,
+                    n + back
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Every vertex lies on the inner side of every face's plane (to 1e-9 of the block's size),
+    /// the faces oriented outward by the mesh's sign of volume.
+    fn check_convex(&self) -> Result<(), String> {
+        let lo = self
+            .vertices
+            .iter()
+            .fold(Vector3::repeat(f64::INFINITY), |a, v| a.inf(v));
+        let hi = self
+            .vertices
+            .iter()
+            .fold(Vector3::repeat(f64::NEG_INFINITY), |a, v| a.sup(v));
+        let size = (hi - lo).norm();
+        let area_vector = |f: &[usize]| {
+            (0..f.len()).fold(Vector3::zeros(), |s: Vector3<f64>, i| {
+                let (a, b) = (self.vertices[f[i]], self.vertices[f[(i + 1) % f.len()]]);
+                s + a.cross(&b) * 0.5
+            })
+        };
+        let volume: f64 = self
+            .faces
+            .iter()
+            .map(|f| area_vector(f).dot(&self.vertices[f[0]]) / 3.0)
+            .sum();
+        if volume.abs() <= 1e-12 * size.powi(3) {
+            return Err("the mesh encloses no volume".into());
+        }
+        let outward = volume.signum();
+        for (k, f) in self.faces.iter().enumerate() {
+            let Some(n) = (area_vector(f) * outward).try_normalize(0.0) else {
+                continue;
+            };
+            let offset = n.dot(&self.vertices[f[0]]);
+            if let Some(v) = self
+                .vertices
+                .iter()
+                .find(|v| n.dot(v) - offset > 1e-9 * size)
+            {
+                return Err(format!(
+                    "the block is not convex: the vertex ({:.6}, {:.6}, {:.6}) m lies outside \
+                     the plane of face {} (a polyhedron body is the convex hull of its vertices: \
+                     cut the block into convex parts)",
+                    v.x,
+                    v.y,
+                    v.z,
+                    k + 1
+                ));
+            }
+        }
+        Ok(())
+    }
+}
