@@ -146,7 +146,12 @@ impl Block {
             if !(v.x.is_finite() && v.y.is_finite() && v.z.is_finite()) {
                 return Err(format!("vertex {} is not finite", i + 1));
             }
-            let key = [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+            // −0.0 and 0.0 are one position (+ 0.0 turns −0.0 into 0.0).
+            let key = [
+                (v.x + 0.0).to_bits(),
+                (v.y + 0.0).to_bits(),
+                (v.z + 0.0).to_bits(),
+            ];
             let id = *index.entry(key).or_insert_with(|| {
                 vertices.push(v);
                 vertices.len() - 1
@@ -190,6 +195,13 @@ impl Block {
         let mut count: HashMap<(usize, usize), i32> = HashMap::new();
         for (a, b) in self.edges() {
             *count.entry((a, b)).or_default() += 1;
+        }
+        if let Some((a, _)) = self.edges().find(|(a, b)| a == b) {
+            let p = self.vertices[a];
+            return Err(format!(
+                "a face repeats the vertex ({:.6}, {:.6}, {:.6}) m: an edge of no length",
+                p.x, p.y, p.z
+            ));
         }
         for (&(a, b), &n) in &count {
             let back = count.get(&(b, a)).copied().unwrap_or(0);

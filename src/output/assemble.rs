@@ -9,6 +9,7 @@ use crr_kinematics::assembly::{ContactFace, ContactSet};
 
 use crate::Error;
 use crate::analysis::assemble::Assembled;
+use crate::input::model_file::ModelFile;
 
 /// One line per contact: the bodies (lower first; `ground`), bed or side, area (m²), normal and
 /// number of corners.
@@ -49,8 +50,8 @@ fn contact_line(c: &ContactFace, lower: &str, upper: &str) -> String {
     )
 }
 
-/// The model file of an assembly as TOML (loads back into the same model).
-pub fn model_toml(a: &Assembled) -> String {
+/// The model file `file` of an assembly `a` as TOML (loads back into the same model).
+pub fn model_toml(a: &Assembled, file: &ModelFile) -> String {
     let header = format!(
         "# Written by `crr assemble` (crr {}): the assembly's bodies with every {} as a\n\
          # rocking interface ({} interfaces, DOF(1) = {}, {} loop closure(s)).\n",
@@ -63,7 +64,7 @@ pub fn model_toml(a: &Assembled) -> String {
         a.model.dof(),
         a.model.closures.len()
     );
-    header + &toml::to_string(&a.file).expect("a model file serialises to TOML")
+    header + &toml::to_string(file).expect("a model file serialises to TOML")
 }
 
 /// Writes the model file to `out` (refused when it exists, unless `force`). A record file given
@@ -76,9 +77,9 @@ pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> 
             out.display()
         )));
     }
-    let mut rebased = a.clone();
+    let mut file = a.file.clone();
     let target = out.parent().unwrap_or(Path::new(""));
-    if let Some(gm) = rebased.file.ground_motion.as_mut() {
+    if let Some(gm) = file.ground_motion.as_mut() {
         for component in [&mut gm.x, &mut gm.y, &mut gm.z].into_iter().flatten() {
             if let SignalSpec::Record(record) = &mut component.signal
                 && record.file.is_relative()
@@ -87,7 +88,7 @@ pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> 
             }
         }
     }
-    crate::output::replace_file::replace_file(out, model_toml(&rebased)).map_err(|source| {
+    crate::output::replace_file::replace_file(out, model_toml(a, &file)).map_err(|source| {
         Error::Output {
             dir: out.to_path_buf(),
             source,
@@ -96,7 +97,7 @@ pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> 
 }
 
 /// `file` as seen from the folder `to`: relative when both resolve (the common prefix of their
-/// canonical paths dropped, a `..` per remaining folder of `to`), else `file` itself.
+/// canonical paths dropped, a `..` per remaining folder of `to`), else `file` made absolute.
 fn rebase(file: &Path, to: &Path) -> PathBuf {
     let dir = if to.as_os_str().is_empty() {
         Path::new(".")
@@ -104,7 +105,8 @@ fn rebase(file: &Path, to: &Path) -> PathBuf {
         to
     };
     let (Ok(file_abs), Ok(dir_abs)) = (file.canonicalize(), dir.canonicalize()) else {
-        return file.to_path_buf();
+        // A record not there yet: an absolute path finds it wherever the model is written.
+        return std::path::absolute(file).unwrap_or_else(|_| file.to_path_buf());
     };
     let (f, d): (Vec<_>, Vec<_>) = (
         file_abs.components().collect(),

@@ -246,14 +246,16 @@ fn the_bundled_run_leaves_rest_at_the_collapse_multiplier() {
     // The monitor flags a bed of the first column held seated 25 ms after the uplift with an
     // edge of its face pulling (0.6 % of the weight): the decisions in motion on the twisting
     // seats are still the local ones (docs/simulation.md, the hypotheses monitor).
-    if let Some(v) = &traj.violation {
-        assert_eq!(
-            (v.kind.as_str(), v.interface.as_str()),
-            ("outside_face", "c11_bed_3"),
-            "{v:?}"
-        );
-        assert!(v.t > uplift && v.t < uplift + 0.05, "{v:?}");
-    }
+    let v = traj
+        .violation
+        .as_ref()
+        .expect("the monitor flags a seated bed");
+    assert_eq!(
+        (v.kind.as_str(), v.interface.as_str()),
+        ("outside_face", "c11_bed_3"),
+        "{v:?}"
+    );
+    assert!(v.t > uplift && v.t < uplift + 0.05, "{v:?}");
     assert_energy_balance(&traj, 100.0);
 }
 

@@ -53,8 +53,6 @@ pub fn least_distance(g: &DMatrix<f64>, h: &DVector<f64>) -> Option<DVector<f64>
 mod tests {
     use super::*;
 
-    /// NNLS against the closed form of a 2 × 2 problem with one active bound, and the
-    /// Karush–Kuhn–Tucker conditions of a random one.
     /// LDP on a closed form (the nearest point of a half-plane), on an inconsistent pair, and the
     /// KKT conditions of a random consistent one, to the interior point's accuracy (1e-8).
     #[test]

@@ -484,8 +484,9 @@ pub enum InterfaceStyle {
 /// The structure whose interfaces are the contacts of `set` (named `CHILD_on_PARENT`; `ground`
 /// for the ground), listed from the ground up so that the spanning tree reaches each body through
 /// its first support and the other supports close loops. A bed's parent is its lower body; with
-/// [`ContactSet::All`] an interface's parent is the body nearer the ground along the contacts
-/// (the lower one at equal distance), its normal and corners turned to point into the child.
+/// [`ContactSet::All`] an interface's parent is the body nearer the ground along the contacts (at
+/// equal distance, a bed's lower body, else the body listed first), its normal and corners turned
+/// to point into the child.
 pub fn structure_of(
     name: &str,
     gravity: f64,

@@ -8,7 +8,8 @@
 //! least overlap over those axes is the depth by which one must move to free the other. A
 //! non-convex block (an annular sector's concave intrados) is tested by its points: the vertices,
 //! edge midpoints and face centroids of each block that lie inside the other (winding number of
-//! its closed surface) deeper than the tolerance (distance to its surface).
+//! its closed surface) deeper than the tolerance (distance to its surface); an overlap that none
+//! of those points enters (two long bars crossing) is not seen.
 
 use nalgebra::Vector3;
 
@@ -20,7 +21,8 @@ pub struct Penetration {
     /// Depth (m): the least translation that separates them (convex blocks), or the depth of the
     /// deepest point of one found inside the other.
     pub depth: f64,
-    /// A point inside both (m).
+    /// A point of the overlap (the deepest point found) or near it (convex blocks: the blocks'
+    /// mean centre moved to the middle of the overlap along the axis of least overlap), m.
     pub point: Vector3<f64>,
 }
 
@@ -99,8 +101,8 @@ fn separating_axes(a: &Surface, b: &Surface, tolerance: f64) -> Option<Penetrati
         }
     }
     let (depth, axis, middle) = least?;
-    // A point inside both: the centroid of the vertices of each block lying within the other's
-    // slab along the axis of least overlap, moved to the middle of the overlap along it.
+    // A point near the overlap, for the message: the mean of the two blocks' vertex centroids,
+    // moved to the middle of the overlap along the axis of least overlap.
     let centre = |s: &Surface| s.vertices.iter().sum::<Vector3<f64>>() / s.vertices.len() as f64;
     let c = 0.5 * (centre(a) + centre(b));
     Some(Penetration {
