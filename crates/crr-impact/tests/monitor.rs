@@ -323,11 +323,25 @@ fn seated_edges(
     side: Side,
 ) -> (crr_impact::monitor::ForceWork, Dynamics) {
     let ground = constant_ground(&[(Axis::X, a[0]), (Axis::Y, a[1]), (Axis::Z, a[2])]);
-    let mut d = Dynamics::new(model, ActivePivots::uniform(model, side));
-    d.seated = (0..model.slot_count).collect();
     let zero = DVector::zeros(model.dof());
+    let all: Vec<usize> = (0..model.slot_count).collect();
+    let pivots = ActivePivots::uniform(model, side);
+    monitored(model, &ground, pivots, &all, (&zero, &zero))
+}
+
+/// The monitor's contact forces and seated edges at (q, q̇) on `pivots` with `seated` held, and
+/// the dynamics that solved them.
+fn monitored(
+    model: &Model,
+    ground: &GroundMotion,
+    pivots: ActivePivots,
+    seated: &[usize],
+    (q, qdot): (&DVector<f64>, &DVector<f64>),
+) -> (crr_impact::monitor::ForceWork, Dynamics) {
+    let mut d = Dynamics::new(model, pivots);
+    d.seated = seated.to_vec();
     let mut work = crr_impact::monitor::ForceWork::default();
-    crr_impact::monitor::contact_forces_into(model, &mut d, &ground, 0.0, &zero, &zero, &mut work)
+    crr_impact::monitor::contact_forces_into(model, &mut d, ground, 0.0, q, qdot, &mut work)
         .unwrap();
     (work, d)
 }
@@ -415,14 +429,8 @@ fn rocking_base_edges_against_moment_balance() {
         let ground = constant_ground(&[(Axis::X, ax), (Axis::Y, ay)]);
         let mut pivots = ActivePivots::uniform(&model, Side::Positive);
         pivots.sides.copy_from_slice(&sides);
-        let mut d = Dynamics::new(&model, pivots);
-        d.seated = vec![0, 1];
         let zero = DVector::zeros(2);
-        let mut work = crr_impact::monitor::ForceWork::default();
-        crr_impact::monitor::contact_forces_into(
-            &model, &mut d, &ground, 0.0, &zero, &zero, &mut work,
-        )
-        .unwrap();
+        let (work, _) = monitored(&model, &ground, pivots, &[0, 1], (&zero, &zero));
         let corner = model.interfaces[0].kind.pivot(&sides);
         let [tilt1, tilt2] = work.edges[..] else {
             panic!("two seated tilts: {:?}", work.edges)
@@ -470,13 +478,9 @@ fn seated_edges_in_motion_against_articulated_wrench() {
     let mut pivots = ActivePivots::uniform(&model, Side::Positive);
     pivots.sides[1] = Side::Negative;
     pivots.sides[3] = Side::Negative;
-    let mut d = Dynamics::new(&model, pivots.clone());
-    d.seated = vec![2, 3];
     let q = DVector::from_column_slice(&[0.04, -0.03, 0.0, 0.0]);
     let qdot = DVector::from_column_slice(&[0.5, -0.8, 0.0, 0.0]);
-    let mut work = crr_impact::monitor::ForceWork::default();
-    crr_impact::monitor::contact_forces_into(&model, &mut d, &ground, 0.0, &q, &qdot, &mut work)
-        .unwrap();
+    let (work, d) = monitored(&model, &ground, pivots.clone(), &[2, 3], (&q, &qdot));
     assert!(d.used_articulated_body());
     assert_eq!(work.edges.len(), 2);
     let iface = &model.interfaces[1];
