@@ -8,6 +8,7 @@ pub mod check;
 pub mod inspect;
 pub mod levels;
 pub mod poincare;
+pub mod rigid_domains;
 pub mod simulation;
 pub mod size_sweep;
 pub mod static_multiplier;

@@ -9,6 +9,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crr_dynamics::equivalent_block;
+use crr_kinematics::shapes::Shape;
 use crr_kinematics::spec::PivotSpec;
 use crr_kinematics::{Model, StructureSpec};
 
@@ -89,22 +90,25 @@ pub fn scale_structure(spec: &StructureSpec, s: f64) -> StructureSpec {
         if let Some(m) = b.mass.as_mut() {
             *m *= s * s * s;
         }
-        if let Some(x) = b.box_shape.as_mut() {
-            scale3(&mut x.center, s);
-            scale3(&mut x.size, s);
-        }
-        if let Some(x) = b.polyhedron.as_mut() {
-            x.vertices.iter_mut().for_each(|v| scale3(v, s));
-        }
-        if let Some(x) = b.prism.as_mut() {
-            x.polygon.iter_mut().for_each(|v| scale3(v, s));
-            scale3(&mut x.extrude, s);
-        }
-        if let Some(x) = b.annular_sector.as_mut() {
-            scale3(&mut x.center, s);
-            x.inner_radius *= s;
-            x.outer_radius *= s;
-            x.thickness *= s;
+        // The body's own shape and each part of a compound body.
+        for fields in b.shape_fields_mut() {
+            if let Some(x) = fields.box_shape.as_mut() {
+                scale3(&mut x.center, s);
+                scale3(&mut x.size, s);
+            }
+            if let Some(x) = fields.polyhedron.as_mut() {
+                x.vertices.iter_mut().for_each(|v| scale3(v, s));
+            }
+            if let Some(x) = fields.prism.as_mut() {
+                x.polygon.iter_mut().for_each(|v| scale3(v, s));
+                scale3(&mut x.extrude, s);
+            }
+            if let Some(x) = fields.annular_sector.as_mut() {
+                scale3(&mut x.center, s);
+                x.inner_radius *= s;
+                x.outer_radius *= s;
+                x.thickness *= s;
+            }
         }
     }
     for i in &mut out.interface {
@@ -125,8 +129,8 @@ pub fn scale_structure(spec: &StructureSpec, s: f64) -> StructureSpec {
 }
 
 /// The height of the structure at rest (m): the highest point of its shapes minus the lowest one
-/// (exact for every shape kind: box corners, polyhedron vertices, prism vertices, and the extreme
-/// heights of an annular sector's arcs). `None` when a shape is degenerate (the model would not
+/// (exact for every shape kind and every part of a compound body: box corners, polyhedron
+/// vertices, prism vertices, and the extreme heights of an annular sector's arcs). `None` when a shape is degenerate (the model would not
 /// build either).
 pub fn structure_height(spec: &StructureSpec) -> Option<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -135,8 +139,12 @@ pub fn structure_height(spec: &StructureSpec) -> Option<f64> {
         hi = hi.max(z);
     };
     let v = |p: &[f64; 3]| Vector3::new(p[0], p[1], p[2]);
-    for b in &spec.body {
-        if let Some(x) = &b.box_shape {
+    let shapes = spec.body.iter().flat_map(|b| {
+        let parts = b.blocks.iter().flat_map(|p| p.shapes());
+        b.own_shapes().into_iter().chain(parts)
+    });
+    for shape in shapes {
+        if let Shape::Box(x) = &shape {
             let r = x.rotation_matrix();
             for i in 0..8 {
                 let sgn = |k: usize| if i & (1 << k) == 0 { -0.5 } else { 0.5 };
@@ -145,16 +153,16 @@ pub fn structure_height(spec: &StructureSpec) -> Option<f64> {
                 add((v(&x.center) + r * local).z);
             }
         }
-        if let Some(x) = &b.polyhedron {
+        if let Shape::Polyhedron(x) = &shape {
             x.vertices.iter().for_each(|p| add(p[2]));
         }
-        if let Some(x) = &b.prism {
+        if let Shape::Prism(x) = &shape {
             x.polygon.iter().for_each(|p| {
                 add(p[2]);
                 add(p[2] + x.extrude[2]);
             });
         }
-        if let Some(x) = &b.annular_sector {
+        if let Shape::AnnularSector(x) = &shape {
             let f = x.frame().ok()?;
             let (es, et, w) = (f.column(0), f.column(1), f.column(2));
             // z(θ) = c + ρ (A cos θ + B sin θ) + ζ w_z: extremes at the ends of the arc and where

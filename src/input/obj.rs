@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use crr_kinematics::shapes::PolyhedronShape;
+use crr_kinematics::shapes::{PolyhedronShape, Shape};
 use crr_kinematics::spec::BodySpec;
 
 use crate::Error;
@@ -105,17 +105,13 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
         let block = Block::from_mesh(&m.mesh, spec).map_err(item)?;
         block.check_closed().map_err(item)?;
         block.check_convex().map_err(item)?;
-        bodies.push(BodySpec {
-            name,
-            density: Some(spec.density),
-            mass: None,
-            box_shape: None,
-            polyhedron: Some(PolyhedronShape {
+        bodies.push(BodySpec::simple(
+            &name,
+            spec.density,
+            Shape::Polyhedron(PolyhedronShape {
                 vertices: block.vertices.iter().map(|v| [v.x, v.y, v.z]).collect(),
             }),
-            prism: None,
-            annular_sector: None,
-        });
+        ));
     }
     Ok(bodies)
 }

@@ -9,6 +9,7 @@ use crr_kinematics::assembly::{ContactFace, ContactSet};
 
 use crate::Error;
 use crate::analysis::assemble::Assembled;
+use crate::analysis::rigid_domains::MechanismModel;
 use crate::input::model_file::ModelFile;
 
 /// One line per contact: the bodies (lower first; `ground`), bed or side, area (m²), normal and
@@ -67,10 +68,128 @@ pub fn model_toml(a: &Assembled, file: &ModelFile) -> String {
     header + &toml::to_string(file).expect("a model file serialises to TOML")
 }
 
+/// The merged model of `crr assemble --mechanism` as TOML, with a header naming the directions.
+pub fn merged_model_toml(m: &MechanismModel, file: &ModelFile) -> String {
+    let a = &m.merged;
+    let header = format!(
+        "# Written by `crr assemble --mechanism` (crr {}): the rigid domains of the assembly's\n\
+         # collapse mechanisms along {} as bodies ({} bodies from {} blocks), every contact\n\
+         # between them a rocking interface ({} interfaces, DOF(1) = {}, {} loop closure(s),\n\
+         # DOF(2) = {}).\n",
+        env!("CARGO_PKG_VERSION"),
+        m.collapses
+            .iter()
+            .map(|c| direction_label(c.direction))
+            .collect::<Vec<_>>()
+            .join(", "),
+        m.domains.len(),
+        m.all_contacts.file.body.len(),
+        a.file.interface.len(),
+        a.model.dof(),
+        a.model.closures.len(),
+        m.mobility.dof2
+    );
+    header + &toml::to_string(file).expect("a model file serialises to TOML")
+}
+
+/// The report of `crr assemble --mechanism`: per direction λ and the interfaces that move, the
+/// rigid domains with their blocks, and the merged model's DOF.
+pub fn mechanism_text(m: &MechanismModel) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "limit analysis of every contact ({} blocks, {} contacts):",
+        m.all_contacts.file.body.len(),
+        m.all_contacts.contacts.len()
+    );
+    for c in &m.collapses {
+        let label = direction_label(c.direction);
+        match c.lambda {
+            None => {
+                let _ = writeln!(
+                    s,
+                    "  {label}: holds up to λ = {} (no mechanism)",
+                    crr_impact::statics::LAMBDA_MAX
+                );
+            }
+            Some(l) => {
+                let _ = writeln!(
+                    s,
+                    "  {label}: λ = {l:.6}, {} moving interface(s){}: {}",
+                    c.hinges.len(),
+                    if c.lifts_off {
+                        " (a block lifts off a support: outside the CRR chain)"
+                    } else {
+                        ""
+                    },
+                    c.hinges.join(", ")
+                );
+            }
+        }
+    }
+    let _ = writeln!(s, "{} rigid domain(s):", m.domains.len());
+    for d in &m.domains {
+        if d.blocks.len() == 1 {
+            let _ = writeln!(s, "  {}", d.name);
+        } else {
+            let _ = writeln!(
+                s,
+                "  {} ({} blocks): {}",
+                d.name,
+                d.blocks.len(),
+                d.blocks.join(", ")
+            );
+        }
+    }
+    let mob = &m.mobility;
+    let _ = writeln!(
+        s,
+        "merged model: {} bodies, {} interfaces, DOF(1) = {}, {} loop closure(s) ({} rows, rank \
+         {}), DOF(2) = {}",
+        m.merged.model.bodies.len(),
+        m.merged.model.interfaces.len(),
+        mob.dof1,
+        mob.closures,
+        mob.constraint_rows,
+        mob.rank,
+        mob.dof2
+    );
+    s
+}
+
+/// `+x`, `-y`… for the axes, else the three components.
+fn direction_label(d: [f64; 3]) -> String {
+    let axes = ["x", "y", "z"];
+    for (k, axis) in axes.iter().enumerate() {
+        for sign in [1.0, -1.0] {
+            let mut e = [0.0; 3];
+            e[k] = sign;
+            if d == e {
+                return format!("{}{axis}", if sign > 0.0 { "+" } else { "-" });
+            }
+        }
+    }
+    format!("({:.6}, {:.6}, {:.6})", d[0], d[1], d[2])
+}
+
 /// Writes the model file to `out` (refused when it exists, unless `force`). A record file given
 /// by a relative path (relative to the assembly's folder) is given relative to the model's folder,
 /// so that the model finds it wherever it is written.
 pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> {
+    write_file(a, out, force, |file| model_toml(a, file))
+}
+
+/// Writes the merged model of `crr assemble --mechanism` to `out`, as [`write_model`].
+pub fn write_merged_model(m: &MechanismModel, out: &Path, force: bool) -> Result<(), Error> {
+    write_file(&m.merged, out, force, |file| merged_model_toml(m, file))
+}
+
+fn write_file(
+    a: &Assembled,
+    out: &Path,
+    force: bool,
+    text: impl Fn(&ModelFile) -> String,
+) -> Result<(), Error> {
     if out.exists() && !force {
         return Err(Error::Argument(format!(
             "{}: the file exists: pass --force to replace it",
@@ -88,11 +207,9 @@ pub fn write_model(a: &Assembled, out: &Path, force: bool) -> Result<(), Error> 
             }
         }
     }
-    crate::output::replace_file::replace_file(out, model_toml(a, &file)).map_err(|source| {
-        Error::Output {
-            dir: out.to_path_buf(),
-            source,
-        }
+    crate::output::replace_file::replace_file(out, text(&file)).map_err(|source| Error::Output {
+        dir: out.to_path_buf(),
+        source,
     })
 }
 

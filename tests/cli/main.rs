@@ -13,6 +13,7 @@ mod hostile_inputs;
 mod input_checks;
 mod inspect;
 mod interrupt;
+mod mechanism;
 mod outputs;
 mod plot;
 mod poincare_limits;

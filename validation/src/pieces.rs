@@ -17,6 +17,7 @@ pub fn convex_pieces(shape: &Shape) -> Vec<Vec<Point3<f64>>> {
         Shape::Polyhedron(p) => vec![p.vertices.iter().map(|v| Point3::from(*v)).collect()],
         Shape::Prism(p) => prism_pieces(p),
         Shape::AnnularSector(s) => sector_pieces(s),
+        Shape::Compound(parts) => parts.iter().flat_map(convex_pieces).collect(),
     }
 }
 

@@ -74,6 +74,7 @@ fn trapezoid(b: f64, bt: f64, height: f64, d: f64) -> StructureSpec {
             extrude: [0.0, d, 0.0],
         }),
         annular_sector: None,
+        blocks: Vec::new(),
     };
     StructureSpec {
         name: "trapezoid".into(),

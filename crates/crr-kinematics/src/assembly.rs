@@ -51,21 +51,20 @@ fn error(item: impl Into<String>, message: impl Into<String>) -> AssemblyError {
     }
 }
 
-/// The shape of a body of an assembly (exactly one is given).
+/// The shape of a block of an assembly: exactly one, not a compound body (an assembly lists the
+/// blocks as they are built; `crr assemble --mechanism` merges them).
 fn shape_of(body: &BodySpec) -> Result<Shape, AssemblyError> {
-    let shapes: Vec<Shape> = [
-        body.box_shape.clone().map(Shape::Box),
-        body.polyhedron.clone().map(Shape::Polyhedron),
-        body.prism.clone().map(Shape::Prism),
-        body.annular_sector.clone().map(Shape::AnnularSector),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
-    match <[Shape; 1]>::try_from(shapes) {
+    let item = || format!("body \"{}\"", body.name);
+    if body.is_compound() {
+        return Err(error(
+            item(),
+            "is a compound body: an assembly lists single blocks (each with one shape)",
+        ));
+    }
+    match <[Shape; 1]>::try_from(body.own_shapes()) {
         Ok([shape]) => Ok(shape),
         Err(s) => Err(error(
-            format!("body \"{}\"", body.name),
+            item(),
             format!("has {} shapes: give exactly one", s.len()),
         )),
     }
@@ -73,13 +72,9 @@ fn shape_of(body: &BodySpec) -> Result<Shape, AssemblyError> {
 
 /// The closed surface of a body's shape, in world coordinates.
 pub fn body_surface(body: &BodySpec) -> Result<Surface, AssemblyError> {
-    let surface = match shape_of(body)? {
-        Shape::Box(s) => s.surface(),
-        Shape::Polyhedron(s) => s.surface(),
-        Shape::Prism(s) => s.surface(),
-        Shape::AnnularSector(s) => s.surface(),
-    };
-    surface.map_err(|e| error(format!("body \"{}\"", body.name), e.to_string()))
+    shape_of(body)?
+        .surface()
+        .map_err(|e| error(format!("body \"{}\"", body.name), e.to_string()))
 }
 
 /// One face of a surface: its polygon, unit outward normal and plane offset n·x.
@@ -563,6 +558,16 @@ pub fn structure_of(
         }
         interfaces.push(spec);
     }
+    // Two bodies meeting on faces in different planes (rigid domains along a stepped joint):
+    // the second and later interfaces of a pair are named `…_2`, `…_3`.
+    let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for spec in &mut interfaces {
+        let count = seen.entry(spec.name.clone()).or_insert(0);
+        *count += 1;
+        if *count > 1 {
+            spec.name = format!("{}_{count}", spec.name);
+        }
+    }
     Ok(StructureSpec {
         name: name.to_string(),
         gravity,
@@ -570,6 +575,132 @@ pub fn structure_of(
         interface: interfaces,
         symmetry: Vec::new(),
     })
+}
+
+/// The contacts with every group of coplanar faces between the same two bodies (or a body and
+/// the ground) replaced by one face, the convex hull of their corners, when that hull is an
+/// interface of `style` (a rectangle; for hinges, one spanning the depth along y). Exact for
+/// rigid bodies: compressive forces at a set of points in a plane transmit the same wrenches as
+/// forces at the vertices of its convex hull (every point of the hull is a convex combination
+/// of them, and the hull's vertices are points of the set), and a rigid pair rocks on an edge of
+/// that hull. Faces of a pair in different planes (a stepped joint) are kept as they are.
+pub fn merge_coplanar(
+    contacts: &[ContactFace],
+    style: InterfaceStyle,
+    tolerance: f64,
+) -> Vec<ContactFace> {
+    let mut used = vec![false; contacts.len()];
+    let mut out = Vec::with_capacity(contacts.len());
+    for i in 0..contacts.len() {
+        if used[i] {
+            continue;
+        }
+        used[i] = true;
+        let first = &contacts[i];
+        let offset = first.normal.dot(&first.corners[0]);
+        // The same pair in the same plane, oriented as the first (lower into upper).
+        let mut group = vec![first.clone()];
+        for (j, c) in contacts.iter().enumerate().skip(i + 1) {
+            if used[j] {
+                continue;
+            }
+            let oriented = if (c.lower, Some(c.upper)) == (first.lower, Some(first.upper)) {
+                c.clone()
+            } else if (c.lower, Some(c.upper)) == (Some(first.upper), first.lower) {
+                let Some(lower) = c.lower else { continue };
+                ContactFace {
+                    lower: Some(c.upper),
+                    upper: lower,
+                    normal: -c.normal,
+                    corners: c.corners.iter().rev().copied().collect(),
+                    ..c.clone()
+                }
+            } else {
+                continue;
+            };
+            let coplanar = (oriented.normal - first.normal).norm() <= 1e-9
+                && oriented
+                    .corners
+                    .iter()
+                    .all(|p| (first.normal.dot(p) - offset).abs() <= tolerance);
+            if coplanar {
+                used[j] = true;
+                group.push(oriented);
+            }
+        }
+        if group.len() == 1 {
+            out.push(group.pop().expect("one face"));
+            continue;
+        }
+        let hull = coplanar_hull(&group, tolerance);
+        let fits = match style {
+            InterfaceStyle::PlanarHinge => planar_pivots(&hull, tolerance).is_some(),
+            InterfaceStyle::RockingBase => is_rectangle(&hull.corners, tolerance),
+        };
+        if fits {
+            out.push(hull);
+        } else {
+            out.extend(group);
+        }
+    }
+    out
+}
+
+/// One face whose corners are the convex hull (counter-clockwise about the normal) of the
+/// corners of `faces`, coplanar faces of one pair oriented alike.
+fn coplanar_hull(faces: &[ContactFace], tolerance: f64) -> ContactFace {
+    let n = faces[0].normal;
+    let u = any_perpendicular(&n);
+    let v = n.cross(&u);
+    let h = n.dot(&faces[0].corners[0]);
+    let mut points: Vec<[f64; 2]> = faces
+        .iter()
+        .flat_map(|f| f.corners.iter().map(|p| [u.dot(p), v.dot(p)]))
+        .collect();
+    let hull = simplified(convex_hull_2d(&mut points), tolerance);
+    ContactFace {
+        corners: hull.iter().map(|p| u * p[0] + v * p[1] + n * h).collect(),
+        area: area_2d(&hull),
+        ..faces[0].clone()
+    }
+}
+
+/// The convex hull of 2D points, counter-clockwise (Andrew's monotone chain).
+fn convex_hull_2d(points: &mut [[f64; 2]]) -> Vec<[f64; 2]> {
+    points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut hull: Vec<[f64; 2]> = Vec::with_capacity(points.len() + 1);
+    for pass in [false, true] {
+        let start = hull.len();
+        let ordered: Vec<[f64; 2]> = if pass {
+            points.iter().rev().copied().collect()
+        } else {
+            points.to_vec()
+        };
+        for p in ordered {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// Whether four corners in order make a rectangle (each corner's two edges at right angles,
+/// within `tolerance` times the edges' lengths).
+fn is_rectangle(corners: &[Vector3<f64>], tolerance: f64) -> bool {
+    corners.len() == 4
+        && (0..4).all(|i| {
+            let (a, b, c) = (corners[(i + 3) % 4], corners[i], corners[(i + 1) % 4]);
+            let (e1, e2) = (a - b, c - b);
+            e1.dot(&e2).abs() <= tolerance * (e1.norm() + e2.norm())
+        })
 }
 
 /// The hinge about y of a contact face of a planar layout (in the x–z plane): its plane must

@@ -57,6 +57,7 @@ pub fn box_body(name: &str, density: f64, center: [f64; 3], size: [f64; 3]) -> B
         polyhedron: None,
         prism: None,
         annular_sector: None,
+        blocks: Vec::new(),
     }
 }
 
@@ -320,15 +321,7 @@ pub fn oriented_hinge(
 }
 
 fn centroid(b: &BodySpec) -> Vector3<f64> {
-    let shape = if let Some(s) = &b.box_shape {
-        crate::shapes::Shape::Box(s.clone())
-    } else if let Some(s) = &b.annular_sector {
-        crate::shapes::Shape::AnnularSector(s.clone())
-    } else if let Some(s) = &b.prism {
-        crate::shapes::Shape::Prism(s.clone())
-    } else {
-        crate::shapes::Shape::Polyhedron(b.polyhedron.clone().expect("a shape"))
-    };
+    let shape = b.own_shapes().pop().expect("fixture bodies have one shape");
     shape
         .mass_properties()
         .expect("fixture shapes are valid")
@@ -422,6 +415,7 @@ fn voussoir(name: &str, density: f64, radii: (f64, f64, f64), span: (f64, f64)) 
             to_angle: span.1,
             thickness: radii.2,
         }),
+        blocks: Vec::new(),
     }
 }
 

@@ -287,74 +287,158 @@ fn quoted(kind: &str, name: &str) -> String {
     format!("{kind} \"{name}\"")
 }
 
-fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
-    let item = quoted("body", &spec.name);
-    let mut shapes = Vec::new();
-    if let Some(s) = &spec.box_shape {
-        shapes.push(Shape::Box(s.clone()));
-    }
-    if let Some(s) = &spec.polyhedron {
-        shapes.push(Shape::Polyhedron(s.clone()));
-    }
-    if let Some(s) = &spec.prism {
-        shapes.push(Shape::Prism(s.clone()));
-    }
-    if let Some(s) = &spec.annular_sector {
-        shapes.push(Shape::AnnularSector(s.clone()));
-    }
-    let shape = match shapes.len() {
-        1 => shapes.pop().expect("one shape"),
-        0 => {
-            return Err(ModelError::new(
-                item,
-                "has no shape: give one of box, polyhedron, prism, annular_sector",
-            ));
-        }
+/// The mass properties at unit density of each part of a body (its one shape, or each block of
+/// a compound body), with the block's own density when it gives one; every block must give
+/// exactly one shape.
+fn body_parts(
+    spec: &BodySpec,
+    item: &str,
+) -> Result<Vec<(MassProperties, Option<f64>)>, ModelError> {
+    let exactly_one = |shapes: Vec<Shape>, what: &str| match shapes.len() {
+        1 => Ok(shapes.into_iter().next().expect("one shape")),
+        0 => Err(ModelError::new(
+            item,
+            format!("{what} no shape: give one of box, polyhedron, prism, annular_sector"),
+        )),
         _ => {
             let kinds: Vec<_> = shapes.iter().map(|s| s.kind()).collect();
-            return Err(ModelError::new(
+            Err(ModelError::new(
                 item,
                 format!(
-                    "has {} shapes ({}): give exactly one",
+                    "{what} {} shapes ({}): give exactly one",
                     kinds.len(),
                     kinds.join(", ")
                 ),
-            ));
+            ))
         }
     };
-    let props: MassProperties = shape
-        .mass_properties()
-        .map_err(|e| ModelError::new(format!("{item} ({})", shape.kind()), e.to_string()))?;
-    let density = match (spec.density, spec.mass) {
-        (_, Some(m)) if !(m.is_finite() && m > 0.0) => {
-            return Err(ModelError::new(
-                item,
-                format!("mass must be a positive number of kg, got {m}"),
-            ));
+    let props = |shape: &Shape, label: String| {
+        shape
+            .mass_properties()
+            .map_err(|e| ModelError::new(format!("{item} ({label})"), e.to_string()))
+    };
+    if !spec.is_compound() {
+        let shape = exactly_one(spec.own_shapes(), "has")?;
+        return Ok(vec![(props(&shape, shape.kind().to_string())?, None)]);
+    }
+    let own = spec.own_shapes();
+    if !own.is_empty() {
+        let kinds: Vec<_> = own.iter().map(|s| s.kind()).collect();
+        return Err(ModelError::new(
+            item,
+            format!(
+                "has blocks and a shape of its own ({}): a compound body's shapes are all in its \
+                 blocks",
+                kinds.join(", ")
+            ),
+        ));
+    }
+    spec.blocks
+        .iter()
+        .enumerate()
+        .map(|(k, part)| {
+            let shape = exactly_one(part.shapes(), &format!("has in block {}", k + 1))?;
+            let label = format!("block {}, {}", k + 1, shape.kind());
+            Ok((props(&shape, label)?, part.density))
+        })
+        .collect()
+}
+
+fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
+    let item = quoted("body", &spec.name);
+    let parts = body_parts(spec, &item)?;
+    let positive = |what: String, x: f64, unit: &str| {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(ModelError::new(
+                item.clone(),
+                format!("{what} must be a positive number of {unit}, got {x}"),
+            ))
         }
-        (Some(d), _) if !(d.is_finite() && d > 0.0) => {
-            return Err(ModelError::new(
-                item,
-                format!("density must be a positive number of kg/m³, got {d}"),
-            ));
+    };
+    if let Some(m) = spec.mass {
+        positive("mass".into(), m, "kg")?;
+    }
+    if let Some(d) = spec.density {
+        positive("density".into(), d, "kg/m³")?;
+    }
+    for (k, part) in spec.blocks.iter().enumerate() {
+        if let Some(d) = part.density {
+            positive(format!("the density of block {}", k + 1), d, "kg/m³")?;
+            if spec.mass.is_some() {
+                return Err(ModelError::new(
+                    item,
+                    format!(
+                        "gives a mass and block {} a density: give the blocks' densities, or \
+                         the body's mass (spread at one density over its blocks)",
+                        k + 1
+                    ),
+                ));
+            }
         }
-        (_, Some(m)) => m / props.volume,
-        (Some(d), None) => d,
-        (None, None) => {
-            return Err(ModelError::new(
-                item,
-                "needs a density (kg/m³) or a mass (kg)",
-            ));
-        }
+    }
+    let volume: f64 = parts.iter().map(|(p, _)| p.volume).sum();
+    // Each part's density: its own, else the body's, else the body's mass over its volume.
+    let mut densities = Vec::with_capacity(parts.len());
+    for (k, (_, own)) in parts.iter().enumerate() {
+        densities.push(match (own, spec.mass, spec.density) {
+            (Some(d), _, _) => *d,
+            (None, Some(m), _) => m / volume,
+            (None, None, Some(d)) => d,
+            (None, None, None) if spec.is_compound() => {
+                return Err(ModelError::new(
+                    item,
+                    format!(
+                        "block {} needs a density (kg/m³): give it, or the body's density or mass",
+                        k + 1
+                    ),
+                ));
+            }
+            (None, None, None) => {
+                return Err(ModelError::new(
+                    item,
+                    "needs a density (kg/m³) or a mass (kg)",
+                ));
+            }
+        });
+    }
+    // Sums over the parts (parallel-axis theorem): m = Σ ρₖVₖ, c = Σ ρₖVₖcₖ / m,
+    // S = Σ ρₖ (Sₖ + Vₖ (cₖ − c)(cₖ − c)ᵀ).
+    let mass: f64 = parts
+        .iter()
+        .zip(&densities)
+        .map(|((p, _), d)| d * p.volume)
+        .sum();
+    let com = parts
+        .iter()
+        .zip(&densities)
+        .fold(Vector3::zeros(), |acc, ((p, _), d)| {
+            acc + p.centroid * (d * p.volume)
+        })
+        / mass;
+    let second_moment = parts
+        .iter()
+        .zip(&densities)
+        .fold(Matrix3::zeros(), |acc, ((p, _), d)| {
+            let r = p.centroid - com;
+            acc + (p.second_moment + r * r.transpose() * p.volume) * *d
+        });
+    let shape = if spec.is_compound() {
+        Shape::Compound(spec.blocks.iter().flat_map(|p| p.shapes()).collect())
+    } else {
+        spec.own_shapes()
+            .pop()
+            .expect("one shape, checked by body_parts")
     };
     let body = Body {
         name: spec.name.clone(),
-        mass: density * props.volume,
-        density,
-        volume: props.volume,
-        com: props.centroid,
-        inertia: props.inertia(density),
-        second_moment: props.second_moment * density,
+        mass,
+        density: mass / volume,
+        volume,
+        com,
+        inertia: Matrix3::identity() * second_moment.trace() - second_moment,
+        second_moment,
         shape,
     };
     // Sizes or densities far outside engineering ranges overflow (or underflow) the mass

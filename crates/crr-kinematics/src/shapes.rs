@@ -97,6 +97,9 @@ impl MassProperties {
 /// wrote the model file.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ShapeError {
+    /// A compound shape with no part.
+    #[error("a compound body needs at least one part")]
+    NoParts,
     /// A NaN or infinite number was found in the named input field.
     #[error("non-finite number in {field}")]
     NonFinite {
@@ -639,6 +642,8 @@ pub enum Shape {
     Prism(PrismShape),
     /// Voussoir / arch-ring piece.
     AnnularSector(AnnularSectorShape),
+    /// A rigid domain of several disjoint parts (a compound body), each a simple shape.
+    Compound(Vec<Shape>),
 }
 
 impl Shape {
@@ -649,17 +654,25 @@ impl Shape {
             Shape::Polyhedron(s) => s.mass_properties(),
             Shape::Prism(s) => s.mass_properties(),
             Shape::AnnularSector(s) => s.mass_properties(),
+            Shape::Compound(parts) => {
+                let props = parts
+                    .iter()
+                    .map(Shape::mass_properties)
+                    .collect::<Result<Vec<_>, _>>()?;
+                MassProperties::combine(&props).ok_or(ShapeError::NoParts)
+            }
         }
     }
 
-    /// Short name of the shape kind: `"box"`, `"polyhedron"`, `"prism"` or
-    /// `"annular_sector"`.
+    /// Short name of the shape kind: `"box"`, `"polyhedron"`, `"prism"`, `"annular_sector"` or
+    /// `"compound"`.
     pub fn kind(&self) -> &'static str {
         match self {
             Shape::Box(_) => "box",
             Shape::Polyhedron(_) => "polyhedron",
             Shape::Prism(_) => "prism",
             Shape::AnnularSector(_) => "annular_sector",
+            Shape::Compound(_) => "compound",
         }
     }
 }

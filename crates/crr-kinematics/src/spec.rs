@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::shapes::{AnnularSectorShape, BoxShape, PolyhedronShape, PrismShape};
+use crate::shapes::{AnnularSectorShape, BoxShape, PolyhedronShape, PrismShape, Shape};
 
 /// Standard value of g used when a model does not give one (m/s²).
 pub const DEFAULT_GRAVITY: f64 = 9.81;
@@ -54,7 +54,8 @@ pub enum SymmetryRelation {
     Opposite,
 }
 
-/// One rigid body: a name, its density or mass, and exactly one shape in world coordinates at rest.
+/// One rigid body: a name, its density or mass, and exactly one shape in world coordinates at rest,
+/// or (a compound body, a rigid domain of several blocks) no shape of its own and its `block`s.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
@@ -78,6 +79,161 @@ pub struct BodySpec {
     /// An annular sector (voussoir, arch ring piece).
     #[serde(default)]
     pub annular_sector: Option<AnnularSectorShape>,
+    /// The blocks of a compound body (`[[body.block]]` tables), each with one shape: the body
+    /// moves as one rigid domain and its mass properties are the exact sums of its blocks'. A
+    /// compound body gives no shape of its own.
+    #[serde(default, rename = "block", skip_serializing_if = "Vec::is_empty")]
+    pub blocks: Vec<BlockSpec>,
+}
+
+/// One block of a compound body: exactly one shape, and its density when it differs from the
+/// body's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSpec {
+    /// The block's name (for reports); optional.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Density ρ (kg/m³); the body's when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+    /// A rectangular box.
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    pub box_shape: Option<BoxShape>,
+    /// The convex hull of a set of points.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polyhedron: Option<PolyhedronShape>,
+    /// A planar polygon swept along a vector.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prism: Option<PrismShape>,
+    /// An annular sector.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub annular_sector: Option<AnnularSectorShape>,
+}
+
+/// The shapes given in the four shape fields of a body or a block, in the fields' order.
+fn listed_shapes(
+    box_shape: &Option<BoxShape>,
+    polyhedron: &Option<PolyhedronShape>,
+    prism: &Option<PrismShape>,
+    annular_sector: &Option<AnnularSectorShape>,
+) -> Vec<Shape> {
+    [
+        box_shape.clone().map(Shape::Box),
+        polyhedron.clone().map(Shape::Polyhedron),
+        prism.clone().map(Shape::Prism),
+        annular_sector.clone().map(Shape::AnnularSector),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+impl BodySpec {
+    /// A body of one shape, with its density.
+    pub fn simple(name: &str, density: f64, shape: Shape) -> BodySpec {
+        let mut b = BodySpec {
+            name: name.to_string(),
+            density: Some(density),
+            mass: None,
+            box_shape: None,
+            polyhedron: None,
+            prism: None,
+            annular_sector: None,
+            blocks: Vec::new(),
+        };
+        match shape {
+            Shape::Box(s) => b.box_shape = Some(s),
+            Shape::Polyhedron(s) => b.polyhedron = Some(s),
+            Shape::Prism(s) => b.prism = Some(s),
+            Shape::AnnularSector(s) => b.annular_sector = Some(s),
+            compound @ Shape::Compound(_) => b.blocks = BlockSpec::all_of(None, None, compound),
+        }
+        b
+    }
+
+    /// The shapes given in the body's own shape fields (exactly one for a valid simple body, none
+    /// for a compound one).
+    pub fn own_shapes(&self) -> Vec<Shape> {
+        listed_shapes(
+            &self.box_shape,
+            &self.polyhedron,
+            &self.prism,
+            &self.annular_sector,
+        )
+    }
+
+    /// Whether the body is compound (has `block`s).
+    pub fn is_compound(&self) -> bool {
+        !self.blocks.is_empty()
+    }
+
+    /// Every shape field of the body and of its blocks, to be transformed in place (scaling).
+    pub fn shape_fields_mut(&mut self) -> Vec<ShapeFieldsMut<'_>> {
+        let mut out = vec![ShapeFieldsMut {
+            box_shape: &mut self.box_shape,
+            polyhedron: &mut self.polyhedron,
+            prism: &mut self.prism,
+            annular_sector: &mut self.annular_sector,
+        }];
+        out.extend(self.blocks.iter_mut().map(|p| ShapeFieldsMut {
+            box_shape: &mut p.box_shape,
+            polyhedron: &mut p.polyhedron,
+            prism: &mut p.prism,
+            annular_sector: &mut p.annular_sector,
+        }));
+        out
+    }
+}
+
+/// The four shape fields of a body or of a block, borrowed mutably.
+pub struct ShapeFieldsMut<'a> {
+    /// A rectangular box.
+    pub box_shape: &'a mut Option<BoxShape>,
+    /// The convex hull of a set of points.
+    pub polyhedron: &'a mut Option<PolyhedronShape>,
+    /// A planar polygon swept along a vector.
+    pub prism: &'a mut Option<PrismShape>,
+    /// An annular sector.
+    pub annular_sector: &'a mut Option<AnnularSectorShape>,
+}
+
+impl BlockSpec {
+    /// The blocks of a shape, each with the given name and density: one for a simple shape, one
+    /// per (flattened) part of a compound shape.
+    pub fn all_of(name: Option<String>, density: Option<f64>, shape: Shape) -> Vec<BlockSpec> {
+        let mut p = BlockSpec {
+            name: name.clone(),
+            density,
+            box_shape: None,
+            polyhedron: None,
+            prism: None,
+            annular_sector: None,
+        };
+        match shape {
+            Shape::Box(s) => p.box_shape = Some(s),
+            Shape::Polyhedron(s) => p.polyhedron = Some(s),
+            Shape::Prism(s) => p.prism = Some(s),
+            Shape::AnnularSector(s) => p.annular_sector = Some(s),
+            Shape::Compound(parts) => {
+                return parts
+                    .into_iter()
+                    .flat_map(|s| BlockSpec::all_of(name.clone(), density, s))
+                    .collect();
+            }
+        }
+        vec![p]
+    }
+
+    /// The shapes given in the block's fields (exactly one for a valid block).
+    pub fn shapes(&self) -> Vec<Shape> {
+        listed_shapes(
+            &self.box_shape,
+            &self.polyhedron,
+            &self.prism,
+            &self.annular_sector,
+        )
+    }
 }
 
 /// A pivot line, given by one point on it or by two points of the contact edge.

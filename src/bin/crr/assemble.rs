@@ -1,11 +1,16 @@
 //! `crr assemble ASSEMBLY [--contacts] [--out MODEL.toml] [--all-contacts] [--planar]
-//! [--tolerance T] [--force]`.
+//! [--mechanism [--direction D]…] [--tolerance T] [--force]`.
 
 use std::path::PathBuf;
 
+use crr::Error;
 use crr::analysis::assemble::{DEFAULT_TOLERANCE, assemble, read_assembly};
+use crr::analysis::rigid_domains::mechanism_model;
+use crr::analysis::static_multiplier::parse_direction;
+use crr::input::model_file::ModelFile;
 use crr::kinematics::assembly::ContactSet;
-use crr::output::assemble::{contacts_text, write_model};
+use crr::output::assemble::{contacts_text, mechanism_text, write_merged_model, write_model};
+use nalgebra::Vector3;
 
 use crate::failure::Failure;
 
@@ -30,6 +35,20 @@ pub(crate) struct Args {
     /// Faces closer than this touch (m).
     #[arg(long, default_value_t = DEFAULT_TOLERANCE)]
     pub(crate) tolerance: f64,
+    /// The limit analysis of the assembly (every contact an interface) along each direction, and
+    /// the model of its rigid domains: the interfaces that move in any mechanism are hinges, the
+    /// blocks no mechanism separates one compound body.
+    #[arg(long)]
+    pub(crate) mechanism: bool,
+    /// A direction of the ground acceleration for --mechanism (±x, ±y, ±z or X,Y,Z; repeat it),
+    /// instead of ±x (and ±y without --planar).
+    #[arg(
+        long,
+        value_name = "D",
+        allow_hyphen_values = true,
+        requires = "mechanism"
+    )]
+    pub(crate) direction: Vec<String>,
     /// Replace an existing model file.
     #[arg(long)]
     pub(crate) force: bool,
@@ -37,6 +56,9 @@ pub(crate) struct Args {
 
 pub(crate) fn run(a: Args) -> Result<(), Failure> {
     let file = read_assembly(&a.assembly)?;
+    if a.mechanism {
+        return run_mechanism(&a, &file);
+    }
     let set = if a.all_contacts {
         ContactSet::All
     } else {
@@ -55,6 +77,33 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
             assembled.model.dof(),
             assembled.model.closures.len()
         );
+    }
+    Ok(())
+}
+
+/// `crr assemble --mechanism`: the report, and the merged model written with `--out`.
+fn run_mechanism(a: &Args, file: &ModelFile) -> Result<(), Failure> {
+    let directions = if a.direction.is_empty() {
+        let mut d = vec![Vector3::x(), -Vector3::x()];
+        if !a.planar {
+            d.extend([Vector3::y(), -Vector3::y()]);
+        }
+        d
+    } else {
+        a.direction
+            .iter()
+            .map(|d| parse_direction(d))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| Failure::Input(Error::Argument(format!("--direction: {e}"))))?
+    };
+    let m = mechanism_model(&a.assembly, file, a.planar, &directions, a.tolerance)?;
+    if a.contacts {
+        print!("{}", contacts_text(&m.all_contacts));
+    }
+    print!("{}", mechanism_text(&m));
+    if let Some(out) = &a.out {
+        write_merged_model(&m, out, a.force)?;
+        println!("model written to {}", out.display());
     }
     Ok(())
 }

@@ -268,6 +268,25 @@ impl Shape {
             Shape::Polyhedron(s) => s.surface(),
             Shape::Prism(s) => s.surface(),
             Shape::AnnularSector(s) => s.surface(),
+            Shape::Compound(parts) => {
+                // The union of the parts' closed surfaces: one mesh of disjoint shells (the
+                // divergence theorem sums over them, so volume and centroid stay exact).
+                let mut all = Surface {
+                    vertices: Vec::new(),
+                    faces: Vec::new(),
+                };
+                for part in parts {
+                    let s = part.surface()?;
+                    let base = all.vertices.len();
+                    all.vertices.extend(s.vertices);
+                    all.faces.extend(
+                        s.faces
+                            .into_iter()
+                            .map(|f| f.into_iter().map(|i| i + base).collect()),
+                    );
+                }
+                Ok(all)
+            }
         }
     }
 }
