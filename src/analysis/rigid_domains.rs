@@ -83,11 +83,19 @@ pub fn mechanism_model(
     tolerance: f64,
 ) -> Result<MechanismModel, Error> {
     let all = assemble(path, file, planar, ContactSet::All, tolerance)?;
-    let collapses = directions
-        .iter()
-        .map(|d| collapse_along(&all.model, *d))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| Error::Argument(format!("{}: {e}", path.display())))?;
+    // One limit analysis per direction, each on its own thread (independent programs; the
+    // answers are collected in the directions' order, so the result does not depend on timing).
+    let collapses = std::thread::scope(|scope| {
+        let handles: Vec<_> = directions
+            .iter()
+            .map(|d| scope.spawn(|| collapse_along(&all.model, *d)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect::<Result<Vec<_>, _>>()
+    })
+    .map_err(|e| Error::Argument(format!("{}: {e}", path.display())))?;
     let domain_of = rigid_domains(&all.model, &collapses);
     let domains = domain_list(&all, &domain_of);
     let merged = merged_model(path, &all, &domain_of, &domains, planar, tolerance)?;
@@ -140,9 +148,7 @@ fn rigid_domains(model: &Model, collapses: &[DirectionCollapse]) -> Vec<usize> {
         let Parent::Body(p) = iface.parent else {
             continue;
         };
-        let moves = collapses
-            .iter()
-            .any(|c| c.hinges.contains(&iface.name));
+        let moves = collapses.iter().any(|c| c.hinges.contains(&iface.name));
         if !moves {
             let (a, b) = (find(&mut root, p), find(&mut root, iface.child));
             let (lo, hi) = (a.min(b), a.max(b));

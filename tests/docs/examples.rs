@@ -199,6 +199,17 @@ fn check_facts(built: &Built) -> bool {
             assert!(close(m00, i0, 1e-12), "{at}: M(0) = {m00}, I₀ = {i0}");
             assert!(close(i0, 1_109.333_333_333_333, 1e-12));
         }
+        "pier_on_plinth" => {
+            // A plinth 1 × 1 × 0.5 m at ρ = 2400 (1200 kg, centre 0.25 m) and a shaft
+            // 0.6 × 0.6 × 2 m at ρ = 2600 (1872 kg, centre 1.5 m): 3072 kg, centre at
+            // (1200·0.25 + 1872·1.5)/3072 = 3108/3072 m.
+            assert_eq!(m.dof(), 1, "{at}");
+            let b = &m.bodies[0];
+            assert_eq!(b.shape.kind(), "compound");
+            assert!(close(b.mass, 3072.0, 1e-14), "{at}");
+            assert!(close(b.volume, 1.22, 1e-14), "{at}");
+            assert!(close(b.com.z, 3108.0 / 3072.0, 1e-14), "{at}");
+        }
         "frustum" => {
             assert_eq!(m.dof(), 1, "{at}");
             assert_eq!(m.bodies[0].shape.kind(), "polyhedron");
@@ -393,7 +404,10 @@ fn every_documented_model_is_valid_and_matches_its_text() {
         .collect();
     shapes.sort();
     shapes.dedup();
-    assert_eq!(shapes, ["annular_sector", "box", "polyhedron", "prism"]);
+    assert_eq!(
+        shapes,
+        ["annular_sector", "box", "compound", "polyhedron", "prism"]
+    );
     let kinds = |closure: bool| -> Vec<usize> {
         let mut k: Vec<usize> = models
             .iter()
