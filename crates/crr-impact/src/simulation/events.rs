@@ -18,6 +18,9 @@ pub(super) struct SegmentEvents<'b> {
     pub(super) ground: &'b GroundMotion,
     /// Rocking slots watched for a zero crossing, with their sides.
     pub(super) rocking: Vec<(usize, Side)>,
+    /// Per rocking slot, its seat: where its impact is (sign(side)·φ at the seat), 0 except for an
+    /// angle that starts the segment a little on the wrong side of its pivot ([`rocking_seats`]).
+    pub(super) seats: Vec<f64>,
     pub(super) kin: Box<Data>,
     pub(super) pivots: ActivePivots,
     pub(super) angles: Vec<f64>,
@@ -119,7 +122,7 @@ impl EventFunctions for SegmentEvents<'_> {
     fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
         self.load_state(y);
         for (i, &(s, side)) in self.rocking.iter().enumerate() {
-            g[i] = side.sign() * self.angles[s] + ROCKING_EVENT_MARGIN;
+            g[i] = side.sign() * self.angles[s] - self.seats[i] + ROCKING_EVENT_MARGIN;
         }
         g[self.collapse_index()] = self.collapse_value();
         if self.uplift.is_some() {
@@ -138,12 +141,12 @@ impl EventFunctions for SegmentEvents<'_> {
         if let Some(&(s, side)) = self.rocking.get(i)
             && s < self.model.dof()
         {
-            return side.sign() * y[s] + ROCKING_EVENT_MARGIN;
+            return side.sign() * y[s] - self.seats[i] + ROCKING_EVENT_MARGIN;
         }
         self.load_state(y);
         if i < self.rocking.len() {
             let (s, side) = self.rocking[i];
-            side.sign() * self.angles[s] + ROCKING_EVENT_MARGIN
+            side.sign() * self.angles[s] - self.seats[i] + ROCKING_EVENT_MARGIN
         } else if i == self.collapse_index() {
             self.collapse_value()
         } else if self.uplift.is_some() && i == self.uplift_index() {
@@ -163,4 +166,22 @@ impl EventFunctions for SegmentEvents<'_> {
             Direction::Any
         }
     }
+}
+
+/// The seat of each rocking slot for its impact event: 0, except for an angle that starts the
+/// segment on the wrong side of its pivot by `sign(side)·φ₀ < 0`, whose seat is then where it
+/// starts. A loop-closing angle is measured from the bodies' poses, so a seated one carries the
+/// loop's round-off (some 1e-10 rad) that a release cannot set to 0 as it sets a tree coordinate;
+/// and an angle released at an impact can pass its seat by round-off before the next impact of
+/// another joint ends the segment (1e-10 rad at the next start). An event at 0 itself would then
+/// start below its root and never fall through it: the joint would rock through its support
+/// unseen, the run stopping later with the state on the wrong side of its pivot. `angles` are
+/// the slot angles at the start of the segment.
+pub(super) fn rocking_seats(rocking: &[(usize, Side)], angles: &[f64], seats: &mut Vec<f64>) {
+    seats.clear();
+    seats.extend(
+        rocking
+            .iter()
+            .map(|&(s, side)| (side.sign() * angles[s]).min(0.0)),
+    );
 }

@@ -349,6 +349,7 @@ pub struct Simulation<'a> {
 #[derive(Clone, Debug, Default)]
 struct SegmentBuffers {
     rocking: Vec<(usize, Side)>,
+    seats: Vec<f64>,
     rocking_coords: Vec<usize>,
     pivots: ActivePivots,
     angles: Vec<f64>,
@@ -797,10 +798,26 @@ impl<'a> Simulation<'a> {
             seg.q = DVector::zeros(n);
             seg.qdot = DVector::zeros(n);
         }
+        // The rocking angles at the start, for their seats (the closure angles from the poses).
+        let mut seats = std::mem::take(&mut seg.seats);
+        if seg.rocking.iter().any(|&(s, _)| s >= n) {
+            assign(&mut seg.q, &self.y[..n]);
+            slot_angles(
+                model,
+                &mut self.out_kin,
+                &seg.q,
+                &self.dynamics.pivots,
+                &mut seg.angles,
+            );
+        } else {
+            seg.angles[..n].copy_from_slice(&self.y[..n]);
+        }
+        rocking_seats(&seg.rocking, &seg.angles, &mut seats);
         let mut events = SegmentEvents {
             model,
             ground: self.ground,
             rocking: std::mem::take(&mut seg.rocking),
+            seats,
             kin: self
                 .spare
                 .events_kin
@@ -892,12 +909,14 @@ impl<'a> Simulation<'a> {
             trial,
             rest,
             rocking,
+            seats,
             pivots,
             angles,
             q,
             qdot,
             ..
         } = events;
+        seg.seats = seats;
         self.spare.events_kin = Some(events_kin);
         self.spare.trial = Some(trial);
         self.spare.rest = rest;
