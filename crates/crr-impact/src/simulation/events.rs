@@ -169,19 +169,31 @@ impl EventFunctions for SegmentEvents<'_> {
 }
 
 /// The seat of each rocking slot for its impact event: 0, except for an angle that starts the
-/// segment on the wrong side of its pivot by `sign(side)·φ₀ < 0`, whose seat is then where it
-/// starts. A loop-closing angle is measured from the bodies' poses, so a seated one carries the
+/// segment on the wrong side of its pivot by more than [`ROCKING_EVENT_MARGIN`]
+/// (`sign(side)·φ₀ < −margin`), whose seat is then where it starts. A loop-closing angle is measured from the bodies' poses, so a seated one carries the
 /// loop's round-off (some 1e-10 rad) that a release cannot set to 0 as it sets a tree coordinate;
 /// and an angle released at an impact can pass its seat by round-off before the next impact of
 /// another joint ends the segment (1e-10 rad at the next start). An event at 0 itself would then
 /// start below its root and never fall through it: the joint would rock through its support
-/// unseen, the run stopping later with the state on the wrong side of its pivot. `angles` are
-/// the slot angles at the start of the segment.
-pub(super) fn rocking_seats(rocking: &[(usize, Side)], angles: &[f64], seats: &mut Vec<f64>) {
+/// unseen, the run stopping later with the state on the wrong side of its pivot. A slot of a
+/// regularised law (`regularised`) keeps its seat at 0: its δ zone is integrated through, and a
+/// zone too narrow for the steps (refused when the model is built) is caught by the run's
+/// invariant rather than healed by a pivot switch on a state the zone's force has ruined.
+/// `angles` are the slot angles at the start of the segment.
+pub(super) fn rocking_seats(
+    rocking: &[(usize, Side)],
+    angles: &[f64],
+    regularised: &[usize],
+    seats: &mut Vec<f64>,
+) {
     seats.clear();
-    seats.extend(
-        rocking
-            .iter()
-            .map(|&(s, side)| (side.sign() * angles[s]).min(0.0)),
-    );
+    seats.extend(rocking.iter().map(|&(s, side)| {
+        let start = side.sign() * angles[s];
+        // Within the margin the event already starts above its root.
+        if start < -ROCKING_EVENT_MARGIN && !regularised.contains(&s) {
+            start
+        } else {
+            0.0
+        }
+    }));
 }

@@ -812,7 +812,13 @@ impl<'a> Simulation<'a> {
         } else {
             seg.angles[..n].copy_from_slice(&self.y[..n]);
         }
-        rocking_seats(&seg.rocking, &seg.angles, &mut seats);
+        // A slot of a regularised law is integrated through its zone: its seat stays at 0.
+        let regularised: Vec<usize> = self
+            .regularised
+            .as_ref()
+            .map(|r| r.slots.iter().map(|z| z.slot).collect())
+            .unwrap_or_default();
+        rocking_seats(&seg.rocking, &seg.angles, &regularised, &mut seats);
         let mut events = SegmentEvents {
             model,
             ground: self.ground,
