@@ -94,6 +94,11 @@ pub fn assemble(
         tolerance,
     )
     .map_err(|e| here(&e))?;
+    // The assembly's [[symmetry]] tables name coordinates of the model written: checked here.
+    let spec = StructureSpec {
+        symmetry: file.symmetry.clone(),
+        ..spec
+    };
     let out = ModelFile {
         body: spec.body.clone(),
         interface: spec.interface.clone(),

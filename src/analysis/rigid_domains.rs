@@ -28,8 +28,8 @@ use crr_impact::statics::{Motion, StaticsOptions, collapse_multiplier};
 use crr_kinematics::assembly::{
     ContactFace, ContactSet, InterfaceStyle, merge_coplanar, structure_of,
 };
-use crr_kinematics::spec::{BlockSpec, BodySpec};
-use crr_kinematics::{ActivePivots, Model, Parent, Side};
+use crr_kinematics::spec::{BlockSpec, BodySpec, SymmetrySpec};
+use crr_kinematics::{ActivePivots, Model, Parent, Side, StructureSpec};
 
 use crate::Error;
 use crate::analysis::assemble::{Assembled, assemble};
@@ -69,7 +69,8 @@ pub struct MechanismModel {
     pub domains: Vec<Domain>,
     /// The merged model: a body per domain, an interface per contact between domains.
     pub merged: Assembled,
-    /// Its mobility at rest: DOF(1), the loops and DOF(2).
+    /// Its mobility at rest: DOF(1), the loops, DOF(2) and, with the assembly's `[[symmetry]]`
+    /// tables (naming the merged model's coordinates), DOF(3).
     pub mobility: Mobility,
 }
 
@@ -82,7 +83,12 @@ pub fn mechanism_model(
     directions: &[Vector3<f64>],
     tolerance: f64,
 ) -> Result<MechanismModel, Error> {
-    let all = assemble(path, file, planar, ContactSet::All, tolerance)?;
+    // The assembly's [[symmetry]] tables name coordinates of the merged model, not of this one.
+    let blocks_only = ModelFile {
+        symmetry: Vec::new(),
+        ..file.clone()
+    };
+    let all = assemble(path, &blocks_only, planar, ContactSet::All, tolerance)?;
     // One limit analysis per direction, each on its own thread (independent programs; the
     // answers are collected in the directions' order, so the result does not depend on timing).
     let collapses = std::thread::scope(|scope| {
@@ -98,7 +104,15 @@ pub fn mechanism_model(
     .map_err(|e| Error::Argument(format!("{}: {e}", path.display())))?;
     let domain_of = rigid_domains(&all.model, &collapses);
     let domains = domain_list(&all, &domain_of);
-    let merged = merged_model(path, &all, &domain_of, &domains, planar, tolerance)?;
+    let merged = merged_model(
+        path,
+        &all,
+        &domain_of,
+        &domains,
+        planar,
+        tolerance,
+        &file.symmetry,
+    )?;
     let zero = DVector::zeros(merged.model.dof());
     let mobility = mobility(
         &merged.model,
@@ -195,7 +209,7 @@ fn domain_list(all: &Assembled, domain_of: &[usize]) -> Vec<Domain> {
 }
 
 /// The model of the domains: each a body (a compound body of its blocks, each block with its own
-/// density), the contacts between domains its interfaces.
+/// density), the contacts between domains its interfaces, with the `symmetry` rows given.
 fn merged_model(
     path: &Path,
     all: &Assembled,
@@ -203,6 +217,7 @@ fn merged_model(
     domains: &[Domain],
     planar: bool,
     tolerance: f64,
+    symmetry: &[SymmetrySpec],
 ) -> Result<Assembled, Error> {
     let bodies: Vec<BodySpec> = domains
         .iter()
@@ -270,9 +285,14 @@ fn merged_model(
         tolerance,
     )
     .map_err(|e| here(&e))?;
+    let spec = StructureSpec {
+        symmetry: symmetry.to_vec(),
+        ..spec
+    };
     let file = ModelFile {
         body: spec.body.clone(),
         interface: spec.interface.clone(),
+        symmetry: symmetry.to_vec(),
         ..all.file.clone()
     };
     let model = Model::from_spec(&spec).map_err(|source| Error::Model {

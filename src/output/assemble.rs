@@ -154,6 +154,13 @@ pub fn mechanism_text(m: &MechanismModel) -> String {
         mob.rank,
         mob.dof2
     );
+    if mob.symmetries > 0 {
+        let _ = writeln!(
+            s,
+            "with its {} symmetry row(s): DOF(3) = {}",
+            mob.symmetries, mob.dof3
+        );
+    }
     s
 }
 

@@ -341,3 +341,34 @@ fn crr_assemble_mechanism_reports_and_writes_the_merged_model() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("an assembly lists bodies only"), "{err}");
 }
+
+/// DOF(3) from the assembly's `[[symmetry]]` tables (naming the merged model's coordinates): the
+/// trilithon's one mechanism sways the two columns through equal angles (the lintel translates:
+/// a parallelogram), so φ_left = φ_right keeps it (DOF(3) = 1) and the mirror relation
+/// φ_left = −φ_right locks it (DOF(3) = 0). A symmetry naming no coordinate is refused naming it.
+#[test]
+fn symmetry_rows_of_the_assembly_give_dof3_of_the_merged_model() {
+    let source = std::fs::read_to_string(bundled_assembly("trilithon")).unwrap();
+    let records = format!("\"{}/examples/records/", env!("CARGO_MANIFEST_DIR"));
+    let with = |relation: &str, first: &str| {
+        let text = source.replace("\"../records/", &records)
+            + &format!(
+                "\n[[symmetry]]\ncoordinates = [\"{first}\", \"column_right_on_ground\"]\nrelation = \"{relation}\"\n"
+            );
+        common::write_model(&format!("trilithon_symmetry_{relation}_{first}"), &text)
+    };
+    for (relation, dof3) in [("equal", 1), ("opposite", 0)] {
+        let m = mechanism(&with(relation, "column_left_on_ground"), true, &along_x());
+        assert_eq!(m.mobility.dof2, 1);
+        assert_eq!(m.mobility.symmetries, 1);
+        assert_eq!(m.mobility.dof3, dof3, "{relation}");
+        assert_eq!(m.merged.file.symmetry.len(), 1);
+        assert!(m.all_contacts.file.symmetry.is_empty());
+    }
+    let path = with("equal", "nope");
+    let file = read_assembly(&path).unwrap();
+    let e = mechanism_model(&path, &file, true, &along_x(), DEFAULT_TOLERANCE)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no coordinate named \"nope\""), "{e}");
+}
