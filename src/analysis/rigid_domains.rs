@@ -16,7 +16,7 @@
 //! The merged model has the same multiplier as the model of every contact along each direction
 //! asked for: merging adds rigidity only where the mechanism has none (so its mechanism is still
 //! admissible, λ_merged ≤ λ_all), and a merged model's mechanism is one of the full model's
-//! (λ_merged ≥ λ_all). `tests/statics/independent.rs` checks it.
+//! (λ_merged ≥ λ_all). `tests/cli/mechanism.rs` checks it on every bundled assembly.
 
 use std::path::Path;
 

@@ -748,6 +748,60 @@ fn planar_pivots(
 mod tests {
     use super::*;
 
+    /// A unit square face at z = 0 from the ground into body `upper`, its corners from (x0, y0).
+    fn square(upper: usize, x0: f64, y0: f64) -> ContactFace {
+        let c = |x: f64, y: f64| Vector3::new(x0 + x, y0 + y, 0.0);
+        ContactFace {
+            lower: None,
+            upper,
+            normal: Vector3::z(),
+            corners: vec![c(0.0, 0.0), c(1.0, 0.0), c(1.0, 1.0), c(0.0, 1.0)],
+            area: 1.0,
+            bed: true,
+        }
+    }
+
+    #[test]
+    fn coplanar_faces_of_one_pair_merge_into_their_hull_when_it_is_a_rectangle() {
+        // Two squares side by side under one body: one face, the 2 × 1 rectangle.
+        let merged = merge_coplanar(
+            &[square(0, 0.0, 0.0), square(0, 1.0, 0.0)],
+            InterfaceStyle::RockingBase,
+            1e-9,
+        );
+        assert_eq!(merged.len(), 1);
+        assert!((merged[0].area - 2.0).abs() < 1e-15);
+        assert_eq!(merged[0].corners.len(), 4);
+        assert!(is_rectangle(&merged[0].corners, 1e-9));
+        // Two feet apart: the hull (3 × 1) spans the gap, the same cone of contact wrenches.
+        let apart = merge_coplanar(
+            &[square(0, 0.0, 0.0), square(0, 2.0, 0.0)],
+            InterfaceStyle::RockingBase,
+            1e-9,
+        );
+        assert_eq!(apart.len(), 1);
+        assert!((apart[0].area - 3.0).abs() < 1e-15);
+        // Diagonal squares: a hexagonal hull, not a rocking base; kept apart.
+        let diagonal = merge_coplanar(
+            &[square(0, 0.0, 0.0), square(0, 1.0, 1.0)],
+            InterfaceStyle::RockingBase,
+            1e-9,
+        );
+        assert_eq!(diagonal.len(), 2);
+        // Other bodies, or another plane, are never merged.
+        let mut high = square(0, 1.0, 0.0);
+        high.corners.iter_mut().for_each(|p| p.z = 0.5);
+        assert_eq!(
+            merge_coplanar(
+                &[square(0, 0.0, 0.0), square(1, 1.0, 0.0), high],
+                InterfaceStyle::RockingBase,
+                1e-9
+            )
+            .len(),
+            3
+        );
+    }
+
     #[test]
     fn clipping_two_squares_gives_their_overlap() {
         let a = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
