@@ -135,3 +135,39 @@ fn walls_stop_with_a_lift_off_above_their_multiplier() {
     }
     assert!(lifted, "the wall's mechanism lifts a block off");
 }
+
+/// Models of rigid domains (`crr assemble --mechanism`: compound bodies) leave rest at their
+/// multiplier too: the bundled façade's portal of two piers of 14 stones and a lintel zone of 24
+/// (λ = 1.25 along ±x), and the arch of 9 stones as 5 domains on 6 hinges (λ = 0.365716); the
+/// multiplier is the one the model of every stone has (`tests/cli/mechanism.rs`).
+#[test]
+fn models_of_rigid_domains_leave_rest_at_their_multiplier() {
+    use crr::analysis::assemble::{DEFAULT_TOLERANCE, read_assembly};
+    use crr::analysis::rigid_domains::mechanism_model;
+    for (name, lambda) in [("facade", 1.25), ("arch", 0.365716)] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("examples/assemblies/{name}.toml"));
+        let file = read_assembly(&path).unwrap();
+        let directions = [Vector3::x(), -Vector3::x()];
+        let m = mechanism_model(&path, &file, true, &directions, DEFAULT_TOLERANCE).unwrap();
+        assert!(
+            m.merged
+                .model
+                .bodies
+                .iter()
+                .any(|b| b.shape.kind() == "compound"),
+            "{name}"
+        );
+        for d in directions {
+            let found = collapse_multiplier(&m.merged.model, d, &StaticsOptions::default())
+                .unwrap()
+                .lambda
+                .unwrap();
+            assert!((found - lambda).abs() < 1e-6, "{name} {d:?}: {found}");
+            assert!(
+                !check_threshold(name, &m.merged.model, d),
+                "{name}: the domains rock, no lift-off"
+            );
+        }
+    }
+}
