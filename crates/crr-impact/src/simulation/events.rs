@@ -170,10 +170,11 @@ impl EventFunctions for SegmentEvents<'_> {
 
 /// The seat of each rocking slot for its impact event: 0, except for an angle that starts the
 /// segment on the wrong side of its pivot by more than [`ROCKING_EVENT_MARGIN`]
-/// (`sign(side)·φ₀ < −margin`), whose seat is then where it starts. A loop-closing angle is measured from the bodies' poses, so a seated one carries the
-/// loop's round-off (some 1e-10 rad) that a release cannot set to 0 as it sets a tree coordinate;
-/// and an angle released at an impact can pass its seat by round-off before the next impact of
-/// another joint ends the segment (1e-10 rad at the next start). An event at 0 itself would then
+/// (`sign(side)·φ₀ < −margin`), whose seat is then where it starts. A loop-closing angle is
+/// measured from the bodies' poses, so a seated one carries the loop's round-off (some 1e-10 rad)
+/// that a release cannot set to 0 as it sets a tree coordinate; and an angle released at an
+/// impact can pass its seat by round-off before the next impact of another joint ends the
+/// segment (1e-10 rad at the next start). An event at 0 itself would then
 /// start below its root and never fall through it: the joint would rock through its support
 /// unseen, the run stopping later with the state on the wrong side of its pivot. A slot of a
 /// regularised law (`regularised`) keeps its seat at 0: its δ zone is integrated through, and a
