@@ -13,6 +13,11 @@
 //!    of its blocks'), the contacts between domains its interfaces (coplanar faces of one pair
 //!    as one face, [`merge_coplanar`]), the tree and loops chosen as for any assembly.
 //!
+//! Where several mechanisms are optimal along a direction, the one read is not the first one a
+//! search meets: the program is solved by an interior point, whose answer lies inside the face of
+//! optimal solutions, so it moves every interface that some optimal mechanism moves (a mirrored
+//! direction gives the mirrored hinges: the arch's domains are symmetric).
+//!
 //! The merged model has the same multiplier as the model of every contact along each direction
 //! asked for: merging adds rigidity only where the mechanism has none (so its mechanism is still
 //! admissible, λ_merged ≤ λ_all), and a merged model's mechanism is one of the full model's

@@ -44,19 +44,45 @@ fn horizontal() -> Vec<Vector3<f64>> {
     vec![Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()]
 }
 
+/// Writes the model of every contact and the merged model of `m` in a scratch folder `tag` and
+/// runs both through `crr::run` (each must complete): (every contact, merged).
+fn run_both(m: &MechanismModel, tag: &str) -> (crr::Run, crr::Run) {
+    let dir = common::scratch(tag);
+    let (all_path, merged_path) = (dir.join("every_contact.toml"), dir.join("merged.toml"));
+    write_model(&m.all_contacts, &all_path, true).unwrap();
+    write_merged_model(m, &merged_path, true).unwrap();
+    let run = |p: &Path| {
+        let input = crr::ModelInput::read(p).unwrap();
+        let run = crr::run(&input, &crr::RunOptions::default()).unwrap();
+        assert!(run.completed(), "{tag}: {:?}", run.summary.error);
+        run
+    };
+    (run(&all_path), run(&merged_path))
+}
+
+/// An assembly of `courses` boxes of `size` (ρ = `density`) stacked from the ground, named
+/// `course_K`.
+fn courses_text(courses: usize, size: [f64; 3], density: f64) -> String {
+    let mut text = String::from("name = \"courses\"\n");
+    for k in 0..courses {
+        text += &format!(
+            "[[body]]\nname = \"course_{k}\"\ndensity = {density}\nbox = {{ center = [0.0, 0.0, {}], size = [{}, {}, {}] }}\n",
+            size[2] * (k as f64 + 0.5),
+            size[0],
+            size[1],
+            size[2]
+        );
+    }
+    text
+}
+
 /// A panel of 5 courses 0.4 × 0.3 × 0.5 m (2.5 m in all, ρ = 2000) rocks whole on a base edge:
 /// one rigid domain, one interface on the ground, DOF(1) = DOF(2) = 2 with a rocking base (1 with
 /// a hinge), λ = b/h = 0.2/1.25 = 0.16 along ±x and 0.15/1.25 = 0.12 along ±y; its compound
 /// body has the panel's mass 2000 × 0.3 m³ and centre at 1.25 m.
 #[test]
 fn a_panel_cut_into_courses_is_one_rigid_domain_rocking_at_b_over_h() {
-    let mut text = String::from("name = \"panel\"\n");
-    for k in 0..5 {
-        text += &format!(
-            "[[body]]\nname = \"course_{k}\"\ndensity = 2000.0\nbox = {{ center = [0.0, 0.0, {}], size = [0.4, 0.3, 0.5] }}\n",
-            0.25 + 0.5 * k as f64
-        );
-    }
+    let text = courses_text(5, [0.4, 0.3, 0.5], 2000.0);
     let path = common::write_model("panel_mechanism", &text);
     let m = mechanism(&path, false, &horizontal());
     assert_eq!(m.domains.len(), 1);
@@ -210,17 +236,7 @@ fn the_merged_arch_moves_as_the_arch_of_every_contact_while_its_mechanism_holds(
     let m = mechanism(&path, true, &along_x());
     let l = m.collapses[0].lambda.unwrap();
     assert!((l - lambda_x).abs() < 1e-6, "{l}");
-    let dir = common::scratch("arch_pulse_models");
-    let (all_path, merged_path) = (dir.join("all.toml"), dir.join("merged.toml"));
-    write_model(&m.all_contacts, &all_path, true).unwrap();
-    write_merged_model(&m, &merged_path, true).unwrap();
-    let run = |p: &Path| {
-        let input = crr::ModelInput::read(p).unwrap();
-        let run = crr::run(&input, &crr::RunOptions::default()).unwrap();
-        assert!(run.completed(), "{:?}", run.summary.error);
-        run
-    };
-    let (all, merged) = (run(&all_path), run(&merged_path));
+    let (all, merged) = run_both(&m, "arch_pulse_models");
     let (ta, tm) = (
         all.trajectory.uplift_time.unwrap(),
         merged.trajectory.uplift_time.unwrap(),
@@ -380,13 +396,7 @@ fn symmetry_rows_of_the_assembly_give_dof3_of_the_merged_model() {
 /// holds through the first peak.
 #[test]
 fn a_panel_of_courses_and_its_domain_agree_through_the_first_peak() {
-    let mut text = String::from("name = \"courses\"\n");
-    for k in 0..5 {
-        text += &format!(
-            "[[body]]\nname = \"course_{k}\"\ndensity = 2500.0\nbox = {{ center = [0.0, 0.0, {}], size = [0.4, 0.4, 0.4] }}\n",
-            0.2 + 0.4 * k as f64
-        );
-    }
+    let mut text = courses_text(5, [0.4, 0.4, 0.4], 2500.0);
     text += &format!(
         "[ground_motion]\nx = {{ sine = {{ amplitude = {}, period = 0.5, cycles = 1 }} }}\n\n[analysis]\nduration = 1.5\nmax_step = 0.002\n",
         1.5 * 0.2 * 9.81
@@ -394,17 +404,7 @@ fn a_panel_of_courses_and_its_domain_agree_through_the_first_peak() {
     let path = common::write_model("courses_pulse", &text);
     let m = mechanism(&path, true, &along_x());
     assert_eq!(m.domains.len(), 1);
-    let dir = common::scratch("courses_pulse_models");
-    let (all_path, merged_path) = (dir.join("stones.toml"), dir.join("merged.toml"));
-    write_model(&m.all_contacts, &all_path, true).unwrap();
-    write_merged_model(&m, &merged_path, true).unwrap();
-    let run = |p: &Path| {
-        let input = crr::ModelInput::read(p).unwrap();
-        let run = crr::run(&input, &crr::RunOptions::default()).unwrap();
-        assert!(run.completed(), "{:?}", run.summary.error);
-        run
-    };
-    let (stones, merged) = (run(&all_path), run(&merged_path));
+    let (stones, merged) = run_both(&m, "courses_pulse_models");
     let (ts, tm) = (
         stones.trajectory.uplift_time.unwrap(),
         merged.trajectory.uplift_time.unwrap(),

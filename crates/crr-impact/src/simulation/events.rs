@@ -177,21 +177,21 @@ impl EventFunctions for SegmentEvents<'_> {
 /// segment (1e-10 rad at the next start). An event at 0 itself would then
 /// start below its root and never fall through it: the joint would rock through its support
 /// unseen, the run stopping later with the state on the wrong side of its pivot. A slot of a
-/// regularised law (`regularised`) keeps its seat at 0: its δ zone is integrated through, and a
-/// zone too narrow for the steps (refused when the model is built) is caught by the run's
+/// regularised law (`regularised(slot)`) keeps its seat at 0: its δ zone is integrated through,
+/// and a zone too narrow for the steps (refused when the model is built) is caught by the run's
 /// invariant rather than healed by a pivot switch on a state the zone's force has ruined.
 /// `angles` are the slot angles at the start of the segment.
 pub(super) fn rocking_seats(
     rocking: &[(usize, Side)],
     angles: &[f64],
-    regularised: &[usize],
+    regularised: impl Fn(usize) -> bool,
     seats: &mut Vec<f64>,
 ) {
     seats.clear();
     seats.extend(rocking.iter().map(|&(s, side)| {
         let start = side.sign() * angles[s];
         // Within the margin the event already starts above its root.
-        if start < -ROCKING_EVENT_MARGIN && !regularised.contains(&s) {
+        if start < -ROCKING_EVENT_MARGIN && !regularised(s) {
             start
         } else {
             0.0

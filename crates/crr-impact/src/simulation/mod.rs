@@ -813,12 +813,12 @@ impl<'a> Simulation<'a> {
             seg.angles[..n].copy_from_slice(&self.y[..n]);
         }
         // A slot of a regularised law is integrated through its zone: its seat stays at 0.
-        let regularised: Vec<usize> = self
-            .regularised
-            .as_ref()
-            .map(|r| r.slots.iter().map(|z| z.slot).collect())
-            .unwrap_or_default();
-        rocking_seats(&seg.rocking, &seg.angles, &regularised, &mut seats);
+        let regularised = |slot: usize| {
+            self.regularised
+                .as_ref()
+                .is_some_and(|r| r.slots.iter().any(|z| z.slot == slot))
+        };
+        rocking_seats(&seg.rocking, &seg.angles, regularised, &mut seats);
         let mut events = SegmentEvents {
             model,
             ground: self.ground,
