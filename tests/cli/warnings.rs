@@ -151,12 +151,14 @@ fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
     assert!(v["normal_force"].as_f64().unwrap() < 0.0);
 }
 
-/// Every bundled model runs without a warning except three whose monitor reports a failure:
-/// the drum column's flight, and two joints held seated with their contact's resultant outside
-/// the face in the 3D arch and the temple (the decisions in motion on loops are not yet the
-/// face-level program everywhere; docs/simulation.md, the hypotheses monitor).
+/// Every bundled model runs without a warning except two whose monitor reports a flight: the
+/// drum column's and the temple's. The temple's run then stops (results kept) when its
+/// entablature lifts off two capitals, a motion outside the CRR chain (docs/simulation.md,
+/// limitations). The 3D arch used to be flagged too, a springing held seated with an edge of its
+/// face pulling at 2.68 s, after a snap of seated angles whose change of energy went unbooked
+/// (1.3e-3 J of energy-balance error; 4.4e-6 J since the snaps are made at the impacts).
 #[test]
-fn the_bundled_models_run_without_warnings_but_the_three_the_monitor_flags() {
+fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
     let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -176,7 +178,14 @@ fn the_bundled_models_run_without_warnings_but_the_three_the_monitor_flags() {
             "--force",
         ]);
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.success(), "{stem}: {err}");
+        if stem == "temple" {
+            assert!(
+                err.contains("entablature_on_c21, entablature_on_c22 lift(s) off"),
+                "{stem}: {err}"
+            );
+        } else {
+            assert!(o.status.success(), "{stem}: {err}");
+        }
         let s: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
@@ -184,12 +193,9 @@ fn the_bundled_models_run_without_warnings_but_the_three_the_monitor_flags() {
         // above would jump): a run outside crr's model, and it says so.
         let flagged = match stem.as_str() {
             "drum_column" => Some("\"bed_3\" would need tension"),
-            // At 2.68 s, as the y tilts of the voussoirs come to rest after a run of impacts,
-            // the right springing's y tilt is seated while an edge of its face would pull.
-            "arch_3d" => Some("\"springing_right\" is held seated with its contact's resultant"),
-            // 25 ms after the temple leaves rest in its y mechanism, a bed of the first column is
-            // held seated with an edge of its face pulling (tests/engine/temple.rs).
-            "temple" => Some("\"c11_bed_3\" is held seated with its contact's resultant"),
+            // At 2.054 s, after a run of impacts of the capitals, the first column's capital
+            // would jump off its neck (tests/engine/temple.rs).
+            "temple" => Some("\"c11_neck\" would need tension"),
             _ => None,
         };
         if let Some(words) = flagged {

@@ -351,3 +351,47 @@ fn a_colonnade_rocking_when_the_ground_falls_faster_than_gravity_stops_with_a_li
         .count();
     assert!(moving > 10, "{moving} samples before the lift-off");
 }
+
+/// Seats that may twist (`twist = true`): the bundled baldachin with its three loop-closing tops
+/// allowed to twist, rocking along x under a pulse (its y tilts seated, its x tilts moving), under
+/// loads across. The program offers a twisting seat's tilts both pivots (a tilt turns about e₁,
+/// or about R(e₁, θ₁)e₂ = n_B × e₁, the axis perpendicular to e₁ and to the child's face normal),
+/// so it is the whole problem there too, and must name the exhaustive search's choice.
+#[test]
+fn the_program_is_the_least_gauss_function_on_seats_that_twist() {
+    let path = crate::common::write_model(
+        "baldachin_twist_program",
+        &crate::twist_closure::twisting_text(),
+    );
+    let model = crr::load_model(&path).unwrap().1;
+    assert!(
+        model.interfaces.iter().any(|f| matches!(
+            f.kind,
+            crr::kinematics::InterfaceKind::RockingBase { twist: true, .. }
+        )),
+        "the model has twisting seats"
+    );
+    let t = G * 0.2 / 1.5;
+    let pulse = SignalSpec::OneSinePulse(PulseSpec {
+        amplitude: 3.0 * t,
+        period: 0.8,
+        start: 0.0,
+    });
+    let ground = GroundMotion::none()
+        .with_component(Axis::X, &ComponentSpec::new(pulse), Path::new("."))
+        .unwrap();
+    let states = moving_states(&model, &ground, 0.8, 8, 9);
+    assert!(states.len() >= 3, "{} states", states.len());
+    let loads = [
+        (0.0, 0.0),
+        (0.5 * t, 1.2 * t),
+        (-t, -2.0 * t),
+        (2.0 * t, 0.9 * t),
+    ];
+    let (opened, lifted) = check(&model, &states, &loads);
+    eprintln!(
+        "twisting baldachin: {} states, {opened} opened, {lifted} lifted",
+        states.len()
+    );
+    assert!(opened > 0, "no load opened anything");
+}

@@ -4,9 +4,9 @@
 //! 3D arch's and temple's runs where some slots are seated and the structure moves, the release
 //! `opening_mode` picks is the strongest single opening above 1e-9 g/size (first in slot order
 //! on ties), and it finds none exactly when the definition finds none (it may then answer with
-//! the active set of several slots, the same either way). The temple is decided by that local
-//! test (its twisting seats keep the contact program out); the 3D arch by the contact program
-//! (`opening_program.rs`), whose answer at these samples is the same single release.
+//! the active set of several slots, the same either way). Both are decided by the contact
+//! program (`opening_program.rs`; the temple's twisting seats included), whose answer at these
+//! samples is the same single release.
 
 use std::path::Path;
 

@@ -295,7 +295,14 @@ impl Simulation<'_> {
             }));
             to_seat.extend_from_slice(&pending);
         }
-        // `kin` holds the kinematics of q_at on the `after` chain (the last evaluation above).
+        // Every joint seated after the impact sits at exactly 0 (the impacting ones already
+        // do; the joints seated with it had residual angles within `simultaneity`) on closed
+        // loops: the change of U this costs is booked with the snap below.
+        snap_to_seats(model, &mut kin, &after, &mut q_at, |k| {
+            held.contains(&k) || to_seat.contains(&k)
+        })
+        .map_err(|source| SimulationError::Dynamics { t, source })?;
+        forward_kinematics(model, &mut kin, &q_at, &after);
         let u_snapped = potential_energy(model, &kin);
         let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;
@@ -324,7 +331,7 @@ impl Simulation<'_> {
         // The switch; the pivots before go back to the scratch.
         std::mem::swap(&mut self.dynamics.pivots, &mut after);
         self.set_seated(record.seated.iter().map(|&s| (s, true)));
-        // The snap of the impacting angles to exactly 0 changes U by round-off: booked too.
+        // The snap of the seated angles to exactly 0 changes U: booked too.
         let u_snap = u_located - u_snapped;
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(work);

@@ -230,9 +230,7 @@ fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
         let parent = model.frame_of(iface.parent);
         let moves = if k < n {
             LiftMoves::Subtree(k)
-        } else if model.closures.iter().any(|c| c.interface == index)
-            && !matches!(iface.kind, InterfaceKind::RockingBase { twist: true, .. })
-        {
+        } else if model.closures.iter().any(|c| c.interface == index) {
             LiftMoves::Closure(index)
         } else {
             continue;
@@ -515,12 +513,109 @@ fn world_axis(model: &Model, d: &Dynamics, index: usize, k: usize) -> Vector3<f6
     let rot = |f: Option<usize>| f.map_or_else(Matrix3::identity, |f| kin.rot_ops[f]);
     match &iface.kind {
         InterfaceKind::Hinge { axis, .. } => rot(model.frame_of(iface.parent)) * axis,
-        InterfaceKind::RockingBase { e1, e2, .. } => {
+        InterfaceKind::RockingBase { e1, normal, .. } => {
+            let e1 = rot(model.frame_of(iface.parent)) * e1;
             if k == iface.slots.start {
-                rot(model.frame_of(iface.parent)) * e1
+                e1
             } else {
-                rot(Some(model.body_coord[iface.child])) * e2
+                // The second tilt turns about R(e₁, θ₁)e₂, perpendicular to e₁ and to the
+                // child's face normal: n_B × e₁ (the child's own e₂ only without a twist).
+                (rot(Some(model.body_coord[iface.child])) * normal)
+                    .cross(&e1)
+                    .normalize()
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crr_dynamics::ground_motion::GroundMotion;
+    use crr_kinematics::closure::relative_angles;
+    use crr_kinematics::fixtures::colonnade_with_top_order;
+    use crr_kinematics::{ActivePivots, Parent};
+    use nalgebra::Rotation3;
+
+    /// The tilt angles (θ₁, θ₂) after turning the child by ε about `w` (world) through any point.
+    fn tilts_after(
+        kind: &InterfaceKind,
+        ra: &Matrix3<f64>,
+        rb: &Matrix3<f64>,
+        w: &Vector3<f64>,
+        eps: f64,
+    ) -> [f64; 2] {
+        let turn = Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(*w), eps);
+        let rel = ra.transpose() * turn.matrix() * rb;
+        let mut out = [0.0; 2];
+        relative_angles(kind, &rel, &mut out);
+        out
+    }
+
+    /// The axis the program gives a seat's tilt is the one about which turning the child changes
+    /// that tilt alone (central differences of the angles measured from the poses), also on a
+    /// seat that has twisted: a colonnade whose tops tilt in the same order as its bases twists
+    /// its slab on them (second order in the columns' tilts), and there the child's own e₂ is
+    /// not the second tilt's axis (it changes θ₁ by about the twist per radian).
+    #[test]
+    fn a_twisting_seats_tilt_axes_change_one_tilt_each() {
+        let mut spec = colonnade_with_top_order(0.2, 1.5, 1.2, 0.4, false);
+        let mut closing = 0;
+        for iface in spec.interface.iter_mut().filter(|i| i.child == "slab") {
+            closing += 1;
+            if closing > 1 {
+                iface.rocking_base.as_mut().unwrap().twist = true;
+            }
+        }
+        let model = Model::from_spec(&spec).unwrap();
+        let n = model.dof();
+        // Every column tilted about x and y, the slab's own tilts chosen to leave it twisted.
+        let mut q = DVector::zeros(n);
+        for k in 0..n {
+            q[k] = 0.03 * (1.0 + 0.37 * k as f64).sin();
+        }
+        let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+        d.evaluate(&model, &GroundMotion::none(), 0.0, &q, &DVector::zeros(n));
+        let kin = &d.kin;
+        let rot = |f: Option<usize>| f.map_or_else(Matrix3::identity, |f| kin.rot_ops[f]);
+        let mut largest_twist_error: f64 = 0.0;
+        let mut checked = 0;
+        for cl in &model.closures {
+            let iface = &model.interfaces[cl.interface];
+            if !matches!(iface.kind, InterfaceKind::RockingBase { twist: true, .. }) {
+                continue;
+            }
+            let parent = match iface.parent {
+                Parent::Ground => None,
+                Parent::Body(b) => Some(model.body_coord[b]),
+            };
+            let (ra, rb) = (rot(parent), rot(Some(model.body_coord[iface.child])));
+            let eps = 1e-6;
+            for (local, k) in iface.slots.clone().enumerate() {
+                let w = world_axis(&model, &d, cl.interface, k);
+                let plus = tilts_after(&iface.kind, &ra, &rb, &w, eps);
+                let minus = tilts_after(&iface.kind, &ra, &rb, &w, -eps);
+                for j in 0..2 {
+                    let rate = (plus[j] - minus[j]) / (2.0 * eps);
+                    let expected = if j == local { 1.0 } else { 0.0 };
+                    assert!(
+                        (rate - expected).abs() < 1e-8,
+                        "{} slot {local}: dθ{j}/dε = {rate}",
+                        iface.name
+                    );
+                }
+                checked += 1;
+            }
+            // The child's own e₂ is off by the twist.
+            let e2_child = rb * iface.kind.axis(1);
+            let plus = tilts_after(&iface.kind, &ra, &rb, &e2_child, 1e-6);
+            let minus = tilts_after(&iface.kind, &ra, &rb, &e2_child, -1e-6);
+            largest_twist_error = largest_twist_error.max(((plus[0] - minus[0]) / 2e-6).abs());
+        }
+        assert_eq!(checked, 6, "three twisting seats, two tilts each");
+        assert!(
+            largest_twist_error > 1e-5,
+            "the seats have not twisted ({largest_twist_error}): the check would not discriminate"
+        );
     }
 }
