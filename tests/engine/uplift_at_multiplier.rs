@@ -46,8 +46,14 @@ fn run_from_rest(model: &Model, a: Vector3<f64>) -> Outcome {
     // A lift-off at t = 0 is found when the run is set up.
     let sim = match Simulation::new(model, &ground, &initial, params) {
         Ok(sim) => sim,
-        Err(SimulationError::LiftOff { interfaces, t }) => {
+        Err(SimulationError::LiftOff {
+            interfaces,
+            t,
+            in_flight,
+        }) => {
             assert_eq!(t, 0.0);
+            // A mechanism at λ turns blocks about other contacts: none flies.
+            assert!(in_flight.is_empty(), "{in_flight:?}");
             return Outcome::LiftOff(interfaces);
         }
         Err(e) => panic!("{e}"),
@@ -58,7 +64,14 @@ fn run_from_rest(model: &Model, a: Vector3<f64>) -> Outcome {
             None => Outcome::AtRest,
         },
         Err(failure) => match failure.error {
-            SimulationError::LiftOff { interfaces, .. } => Outcome::LiftOff(interfaces),
+            SimulationError::LiftOff {
+                interfaces,
+                in_flight,
+                ..
+            } => {
+                assert!(in_flight.is_empty(), "{in_flight:?}");
+                Outcome::LiftOff(interfaces)
+            }
             e => panic!("{e}"),
         },
     }

@@ -273,15 +273,74 @@ pub enum SimulationError {
     /// opens; in motion: the motion of least Gauss function), which the CRR chain (every
     /// interface on a pivot) cannot follow.
     #[error(
-        "at t = {t} s the contact faces' program finds a motion in which {} lift(s) off a support (a block leaves one of its supports; at rest, when the ground acceleration exceeds the collapse multiplier in such a mechanism): outside the CRR model, which keeps every interface on a pivot; see `crr check` for the mechanism",
-        interfaces.join(", ")
+        "at t = {t} s the contact faces' program finds a motion in which {} lift(s) off a support ({}; at rest, when the ground acceleration exceeds the collapse multiplier in such a mechanism): outside the CRR model, which keeps every interface on a pivot; see `crr check` for the mechanism",
+        interfaces.join(", "),
+        flight_words(in_flight)
     )]
     LiftOff {
         /// Time (s).
         t: f64,
         /// The interfaces that open entirely.
         interfaces: Vec<String>,
+        /// The bodies left with no path to the ground through the contacts that stay closed: a
+        /// flight. Empty when every body keeps a support (a block leaving one of its supports
+        /// while another holds it: the loop would have to be released or the chain re-rooted).
+        in_flight: Vec<String>,
     },
+}
+
+/// The words of [`SimulationError::LiftOff`] on the bodies it leaves without support.
+fn flight_words(in_flight: &[String]) -> String {
+    if in_flight.is_empty() {
+        "every body keeps a support through other contacts: following it needs the loop \
+         released or the chain re-rooted, which crr does not do"
+            .to_string()
+    } else {
+        format!("{} lose(s) every support: a flight", in_flight.join(", "))
+    }
+}
+
+/// The bodies with no path to the ground through the interfaces other than `lifting` (each
+/// interface joins its parent and its child), in the model's order: the bodies that would fly
+/// if those interfaces opened.
+pub fn bodies_without_support(model: &Model, lifting: &[String]) -> Vec<String> {
+    let nb = model.bodies.len();
+    let mut supported = vec![false; nb];
+    let kept: Vec<&crr_kinematics::Interface> = model
+        .interfaces
+        .iter()
+        .filter(|f| !lifting.contains(&f.name))
+        .collect();
+    let parent_of = |f: &crr_kinematics::Interface| match f.parent {
+        crr_kinematics::Parent::Ground => None,
+        crr_kinematics::Parent::Body(b) => Some(b),
+    };
+    // Grow the supported set from the ground until nothing changes (at most one pass per body).
+    loop {
+        let mut changed = false;
+        for f in &kept {
+            let (a, b) = (parent_of(f), f.child);
+            let a_supported = a.is_none_or(|a| supported[a]);
+            if a_supported && !supported[b] {
+                supported[b] = true;
+                changed = true;
+            }
+            if let Some(a) = a
+                && supported[b]
+                && !supported[a]
+            {
+                supported[a] = true;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    (0..nb)
+        .filter(|&b| !supported[b])
+        .map(|b| model.bodies[b].name.clone())
+        .collect()
 }
 
 /// A run that failed part-way: the error and everything computed before it.
@@ -1281,5 +1340,48 @@ mod parameter_tests {
         assert_eq!(p.max_impacts, 1_000_000);
         assert_eq!(p.friction, None);
         assert_eq!(p.collapse_drop, 1e-3);
+    }
+}
+
+#[cfg(test)]
+mod flight_tests {
+    //! Which bodies a lift-off leaves without support, on a trilithon (two columns on the
+    //! ground, an architrave on both; its right top closes the loop) and a stack of three drums.
+    use crr_kinematics::Model;
+    use crr_kinematics::fixtures::{serial_chain, trilithon};
+
+    use super::bodies_without_support;
+
+    fn names(list: &[&str]) -> Vec<String> {
+        list.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn a_body_flies_only_when_no_closed_contact_joins_it_to_the_ground() {
+        let model = Model::from_spec(&trilithon(0.2, 1.5, 1.2, 0.4, 1.0)).unwrap();
+        // The architrave leaving one column keeps the other, through the tree or the loop.
+        for one in ["top_left", "top_right"] {
+            assert!(
+                bodies_without_support(&model, &names(&[one])).is_empty(),
+                "{one}"
+            );
+        }
+        // Leaving both, it flies; a column leaving the ground still touches the architrave,
+        // which stands on the other column.
+        assert_eq!(
+            bodies_without_support(&model, &names(&["top_left", "top_right"])),
+            names(&["architrave"])
+        );
+        assert!(bodies_without_support(&model, &names(&["base_left"])).is_empty());
+        // Both bases: the whole frame flies.
+        assert_eq!(
+            bodies_without_support(&model, &names(&["base_left", "base_right"])).len(),
+            3
+        );
+        // A serial chain: a joint that opens carries everything above it away.
+        let chain = Model::from_spec(&serial_chain(3)).unwrap();
+        let second = chain.interfaces[1].name.clone();
+        let above: Vec<String> = chain.bodies[1..].iter().map(|b| b.name.clone()).collect();
+        assert_eq!(bodies_without_support(&chain, &[second]), above);
     }
 }

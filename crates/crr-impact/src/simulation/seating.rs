@@ -867,6 +867,7 @@ impl Simulation<'_> {
         if let Some(interfaces) = self.spare.rest.lift_off.take() {
             return Err(SimulationError::LiftOff {
                 t: self.t,
+                in_flight: bodies_without_support(self.model, &interfaces),
                 interfaces,
             });
         }
