@@ -6,6 +6,8 @@
 //!   synthetic accelerogram (smoothed, enveloped white noise from a fixed seed, PGA 0.3 g);
 //! - `bundled_models`: the files of `examples/models` as `crr simulate` runs them (model,
 //!   ground motion, initial state and `[analysis]` from the file; no output written);
+//! - `colonnade_row`: how a run with loops grows: planar colonnades of 2 to 16 columns of three
+//!   drums under architraves, 6 s of the bundled record, with the fitted exponent printed;
 //! - `many_bodies`: how a run grows with the number of bodies: a stack of n drums standing
 //!   seated for 0.5 s, and n free-standing blocks of distinct sizes under one sine pulse for 1 s.
 //!
@@ -473,6 +475,70 @@ fn many_bodies(c: &mut Criterion) {
     group.finish();
 }
 
+/// Loops as they grow: a planar colonnade of k columns of 3 drums under architraves
+/// (`fixtures::colonnade_row`, DOF(1) = 4k − 1, k − 1 loops) under 6 s of the bundled record
+/// along x. Each size is run once outside criterion and its wall time per integration step
+/// printed, with the exponent p of cost per step ∝ DOF^p fitted over the sizes (least squares
+/// in log–log): the issue asks for p ≤ 1.5 on such families. k = 16 is printed, not timed by
+/// criterion (about 20 s a run).
+fn colonnade_row_growth(c: &mut Criterion) {
+    use crr_dynamics::ground_motion::{RecordFormat, RecordSpec};
+    let mut group = c.benchmark_group("colonnade_row");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(200))
+        .measurement_time(Duration::from_secs(5));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let record = ComponentSpec::new(SignalSpec::Record(RecordSpec {
+        file: root.join("examples/records/synthetic.AT2"),
+        format: RecordFormat::PeerAt2,
+        units: None,
+        time_column: None,
+        accel_column: None,
+        skip_rows: None,
+    }));
+    let ground = GroundMotion::none()
+        .with_component(Axis::X, &record, root)
+        .expect("the bundled record");
+    let params = Parameters {
+        duration: 6.0,
+        ..Parameters::default()
+    };
+    let mut points = Vec::new();
+    for k in [2, 4, 8, 16] {
+        let model = Model::from_spec(&crr_kinematics::fixtures::colonnade_row(k, 3))
+            .expect("valid colonnade");
+        let init = at_rest(&model);
+        let start = std::time::Instant::now();
+        let traj = run(&model, &ground, &init, params.clone());
+        let seconds = start.elapsed().as_secs_f64();
+        assert!(traj.uplift_time.is_some(), "colonnade_row/{k}: no uplift");
+        check(&format!("colonnade_row/{k}"), &traj, Some(false));
+        let per_step = seconds / traj.solver_stats.steps as f64;
+        eprintln!(
+            "colonnade_row/{k}: DOF {}, {} steps, {seconds:.2} s, {:.1} µs per step",
+            model.dof(),
+            traj.solver_stats.steps,
+            per_step * 1e6
+        );
+        points.push(((model.dof() as f64).ln(), per_step.ln()));
+        if k <= 8 {
+            group.bench_function(BenchmarkId::from_parameter(k), |b| {
+                b.iter(|| black_box(run(&model, &ground, black_box(&init), params.clone())));
+            });
+        }
+    }
+    let n = points.len() as f64;
+    let (mx, my) = (
+        points.iter().map(|p| p.0).sum::<f64>() / n,
+        points.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    eprintln!("colonnade_row: cost per step ∝ DOF^{slope:.2} (DOF 7 to 63)");
+    group.finish();
+}
+
 // The Poincaré section and study benches share this binary (one LTO link fewer each in CI).
 #[path = "groups/poincare.rs"]
 mod poincare_group;
@@ -486,6 +552,7 @@ criterion_group!(
     drum_column_record,
     bundled_models,
     many_bodies,
+    colonnade_row_growth,
     poincare_group::section_200_periods,
     study_group::bench_study
 );

@@ -666,6 +666,81 @@ pub fn serial_chain(n: usize) -> StructureSpec {
     }
 }
 
+/// A planar colonnade in the x–z plane: `columns` columns of `drums` drums each (2b × 2b × h_d,
+/// b = 0.3 m, h_d = 1.3 m, at x = 2.5 m·i), every bed a hinge about +y with P⁺ at the +x edge,
+/// and an architrave (0.6 m high, 2b deep) between each pair of neighbouring columns, resting on
+/// the right half of the left column's top and the left half of the right column's: `columns − 1`
+/// architraves, each on its left column in the tree and closing a loop on its right one. Bodies
+/// `c{i}_d{j}` and `a{i}`, interfaces `c{i}_bed{j}`, `a{i}_on_c{i}` and `a{i}_on_c{i+1}`. The
+/// family on which the cost of loops is measured as it grows (benches/simulation.rs).
+pub fn colonnade_row(columns: usize, drums: usize) -> StructureSpec {
+    let (b, h_d, spacing, h_a) = (0.3, 1.3, 2.5, 0.6);
+    let about_y = [0.0, 1.0, 0.0];
+    let mut body = Vec::new();
+    let mut interface = Vec::new();
+    for i in 0..columns {
+        let x = i as f64 * spacing;
+        for j in 0..drums {
+            let name = format!("c{i}_d{j}");
+            let z = j as f64 * h_d;
+            body.push(box_body(
+                &name,
+                2500.0,
+                [x, 0.0, z + 0.5 * h_d],
+                [2.0 * b, 2.0 * b, h_d],
+            ));
+            let parent = if j == 0 {
+                "ground".to_string()
+            } else {
+                format!("c{i}_d{}", j - 1)
+            };
+            interface.push(hinge(
+                &format!("c{i}_bed{j}"),
+                &parent,
+                &name,
+                about_y,
+                [x + b, 0.0, z],
+                [x - b, 0.0, z],
+            ));
+        }
+    }
+    let top = drums as f64 * h_d;
+    let last = drums.saturating_sub(1);
+    for i in 0..columns.saturating_sub(1) {
+        let (x0, x1) = (i as f64 * spacing, (i + 1) as f64 * spacing);
+        let name = format!("a{i}");
+        body.push(box_body(
+            &name,
+            2500.0,
+            [0.5 * (x0 + x1), 0.0, top + 0.5 * h_a],
+            [x1 - x0, 2.0 * b, h_a],
+        ));
+        interface.push(hinge(
+            &format!("a{i}_on_c{i}"),
+            &format!("c{i}_d{last}"),
+            &name,
+            about_y,
+            [x0 + b, 0.0, top],
+            [x0, 0.0, top],
+        ));
+        interface.push(hinge(
+            &format!("a{i}_on_c{}", i + 1),
+            &format!("c{}_d{last}", i + 1),
+            &name,
+            about_y,
+            [x1, 0.0, top],
+            [x1 - b, 0.0, top],
+        ));
+    }
+    StructureSpec {
+        name: format!("colonnade_row_{columns}x{drums}"),
+        gravity: crate::spec::DEFAULT_GRAVITY,
+        body,
+        interface,
+        symmetry: Vec::new(),
+    }
+}
+
 /// Several structures side by side as one: part i is `parts[i]` translated by `spacing`·i along
 /// x, its body and interface names prefixed with `p<i>_`. Nothing joins the parts (each keeps its
 /// own interfaces to the ground), so the model has at least `parts.len()` connected parts.
