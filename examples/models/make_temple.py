@@ -107,6 +107,11 @@ y = { record = { file = "../records/synthetic_y.AT2", format = "peer-at2" } }
 
 [analysis]
 duration = 6.0
+# The bay rocks by 1e-6 to 1e-4 rad: snapping joints within the default simultaneity (1e-8 rad)
+# of their seats to exactly 0 under the bay's 74 t of stone moved a tenth of the energy the
+# impacts dissipated before its first flight, which the run warns about; within 1e-11 rad the
+# snaps move 3e-5 of it.
+simultaneity = 1e-11
 """
     text = HEADER + '\nname = "temple"\ngravity = 9.81\n\n' + "\n".join(bodies) + "\n" + "\n".join(ifaces) + "\n" + tail
     out = pathlib.Path(__file__).with_name("temple.toml")

@@ -643,6 +643,7 @@ impl Prepared {
                 body: t.collapse.as_ref().map(|c| c.body.clone()),
             },
             energy_balance_error: t.energy_balance_error,
+            energy_at_snaps: t.energy_at_snaps,
             hypothesis_violation: t.violation.as_ref().map(|v| ViolationSummary {
                 time: v.t,
                 interface: v.interface.clone(),
@@ -691,6 +692,23 @@ fn warnings(
             100.0 * t.energy_balance_error / scale,
             scale,
             100.0 * ENERGY_BALANCE_WARNING
+        ));
+    }
+    // The snaps against the losses over the part of the run inside the model (until the
+    // monitor's first violation): past a flight the energies grow and would hide them.
+    let x = &t.snaps_and_losses;
+    let snap_floor = 1e-12 * p.model.total_mass() * p.model.gravity * p.model.size;
+    if x.snaps > (crr_impact::simulation::SNAP_ENERGY_FRACTION * x.lost.abs()).max(snap_floor) {
+        out.push(format!(
+            "until t = {} s the snaps of joints to their seats moved {:.3e} J against {:.3e} J \
+             dissipated by the impacts (more than {} % of it): the motion is small against \
+             `simultaneity` ({} rad, the angle within which joints impact and seat together), so \
+             the energy booked as dissipated is partly the idealisation's; lower it",
+            x.t,
+            x.snaps,
+            x.lost,
+            100.0 * crr_impact::simulation::SNAP_ENERGY_FRACTION,
+            num(p.params.simultaneity)
         ));
     }
     let analysis = p.file.analysis.clone().unwrap_or_default();

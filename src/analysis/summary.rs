@@ -56,6 +56,10 @@ pub struct Summary {
     pub collapse: CollapseSummary,
     /// Largest |T + U − W + D − E(0)| over the samples (J).
     pub energy_balance_error: f64,
+    /// Σ|ΔT + ΔU| of the snaps booked in D (J): seated joints set to exactly 0 with the loops
+    /// closed again, at impacts and at seating, and a twisting seat's loop closed on its new
+    /// corner. Compare with `energy_lost_at_impacts`.
+    pub energy_at_snaps: f64,
     /// The first failure of the rigid-contact hypotheses (flight, a resultant outside its face,
     /// sliding), if any.
     pub hypothesis_violation: Option<ViolationSummary>,

@@ -26,9 +26,9 @@ fn a_loose_tolerance_is_an_error_not_a_false_collapse() {
 /// with v7_on_v8 at +5.1e-4 rad on its − pivot: released at an impact, it passed its seat by
 /// 1.05e-10 rad before another joint's impact ended the segment. Both runs now go on, every
 /// rocking angle on its pivot's side at every sample to 2e-6 rad (5 µm at the extrados: the stones
-/// do not pass through one another), until the end or until a block lifts off a support (×3.0:
-/// v5 off v4 at 1.86 s, with more than 50 impacts before; the seats' snaps are now made where
-/// their energy is booked, which changes this chaotic history). An angle that crosses its seat
+/// do not pass through one another), ×1.8 to its end and ×3.0 until v5 lifts off v4 at 1.86 s,
+/// with more than 50 impacts before (the seats' snaps are now made where their energy is
+/// booked, which changes these chaotic histories). An angle that crosses its seat
 /// between two impacts of its neighbours switches pivot at the next one; the run stops with an
 /// error beyond 1e-5 rad.
 #[test]
@@ -59,12 +59,16 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
             ..Default::default()
         };
         let run = crr::run(&input, &opts).unwrap();
-        // A block lifting off a support stops the run (outside the CRR chain): not a failure of
-        // the invariant, and the samples before are checked.
-        if let Some(e) = &run.summary.error {
-            assert!(e.contains("lift(s) off"), "×{scale}: {e}");
+        // ×1.8 runs to the end; ×3.0 stops when a block lifts off a support (outside the CRR
+        // chain): not a failure of the invariant, and the samples before are checked.
+        if scale < 2.0 {
+            assert!(run.completed(), "×{scale}: {:?}", run.summary.error);
+            assert!(run.trajectory.impacts.len() > 100, "×{scale}");
+        } else {
+            let e = run.summary.error.as_deref().unwrap_or("it completed");
+            assert!(e.contains("v5_on_v4 lift(s) off"), "×{scale}: {e}");
+            assert!(run.trajectory.impacts.len() > 50, "×{scale}");
         }
-        assert!(run.trajectory.impacts.len() > 50, "×{scale}");
         let model = &run.model;
         let mut kin = crr::kinematics::Data::new(model);
         let mut angles = vec![0.0; model.slot_count];

@@ -398,6 +398,24 @@ fn the_program_is_the_least_gauss_function_on_seats_that_twist() {
         .unwrap();
     let states = moving_states(&model, &ground, 0.8, 8, 9);
     assert!(states.len() >= 3, "{} states", states.len());
+    // The states compared hold twisting seats' tilts seated (the tops' y tilts).
+    let twisting_slot = |k: usize| {
+        model.interfaces.iter().any(|f| {
+            f.slots.contains(&k)
+                && matches!(
+                    f.kind,
+                    crr::kinematics::InterfaceKind::RockingBase { twist: true, .. }
+                )
+        })
+    };
+    let with_twisting = states
+        .iter()
+        .filter(|s| s.3.iter().any(|&k| twisting_slot(k)))
+        .count();
+    assert!(
+        with_twisting >= 3,
+        "{with_twisting} states seat a twisting tilt"
+    );
     let loads = [
         (0.0, 0.0),
         (0.5 * t, 1.2 * t),

@@ -210,12 +210,12 @@ fn assert_energy_balance(traj: &crr::impact::Trajectory, least: f64) {
 /// it by 0.26 ms (a load 0.17 % above λ_c). From there the contact program decides which seats
 /// open, the twisting seats included, with both pivots of every seat offered: no seated face is
 /// held with its resultant outside it (the local decisions of the twisting seats held a bed of the
-/// first column seated 25 ms after the uplift with an edge pulling). At 2.054 s, after a run of
-/// impacts of the capitals, the monitor finds the first capital's rocking neck pulling (a
-/// flight: the capital would jump): the results after that are outside the model, and said so.
-/// At 2.434 s the program finds the entablature lifting off two capitals of the back row, which
-/// the CRR chain cannot follow: the run stops there with an error, the results before kept.
-/// Until the flight the energy balance closes to 1e-6 of the energy dissipated at the impacts.
+/// first column seated 25 ms after the uplift with an edge pulling). At 2.054 s the program finds
+/// the first column's capital lifting off its neck, which the CRR chain cannot follow: the run
+/// stops there with an error, the results before kept, and the monitor's only report is at that
+/// instant. Until then the energy balance closes to 1e-6 of the energy dissipated at the impacts,
+/// and the snaps of joints to their seats (the model's `simultaneity` is 1e-11 rad: the bay
+/// rocks by 1e-6 to 1e-4 rad) move less than 1e-3 of it.
 #[test]
 fn the_bundled_run_leaves_rest_at_the_collapse_multiplier() {
     let path = common::write_model("temple_bundled", &temple_text());
@@ -250,33 +250,27 @@ fn the_bundled_run_leaves_rest_at_the_collapse_multiplier() {
     );
     assert!((uplift - 1.615273).abs() < 1e-5, "{uplift}");
     assert!(traj.collapse.is_none());
-    // The first failure the monitor reports is a flight of a rocking neck, not a seated face
-    // pulling.
-    let v = traj
-        .violation
-        .as_ref()
-        .expect("the monitor flags the flight");
-    assert_eq!(
-        (v.kind.as_str(), v.interface.as_str()),
-        ("tension", "c11_neck"),
-        "{v:?}"
-    );
-    assert!(v.t > uplift + 0.4, "{v:?}");
-    // The run stops at the lift-off, naming the seats the entablature leaves.
+    // The run stops when the first capital lifts off its neck (it keeps the entablature above),
+    // with the results before it kept.
     let message = run.summary.error.as_deref().expect("the run stops");
     assert!(
-        message.contains("lift(s) off")
-            && message.contains("entablature_on_c21")
-            && message.contains("entablature_on_c22"),
+        message.contains("c11_neck lift(s) off") && message.contains("every body keeps a support"),
         "{message}"
     );
     let end = traj.samples.times().last().copied().unwrap();
-    assert!(end > 2.4 && end < 2.5, "{end}");
-    assert!(traj.impacts.len() > 100, "{} impacts", traj.impacts.len());
-    // T + U − W + D = E(0) at every sample before the flight, against the energy dissipated.
-    let samples: Vec<_> = traj.samples.iter().filter(|s| s.t < v.t).collect();
+    assert!(end > uplift + 0.4, "{end}");
+    assert!(traj.impacts.len() > 50, "{} impacts", traj.impacts.len());
+    // Nothing the monitor checks fails before that instant.
+    if let Some(v) = &traj.violation {
+        assert!(v.t >= end - 1e-9, "{v:?} before the stop at {end} s");
+    }
+    // T + U − W + D = E(0) at every sample, against the energy dissipated; the snaps move a
+    // negligible part of it.
+    let samples: Vec<_> = traj.samples.iter().collect();
     let dissipated = samples.last().unwrap().dissipated;
     assert!(dissipated > 0.1, "D = {dissipated} J");
+    let x = &traj.snaps_and_losses;
+    assert!(x.snaps < 1e-3 * x.lost, "{x:?}");
     let e0 = {
         let s = &samples[0];
         s.kinetic + s.potential - s.work_in + s.dissipated

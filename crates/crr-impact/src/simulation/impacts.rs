@@ -295,15 +295,25 @@ impl Simulation<'_> {
             }));
             to_seat.extend_from_slice(&pending);
         }
-        // Every joint seated after the impact sits at exactly 0 (the impacting ones already
-        // do; the joints seated with it had residual angles within `simultaneity`) on closed
-        // loops: the change of U this costs is booked with the snap below.
-        snap_to_seats(model, &mut kin, &after, &mut q_at, |k| {
-            held.contains(&k) || to_seat.contains(&k)
-        })
+        // Every tree joint seated after the impact goes to exactly 0 (the joints seated with the
+        // impacting ones had residual angles within `simultaneity`) and the loops close again,
+        // positions then velocities, holding the impacting joints at the 0 they leave from on
+        // their new pivots: the change of T + U this costs is booked with the snap below.
+        let kinetic_projected = kinetic_after;
+        snap_to_seats(
+            model,
+            &mut kin,
+            &after,
+            &mut q_at,
+            &mut qdot_after,
+            |k| held.contains(&k) || to_seat.contains(&k),
+            |k| impacting.contains(&k),
+        )
         .map_err(|source| SimulationError::Dynamics { t, source })?;
         forward_kinematics(model, &mut kin, &q_at, &after);
         let u_snapped = potential_energy(model, &kin);
+        crr_kinematics::velocities(model, &mut kin, &qdot_after);
+        let t_snapped = crr_kinematics::body_kinetic_energy(model, &kin);
         let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;
         let record = ImpactRecord {
@@ -331,8 +341,9 @@ impl Simulation<'_> {
         // The switch; the pivots before go back to the scratch.
         std::mem::swap(&mut self.dynamics.pivots, &mut after);
         self.set_seated(record.seated.iter().map(|&s| (s, true)));
-        // The snap of the seated angles to exactly 0 changes U: booked too.
-        let u_snap = u_located - u_snapped;
+        // The snaps (the impacting angles to 0 before the law, the seated ones and the loops
+        // after it) change T + U: booked too.
+        let u_snap = u_located - u_snapped + kinetic_projected - t_snapped;
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(work);
         self.spare.laws = laws;
@@ -353,6 +364,8 @@ impl Simulation<'_> {
             pending,
         };
         self.dissipated_at_impacts += lost + u_snap;
+        self.lost_at_impacts += lost;
+        self.tally_snap(u_snap);
         self.impacts.push(record);
         self.reset_solver();
         // The joints that open right after the impact open before the post-impact sample, so

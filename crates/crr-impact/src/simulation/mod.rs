@@ -273,7 +273,7 @@ pub enum SimulationError {
     /// opens; in motion: the motion of least Gauss function), which the CRR chain (every
     /// interface on a pivot) cannot follow.
     #[error(
-        "at t = {t} s the contact faces' program finds a motion in which {} lift(s) off a support ({}; at rest, when the ground acceleration exceeds the collapse multiplier in such a mechanism): outside the CRR model, which keeps every interface on a pivot; see `crr check` for the mechanism",
+        "at t = {t} s the contact faces' program finds a motion in which {} lift(s) off a support ({}): outside the CRR model, which keeps every interface on a pivot",
         interfaces.join(", "),
         flight_words(in_flight)
     )]
@@ -289,11 +289,30 @@ pub enum SimulationError {
     },
 }
 
+/// Snaps (seated joints set to exactly 0, loops closed again) that moved more than this
+/// fraction of the energy the impacts dissipated, over the part of the run inside the model, are
+/// a warning (`crr simulate`): the energy booked as dissipated is then partly the
+/// idealisation's, not the impact laws'.
+pub const SNAP_ENERGY_FRACTION: f64 = 1e-2;
+
+/// The snaps' Σ|ΔT + ΔU| and the impacts' Σ`energy_lost` until a time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SnapsAndLosses {
+    /// Time (s): the monitor's first violation, or the end of the run.
+    pub t: f64,
+    /// Σ|ΔT + ΔU| of the snaps until then (J).
+    pub snaps: f64,
+    /// Σ of the impacts' `energy_lost` until then (J).
+    pub lost: f64,
+}
+
 /// The words of [`SimulationError::LiftOff`] on the bodies it leaves without support.
 fn flight_words(in_flight: &[String]) -> String {
     if in_flight.is_empty() {
         "every body keeps a support through other contacts: following it needs the loop \
-         released or the chain re-rooted, which crr does not do"
+         released or the chain re-rooted, which crr does not do; at rest this happens when the \
+         ground acceleration exceeds the collapse multiplier of such a mechanism, which `crr \
+         check` reports"
             .to_string()
     } else {
         format!("{} lose(s) every support: a flight", in_flight.join(", "))
@@ -378,6 +397,12 @@ pub struct Simulation<'a> {
     seated: Vec<bool>,
     last_impact: Vec<f64>,
     dissipated_at_impacts: f64,
+    /// Σ|ΔT + ΔU| of the snaps booked in `dissipated_at_impacts` ([`Trajectory::energy_at_snaps`]).
+    energy_at_snaps: f64,
+    /// Σ of the impacts' `energy_lost` so far (J).
+    lost_at_impacts: f64,
+    /// The snaps and the impacts' losses when the monitor first found a hypothesis failing.
+    snaps_at_violation: Option<SnapsAndLosses>,
     u_rest: f64,
     energy_start: f64,
     next_sample: usize,
@@ -516,26 +541,41 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
     Ok(())
 }
 
-/// Sets the seated tree coordinates of `q` (`seated(k)`) to exactly 0 and closes the loops again
-/// by the least change of the free ones: what the integrator's projection would do at its next
-/// reset, done where the caller can book the change of U it costs. On a heavy structure moving
-/// little this is not negligible: snapping residual angles of 1e-8 rad (`simultaneity`) under
-/// the bundled temple's entablature moves U by millijoules, the order of its impact losses.
+/// Sets the tree coordinates `seated(k)` of q and q̇ to exactly 0 and closes the loops again by
+/// the least change of the other coordinates, positions then velocities (Φ = 0, Φ_q q̇ = 0):
+/// what the integrator's projection does after its next step, done where the caller can book
+/// the change of T + U. The coordinates `keep(k)` (tree coordinates that must stay where they
+/// are, e.g. at exactly 0 on a new pivot) are held too, unless the loops cannot be closed
+/// without them. Seated closure angles are not rows of Φ and keep their residual (below
+/// `simultaneity`). On a heavy structure moving little the change is not negligible: residual
+/// angles of 1e-8 rad under the bundled temple's entablature move U by millijoules, the order
+/// of its impact losses.
 pub(super) fn snap_to_seats(
     model: &Model,
     kin: &mut Data,
     pivots: &ActivePivots,
     q: &mut DVector<f64>,
+    qdot: &mut DVector<f64>,
     seated: impl Fn(usize) -> bool,
+    keep: impl Fn(usize) -> bool,
 ) -> Result<(), crr_dynamics::DynamicsError> {
+    use crr_dynamics::closed_chain::{project_positions, project_velocities};
     let n = model.dof();
     for k in (0..n).filter(|&k| seated(k)) {
         q[k] = 0.0;
+        qdot[k] = 0.0;
     }
-    if model.constraint_rows > 0 {
-        let free: Vec<usize> = (0..n).filter(|&k| !seated(k)).collect();
-        crr_dynamics::closed_chain::project_positions(model, kin, pivots, q, Some(&free))?;
+    if model.constraint_rows == 0 {
+        return Ok(());
     }
+    let mut free: Vec<usize> = (0..n).filter(|&k| !seated(k) && !keep(k)).collect();
+    let start = q.clone();
+    if project_positions(model, kin, pivots, q, Some(&free)).is_err() {
+        q.copy_from(&start);
+        free = (0..n).filter(|&k| !seated(k)).collect();
+        project_positions(model, kin, pivots, q, Some(&free))?;
+    }
+    project_velocities(model, kin, pivots, q, qdot, Some(&free));
     Ok(())
 }
 
@@ -645,6 +685,9 @@ impl<'a> Simulation<'a> {
             seated,
             last_impact: vec![f64::NEG_INFINITY; model.slot_count],
             dissipated_at_impacts: 0.0,
+            energy_at_snaps: 0.0,
+            lost_at_impacts: 0.0,
+            snaps_at_violation: None,
             u_rest,
             energy_start: 0.0,
             next_sample: 0,
@@ -739,6 +782,11 @@ impl<'a> Simulation<'a> {
     /// Seats (`true`) or releases (`false`) slots. The seated set is held twice, as the mask
     /// the events read and as the list the dynamics solves with; this is the one place either
     /// changes after the start, and both change together.
+    /// Tallies a snap's change of T + U, already booked in D ([`Trajectory::energy_at_snaps`]).
+    pub(super) fn tally_snap(&mut self, change: f64) {
+        self.energy_at_snaps += change.abs();
+    }
+
     pub(super) fn set_seated(&mut self, changes: impl IntoIterator<Item = (usize, bool)>) {
         for (s, seated) in changes {
             self.seated[s] = seated;
@@ -1205,6 +1253,12 @@ impl<'a> Simulation<'a> {
             collapse: self.collapse,
             violation: self.violation,
             energy_balance_error: balance,
+            energy_at_snaps: self.energy_at_snaps,
+            snaps_and_losses: self.snaps_at_violation.unwrap_or(SnapsAndLosses {
+                t: self.t,
+                snaps: self.energy_at_snaps,
+                lost: self.lost_at_impacts,
+            }),
             end_time: self.t,
             solver_stats: self.solver.stats(),
         }
@@ -1232,6 +1286,13 @@ pub struct Trajectory {
     pub violation: Option<crate::monitor::Violation>,
     /// Largest |T + U − W + D − E(0)| over the samples (J).
     pub energy_balance_error: f64,
+    /// Σ|ΔT + ΔU| of the snaps booked in D (J): seated joints set to exactly 0 and the loops
+    /// closed again at impacts and at seating, and a twisting seat's loop closed on its new
+    /// corner. Not a physical loss: a measure of what the idealisation moved, to compare with D.
+    pub energy_at_snaps: f64,
+    /// The snaps against the impacts' losses over the part of the run inside the model: until
+    /// the monitor's first violation, or the end.
+    pub snaps_and_losses: SnapsAndLosses,
     /// Time reached (s).
     pub end_time: f64,
     /// Integrator work over the whole run: steps, rejections, right-hand side evaluations.
@@ -1251,6 +1312,8 @@ impl Trajectory {
             collapse: None,
             violation: None,
             energy_balance_error: 0.0,
+            energy_at_snaps: 0.0,
+            snaps_and_losses: SnapsAndLosses::default(),
             end_time: 0.0,
             solver_stats: Default::default(),
         }

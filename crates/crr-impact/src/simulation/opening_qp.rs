@@ -62,8 +62,8 @@ pub struct OpeningDecision {
     pub rates: Vec<(f64, f64)>,
     /// q̈ of the program's minimum (rad/s²).
     pub qddot: DVector<f64>,
-    /// Every seated slot was offered both pivots. When false (a twisting base's tilt, or a flip
-    /// that would move a free slot's axis) the program is the exact one restricted to the
+    /// Every seated slot was offered both pivots. When false (a flip that would move a free
+    /// slot's axis) the program is the exact one restricted to the
     /// current side of those slots: its "holds" and its releases stand (checked by the chain),
     /// but a lift-off it finds may be an artefact of the restriction.
     pub complete: bool,
@@ -216,7 +216,7 @@ impl Scale {
 
 /// The lifts offered: every seated slot at its seat whose other pivot turns no free
 /// coordinate's axis (a rocking base's other tilt moves its corner along that tilt's axis,
-/// which is fine) and is not a twisting base's tilt.
+/// which is fine), twisting seats included.
 fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
     let kin = &d.kin;
     let n = model.dof();
@@ -502,8 +502,8 @@ fn base_decision(
     }
 }
 
-/// The world axis of slot k of interface `index` (as in `slot_row`: on the parent, a rocking
-/// base's second tilt on the child).
+/// The world axis of slot k of interface `index`: a tree coordinate's own; a closure's first tilt
+/// (or hinge axis) on the parent; its second tilt about R(e₁, θ₁)e₂ = n_B × e₁.
 fn world_axis(model: &Model, d: &Dynamics, index: usize, k: usize) -> Vector3<f64> {
     let kin = &d.kin;
     if k < model.dof() {

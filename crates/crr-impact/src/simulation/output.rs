@@ -71,6 +71,13 @@ impl Simulation<'_> {
                     tol,
                     correction,
                 );
+                if self.violation.is_some() {
+                    self.snaps_at_violation = Some(super::SnapsAndLosses {
+                        t,
+                        snaps: self.energy_at_snaps,
+                        lost: self.lost_at_impacts,
+                    });
+                }
             }
         }
         // T from the bodies' velocities (no M): the monitor's solve filled them.

@@ -2,7 +2,6 @@
 //! by single releases and an active set), releasing them, and seating joints that come to rest.
 
 use super::*;
-use crr_dynamics::closed_chain::project_velocities;
 use crr_kinematics::Interface;
 use crr_kinematics::kinematics::frame_point;
 use nalgebra::{Matrix3, Vector3};
@@ -222,8 +221,8 @@ fn loop_opening(
     qdot: &DVector<f64>,
     tol: f64,
 ) -> Option<Option<Vec<(usize, Side)>>> {
-    // A program with some slot held to its current side (a twisting base's tilt) is not the
-    // whole problem: the local test decides then, as before the program.
+    // A program with some slot held to its current side (a flip that would move a free slot's
+    // axis) is not the whole problem: the local test decides then, as before the program.
     if !offers_both_pivots(model, trial) {
         return None;
     }
@@ -893,7 +892,8 @@ impl Simulation<'_> {
             }
             self.set_seated(mode.iter().map(|&(s, _)| (s, false)));
             if twisting_flip {
-                self.close_loops_after_a_twisting_flip()?;
+                let released: Vec<usize> = mode.iter().map(|&(s, _)| s).collect();
+                self.close_loops_after_a_twisting_flip(&released)?;
             }
             if from_rest {
                 self.uplift_time.get_or_insert(self.t);
@@ -907,37 +907,48 @@ impl Simulation<'_> {
     /// about the normal on the old corner by its twist τ, so its new corner lies |P′ − P|·τ from
     /// the parent's (a second-order offset: τ is of the order of the product of the tilts).
     /// The loop is closed again on the new corner here, positions then velocities (least
-    /// change, the seated tree coordinates held), and the change of T + U that this costs is
-    /// booked as dissipated, as the snaps at impacts are: otherwise the integrator's projection
-    /// after its next step makes the same correction unbooked (on the bundled temple, 2e-9 rad
-    /// and 1.7 mJ of the energy balance per flip).
-    fn close_loops_after_a_twisting_flip(&mut self) -> Result<(), SimulationError> {
+    /// change, the seated tree coordinates and the ones just `released` held: they leave their
+    /// seats from exactly 0), and the change of T + U that this costs is booked as dissipated,
+    /// as the snaps at impacts are: otherwise the integrator's projection after its next step
+    /// makes the same correction unbooked (on the bundled temple, 2e-9 rad and 1.7 mJ of the
+    /// energy balance per flip).
+    fn close_loops_after_a_twisting_flip(
+        &mut self,
+        released: &[usize],
+    ) -> Result<(), SimulationError> {
         let model = self.model;
         let n = model.dof();
         let (mut q, mut qdot) = (self.q(), self.qdot());
-        let free: Vec<usize> = (0..n).filter(|&k| !self.seated[k]).collect();
         let seated = self.seated.clone();
-        let (ground, t) = (self.ground, self.t);
-        let energy = |d: &mut Dynamics, q: &DVector<f64>, qdot: &DVector<f64>| {
-            d.evaluate(model, ground, t, q, qdot);
-            d.ensure_mass_matrix(model);
-            0.5 * qdot.dot(&(&d.kin.mass_matrix * qdot)) + potential_energy(model, &d.kin)
+        let mut kin = self
+            .spare
+            .events_kin
+            .take()
+            .unwrap_or_else(|| Box::new(Data::new(model)));
+        let pivots = &self.dynamics.pivots;
+        let energy = |kin: &mut Data, q: &DVector<f64>, qdot: &DVector<f64>| {
+            forward_kinematics(model, kin, q, pivots);
+            crr_kinematics::velocities(model, kin, qdot);
+            crr_kinematics::body_kinetic_energy(model, kin) + potential_energy(model, kin)
         };
-        let mut d = self.take_trial();
-        d.pivots.clone_from(&self.dynamics.pivots);
-        d.seated.clone_from(&self.dynamics.seated);
-        let before = energy(&mut d, &q, &qdot);
-        let projected = snap_to_seats(model, &mut d.kin, &d.pivots, &mut q, |k| seated[k]);
-        if projected.is_ok() {
-            project_velocities(model, &mut d.kin, &d.pivots, &q, &mut qdot, Some(&free));
-        }
-        let after = energy(&mut d, &q, &qdot);
-        self.spare.trial = Some(d);
+        let before = energy(&mut kin, &q, &qdot);
+        let projected = snap_to_seats(
+            model,
+            &mut kin,
+            pivots,
+            &mut q,
+            &mut qdot,
+            |k| seated[k],
+            |k| released.contains(&k),
+        );
+        let after = energy(&mut kin, &q, &qdot);
+        self.spare.events_kin = Some(kin);
         projected.map_err(|e| SimulationError::Dynamics {
             t: self.t,
             source: e,
         })?;
         self.dissipated_at_impacts += before - after;
+        self.tally_snap(before - after);
         self.y[..n].copy_from_slice(q.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot.as_slice());
         Ok(())
@@ -1144,23 +1155,32 @@ impl Simulation<'_> {
         d.ensure_mass_matrix(model);
         let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * qdot));
         let u_before = potential_energy(model, &d.kin);
-        // Seating removes the kinetic energy of the stopped joints and the potential energy of
-        // their residual angle (below `simultaneity`, the loops closed again): both are booked
-        // as dissipated.
-        let mut q_new = self.q();
+        // Seating removes the kinetic energy of the stopped joints (booked as dissipated); the
+        // snap of their residual angles (below `simultaneity`) to exactly 0, with the loops
+        // closed again, positions then velocities, changes T + U further: booked too, and
+        // tallied as a snap.
+        let (mut q_new, mut qd_new) = (self.q(), qd);
         let seated = &self.seated;
-        snap_to_seats(model, kin, &self.dynamics.pivots, &mut q_new, |k| {
-            seated[k] || closing.contains(&k)
-        })
+        snap_to_seats(
+            model,
+            kin,
+            &self.dynamics.pivots,
+            &mut q_new,
+            &mut qd_new,
+            |k| seated[k] || closing.contains(&k),
+            |_| false,
+        )
         .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
-        self.y[..model.dof()].copy_from_slice(q_new.as_slice());
-        let u_after = {
-            forward_kinematics(model, kin, &q_new, &self.dynamics.pivots);
-            potential_energy(model, kin)
-        };
-        self.dissipated_at_impacts += before - kinetic + u_before - u_after;
+        forward_kinematics(model, kin, &q_new, &self.dynamics.pivots);
+        let u_after = potential_energy(model, kin);
+        crr_kinematics::velocities(model, kin, &qd_new);
+        let t_after = crr_kinematics::body_kinetic_energy(model, kin);
+        let snap = kinetic - t_after + u_before - u_after;
+        self.dissipated_at_impacts += before - kinetic + snap;
+        self.tally_snap(snap);
         let n = model.dof();
-        self.y[n..2 * n].copy_from_slice(qd.as_slice());
+        self.y[..n].copy_from_slice(q_new.as_slice());
+        self.y[n..2 * n].copy_from_slice(qd_new.as_slice());
         self.set_seated(closing.iter().map(|&s| (s, true)));
         self.reset_solver();
         self.release_if_opening()?;
