@@ -59,9 +59,19 @@ def assert_same_run(result: crr.Result, out: Path) -> None:
 @pytest.mark.parametrize("model", MODELS)
 def test_every_bundled_model_runs_as_the_command_line(model, cli, in_root, tmp_path):
     out = tmp_path / "cli"
-    run_cli(cli, ["simulate", model, "--out", str(out), "--quiet"])
-    result = crr.simulate(crr.Model.from_file(model))
-    assert result.completed
+    if model.endswith("temple.toml"):
+        # The temple's run stops when a capital lifts off its neck (outside the CRR chain): the
+        # command line writes the partial results and exits with 1, Python raises
+        # SimulationError holding the same partial run.
+        run_cli(cli, ["simulate", model, "--out", str(out), "--quiet"], expect=1)
+        with pytest.raises(crr.SimulationError, match="lift") as failure:
+            crr.simulate(crr.Model.from_file(model))
+        result = failure.value.result
+        assert not result.completed
+    else:
+        run_cli(cli, ["simulate", model, "--out", str(out), "--quiet"])
+        result = crr.simulate(crr.Model.from_file(model))
+        assert result.completed
     assert len(result.t) > 10
     assert_same_run(result, out)
 
