@@ -299,8 +299,7 @@ impl Simulation<'_> {
         // impacting ones had residual angles within `simultaneity`) and the loops close again,
         // positions then velocities, holding the impacting joints at the 0 they leave from on
         // their new pivots: the change of T + U this costs is booked with the snap below.
-        let kinetic_projected = kinetic_after;
-        snap_to_seats(
+        let (t_snapped, u_snapped) = snap_to_seats(
             model,
             &mut kin,
             &after,
@@ -310,10 +309,6 @@ impl Simulation<'_> {
             |k| impacting.contains(&k),
         )
         .map_err(|source| SimulationError::Dynamics { t, source })?;
-        forward_kinematics(model, &mut kin, &q_at, &after);
-        let u_snapped = potential_energy(model, &kin);
-        crr_kinematics::velocities(model, &mut kin, &qdot_after);
-        let t_snapped = crr_kinematics::body_kinetic_energy(model, &kin);
         let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;
         let record = ImpactRecord {
@@ -343,7 +338,7 @@ impl Simulation<'_> {
         self.set_seated(record.seated.iter().map(|&s| (s, true)));
         // The snaps (the impacting angles to 0 before the law, the seated ones and the loops
         // after it) change T + U: booked too.
-        let u_snap = u_located - u_snapped + kinetic_projected - t_snapped;
+        let u_snap = u_located - u_snapped + kinetic_after - t_snapped;
         self.spare.events_kin = Some(kin);
         self.spare.trial = Some(work);
         self.spare.laws = laws;
@@ -363,9 +358,8 @@ impl Simulation<'_> {
             candidates,
             pending,
         };
-        self.dissipated_at_impacts += lost + u_snap;
-        self.lost_at_impacts += lost;
-        self.tally_snap(u_snap);
+        self.dissipated_at_impacts += lost;
+        self.book_snap(u_snap);
         self.impacts.push(record);
         self.reset_solver();
         // The joints that open right after the impact open before the post-impact sample, so

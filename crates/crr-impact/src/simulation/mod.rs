@@ -399,8 +399,6 @@ pub struct Simulation<'a> {
     dissipated_at_impacts: f64,
     /// Σ|ΔT + ΔU| of the snaps booked in `dissipated_at_impacts` ([`Trajectory::energy_at_snaps`]).
     energy_at_snaps: f64,
-    /// Σ of the impacts' `energy_lost` so far (J).
-    lost_at_impacts: f64,
     /// The snaps and the impacts' losses when the monitor first found a hypothesis failing.
     snaps_at_violation: Option<SnapsAndLosses>,
     u_rest: f64,
@@ -549,7 +547,7 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
 /// without them. Seated closure angles are not rows of Φ and keep their residual (below
 /// `simultaneity`). On a heavy structure moving little the change is not negligible: residual
 /// angles of 1e-8 rad under the bundled temple's entablature move U by millijoules, the order
-/// of its impact losses.
+/// of its impact losses. Returns (T, U) of the state reached ([`state_energies`]).
 pub(super) fn snap_to_seats(
     model: &Model,
     kin: &mut Data,
@@ -558,25 +556,40 @@ pub(super) fn snap_to_seats(
     qdot: &mut DVector<f64>,
     seated: impl Fn(usize) -> bool,
     keep: impl Fn(usize) -> bool,
-) -> Result<(), crr_dynamics::DynamicsError> {
+) -> Result<(f64, f64), crr_dynamics::DynamicsError> {
     use crr_dynamics::closed_chain::{project_positions, project_velocities};
     let n = model.dof();
     for k in (0..n).filter(|&k| seated(k)) {
         q[k] = 0.0;
         qdot[k] = 0.0;
     }
-    if model.constraint_rows == 0 {
-        return Ok(());
+    if model.constraint_rows > 0 {
+        let mut free: Vec<usize> = (0..n).filter(|&k| !seated(k) && !keep(k)).collect();
+        let start = q.clone();
+        if project_positions(model, kin, pivots, q, Some(&free)).is_err() {
+            q.copy_from(&start);
+            free = (0..n).filter(|&k| !seated(k)).collect();
+            project_positions(model, kin, pivots, q, Some(&free))?;
+        }
+        project_velocities(model, kin, pivots, q, qdot, Some(&free));
     }
-    let mut free: Vec<usize> = (0..n).filter(|&k| !seated(k) && !keep(k)).collect();
-    let start = q.clone();
-    if project_positions(model, kin, pivots, q, Some(&free)).is_err() {
-        q.copy_from(&start);
-        free = (0..n).filter(|&k| !seated(k)).collect();
-        project_positions(model, kin, pivots, q, Some(&free))?;
-    }
-    project_velocities(model, kin, pivots, q, qdot, Some(&free));
-    Ok(())
+    Ok(state_energies(model, kin, pivots, q, qdot))
+}
+
+/// (T, U) at (q, q̇) on `pivots`, T from the bodies' velocities, leaving `kin` evaluated there.
+pub(super) fn state_energies(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> (f64, f64) {
+    forward_kinematics(model, kin, q, pivots);
+    crr_kinematics::velocities(model, kin, qdot);
+    (
+        crr_kinematics::body_kinetic_energy(model, kin),
+        potential_energy(model, kin),
+    )
 }
 
 impl<'a> Simulation<'a> {
@@ -686,7 +699,6 @@ impl<'a> Simulation<'a> {
             last_impact: vec![f64::NEG_INFINITY; model.slot_count],
             dissipated_at_impacts: 0.0,
             energy_at_snaps: 0.0,
-            lost_at_impacts: 0.0,
             snaps_at_violation: None,
             u_rest,
             energy_start: 0.0,
@@ -779,14 +791,21 @@ impl<'a> Simulation<'a> {
         std::mem::replace(&mut self.samples, empty)
     }
 
-    /// Seats (`true`) or releases (`false`) slots. The seated set is held twice, as the mask
-    /// the events read and as the list the dynamics solves with; this is the one place either
-    /// changes after the start, and both change together.
-    /// Tallies a snap's change of T + U, already booked in D ([`Trajectory::energy_at_snaps`]).
-    pub(super) fn tally_snap(&mut self, change: f64) {
+    /// Books a snap's change of T + U (before − after) in D and tallies it
+    /// ([`Trajectory::energy_at_snaps`]).
+    pub(super) fn book_snap(&mut self, change: f64) {
+        self.dissipated_at_impacts += change;
         self.energy_at_snaps += change.abs();
     }
 
+    /// Σ of the impacts' `energy_lost` so far (J).
+    pub(super) fn lost_at_impacts(&self) -> f64 {
+        self.impacts.iter().map(|i| i.energy_lost).sum()
+    }
+
+    /// Seats (`true`) or releases (`false`) slots. The seated set is held twice, as the mask
+    /// the events read and as the list the dynamics solves with; this is the one place either
+    /// changes after the start, and both change together.
     pub(super) fn set_seated(&mut self, changes: impl IntoIterator<Item = (usize, bool)>) {
         for (s, seated) in changes {
             self.seated[s] = seated;
@@ -1243,6 +1262,11 @@ impl<'a> Simulation<'a> {
             peak_abs[p.coordinate] = peak_abs[p.coordinate].max(p.value.abs());
         }
         let balance = self.energy_balance_error();
+        let snaps_and_losses = self.snaps_at_violation.unwrap_or(SnapsAndLosses {
+            t: self.t,
+            snaps: self.energy_at_snaps,
+            lost: self.lost_at_impacts(),
+        });
         Trajectory {
             coordinates: self.model.coords.iter().map(|c| c.name.clone()).collect(),
             samples: self.samples,
@@ -1254,11 +1278,7 @@ impl<'a> Simulation<'a> {
             violation: self.violation,
             energy_balance_error: balance,
             energy_at_snaps: self.energy_at_snaps,
-            snaps_and_losses: self.snaps_at_violation.unwrap_or(SnapsAndLosses {
-                t: self.t,
-                snaps: self.energy_at_snaps,
-                lost: self.lost_at_impacts,
-            }),
+            snaps_and_losses,
             end_time: self.t,
             solver_stats: self.solver.stats(),
         }

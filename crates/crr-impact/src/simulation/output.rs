@@ -75,7 +75,7 @@ impl Simulation<'_> {
                     self.snaps_at_violation = Some(super::SnapsAndLosses {
                         t,
                         snaps: self.energy_at_snaps,
-                        lost: self.lost_at_impacts,
+                        lost: self.lost_at_impacts(),
                     });
                 }
             }

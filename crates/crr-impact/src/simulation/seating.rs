@@ -696,9 +696,10 @@ pub(super) fn closure_other_side_reaction(
 /// Whether slot `k` is a tilt of a loop-closing seat that may twist.
 fn is_twisting_closure_slot(model: &Model, k: usize) -> bool {
     k >= model.dof()
-        && model.interfaces.iter().any(|f| {
-            f.slots.contains(&k) && matches!(f.kind, InterfaceKind::RockingBase { twist: true, .. })
-        })
+        && matches!(
+            model.interfaces[slot_interface(model, k)].kind,
+            InterfaceKind::RockingBase { twist: true, .. }
+        )
 }
 
 /// The rest position (in the coordinates of the frame that carries it) of interface `iface`'s
@@ -926,13 +927,8 @@ impl Simulation<'_> {
             .take()
             .unwrap_or_else(|| Box::new(Data::new(model)));
         let pivots = &self.dynamics.pivots;
-        let energy = |kin: &mut Data, q: &DVector<f64>, qdot: &DVector<f64>| {
-            forward_kinematics(model, kin, q, pivots);
-            crr_kinematics::velocities(model, kin, qdot);
-            crr_kinematics::body_kinetic_energy(model, kin) + potential_energy(model, kin)
-        };
-        let before = energy(&mut kin, &q, &qdot);
-        let projected = snap_to_seats(
+        let (t_before, u_before) = state_energies(model, &mut kin, pivots, &q, &qdot);
+        let snapped = snap_to_seats(
             model,
             &mut kin,
             pivots,
@@ -941,14 +937,12 @@ impl Simulation<'_> {
             |k| seated[k],
             |k| released.contains(&k),
         );
-        let after = energy(&mut kin, &q, &qdot);
         self.spare.events_kin = Some(kin);
-        projected.map_err(|e| SimulationError::Dynamics {
+        let (t_after, u_after) = snapped.map_err(|e| SimulationError::Dynamics {
             t: self.t,
             source: e,
         })?;
-        self.dissipated_at_impacts += before - after;
-        self.tally_snap(before - after);
+        self.book_snap(t_before + u_before - t_after - u_after);
         self.y[..n].copy_from_slice(q.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot.as_slice());
         Ok(())
@@ -1161,7 +1155,7 @@ impl Simulation<'_> {
         // tallied as a snap.
         let (mut q_new, mut qd_new) = (self.q(), qd);
         let seated = &self.seated;
-        snap_to_seats(
+        let (t_after, u_after) = snap_to_seats(
             model,
             kin,
             &self.dynamics.pivots,
@@ -1171,13 +1165,8 @@ impl Simulation<'_> {
             |_| false,
         )
         .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
-        forward_kinematics(model, kin, &q_new, &self.dynamics.pivots);
-        let u_after = potential_energy(model, kin);
-        crr_kinematics::velocities(model, kin, &qd_new);
-        let t_after = crr_kinematics::body_kinetic_energy(model, kin);
-        let snap = kinetic - t_after + u_before - u_after;
-        self.dissipated_at_impacts += before - kinetic + snap;
-        self.tally_snap(snap);
+        self.dissipated_at_impacts += before - kinetic;
+        self.book_snap(kinetic - t_after + u_before - u_after);
         let n = model.dof();
         self.y[..n].copy_from_slice(q_new.as_slice());
         self.y[n..2 * n].copy_from_slice(qd_new.as_slice());
