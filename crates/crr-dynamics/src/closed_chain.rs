@@ -10,8 +10,8 @@ use crr_kinematics::{
     forward_kinematics,
 };
 
-use crate::eom::{DynamicsError, constraint_row_scale};
-use crate::linalg::{JacobiSvd, pinv_solve_in, pivot_columns, rank};
+use crate::eom::{DynamicsError, SelectedRowsWork, constraint_row_scale, solve_selected_rows};
+use crate::linalg::{JacobiSvd, RANK_TOLERANCE, pinv_solve_in, pivot_columns, rank};
 
 /// Convergence threshold of the Newton projections, relative to the model size for point rows.
 pub const CLOSURE_TOLERANCE: f64 = 1e-13;
@@ -220,11 +220,81 @@ pub fn project_velocities(
     qdot: &mut DVector<f64>,
     free: Option<&[usize]>,
 ) -> f64 {
+    project_velocities_with(model, kin, pivots, q, qdot, free, None)
+}
+
+/// Independent rows of the row-scaled Φ_q kept between velocity projections
+/// ([`project_velocities_with`]): the integration projects after every step with the same
+/// chain, and the rows that were independent at the last step almost always still are.
+#[derive(Clone, Debug, Default)]
+pub struct VelocityProjection {
+    /// The columns (coordinates changed) and the rows selected for them.
+    selection: Option<(Vec<usize>, Vec<usize>)>,
+    work: SelectedRowsWork,
+    /// Projections that ran the SVD (no selection for these columns, or its check failed).
+    pub decompositions: usize,
+    /// Projections solved on the selected rows.
+    pub reused: usize,
+}
+
+/// [`project_velocities`] reusing independent rows from `cache`: the minimum-norm correction
+/// δq̇ = −Φ_qᵀ(Φ_q Φ_qᵀ)⁺ Φ_q q̇ is, since Φ_q q̇ lies in the range of Φ_q, exactly
+/// −Φ_Sᵀ(Φ_S Φ_Sᵀ)⁻¹ Φ_S q̇ on any independent rows S spanning the others: one Cholesky factor of
+/// the (sparse) Gram matrix of S instead of a Jacobi SVD of Φ_q. The rows are kept only while
+/// the SVD would make the same rank decision (same check and threshold, RANK_TOLERANCE·‖Φ_q‖, as
+/// the equations of motion's selected rows); otherwise the SVD solves and selects them again.
+pub fn project_velocities_with(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    q: &DVector<f64>,
+    qdot: &mut DVector<f64>,
+    free: Option<&[usize]>,
+    cache: Option<&mut VelocityProjection>,
+) -> f64 {
     let (_, jac) = scaled(model, kin, q, pivots);
     let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
     let res = &jac * &*qdot;
-    let sub = DMatrix::from_fn(jac.nrows(), cols.len(), |i, j| jac[(i, cols[j])]);
-    let (dx, _) = pinv_solve_in(&sub, &res, jac.norm());
+    let whole = jac.norm();
+    let Some(cache) = cache else {
+        let sub = DMatrix::from_fn(jac.nrows(), cols.len(), |i, j| jac[(i, cols[j])]);
+        let (dx, _) = pinv_solve_in(&sub, &res, whole);
+        for (j, &c) in cols.iter().enumerate() {
+            qdot[c] -= dx[j];
+        }
+        return res.amax();
+    };
+    // The rows of Φ_q over the columns, as the columns of its transpose.
+    let bt = DMatrix::from_fn(cols.len(), jac.nrows(), |j, i| jac[(i, cols[j])]);
+    if let Some((for_cols, selected)) = &cache.selection
+        && *for_cols == cols
+    {
+        let (mut dz, mut unused) = (DVector::zeros(cols.len()), DVector::zeros(0));
+        let tol = RANK_TOLERANCE * whole;
+        if solve_selected_rows(
+            &mut cache.work,
+            &bt,
+            &res,
+            selected,
+            RANK_TOLERANCE,
+            tol,
+            false,
+            &mut dz,
+            &mut unused,
+        ) {
+            cache.reused += 1;
+            for (j, &c) in cols.iter().enumerate() {
+                qdot[c] += dz[j];
+            }
+            return res.amax();
+        }
+    }
+    cache.decompositions += 1;
+    let svd = JacobiSvd::thin(&bt.transpose());
+    let tol = svd.tolerance().max(RANK_TOLERANCE * whole);
+    let dx = svd.solve_with(&res, tol);
+    let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
+    cache.selection = Some((cols.clone(), pivot_columns(&bt, rank)));
     for (j, &c) in cols.iter().enumerate() {
         qdot[c] -= dx[j];
     }

@@ -21,6 +21,7 @@ pub mod mechanism;
 pub mod roots;
 pub mod run;
 pub mod single_coordinate;
+pub mod sparse_cholesky;
 pub mod system;
 
 pub use analysis::{AnalysisSpec, MethodName};

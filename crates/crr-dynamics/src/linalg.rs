@@ -165,6 +165,55 @@ pub struct JacobiSvd {
     pub singular_values: DVector<f64>,
     /// The decomposition is of Aᵀ ([`Self::thin`] of a wide A): `w` and `v` describe Aᵀ.
     transposed: bool,
+    /// [`Self::thin`] only: the rows and columns of A that hold a nonzero entry, when some do
+    /// not (A's shape is `shape`). `w`, `v` and `singular_values` then describe the submatrix
+    /// of those rows and columns; solves scatter back (a zero column's unknown is 0, a zero
+    /// row's multiplier is 0: both the minimum-norm choice).
+    support: Option<Support>,
+}
+
+/// The nonzero rows and columns of a matrix of shape `shape`, in order.
+#[derive(Clone, Debug)]
+struct Support {
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    shape: (usize, usize),
+}
+
+impl Support {
+    /// The nonzero rows and columns of `a`, or None when every row and column has an entry.
+    fn of(a: &DMatrix<f64>) -> Option<Support> {
+        let (m, n) = a.shape();
+        let mut row_used = vec![false; m];
+        let mut cols = Vec::with_capacity(n);
+        for j in 0..n {
+            let mut used = false;
+            for (i, &x) in a.column(j).iter().enumerate() {
+                if x != 0.0 {
+                    row_used[i] = true;
+                    used = true;
+                }
+            }
+            if used {
+                cols.push(j);
+            }
+        }
+        let rows: Vec<usize> = (0..m).filter(|&i| row_used[i]).collect();
+        (rows.len() < m || cols.len() < n).then_some(Support {
+            rows,
+            cols,
+            shape: (m, n),
+        })
+    }
+
+    /// `x` (indexed like A's kept columns or rows, `kept`) spread to length `len` with zeros.
+    fn scatter(x: &DVector<f64>, kept: &[usize], len: usize) -> DVector<f64> {
+        let mut out = DVector::zeros(len);
+        for (k, &i) in kept.iter().enumerate() {
+            out[i] = x[k];
+        }
+        out
+    }
 }
 
 /// Largest number of Jacobi sweeps (each visits every column pair once); convergence is
@@ -228,13 +277,32 @@ impl JacobiSvd {
             v,
             singular_values,
             transposed: false,
+            support: None,
         }
     }
 
     /// The decomposition of A or of Aᵀ, whichever has fewer columns (Jacobi's work grows with the
     /// square of the column count): for solves, pseudo-inverses and ranks. A wide matrix (the
     /// seated-slot rows of a chain) costs a fraction of [`Self::new`]. No null space.
+    ///
+    /// Rows and columns of exact zeros are left out first: they change no solve and no nonzero
+    /// singular value, and planar structures have many (a planar loop's out-of-plane closure
+    /// rows are identically zero), which would otherwise set the work.
     pub fn thin(a: &DMatrix<f64>) -> Self {
+        if let Some(support) = Support::of(a) {
+            let sub = a
+                .select_rows(support.rows.iter())
+                .select_columns(support.cols.iter());
+            return Self {
+                support: Some(support),
+                ..Self::thin_dense(&sub)
+            };
+        }
+        Self::thin_dense(a)
+    }
+
+    /// [`Self::thin`] without leaving zero rows and columns out.
+    fn thin_dense(a: &DMatrix<f64>) -> Self {
         if a.nrows() < a.ncols() {
             Self {
                 transposed: true,
@@ -268,6 +336,15 @@ impl JacobiSvd {
 
     /// [`Self::solve`] with singular values at or below `tol` (absolute) dropped.
     pub fn solve_with(&self, b: &DVector<f64>, tol: f64) -> DVector<f64> {
+        if let Some(sup) = &self.support {
+            let x = self.solve_kept(&b.select_rows(sup.rows.iter()), tol);
+            return Support::scatter(&x, &sup.cols, sup.shape.1);
+        }
+        self.solve_kept(b, tol)
+    }
+
+    /// [`Self::solve_with`] on the decomposed (kept) rows and columns.
+    fn solve_kept(&self, b: &DVector<f64>, tol: f64) -> DVector<f64> {
         if self.transposed {
             // A = (Aᵀ)ᵀ: A⁺ b = ((Aᵀ)ᵀ)⁺ b.
             return self.solve_transposed_raw(b, tol);
@@ -290,6 +367,15 @@ impl JacobiSvd {
     /// y = (Aᵀ)⁺ c = Σ_{σⱼ > tol} wⱼ (vⱼᵀ c)/σⱼ², the minimum-norm least-squares solution of
     /// Aᵀ y = c (singular values at or below `tol`, absolute, dropped).
     pub fn solve_transposed_with(&self, c: &DVector<f64>, tol: f64) -> DVector<f64> {
+        if let Some(sup) = &self.support {
+            let y = self.solve_transposed_kept(&c.select_rows(sup.cols.iter()), tol);
+            return Support::scatter(&y, &sup.rows, sup.shape.0);
+        }
+        self.solve_transposed_kept(c, tol)
+    }
+
+    /// [`Self::solve_transposed_with`] on the decomposed (kept) rows and columns.
+    fn solve_transposed_kept(&self, c: &DVector<f64>, tol: f64) -> DVector<f64> {
         if self.transposed {
             return self.solve_raw(c, tol);
         }
@@ -318,10 +404,22 @@ impl JacobiSvd {
                 out += self.v.column(j) * self.w.column(j).transpose() / (sigma * sigma);
             }
         }
-        if self.transposed {
+        let out = if self.transposed {
             out.transpose()
         } else {
             out
+        };
+        match &self.support {
+            Some(sup) => {
+                let mut full = DMatrix::zeros(sup.shape.1, sup.shape.0);
+                for (a, &i) in sup.cols.iter().enumerate() {
+                    for (b, &j) in sup.rows.iter().enumerate() {
+                        full[(i, j)] = out[(a, b)];
+                    }
+                }
+                full
+            }
+            None => out,
         }
     }
 
@@ -332,7 +430,7 @@ impl JacobiSvd {
     /// On a decomposition from [`Self::thin`] of a wide matrix (it has no full V).
     pub fn null_space(&self) -> DMatrix<f64> {
         assert!(
-            !self.transposed,
+            !self.transposed && self.support.is_none(),
             "JacobiSvd::null_space needs JacobiSvd::new, not thin"
         );
         let tol = self.tolerance();
@@ -428,6 +526,63 @@ pub fn pivot_columns(a: &DMatrix<f64>, r: usize) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_thin_decomposition_leaves_zero_rows_and_columns_out_without_changing_a_solve() {
+        // A rank-2 core (3 × 3) embedded in 6 × 5 with zero rows 1, 4, 5 and zero columns 0, 3.
+        // Its minimum-norm solutions are the core's, scattered: a zero column's unknown and a
+        // zero row's multiplier are 0. Checked against the normal equations of the core, solved
+        // by hand through its null space (independent of the SVD).
+        let core = DMatrix::from_row_slice(3, 3, &[1.0, 2.0, 3.0, 2.0, -1.0, 0.5, 3.0, 1.0, 3.5]);
+        let (rows, cols) = ([0, 2, 3], [1, 2, 4]);
+        let mut a = DMatrix::zeros(6, 5);
+        for (i, &r) in rows.iter().enumerate() {
+            for (j, &c) in cols.iter().enumerate() {
+                a[(r, c)] = core[(i, j)];
+            }
+        }
+        let b = DVector::from_column_slice(&[1.0, 7.0, -2.0, 0.5, 9.0, -4.0]);
+        let thin = JacobiSvd::thin(&a);
+        assert_eq!(thin.rank(), 2);
+        let x = thin.solve(&b);
+        for c in [0, 3] {
+            assert_eq!(x[c], 0.0, "zero column {c}");
+        }
+        // x solves the normal equations Aᵀ A x = Aᵀ b and is orthogonal to the core's null
+        // space, n = (−0.8, −1.1, 1) by hand (row 3 = row 1 + row 2 of the core; from rows 1
+        // and 2, b = 2a + c/2 and 5a + 4c = 0).
+        let normal = a.transpose() * (&a * &x - &b);
+        assert!(
+            normal.amax() <= 1e-12 * b.norm(),
+            "normal equations {normal}"
+        );
+        let mut null = DVector::zeros(5);
+        let n_core = DVector::from_column_slice(&[-0.8, -1.1, 1.0]);
+        assert!((&core * &n_core).amax() < 1e-14);
+        for (j, &c) in cols.iter().enumerate() {
+            null[c] = n_core[j];
+        }
+        assert!(x.dot(&null).abs() <= 1e-12 * x.norm());
+        // The transposed solve: zero rows get 0 multipliers, and Aᵀ y reproduces c when c is
+        // in the range of Aᵀ.
+        let c = a.transpose() * DVector::from_column_slice(&[1.0, 0.0, 2.0, -1.0, 0.0, 0.0]);
+        let y = thin.solve_transposed_with(&c, thin.tolerance());
+        for r in [1, 4, 5] {
+            assert_eq!(y[r], 0.0, "zero row {r}");
+        }
+        assert!((a.transpose() * &y - &c).amax() <= 1e-12 * c.norm());
+        // The pseudo-inverse has the full shape and gives the same solution.
+        let pinv = thin.pseudo_inverse();
+        assert_eq!(pinv.shape(), (5, 6));
+        assert!((&pinv * &b - &x).amax() <= 1e-12 * x.norm());
+        // All zeros: rank 0, zero solution.
+        let zero = JacobiSvd::thin(&DMatrix::zeros(3, 2));
+        assert_eq!(zero.rank(), 0);
+        assert_eq!(
+            zero.solve(&DVector::from_element(3, 1.0)),
+            DVector::zeros(2)
+        );
+    }
 
     #[test]
     fn cholesky_solves_a_random_spd_system_to_round_off() {

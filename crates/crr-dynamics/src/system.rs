@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crr_kinematics::Model;
 
-use crate::closed_chain::{Partition, project_positions, project_velocities};
+use crate::closed_chain::{Partition, project_positions, project_velocities_with};
 use crate::eom::{Dynamics, GeneralizedForce};
 use crate::ground_motion::GroundMotion;
 use crate::integrator::{OdeSystem, RhsError};
@@ -147,13 +147,14 @@ impl OdeSystem for ConstrainedSystem<'_> {
             let d = &mut *self.dynamics;
             project_positions(self.model, &mut d.kin, &d.pivots, &mut self.q, Some(&free))
                 .map_err(|e| RhsError(e.to_string()))?;
-            project_velocities(
+            project_velocities_with(
                 self.model,
                 &mut d.kin,
                 &d.pivots,
                 &self.q,
                 &mut self.qdot,
                 Some(&free),
+                Some(&mut d.velocity_projection),
             );
         }
         y[..n].copy_from_slice(self.q.as_slice());

@@ -40,11 +40,11 @@ impl Dynamics {
         for (i, &k) in self.free.iter().enumerate() {
             self.z[i] = self.residual[k];
         }
-        forward_substitute(&self.factor, self.z.as_mut_slice());
+        self.factor.forward(self.z.as_mut_slice());
         let seated_rows = self.seated.iter().filter(|&&s| self.is_row(s)).count();
         let rows = model.constraint_rows + seated_rows;
         if rows == 0 {
-            back_substitute_transposed(&self.factor, self.z.as_mut_slice());
+            self.factor.backward_transposed(self.z.as_mut_slice());
             self.scatter_accelerations();
             self.lambda.fill(0.0);
             self.seat_reactions
@@ -73,7 +73,7 @@ impl Dynamics {
             }
         }
         for mut col in bt.column_iter_mut() {
-            forward_substitute(&self.factor, col.as_mut_slice());
+            self.factor.forward(col.as_mut_slice());
         }
         // With seated coordinates eliminated, B's own σ_max can be round-off (a loop whose free
         // coordinates do not enter its closure here): the rank threshold is then taken against the
@@ -107,6 +107,7 @@ impl Dynamics {
                 &bt,
                 &residual,
                 &self.selections[c].selected,
+                RANK_TOLERANCE.sqrt(),
                 floor,
                 self.min_norm_multipliers,
                 &mut dz,
@@ -143,7 +144,7 @@ impl Dynamics {
             }
         }
         self.z += &dz;
-        back_substitute_transposed(&self.factor, self.z.as_mut_slice());
+        self.factor.backward_transposed(self.z.as_mut_slice());
         self.scatter_accelerations();
         self.lambda = lambda_scaled
             .rows(0, model.constraint_rows)

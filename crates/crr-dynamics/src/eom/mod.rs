@@ -28,11 +28,9 @@ use crr_kinematics::{
 
 use crate::articulated_body::ArticulatedBody;
 use crate::ground_motion::GroundMotion;
-use crate::linalg::{
-    JacobiSvd, RANK_TOLERANCE, back_substitute_transposed, cholesky_in_place, cholesky_solve,
-    forward_substitute, pivot_columns,
-};
+use crate::linalg::{JacobiSvd, RANK_TOLERANCE, cholesky_in_place, cholesky_solve, pivot_columns};
 use crate::single_coordinate;
+use crate::sparse_cholesky::SparseCholesky;
 
 /// A failure of the equations of motion at some state.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -131,12 +129,17 @@ pub struct Dynamics {
     rows_work: SelectedRowsWork,
     /// The last closed-chain solve used the selected rows (not the SVD).
     used_selected: bool,
-    /// Cholesky factor L of M_ff, the block of M over the free (not seated) coordinates.
-    factor: DMatrix<f64>,
+    /// Cholesky factor L of M_ff, the block of M over the free (not seated) coordinates, on
+    /// its tree pattern (no fill in the order of `free`).
+    factor: SparseCholesky,
+    /// The free coordinates `factor`'s pattern was analysed for.
+    factor_free: Vec<usize>,
     row_scale: DVector<f64>,
     /// Seated tree coordinates (q̈ₖ = 0), by coordinate.
     locked: Vec<bool>,
-    /// The coordinates not seated, in order: the columns of `factor`.
+    /// The coordinates not seated, descendants before ancestors (decreasing index: a parent's
+    /// index is below its children's): the columns of `factor`, in the order that gives a
+    /// tree's mass matrix no fill (Featherstone's L^T L order).
     free: Vec<usize>,
     /// r = Q + F_extra − h at the last evaluation (N m).
     residual: DVector<f64>,
@@ -152,6 +155,8 @@ pub struct Dynamics {
     /// The last [`Self::accelerations_with`] used the one-coordinate closed form
     /// ([`crate::single_coordinate`]).
     used_single_coordinate: bool,
+    /// Independent constraint rows kept for the integration's velocity projections.
+    pub velocity_projection: crate::closed_chain::VelocityProjection,
     /// The one-coordinate kernel of the last active pivot ([`Self::integration_accelerations`]).
     kernel: Option<single_coordinate::Kernel>,
     /// The kernel of the pivot before: a rocking block alternates between two.
@@ -217,7 +222,8 @@ mod single_coordinate_path;
 mod slot_rows;
 
 pub use selected_rows::DEPENDENT_ROW_TOLERANCE;
-use selected_rows::{RowSelection, SELECTION_CACHE, SelectedRowsWork, solve_selected_rows};
+use selected_rows::{RowSelection, SELECTION_CACHE};
+pub(crate) use selected_rows::{SelectedRowsWork, solve_selected_rows};
 pub use slot_rows::slot_row;
 
 impl Dynamics {
@@ -231,7 +237,8 @@ impl Dynamics {
             ground_force: DVector::zeros(n),
             qddot: DVector::zeros(n),
             lambda: DVector::zeros(model.constraint_rows),
-            factor: DMatrix::zeros(n, n),
+            factor: SparseCholesky::default(),
+            factor_free: Vec::new(),
             row_scale: constraint_row_scale(model),
             seated: Vec::new(),
             seat_reactions: DVector::zeros(0),
@@ -248,10 +255,11 @@ impl Dynamics {
             mass_current: false,
             used_articulated: false,
             used_single_coordinate: false,
+            velocity_projection: Default::default(),
             kernel: None,
             previous_kernel: None,
             locked: vec![false; n],
-            free: (0..n).collect(),
+            free: (0..n).rev().collect(),
             residual: DVector::zeros(n),
             z: DVector::zeros(n),
         }
@@ -302,19 +310,41 @@ impl Dynamics {
             }
         }
         self.free.clear();
-        self.free.extend((0..n).filter(|&k| !self.locked[k]));
-        let nf = self.free.len();
-        if self.factor.nrows() != nf {
-            self.factor = DMatrix::zeros(nf, nf);
+        self.free.extend((0..n).rev().filter(|&k| !self.locked[k]));
+        if self.factor_free != self.free {
+            self.analyse_mass_pattern(model);
         }
-        for (i, &fi) in self.free.iter().enumerate() {
-            for (j, &fj) in self.free.iter().enumerate().take(i + 1) {
-                self.factor[(i, j)] = self.kin.mass_matrix[(fi, fj)];
+        let (free, mass) = (&self.free, &self.kin.mass_matrix);
+        self.factor
+            .factor(|i, j| mass[(free[i], free[j])])
+            .map_err(|k| DynamicsError::SingularMassMatrix {
+                coordinate: model.coords[self.free[k]].name.clone(),
+            })
+    }
+
+    /// The pattern of M_ff for `factor`: M_ij ≠ 0 only when one of coordinates i, j carries the
+    /// other (composite rigid bodies write nothing else), so row i's entries left of the
+    /// diagonal, in the order of `free`, are the free descendants of coordinate i.
+    fn analyse_mass_pattern(&mut self, model: &Model) {
+        let n = model.dof();
+        let mut position = vec![usize::MAX; n];
+        for (i, &k) in self.free.iter().enumerate() {
+            position[k] = i;
+        }
+        let mut descendants: Vec<Vec<usize>> = vec![Vec::new(); self.free.len()];
+        for (i, &k) in self.free.iter().enumerate() {
+            let mut up = model.coords[k].parent;
+            while let Some(a) = up {
+                if position[a] != usize::MAX {
+                    descendants[position[a]].push(i);
+                }
+                up = model.coords[a].parent;
             }
         }
-        cholesky_in_place(&mut self.factor).map_err(|k| DynamicsError::SingularMassMatrix {
-            coordinate: model.coords[self.free[k]].name.clone(),
-        })
+        self.factor.analyse(self.free.len(), |i, out| {
+            out.extend_from_slice(&descendants[i])
+        });
+        self.factor_free.clone_from(&self.free);
     }
 
     /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains with no seated closure
