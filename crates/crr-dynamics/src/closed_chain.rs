@@ -116,7 +116,7 @@ pub fn mobility_after_step(model: &Model, step: f64) -> Result<FiniteMobility, D
     let null = if model.closure_rows == 0 {
         DMatrix::identity(n, n)
     } else {
-        JacobiSvd::new(&closure_rows).null_space()
+        crate::linalg::null_space(&closure_rows)
     };
     if null.ncols() == 0 {
         return Ok(FiniteMobility {

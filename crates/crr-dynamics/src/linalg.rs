@@ -478,6 +478,20 @@ pub fn pinv_solve_in(a: &DMatrix<f64>, b: &DVector<f64>, reference: f64) -> (DVe
     (svd.solve_with(b, tol), rank)
 }
 
+/// Orthonormal basis of the null space of A, as columns: the right singular vectors of its
+/// Jacobi SVD with σ ≤ `RANK_TOLERANCE · σ_max` ([`JacobiSvd::null_space`]). A's rows of exact
+/// zeros are left out first: they constrain nothing and change no singular value, and a planar
+/// structure's loops have many (their out-of-plane rows), which would otherwise set the work.
+pub fn null_space(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let rows: Vec<usize> = (0..a.nrows())
+        .filter(|&i| a.row(i).iter().any(|&x| x != 0.0))
+        .collect();
+    if rows.len() == a.nrows() {
+        return JacobiSvd::new(a).null_space();
+    }
+    JacobiSvd::new(&a.select_rows(rows.iter())).null_space()
+}
+
 /// A⁺, the pseudo-inverse with singular values below `RANK_TOLERANCE · σ_max` dropped.
 pub fn pseudo_inverse(a: &DMatrix<f64>) -> DMatrix<f64> {
     if a.nrows() == 0 || a.ncols() == 0 {
@@ -526,6 +540,30 @@ pub fn pivot_columns(a: &DMatrix<f64>, r: usize) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_null_space_without_zero_rows_is_the_null_space() {
+        // Rows (1, 1, 0, 0), (0, 0, 1, −1) and three zero rows: the null space is spanned by
+        // (1, −1, 0, 0)/√2 and (0, 0, 1, 1)/√2 (by hand). Bases differ by a rotation, so their
+        // projectors N Nᵀ are compared.
+        let mut a = DMatrix::zeros(5, 4);
+        a[(1, 0)] = 1.0;
+        a[(1, 1)] = 1.0;
+        a[(3, 2)] = 1.0;
+        a[(3, 3)] = -1.0;
+        let n = null_space(&a);
+        assert_eq!(n.ncols(), 2);
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let mut by_hand = DMatrix::zeros(4, 2);
+        by_hand[(0, 0)] = h;
+        by_hand[(1, 0)] = -h;
+        by_hand[(2, 1)] = h;
+        by_hand[(3, 1)] = h;
+        let diff = &n * n.transpose() - &by_hand * by_hand.transpose();
+        assert!(diff.amax() <= 1e-15, "{diff}");
+        // No rows at all constrain nothing.
+        assert_eq!(null_space(&DMatrix::zeros(3, 4)).ncols(), 4);
+    }
 
     #[test]
     fn the_thin_decomposition_leaves_zero_rows_and_columns_out_without_changing_a_solve() {

@@ -205,7 +205,7 @@ fn evaluate_chain_holding(
         slot_row(model, kin, s, &mut row);
         rows.row_mut(closure_rows + i).copy_from(&row.transpose());
     }
-    chain.null = Some(JacobiSvd::new(&rows).null_space());
+    chain.null = Some(crr_dynamics::linalg::null_space(&rows));
 }
 
 /// `dst` = `src`, reusing `dst`'s storage when the shapes agree.
@@ -252,7 +252,7 @@ pub(crate) struct LawWorkspace {
 /// threshold [`crr_dynamics::linalg::RANK_TOLERANCE`]).
 fn null_space(phi: &DMatrix<f64>, scale: &DVector<f64>) -> DMatrix<f64> {
     let a = DMatrix::from_fn(phi.nrows(), phi.ncols(), |i, j| scale[i] * phi[(i, j)]);
-    JacobiSvd::new(&a).null_space()
+    crr_dynamics::linalg::null_space(&a)
 }
 
 fn check_inputs(

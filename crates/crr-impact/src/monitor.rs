@@ -27,7 +27,6 @@ use serde::Serialize;
 use crr_dynamics::DynamicsError;
 use crr_dynamics::eom::{Dynamics, effective_gravity, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
-use crr_dynamics::linalg::JacobiSvd;
 use crr_kinematics::{InterfaceKind, Model, Role};
 
 /// The force a contact transmits to its child side.
@@ -436,7 +435,7 @@ pub fn self_stress_normals(
             bt.column_mut(i).copy_from(&(&row * scale[i]));
         }
     }
-    let states = JacobiSvd::new(&bt).null_space();
+    let states = crr_dynamics::linalg::null_space(&bt);
     if states.ncols() == 0 {
         return None;
     }

@@ -143,11 +143,17 @@ fn opening_mode_local(
     // local search over the sides picked modes that later needed tension (the 3D arch under its
     // record), so single releases and the active set keep that case.
     let rate_scale = (model.gravity / model.size).sqrt();
-    if model.constraint_rows > 0
-        && qdot.amax() <= 1e-12 * rate_scale
-        && let Some(mode) = opening_from_rest(model, ground, template, trial, rest, t, q, qdot, tol)
-    {
-        return mode;
+    if model.constraint_rows > 0 && qdot.amax() <= 1e-12 * rate_scale {
+        trial.pivots.clone_from(&template.pivots);
+        trial.seated.clone_from(&seated);
+        trial.evaluate(model, ground, t, q, qdot);
+        if let Some(mode) = loop_opening(model, ground, template, trial, rest, t, q, qdot, tol) {
+            return mode;
+        }
+        if let Some(mode) = opening_from_rest(model, ground, template, trial, rest, t, q, qdot, tol)
+        {
+            return mode;
+        }
     }
     // The current sides: one evaluation of the state (M, h …) serves every solve, unless the
     // articulated-body algorithm solves (it does not use M, and its solve is as cheap as the
