@@ -24,14 +24,14 @@ pub(super) const SELECTION_CACHE: usize = 256;
 /// threshold √RANK_TOLERANCE/√rows ≥ 3e-6: the rank decision is the SVD's.
 pub const DEPENDENT_ROW_TOLERANCE: f64 = 1e-9;
 
-/// Safety factor between the lower bound on σ_min(B_S) and the SVD's rank threshold, and
-/// between ‖R_D‖ and that threshold: a margin for the round-off of both computations. The bound
-/// on σ_min(B_S) is certified (an upper bound on ‖G⁻¹‖₂, not an estimate), and the round-off of
-/// G = B_S B_Sᵀ moves its eigenvalues by about r ε σ_max(B)² (1e-14 σ_max² for r = 60), far below
-/// the squared threshold RANK_TOLERANCE σ_max² = 1e-9 σ_max²: a factor 2 covers it. (It was 10
-/// with the looser trace bound; on a row of 16 columns σ_min(B_S) sits 7.6 times above the
-/// threshold and every output sample fell back to the SVD.)
-pub(super) const RANK_MARGIN: f64 = 2.0;
+/// Safety factor between σ_min(B_S) and the SVD's rank threshold, and between ‖R_D‖ and that
+/// threshold: a margin for round-off. σ_min(B_S) > margin·threshold is certified by the Cholesky
+/// factorisation of G − (margin·threshold)² I succeeding, whose backward error (about r ε ‖G‖,
+/// 1e-14 ‖B‖² for r = 60) is some 1e-5 of the shift (at least RANK_TOLERANCE ‖B‖_F²); a tenth
+/// covers it. (It was 10 with a bound through ‖L_G⁻¹‖_F: on a row of 32 columns whose monitor
+/// solve has σ_min(B_S) within a few tenths of the threshold, every output sample fell back to
+/// the SVD.)
+pub(super) const RANK_MARGIN: f64 = 1.1;
 
 /// Workspace of [`solve_selected_rows`], kept in [`Dynamics`] so that the solve allocates
 /// nothing once sized.
@@ -58,8 +58,6 @@ pub(crate) struct SelectedRowsWork {
     nn: DMatrix<f64>,
     /// Scratch of length max(r, rows D).
     e: Vec<f64>,
-    /// The absolute row sums of L_G⁻¹.
-    row_sums: Vec<f64>,
     /// Scratch over the free coordinates (zero between uses): a row of R_D.
     rest: Vec<f64>,
     /// y = −G⁻¹ e_S.
@@ -71,8 +69,8 @@ pub(crate) struct SelectedRowsWork {
 /// constraint residual at z_free), and, when `min_norm`, the minimum-norm multipliers over all
 /// rows, Bᵀλ = dz (otherwise λ_S = y, λ_D = 0: another solution of the same equations). Returns
 /// false (use the SVD) unless the rank decision is provably the SVD's, within [`RANK_MARGIN`]:
-/// σ_min(B_S)² ≥ 1/b, b an upper bound of ‖G⁻¹‖₂ from L_G⁻¹, must exceed the SVD's threshold
-/// max(`relative`·σ_max(B), `floor`) (bounded above by `relative`·‖B‖_F; the equations of motion
+/// σ_min(B_S) must exceed the SVD's threshold (certified by the Cholesky factorisation of
+/// G − (margin·threshold)² I succeeding) max(`relative`·σ_max(B), `floor`) (bounded above by `relative`·‖B‖_F; the equations of motion
 /// use √RANK_TOLERANCE, the projections RANK_TOLERANCE), so the SVD keeps r = |S| singular
 /// values; and the rows D not selected must lie in the span of B_S:
 /// B_D = C B_S + R_D with ‖R_D‖_F ≤ [`DEPENDENT_ROW_TOLERANCE`]·‖B‖_F, which bounds
@@ -149,38 +147,29 @@ pub(crate) fn solve_selected_rows(
             };
         }
     }
-    if work.g.factor_dense(&work.g_dense).is_err() {
+    // σ_min(B_S)² = λ_min(G) > τ exactly when G − τI is positive definite: its Cholesky
+    // factorisation succeeding certifies the rank decision (τ = (margin·threshold)², far above
+    // the factorisation's backward error r ε ‖G‖). Then G itself is factorised on the same
+    // pattern for the solves.
+    let tau = (RANK_MARGIN * threshold).powi(2);
+    let g_dense = &work.g_dense;
+    work.g.analyse(r, |k, out| {
+        out.extend((0..k).filter(|&j| g_dense[(k, j)] != 0.0));
+    });
+    if r > 0
+        && (!tau.is_finite()
+            || work
+                .g
+                .factor(|i, j| g_dense[(i, j)] - if i == j { tau } else { 0.0 })
+                .is_err())
+    {
         return false;
     }
-    // ‖G⁻¹‖₂ = ‖L_G⁻¹‖₂² = 1/σ_min(B_S)², bounded above by both ‖L_G⁻¹‖_F² (the trace of G⁻¹)
-    // and ‖L_G⁻¹‖₁‖L_G⁻¹‖_∞ (‖A‖₂² ≤ ‖A‖₁‖A‖_∞), from the columns of L_G⁻¹ alone. The trace
-    // counts every eigenvalue, r times too much on a flat spectrum (a long row of loops); the
-    // product of the column and row sums is close to ‖L_G⁻¹‖₂² when L_G⁻¹ is near diagonal.
-    let (mut frobenius2, mut column_sum) = (0.0f64, 0.0f64);
+    if work.g.factor(|i, j| g_dense[(i, j)]).is_err() {
+        return false;
+    }
     work.e.clear();
     work.e.resize(r.max(d), 0.0);
-    work.row_sums.clear();
-    work.row_sums.resize(r, 0.0);
-    for k in 0..r {
-        let e = &mut work.e[..r];
-        e.fill(0.0);
-        e[k] = 1.0;
-        work.g.forward(e);
-        let mut sum = 0.0;
-        for (x, row_sum) in e[k..].iter().zip(&mut work.row_sums[k..]) {
-            frobenius2 += x * x;
-            sum += x.abs();
-            *row_sum += x.abs();
-        }
-        column_sum = column_sum.max(sum);
-    }
-    let row_sum = work.row_sums.iter().fold(0.0f64, |a, &b| a.max(b));
-    let inv_norm2 = frobenius2.min(column_sum * row_sum);
-    // A NaN fails the check too.
-    let sigma_min = 1.0 / inv_norm2.sqrt();
-    if r > 0 && (sigma_min.is_nan() || sigma_min <= RANK_MARGIN * threshold) {
-        return false;
-    }
     // C (rows D in the basis of B_S) and ‖R_D‖_F; a zero row of B has a zero row of C and R_D.
     work.c.clear();
     work.c.resize(d * r, 0.0);
