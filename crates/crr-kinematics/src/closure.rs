@@ -81,7 +81,27 @@ pub fn constraint_residual(
 
 /// Fills `data.phi_q` with Φ_q = ∂Φ/∂q. Requires [`crate::forward_kinematics`].
 pub fn constraint_jacobian(model: &Model, data: &mut Data, pivots: &ActivePivots) {
-    data.phi_q.fill(0.0);
+    // Only the entries written below are ever nonzero (`Data::new` starts from zeros and nothing
+    // else writes Φ_q): a closure's rows depend on the coordinates of its two frames' paths to
+    // the ground alone. Zeroing those, not the whole rows × DOF(1) matrix, keeps the cost with
+    // the loops' depth rather than the structure's size.
+    for (k, &(a, b, _)) in model.symmetries.iter().enumerate() {
+        data.phi_q[(model.closure_rows + k, a)] = 0.0;
+        data.phi_q[(model.closure_rows + k, b)] = 0.0;
+    }
+    for cl in &model.closures {
+        let (a, b) = closure_frames(model, cl.interface);
+        let rows = 3 + orientation_pairs(&model.interfaces[cl.interface].kind).1;
+        for frame in [a, b] {
+            let mut j = frame;
+            while let Some(jj) = j {
+                for r in 0..rows {
+                    data.phi_q[(cl.first_row + r, jj)] = 0.0;
+                }
+                j = model.coords[jj].parent;
+            }
+        }
+    }
     for (k, &(a, b, s)) in model.symmetries.iter().enumerate() {
         data.phi_q[(model.closure_rows + k, a)] = 1.0;
         data.phi_q[(model.closure_rows + k, b)] -= s;

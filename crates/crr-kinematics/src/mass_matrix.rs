@@ -54,7 +54,9 @@ pub fn mass_matrix(model: &Model, data: &mut Data) {
             data.composite_inertia[p] += ck;
         }
     }
-    data.mass_matrix.fill(0.0);
+    // M_ij of coordinates that do not carry one another is 0 and never written here (zero since
+    // `Data::new`; nothing else writes M): only the pairs along each path to the ground are set,
+    // so the cost is the tree's depth times DOF(1), not DOF(1)².
     for i in 0..n {
         let f = data.composite_inertia[i] * spatial_axis(data, i);
         let mut j = Some(i);
