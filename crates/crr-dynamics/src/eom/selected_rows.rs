@@ -148,10 +148,14 @@ pub(crate) fn solve_selected_rows(
         }
     }
     // σ_min(B_S)² = λ_min(G) > τ exactly when G − τI is positive definite: its Cholesky
-    // factorisation succeeding certifies the rank decision (τ = (margin·threshold)², far above
-    // the factorisation's backward error r ε ‖G‖). Then G itself is factorised on the same
-    // pattern for the solves.
-    let tau = (RANK_MARGIN * threshold).powi(2);
+    // factorisation succeeding certifies the rank decision, provided τ is well above the
+    // factorisation's backward error (about r ε ‖G‖ ≤ r ε ‖B‖_F²). The equations of motion's
+    // τ = (margin·√RANK_TOLERANCE·‖B‖_F)² is 1e-9 ‖B‖_F², far above it; the projections'
+    // RANK_TOLERANCE threshold squared (1e-18) is not, so τ is raised to ten times that error
+    // there: rows closer to dependent than that go to the SVD. Then G itself is factorised on
+    // the same pattern for the solves.
+    let rounding = 10.0 * r.max(1) as f64 * f64::EPSILON * b_norm * b_norm;
+    let tau = (RANK_MARGIN * threshold).powi(2).max(rounding);
     let g_dense = &work.g_dense;
     work.g.analyse(r, |k, out| {
         out.extend((0..k).filter(|&j| g_dense[(k, j)] != 0.0));
