@@ -256,28 +256,22 @@ pub fn project_velocities_with(
     let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
     let res = &jac * &*qdot;
     let whole = jac.norm();
-    let Some(cache) = cache else {
-        let sub = DMatrix::from_fn(jac.nrows(), cols.len(), |i, j| jac[(i, cols[j])]);
-        let (dx, _) = pinv_solve_in(&sub, &res, whole);
-        for (j, &c) in cols.iter().enumerate() {
-            qdot[c] -= dx[j];
-        }
-        return res.amax();
-    };
-    // The rows of Φ_q over the columns, as the columns of its transpose.
-    let bt = DMatrix::from_fn(cols.len(), jac.nrows(), |j, i| jac[(i, cols[j])]);
-    if let Some((for_cols, selected)) = &cache.selection
+    // Φ_q over the columns changed, and its transpose (its rows as columns) for the kept rows.
+    let sub = jac.select_columns(cols.iter());
+    let bt = sub.transpose();
+    let mut cache = cache;
+    if let Some(cache) = cache.as_deref_mut()
+        && let Some((for_cols, selected)) = &cache.selection
         && *for_cols == cols
     {
         let (mut dz, mut unused) = (DVector::zeros(cols.len()), DVector::zeros(0));
-        let tol = RANK_TOLERANCE * whole;
         if solve_selected_rows(
             &mut cache.work,
             &bt,
             &res,
             selected,
             RANK_TOLERANCE,
-            tol,
+            RANK_TOLERANCE * whole,
             false,
             &mut dz,
             &mut unused,
@@ -289,12 +283,15 @@ pub fn project_velocities_with(
             return res.amax();
         }
     }
-    cache.decompositions += 1;
-    let svd = JacobiSvd::thin(&bt.transpose());
+    // The SVD (`pinv_solve_in`'s threshold), and the rows it keeps for the next projection.
+    let svd = JacobiSvd::thin(&sub);
     let tol = svd.tolerance().max(RANK_TOLERANCE * whole);
     let dx = svd.solve_with(&res, tol);
-    let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
-    cache.selection = Some((cols.clone(), pivot_columns(&bt, rank)));
+    if let Some(cache) = cache {
+        cache.decompositions += 1;
+        let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
+        cache.selection = Some((cols.clone(), pivot_columns(&bt, rank)));
+    }
     for (j, &c) in cols.iter().enumerate() {
         qdot[c] -= dx[j];
     }

@@ -37,6 +37,10 @@ pub struct SparseCholesky {
     col_idx: Vec<usize>,
     /// The pattern is nearly full: dense factorisation and solves.
     dense: bool,
+    /// Scratch of [`Self::analyse`]: elimination-tree parents, visit marks, a row's entries.
+    parent: Vec<usize>,
+    mark: Vec<usize>,
+    entries: Vec<usize>,
 }
 
 impl SparseCholesky {
@@ -47,23 +51,32 @@ impl SparseCholesky {
         const NONE: usize = usize::MAX;
         if self.l.nrows() != n {
             self.l = DMatrix::zeros(n, n);
-        } else {
+        } else if self.dense {
             self.l.fill(0.0);
+        } else {
+            // Only the old pattern below the diagonal holds numbers (the diagonal is rewritten).
+            for k in 0..self.n {
+                for &j in &self.row_idx[self.row_ptr[k]..self.row_ptr[k + 1]] {
+                    self.l[(k, j)] = 0.0;
+                }
+            }
         }
         self.n = n;
         self.row_ptr.clear();
         self.row_idx.clear();
         self.row_ptr.push(0);
-        let mut parent = vec![NONE; n];
-        let mut mark = vec![NONE; n];
-        let mut entries = Vec::new();
+        let (parent, mark, entries) = (&mut self.parent, &mut self.mark, &mut self.entries);
+        parent.clear();
+        parent.resize(n, NONE);
+        mark.clear();
+        mark.resize(n, NONE);
         for k in 0..n {
             mark[k] = k;
             let start = self.row_idx.len();
             entries.clear();
-            lower(k, &mut entries);
+            lower(k, entries);
             // Row k of L: every node on the elimination-tree paths from A's nonzeros up to k.
-            for &i in &entries {
+            for &i in entries.iter() {
                 debug_assert!(i < k, "lower pattern of row {k} holds column {i}");
                 let mut j = i;
                 while mark[j] != k {

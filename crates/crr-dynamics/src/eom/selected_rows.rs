@@ -83,8 +83,9 @@ pub(crate) struct SelectedRowsWork {
 /// rows enter I + C Cᵀ.
 ///
 /// Rows of B are sparse (a closure row touches the coordinates of its loop, and L⁻¹ spreads it
-/// to their ancestors only): every product runs over a row's nonzeros. Work on a colonnade of k
-/// columns: O(k) for the rows and G's banded factor, against O(m r n_f + r³) dense.
+/// to their ancestors only): every product runs over a row's nonzeros, and G's factor over its
+/// pattern (banded on a row of columns), against O(m r n_f + r³) dense; finding the nonzeros is
+/// a scan of Bᵀ, O(m n_f).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_selected_rows(
     work: &mut SelectedRowsWork,

@@ -136,14 +136,15 @@ fn opening_mode_local(
         return None;
     }
     let tol = 1e-9 * model.gravity / model.size;
-    // A structure with loops at rest: Gauss' principle over the seated slots' sides decides
-    // (uplift_from_rest.rs). It finds the mechanisms of several joints in hyperstatic loops (an
-    // arch that rocks out of its plane) that single releases and the active set below miss, and
-    // it costs a few factorisations instead of a solve per seated slot and side. In motion its
-    // local search over the sides picked modes that later needed tension (the 3D arch under its
-    // record), so single releases and the active set keep that case.
+    // A structure with loops at rest: the contact program decides (loop_opening, below), and
+    // where it cannot, Gauss' principle over the seated slots' sides (uplift_from_rest.rs). Both
+    // find the mechanisms of several joints in hyperstatic loops (an arch that rocks out of its
+    // plane) that single releases and the active set below miss. In motion the search over
+    // sides picked modes that later needed tension (the 3D arch under its record), so single
+    // releases and the active set keep that case.
     let rate_scale = (model.gravity / model.size).sqrt();
-    if model.constraint_rows > 0 && qdot.amax() <= 1e-12 * rate_scale {
+    let at_rest = model.constraint_rows > 0 && qdot.amax() <= 1e-12 * rate_scale;
+    if at_rest {
         trial.pivots.clone_from(&template.pivots);
         trial.seated.clone_from(&seated);
         trial.evaluate(model, ground, t, q, qdot);
@@ -176,8 +177,8 @@ fn opening_mode_local(
     }
     // With loops, one convex program over the seated faces decides (opening_qp.rs); the single
     // releases and the active set below remain for open chains (where single releases are
-    // exact) and for a program that fails.
-    if model.constraint_rows > 0 {
+    // exact) and for a program that fails. At rest it has run above, on the same state.
+    if model.constraint_rows > 0 && !at_rest {
         if may_open.is_none() {
             trial.evaluate(model, ground, t, q, qdot);
         }
