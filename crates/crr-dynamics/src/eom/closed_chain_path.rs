@@ -25,12 +25,43 @@ impl Dynamics {
         self.used_selected = false;
         self.factorise(model)?;
         self.add_extra_force(model, t, q, qdot, extra);
-        let n = model.dof();
-        let nf = self.free.len();
         // r = Q + F_extra − h: the generalized force left for inertia and constraints.
         self.residual.copy_from(&self.load);
         self.residual += &self.extra_force;
         self.residual -= &self.kin.velocity_product;
+        self.solve_rows(model, t, true)
+    }
+
+    /// The velocity an impulse leaves on the state last given to [`Self::evaluate`]: Gauss'
+    /// principle of impulsive motion, M q̇⁺ = p + Φ'ᵀΛ with Φ' q̇⁺ = 0 over the closure rows and
+    /// the rate rows of the seated slots (the seated tree coordinates of an open chain keep
+    /// q̇ = 0 by elimination). `p` is the generalized momentum the bodies carry into the impact;
+    /// q̇⁺ is the velocity of the constrained chain nearest M⁻¹p in the kinetic metric, i.e. the
+    /// plastic impact on those rows. The same factorisations and selected rows as the
+    /// accelerations (no SVD while the selected rows stay independent). Returns q̇⁺; the impulses
+    /// Λ are left in `lambda` and `seat_reactions`.
+    pub fn solve_impulse(
+        &mut self,
+        model: &Model,
+        t: f64,
+        p: &DVector<f64>,
+    ) -> Result<&DVector<f64>, DynamicsError> {
+        self.used_articulated = false;
+        self.used_single_coordinate = false;
+        self.used_selected = false;
+        self.factorise(model)?;
+        self.residual.copy_from(p);
+        self.solve_rows(model, t, false)?;
+        Ok(&self.qddot)
+    }
+
+    /// Gauss' principle on the constraint rows for the generalized force in `residual`, after
+    /// [`Self::factorise`]: q̈ (or q̇⁺) into `qddot`, the multipliers into `lambda` and
+    /// `seat_reactions`. `with_bias`: the rows' right-hand sides are −(Φ̇_q q̇) (accelerations);
+    /// without, 0 (impulses).
+    fn solve_rows(&mut self, model: &Model, t: f64, with_bias: bool) -> Result<(), DynamicsError> {
+        let n = model.dof();
+        let nf = self.free.len();
         // Gauss' principle in the coordinates z = Lᵀq̈_f (M_ff = L Lᵀ): z is the point of the
         // affine set B z = −c nearest to z_free = L⁻¹ r_f, with B = Φ'_f L⁻ᵀ the row-scaled closures
         // and the seated rows not eliminated, over the free columns. Decomposing B (rows × free) rather
@@ -60,13 +91,18 @@ impl Dynamics {
             }
         }
         let mut bias = DVector::zeros(rows);
-        bias.rows_mut(0, model.constraint_rows)
-            .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
+        if with_bias {
+            bias.rows_mut(0, model.constraint_rows)
+                .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
+        }
         let mut seated_row_matrix = DMatrix::zeros(n, seated_rows);
         let mut row = DVector::zeros(n);
         let row_slots = self.seated.iter().copied().filter(|&s| self.is_row(s));
         for (k, slot) in row_slots.enumerate() {
-            bias[model.constraint_rows + k] = slot_row(model, &self.kin, slot, &mut row);
+            let row_bias = slot_row(model, &self.kin, slot, &mut row);
+            if with_bias {
+                bias[model.constraint_rows + k] = row_bias;
+            }
             seated_row_matrix.column_mut(k).copy_from(&row);
             for (j, &c) in self.free.iter().enumerate() {
                 bt[(j, model.constraint_rows + k)] = row[c];

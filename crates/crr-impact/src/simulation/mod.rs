@@ -39,7 +39,7 @@ use crr_kinematics::{
 
 use crate::laws::{
     ImpactError, LawWorkspace, RegularisedSlot, dirac_law_holding, dirac_regularised_force,
-    momentum_law_with, restitution_law_holding,
+    momentum_law_projected, restitution_law_holding,
 };
 
 mod events;

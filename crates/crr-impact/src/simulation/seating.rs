@@ -1152,7 +1152,7 @@ impl Simulation<'_> {
             qdot,
             &self.dynamics.pivots,
             &held,
-        );
+        )?;
         d.ensure_mass_matrix(model);
         let before = 0.5 * qdot.dot(&(&d.kin.mass_matrix * qdot));
         let u_before = potential_energy(model, &d.kin);
