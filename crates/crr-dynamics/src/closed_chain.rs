@@ -10,7 +10,9 @@ use crr_kinematics::{
     forward_kinematics,
 };
 
-use crate::eom::{DynamicsError, SelectedRowsWork, constraint_row_scale, solve_selected_rows};
+use crate::eom::{
+    DynamicsError, SelectedRowsWork, SparseRows, constraint_row_scale, solve_selected_rows,
+};
 use crate::linalg::{JacobiSvd, RANK_TOLERANCE, pinv_solve_in, pivot_columns, rank};
 
 /// Convergence threshold of the Newton projections, relative to the model size for point rows.
@@ -267,7 +269,7 @@ pub fn project_velocities_with(
         let (mut dz, mut unused) = (DVector::zeros(cols.len()), DVector::zeros(0));
         if solve_selected_rows(
             &mut cache.work,
-            &bt,
+            &SparseRows::from_transposed(&bt),
             &res,
             selected,
             RANK_TOLERANCE,

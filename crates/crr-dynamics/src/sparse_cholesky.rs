@@ -181,6 +181,32 @@ impl SparseCholesky {
         }
     }
 
+    /// [`Self::forward`] on a right-hand side whose nonzeros lie in `pattern` (ascending), a set
+    /// closed under the elimination tree's parents (every row below a pattern entry in L's
+    /// columns is in the pattern): then x has the same pattern, and only its entries are
+    /// visited. The same operations in the same order as [`Self::forward`], which skips the
+    /// zeros outside the pattern. On a tree-ordered mass matrix the coordinates on the paths
+    /// to the ground of a loop's two frames are such a set (a closure row's pattern).
+    pub fn forward_on(&self, pattern: &[usize], b: &mut [f64]) {
+        if self.dense {
+            return forward_substitute(&self.l, b);
+        }
+        for &j in pattern {
+            if b[j] == 0.0 {
+                continue;
+            }
+            let x = b[j] / self.l[(j, j)];
+            b[j] = x;
+            for &k in &self.col_idx[self.col_ptr[j]..self.col_ptr[j + 1]] {
+                debug_assert!(
+                    pattern.binary_search(&k).is_ok(),
+                    "pattern not closed at {k}"
+                );
+                b[k] -= self.l[(k, j)] * x;
+            }
+        }
+    }
+
     /// Solves Lᵀ x = y in place.
     pub fn backward_transposed(&self, b: &mut [f64]) {
         if self.dense {
@@ -274,6 +300,24 @@ mod tests {
         let mut touched = touched;
         touched.sort_unstable();
         assert_eq!(touched, expected);
+        // A right-hand side on the paths of nodes 8 and 6 to the root (a closure row between
+        // their frames: 8, 4, 1, 0 and 6, 5, 2, 0): the solve over that pattern alone gives the
+        // full solve's result to the last bit.
+        let on_paths = [8, 4, 1, 0, 6, 5, 2];
+        let mut pattern: Vec<usize> = on_paths
+            .iter()
+            .map(|c| perm.iter().position(|p| p == c).unwrap())
+            .collect();
+        pattern.sort_unstable();
+        let mut full = vec![0.0; n];
+        for (k, &i) in pattern.iter().enumerate() {
+            full[i] = 0.4 - 0.13 * k as f64;
+        }
+        let mut on = full.clone();
+        chol.forward(&mut full);
+        chol.forward_on(&pattern, &mut on);
+        assert_eq!(full, on);
+        assert!((0..n).all(|i| pattern.contains(&i) || on[i] == 0.0));
     }
 
     #[test]

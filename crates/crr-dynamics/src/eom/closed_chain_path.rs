@@ -83,34 +83,10 @@ impl Dynamics {
             self.tree_reactions(None);
             return self.check_finite(t);
         }
-        // Bᵀ = L⁻¹ (row-scaled Φ_q, seated rows)ᵀ over the free columns, column by column.
-        let mut bt = DMatrix::zeros(nf, rows);
-        for i in 0..model.constraint_rows {
-            for (j, &k) in self.free.iter().enumerate() {
-                bt[(j, i)] = self.row_scale[i] * self.kin.phi_q[(i, k)];
-            }
-        }
+        // The rows over every coordinate (row-scaled Φ_q, the seated slots' rate rows), each on
+        // its structural pattern, and their right-hand sides.
         let mut bias = DVector::zeros(rows);
-        if with_bias {
-            bias.rows_mut(0, model.constraint_rows)
-                .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
-        }
-        let mut seated_row_matrix = DMatrix::zeros(n, seated_rows);
-        let mut row = DVector::zeros(n);
-        let row_slots = self.seated.iter().copied().filter(|&s| self.is_row(s));
-        for (k, slot) in row_slots.enumerate() {
-            let row_bias = slot_row(model, &self.kin, slot, &mut row);
-            if with_bias {
-                bias[model.constraint_rows + k] = row_bias;
-            }
-            seated_row_matrix.column_mut(k).copy_from(&row);
-            for (j, &c) in self.free.iter().enumerate() {
-                bt[(j, model.constraint_rows + k)] = row[c];
-            }
-        }
-        for mut col in bt.column_iter_mut() {
-            self.factor.forward(col.as_mut_slice());
-        }
+        self.gather_rows(model, with_bias, &mut bias);
         // With seated coordinates eliminated, B's own σ_max can be round-off (a loop whose free
         // coordinates do not enter its closure here): the rank threshold is then taken against the
         // whole row-scaled Jacobian with every column, Jacobi-scaled by M's diagonal
@@ -118,19 +94,41 @@ impl Dynamics {
         let mut floor = 0.0;
         if nf < n {
             let mut whole = 0.0;
-            for j in 0..n {
-                let mut col = 0.0;
-                for i in 0..model.constraint_rows {
-                    col += (self.row_scale[i] * self.kin.phi_q[(i, j)]).powi(2);
+            for i in 0..rows {
+                let (idx, val) = self.rows_full.row(i);
+                for (&j, &v) in idx.iter().zip(val) {
+                    whole += v * v / self.kin.mass_matrix[(j, j)];
                 }
-                for k in 0..seated_rows {
-                    col += seated_row_matrix[(j, k)].powi(2);
-                }
-                whole += col / self.kin.mass_matrix[(j, j)];
             }
             floor = RANK_TOLERANCE.sqrt() * whole.sqrt();
         }
-        let residual = bt.tr_mul(&self.z) + &bias;
+        // B = (rows over the free columns) L⁻ᵀ, row by row: each row's pattern is closed under
+        // the tree's parents, so L⁻¹ keeps it (`forward_on`).
+        self.rows_b.clear(nf);
+        self.spread.clear();
+        self.spread.resize(nf, 0.0);
+        for i in 0..rows {
+            self.pattern.clear();
+            let (idx, val) = self.rows_full.row(i);
+            for (&k, &v) in idx.iter().zip(val) {
+                let p = self.free_position[k];
+                if p != usize::MAX {
+                    self.pattern.push(p);
+                    self.spread[p] = v;
+                }
+            }
+            self.pattern.sort_unstable();
+            self.factor.forward_on(&self.pattern, &mut self.spread);
+            let spread = &mut self.spread;
+            self.rows_b.push_row(
+                self.pattern
+                    .iter()
+                    .map(|&p| (p, std::mem::take(&mut spread[p])))
+                    .filter(|(_, v)| *v != 0.0),
+            );
+        }
+        let residual =
+            DVector::from_fn(rows, |i, _| self.rows_b.dot(i, self.z.as_slice()) + bias[i]);
         let cached = self
             .selections
             .iter()
@@ -140,7 +138,7 @@ impl Dynamics {
         let fast = match (cached, self.closed_chain_solve) {
             (Some(c), ClosedChainSolve::SelectedRows) => solve_selected_rows(
                 &mut self.rows_work,
-                &bt,
+                &self.rows_b,
                 &residual,
                 &self.selections[c].selected,
                 RANK_TOLERANCE.sqrt(),
@@ -153,6 +151,7 @@ impl Dynamics {
         };
         self.used_selected = fast;
         if !fast {
+            let bt = self.rows_b.dense_transposed();
             let svd = JacobiSvd::thin(&bt.transpose());
             // The threshold of the former solve on B Bᵀ (σ(BBᵀ) = σ(B)²): same rank decisions.
             let tol = svd.tolerance_relative(RANK_TOLERANCE.sqrt()).max(floor);
@@ -197,9 +196,83 @@ impl Dynamics {
                 a += 1;
             }
         }
-        let row_force = &seated_row_matrix * row_reactions;
+        // The generalized force of every row's multiplier, Φ_qᵀλ plus the seated rows' (the
+        // scaled rows times the scaled multipliers), over the rows' patterns.
+        let mut row_force = DVector::zeros(n);
+        for i in 0..rows {
+            let (idx, val) = self.rows_full.row(i);
+            for (&j, &v) in idx.iter().zip(val) {
+                row_force[j] += v * lambda_scaled[i];
+            }
+        }
         self.tree_reactions(Some(&row_force));
         self.check_finite(t)
+    }
+
+    /// The constraint rows over every coordinate into `rows_full`, each on its structural
+    /// pattern (columns ascending): the row-scaled rows of Φ_q (a closure's rows on the paths
+    /// of its two frames to the ground, a symmetry row on its two coordinates), then the rate
+    /// rows of the seated slots held by rows (a tree coordinate's eₖ, a closure angle's on its
+    /// interface's frame paths). Their right-hand sides into `bias` when `with_bias`.
+    fn gather_rows(&mut self, model: &Model, with_bias: bool, bias: &mut DVector<f64>) {
+        let n = model.dof();
+        self.rows_full.clear(n);
+        let mut closures: Vec<(usize, usize)> = model
+            .closures
+            .iter()
+            .map(|cl| (cl.first_row, cl.interface))
+            .collect();
+        closures.sort_unstable();
+        for (c, &(first, interface)) in closures.iter().enumerate() {
+            let last = closures.get(c + 1).map_or(model.closure_rows, |x| x.0);
+            frame_paths(model, interface, &mut self.path);
+            for i in first..last {
+                let scale = self.row_scale[i];
+                let phi_q = &self.kin.phi_q;
+                self.rows_full
+                    .push_row(self.path.iter().map(|&k| (k, scale * phi_q[(i, k)])));
+            }
+        }
+        for (k, &(a, b, _)) in model.symmetries.iter().enumerate() {
+            let i = model.closure_rows + k;
+            coordinate_paths(model, &[a, b], &mut self.path);
+            let scale = self.row_scale[i];
+            let phi_q = &self.kin.phi_q;
+            self.rows_full
+                .push_row(self.path.iter().map(|&k| (k, scale * phi_q[(i, k)])));
+        }
+        debug_assert_eq!(self.rows_full.rows(), model.constraint_rows);
+        if with_bias {
+            bias.rows_mut(0, model.constraint_rows)
+                .copy_from(&self.kin.phi_bias.component_mul(&self.row_scale));
+        }
+        let mut row = std::mem::take(&mut self.dense_row);
+        row.resize_vertically_mut(n, 0.0);
+        let row_slots: Vec<usize> = self
+            .seated
+            .iter()
+            .copied()
+            .filter(|&s| self.is_row(s))
+            .collect();
+        for (k, slot) in row_slots.into_iter().enumerate() {
+            let row_bias = slot_row(model, &self.kin, slot, &mut row);
+            if with_bias {
+                bias[model.constraint_rows + k] = row_bias;
+            }
+            if slot < n {
+                coordinate_paths(model, &[slot], &mut self.path);
+            } else {
+                let interface = model
+                    .interfaces
+                    .iter()
+                    .position(|f| f.slots.contains(&slot))
+                    .expect("a closure slot belongs to an interface");
+                frame_paths(model, interface, &mut self.path);
+            }
+            self.rows_full
+                .push_row(self.path.iter().map(|&j| (j, row[j])));
+        }
+        self.dense_row = row;
     }
 
     /// Sets `extra_force` to the extra generalized force at this state (0 without one).
@@ -232,7 +305,8 @@ impl Dynamics {
     }
 
     /// Reactions of the eliminated seated coordinates: the residual of their rows of the
-    /// equations of motion, M_k· q̈ − r_k − (Φ_qᵀλ)_k − (seated rows' force)_k, written at their
+    /// equations of motion, M_k· q̈ − r_k − (`row_force`)_k (Φ_qᵀλ and the seated rows' force,
+    /// none without constraint rows), written at their
     /// places in `seat_reactions` (sized to `seated`). q̈ vanishes on the seated coordinates, so
     /// M_k· q̈ sums over the free ones only.
     pub(super) fn tree_reactions(&mut self, row_force: Option<&DVector<f64>>) {
@@ -246,13 +320,37 @@ impl Dynamics {
                 .map(|&j| self.kin.mass_matrix[(s, j)] * self.qddot[j])
                 .sum();
             let mut reaction = inertial - self.residual[s];
-            for r in 0..self.lambda.len() {
-                reaction -= self.kin.phi_q[(r, s)] * self.lambda[r];
-            }
             if let Some(f) = row_force {
                 reaction -= f[s];
             }
             self.seat_reactions[i] = reaction;
         }
     }
+}
+
+/// The coordinates on the paths to the ground of an interface's parent and child frames (its
+/// closure rows' and angle rows' structural pattern), ascending, into `out`.
+fn frame_paths(model: &Model, interface: usize, out: &mut Vec<usize>) {
+    let iface = &model.interfaces[interface];
+    let child = model.body_coord[iface.child];
+    match model.frame_of(iface.parent) {
+        Some(parent) => coordinate_paths(model, &[parent, child], out),
+        None => coordinate_paths(model, &[child], out),
+    }
+}
+
+/// The coordinates `from` and their ancestors, ascending, into `out`: a pattern closed under
+/// the tree's parents, which L⁻¹ keeps ([`SparseCholesky::forward_on`]; a row's own nonzeros
+/// may be fewer, the rest are filled by L⁻¹ or stay zero).
+fn coordinate_paths(model: &Model, from: &[usize], out: &mut Vec<usize>) {
+    out.clear();
+    for &start in from {
+        let mut j = Some(start);
+        while let Some(k) = j {
+            out.push(k);
+            j = model.coords[k].parent;
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
 }

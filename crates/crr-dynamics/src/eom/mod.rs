@@ -141,6 +141,19 @@ pub struct Dynamics {
     /// index is below its children's): the columns of `factor`, in the order that gives a
     /// tree's mass matrix no fill (Featherstone's L^T L order).
     free: Vec<usize>,
+    /// Position of each coordinate in `free` (`usize::MAX` when seated).
+    free_position: Vec<usize>,
+    /// The constraint rows over every coordinate on their patterns (row-scaled Φ_q, seated
+    /// rows) at the last closed-chain solve.
+    rows_full: SparseRows,
+    /// B = those rows over the free columns times L⁻ᵀ, on the same patterns.
+    rows_b: SparseRows,
+    /// Scratch of the closed-chain solve: a row spread over the free coordinates (zero between
+    /// uses), a row's free pattern, an interface's frame paths, a dense rate row.
+    spread: Vec<f64>,
+    pattern: Vec<usize>,
+    path: Vec<usize>,
+    dense_row: DVector<f64>,
     /// r = Q + F_extra − h at the last evaluation (N m).
     residual: DVector<f64>,
     /// Working vector over the free coordinates: z_free, then q̈_f.
@@ -223,7 +236,7 @@ mod slot_rows;
 
 pub use selected_rows::DEPENDENT_ROW_TOLERANCE;
 use selected_rows::{RowSelection, SELECTION_CACHE};
-pub(crate) use selected_rows::{SelectedRowsWork, solve_selected_rows};
+pub(crate) use selected_rows::{SelectedRowsWork, SparseRows, solve_selected_rows};
 pub use slot_rows::slot_row;
 
 impl Dynamics {
@@ -260,6 +273,13 @@ impl Dynamics {
             previous_kernel: None,
             locked: vec![false; n],
             free: (0..n).rev().collect(),
+            free_position: Vec::new(),
+            rows_full: SparseRows::default(),
+            rows_b: SparseRows::default(),
+            spread: Vec::new(),
+            pattern: Vec::new(),
+            path: Vec::new(),
+            dense_row: DVector::zeros(n),
             residual: DVector::zeros(n),
             z: DVector::zeros(n),
         }
@@ -311,7 +331,7 @@ impl Dynamics {
         }
         self.free.clear();
         self.free.extend((0..n).rev().filter(|&k| !self.locked[k]));
-        if self.factor_free != self.free {
+        if self.factor_free != self.free || self.free_position.len() != n {
             self.analyse_mass_pattern(model);
         }
         let (free, mass) = (&self.free, &self.kin.mass_matrix);
@@ -345,6 +365,7 @@ impl Dynamics {
             out.extend_from_slice(&descendants[i])
         });
         self.factor_free.clone_from(&self.free);
+        self.free_position = position;
     }
 
     /// Computes q̈ (and λ for closed chains) at (t, q, q̇). Open chains with no seated closure

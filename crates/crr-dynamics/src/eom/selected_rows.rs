@@ -33,6 +33,86 @@ pub const DEPENDENT_ROW_TOLERANCE: f64 = 1e-9;
 /// the SVD.)
 pub(super) const RANK_MARGIN: f64 = 1.1;
 
+/// Rows of a matrix stored by their nonzeros (compressed rows, column indices ascending): B's
+/// rows, whose patterns are a loop's coordinates, so that products run over them and nothing is
+/// O(rows × columns).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SparseRows {
+    /// Number of columns.
+    pub(crate) cols: usize,
+    ptr: Vec<usize>,
+    idx: Vec<usize>,
+    val: Vec<f64>,
+}
+
+impl SparseRows {
+    /// Empties the rows (keeping the storage) for a matrix of `cols` columns.
+    pub(crate) fn clear(&mut self, cols: usize) {
+        self.cols = cols;
+        self.ptr.clear();
+        self.ptr.push(0);
+        self.idx.clear();
+        self.val.clear();
+    }
+
+    /// Appends a row from its (column, value) entries, columns ascending.
+    pub(crate) fn push_row(&mut self, entries: impl Iterator<Item = (usize, f64)>) {
+        for (j, v) in entries {
+            debug_assert!(j < self.cols);
+            debug_assert!(
+                self.idx.len() == self.ptr[self.ptr.len() - 1] || *self.idx.last().unwrap() < j
+            );
+            self.idx.push(j);
+            self.val.push(v);
+        }
+        self.ptr.push(self.idx.len());
+    }
+
+    /// Number of rows.
+    pub(crate) fn rows(&self) -> usize {
+        self.ptr.len() - 1
+    }
+
+    /// Row i's column indices and values.
+    pub(crate) fn row(&self, i: usize) -> (&[usize], &[f64]) {
+        let range = self.ptr[i]..self.ptr[i + 1];
+        (&self.idx[range.clone()], &self.val[range])
+    }
+
+    /// Row i against a dense vector.
+    pub(crate) fn dot(&self, i: usize, x: &[f64]) -> f64 {
+        let (idx, val) = self.row(i);
+        idx.iter().zip(val).map(|(&j, v)| v * x[j]).sum()
+    }
+
+    /// The rows of B given as the columns of Bᵀ (exact zeros left out).
+    pub(crate) fn from_transposed(bt: &DMatrix<f64>) -> Self {
+        let mut rows = Self::default();
+        rows.clear(bt.nrows());
+        for col in bt.column_iter() {
+            rows.push_row(col.iter().copied().enumerate().filter(|(_, x)| *x != 0.0));
+        }
+        rows
+    }
+
+    /// Bᵀ as a dense matrix (columns × rows), for the SVD.
+    pub(crate) fn dense_transposed(&self) -> DMatrix<f64> {
+        let mut bt = DMatrix::zeros(self.cols, self.rows());
+        for i in 0..self.rows() {
+            let (idx, val) = self.row(i);
+            for (&j, &v) in idx.iter().zip(val) {
+                bt[(j, i)] = v;
+            }
+        }
+        bt
+    }
+
+    /// ‖B‖_F.
+    pub(crate) fn norm(&self) -> f64 {
+        self.val.iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+}
+
 /// Workspace of [`solve_selected_rows`], kept in [`Dynamics`] so that the solve allocates
 /// nothing once sized.
 #[derive(Clone, Debug, Default)]
@@ -41,9 +121,11 @@ pub(crate) struct SelectedRowsWork {
     is_selected: Vec<bool>,
     /// The rows not selected, in order.
     others: Vec<usize>,
-    /// The nonzero columns of each row of B: `nz_idx[nz_ptr[i]..nz_ptr[i + 1]]`.
-    nz_ptr: Vec<usize>,
-    nz_idx: Vec<usize>,
+    /// B_S by columns: the selected rows (by position k in `selected`) with a nonzero in column
+    /// j, and their values, at `by_col_*[by_col_ptr[j]..by_col_ptr[j + 1]]`.
+    by_col_ptr: Vec<usize>,
+    by_col_row: Vec<usize>,
+    by_col_val: Vec<f64>,
     /// G = B_S B_Sᵀ (r × r, lower triangle).
     g_dense: DMatrix<f64>,
     /// L_G, the Cholesky factor of G on its pattern (closures sharing no coordinate do not
@@ -89,7 +171,7 @@ pub(crate) struct SelectedRowsWork {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_selected_rows(
     work: &mut SelectedRowsWork,
-    bt: &DMatrix<f64>,
+    b: &SparseRows,
     residual: &DVector<f64>,
     selected: &[usize],
     relative: f64,
@@ -98,10 +180,9 @@ pub(crate) fn solve_selected_rows(
     dz: &mut DVector<f64>,
     lambda: &mut DVector<f64>,
 ) -> bool {
-    let (nf, m) = (bt.nrows(), bt.ncols());
+    let (nf, m) = (b.cols, b.rows());
     let r = selected.len();
-    let row = |i: usize| &bt.as_slice()[i * nf..(i + 1) * nf];
-    let b_norm = bt.norm();
+    let b_norm = b.norm();
     let threshold = (relative * b_norm).max(floor);
     work.is_selected.clear();
     work.is_selected.resize(m, false);
@@ -114,38 +195,61 @@ pub(crate) fn solve_selected_rows(
     work.others.clear();
     work.others.extend((0..m).filter(|&i| !work.is_selected[i]));
     let d = work.others.len();
-    work.nz_ptr.clear();
-    work.nz_idx.clear();
-    work.nz_ptr.push(0);
-    for i in 0..m {
-        work.nz_idx.extend(
-            row(i)
-                .iter()
-                .enumerate()
-                .filter(|(_, x)| **x != 0.0)
-                .map(|(j, _)| j),
-        );
-        work.nz_ptr.push(work.nz_idx.len());
+    // B_S by columns (a counting sort over the selected rows' entries).
+    work.by_col_ptr.clear();
+    work.by_col_ptr.resize(nf + 1, 0);
+    for &i in selected {
+        for &j in b.row(i).0 {
+            work.by_col_ptr[j + 1] += 1;
+        }
     }
-    let (nz_ptr, nz_idx) = (&work.nz_ptr, &work.nz_idx);
-    let nz = |i: usize| &nz_idx[nz_ptr[i]..nz_ptr[i + 1]];
-    // Row i of B against a dense vector, over i's nonzeros.
-    let sdot = |i: usize, other: &[f64]| {
-        let ri = row(i);
-        nz(i).iter().map(|&j| ri[j] * other[j]).sum::<f64>()
+    for j in 0..nf {
+        work.by_col_ptr[j + 1] += work.by_col_ptr[j];
+    }
+    let entries = work.by_col_ptr[nf];
+    work.by_col_row.clear();
+    work.by_col_row.resize(entries, 0);
+    work.by_col_val.clear();
+    work.by_col_val.resize(entries, 0.0);
+    {
+        let mut next = work.by_col_ptr.clone();
+        for (k, &i) in selected.iter().enumerate() {
+            let (idx, val) = b.row(i);
+            for (&j, &v) in idx.iter().zip(val) {
+                work.by_col_row[next[j]] = k;
+                work.by_col_val[next[j]] = v;
+                next[j] += 1;
+            }
+        }
+    }
+    let (by_ptr, by_row, by_val) = (&work.by_col_ptr, &work.by_col_row, &work.by_col_val);
+    // out[k] = b_i · b_{S_k} for every k, over row i's columns and the selected rows there.
+    let products = |i: usize, out: &mut [f64]| {
+        out.fill(0.0);
+        let (idx, val) = b.row(i);
+        for (&j, &v) in idx.iter().zip(val) {
+            for e in by_ptr[j]..by_ptr[j + 1] {
+                out[by_row[e]] += v * by_val[e];
+            }
+        }
     };
+    // G = B_S B_Sᵀ column of B by column of B: Σ_j over the pairs of selected rows in column j.
     if work.g_dense.nrows() != r {
         work.g_dense = DMatrix::zeros(r, r);
+    } else {
+        work.g_dense.fill(0.0);
     }
-    for k in 0..r {
-        for l in 0..=k {
-            let (a, b) = (selected[k], selected[l]);
-            // Over the shorter pattern.
-            work.g_dense[(k, l)] = if nz(a).len() <= nz(b).len() {
-                sdot(a, row(b))
-            } else {
-                sdot(b, row(a))
-            };
+    for j in 0..nf {
+        for e in by_ptr[j]..by_ptr[j + 1] {
+            for f in by_ptr[j]..=e {
+                let (k, l) = (by_row[e], by_row[f]);
+                let v = by_val[e] * by_val[f];
+                if k >= l {
+                    work.g_dense[(k, l)] += v;
+                } else {
+                    work.g_dense[(l, k)] += v;
+                }
+            }
         }
     }
     // σ_min(B_S)² = λ_min(G) > τ exactly when G − τI is positive definite: its Cholesky
@@ -183,25 +287,23 @@ pub(crate) fn solve_selected_rows(
     work.rest.resize(nf, 0.0);
     let mut outside = 0.0;
     for (a, &i) in work.others.iter().enumerate() {
-        if nz(i).is_empty() {
+        if b.row(i).0.is_empty() {
             continue;
         }
         work.coupled.push(a);
         let coef = &mut work.c[a * r..(a + 1) * r];
-        for (k, x) in coef.iter_mut().enumerate() {
-            *x = sdot(i, row(selected[k]));
-        }
+        products(i, coef);
         work.g.solve(coef);
         // R_D's row i = b_i − Σ_k c_k b_{S_k}, on the union of their patterns.
-        let ri = row(i);
-        for &j in nz(i) {
-            work.rest[j] = ri[j];
+        let (idx, val) = b.row(i);
+        for (&j, &v) in idx.iter().zip(val) {
+            work.rest[j] = v;
         }
         for (k, &ck) in coef.iter().enumerate() {
             if ck != 0.0 {
-                let rk = row(selected[k]);
-                for &j in nz(selected[k]) {
-                    work.rest[j] -= ck * rk[j];
+                let (idx, val) = b.row(selected[k]);
+                for (&j, &v) in idx.iter().zip(val) {
+                    work.rest[j] -= ck * v;
                 }
             }
         }
@@ -210,10 +312,10 @@ pub(crate) fn solve_selected_rows(
             outside += work.rest[j] * work.rest[j];
             work.rest[j] = 0.0;
         };
-        nz(i).iter().for_each(|&j| take(j));
+        idx.iter().for_each(|&j| take(j));
         for (k, &ck) in coef.iter().enumerate() {
             if ck != 0.0 {
-                nz(selected[k]).iter().for_each(|&j| take(j));
+                b.row(selected[k]).0.iter().for_each(|&j| take(j));
             }
         }
     }
@@ -230,9 +332,9 @@ pub(crate) fn solve_selected_rows(
     dz.resize_vertically_mut(nf, 0.0);
     dz.fill(0.0);
     for (k, &i) in selected.iter().enumerate() {
-        let ri = row(i);
-        for &j in nz(i) {
-            dz[j] += work.y[k] * ri[j];
+        let (idx, val) = b.row(i);
+        for (&j, &v) in idx.iter().zip(val) {
+            dz[j] += work.y[k] * v;
         }
     }
     lambda.resize_vertically_mut(m, 0.0);
