@@ -93,13 +93,18 @@ impl Dynamics {
         // (‖Φ'_j‖/√M_jj, the size of B's column j), so that noise is never inverted.
         let mut floor = 0.0;
         if nf < n {
-            let mut whole = 0.0;
+            // Σ_j ‖Φ'_j‖²/M_jj, the columns' squares summed first (in `dense_row`, free here).
+            let columns = &mut self.dense_row;
+            columns.fill(0.0);
             for i in 0..rows {
-                let (idx, val) = self.rows_full.row(i);
-                for (&j, &v) in idx.iter().zip(val) {
-                    whole += v * v / self.kin.mass_matrix[(j, j)];
+                for &(j, v) in self.rows_full.row(i) {
+                    columns[j] += v * v;
                 }
             }
+            let whole: f64 = (0..n)
+                .filter(|&j| columns[j] != 0.0)
+                .map(|j| columns[j] / self.kin.mass_matrix[(j, j)])
+                .sum();
             floor = RANK_TOLERANCE.sqrt() * whole.sqrt();
         }
         // B = (rows over the free columns) L⁻ᵀ, row by row: each row's pattern is closed under
@@ -109,15 +114,17 @@ impl Dynamics {
         self.spread.resize(nf, 0.0);
         for i in 0..rows {
             self.pattern.clear();
-            let (idx, val) = self.rows_full.row(i);
-            for (&k, &v) in idx.iter().zip(val) {
+            for &(k, v) in self.rows_full.row(i) {
                 let p = self.free_position[k];
                 if p != usize::MAX {
                     self.pattern.push(p);
                     self.spread[p] = v;
                 }
             }
-            self.pattern.sort_unstable();
+            // `free` runs down the coordinates, so ascending coordinates give descending
+            // positions.
+            self.pattern.reverse();
+            debug_assert!(self.pattern.windows(2).all(|w| w[0] < w[1]));
             self.factor.forward_on(&self.pattern, &mut self.spread);
             let spread = &mut self.spread;
             self.rows_b.push_row(
@@ -127,8 +134,11 @@ impl Dynamics {
                     .filter(|(_, v)| *v != 0.0),
             );
         }
-        let residual =
-            DVector::from_fn(rows, |i, _| self.rows_b.dot(i, self.z.as_slice()) + bias[i]);
+        // e = B z + bias: the constraint residual at z_free (in `bias`'s storage).
+        let mut residual = bias;
+        for i in 0..rows {
+            residual[i] += self.rows_b.dot(i, self.z.as_slice());
+        }
         let cached = self
             .selections
             .iter()
@@ -200,8 +210,7 @@ impl Dynamics {
         // scaled rows times the scaled multipliers), over the rows' patterns.
         let mut row_force = DVector::zeros(n);
         for i in 0..rows {
-            let (idx, val) = self.rows_full.row(i);
-            for (&j, &v) in idx.iter().zip(val) {
+            for &(j, v) in self.rows_full.row(i) {
                 row_force[j] += v * lambda_scaled[i];
             }
         }
@@ -217,20 +226,26 @@ impl Dynamics {
     fn gather_rows(&mut self, model: &Model, with_bias: bool, bias: &mut DVector<f64>) {
         let n = model.dof();
         self.rows_full.clear(n);
-        let mut closures: Vec<(usize, usize)> = model
-            .closures
-            .iter()
-            .map(|cl| (cl.first_row, cl.interface))
-            .collect();
-        closures.sort_unstable();
-        for (c, &(first, interface)) in closures.iter().enumerate() {
-            let last = closures.get(c + 1).map_or(model.closure_rows, |x| x.0);
-            frame_paths(model, interface, &mut self.path);
-            for i in first..last {
+        // The closures hold consecutive rows in their order (`Closure::first_row`, `rows`); their
+        // patterns depend on the tree alone and are found once.
+        if self.closure_paths.len() != model.closures.len() {
+            self.closure_paths = model
+                .closures
+                .iter()
+                .map(|cl| {
+                    let mut path = Vec::new();
+                    frame_paths(model, cl.interface, &mut path);
+                    path
+                })
+                .collect();
+        }
+        for (cl, path) in model.closures.iter().zip(&self.closure_paths) {
+            debug_assert_eq!(cl.first_row, self.rows_full.rows());
+            for i in cl.first_row..cl.first_row + cl.rows {
                 let scale = self.row_scale[i];
                 let phi_q = &self.kin.phi_q;
                 self.rows_full
-                    .push_row(self.path.iter().map(|&k| (k, scale * phi_q[(i, k)])));
+                    .push_row(path.iter().map(|&k| (k, scale * phi_q[(i, k)])));
             }
         }
         for (k, &(a, b, _)) in model.symmetries.iter().enumerate() {
@@ -248,13 +263,12 @@ impl Dynamics {
         }
         let mut row = std::mem::take(&mut self.dense_row);
         row.resize_vertically_mut(n, 0.0);
-        let row_slots: Vec<usize> = self
-            .seated
-            .iter()
-            .copied()
-            .filter(|&s| self.is_row(s))
-            .collect();
-        for (k, slot) in row_slots.into_iter().enumerate() {
+        let mut k = 0;
+        for index in 0..self.seated.len() {
+            let slot = self.seated[index];
+            if !self.is_row(slot) {
+                continue;
+            }
             let row_bias = slot_row(model, &self.kin, slot, &mut row);
             if with_bias {
                 bias[model.constraint_rows + k] = row_bias;
@@ -271,6 +285,7 @@ impl Dynamics {
             }
             self.rows_full
                 .push_row(self.path.iter().map(|&j| (j, row[j])));
+            k += 1;
         }
         self.dense_row = row;
     }

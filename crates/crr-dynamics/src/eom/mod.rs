@@ -152,6 +152,8 @@ pub struct Dynamics {
     /// uses), a row's free pattern, an interface's frame paths, a dense rate row.
     spread: Vec<f64>,
     pattern: Vec<usize>,
+    /// Each closure's rows' pattern: its frames' paths to the ground (found once per model).
+    closure_paths: Vec<Vec<usize>>,
     path: Vec<usize>,
     dense_row: DVector<f64>,
     /// r = Q + F_extra − h at the last evaluation (N m).
@@ -278,6 +280,7 @@ impl Dynamics {
             rows_b: SparseRows::default(),
             spread: Vec::new(),
             pattern: Vec::new(),
+            closure_paths: Vec::new(),
             path: Vec::new(),
             dense_row: DVector::zeros(n),
             residual: DVector::zeros(n),

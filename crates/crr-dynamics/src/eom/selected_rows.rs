@@ -33,16 +33,15 @@ pub const DEPENDENT_ROW_TOLERANCE: f64 = 1e-9;
 /// the SVD.)
 pub(super) const RANK_MARGIN: f64 = 1.1;
 
-/// Rows of a matrix stored by their nonzeros (compressed rows, column indices ascending): B's
-/// rows, whose patterns are a loop's coordinates, so that products run over them and nothing is
-/// O(rows × columns).
+/// Rows of a matrix stored by their nonzeros (compressed rows of (column, value), columns
+/// ascending): B's rows, whose patterns are a loop's coordinates, so that products run over them
+/// and nothing is O(rows × columns).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SparseRows {
     /// Number of columns.
     pub(crate) cols: usize,
     ptr: Vec<usize>,
-    idx: Vec<usize>,
-    val: Vec<f64>,
+    entries: Vec<(usize, f64)>,
 }
 
 impl SparseRows {
@@ -51,21 +50,16 @@ impl SparseRows {
         self.cols = cols;
         self.ptr.clear();
         self.ptr.push(0);
-        self.idx.clear();
-        self.val.clear();
+        self.entries.clear();
     }
 
     /// Appends a row from its (column, value) entries, columns ascending.
     pub(crate) fn push_row(&mut self, entries: impl Iterator<Item = (usize, f64)>) {
-        for (j, v) in entries {
-            debug_assert!(j < self.cols);
-            debug_assert!(
-                self.idx.len() == self.ptr[self.ptr.len() - 1] || *self.idx.last().unwrap() < j
-            );
-            self.idx.push(j);
-            self.val.push(v);
-        }
-        self.ptr.push(self.idx.len());
+        let start = self.entries.len();
+        self.entries.extend(entries);
+        debug_assert!(self.entries[start..].windows(2).all(|w| w[0].0 < w[1].0));
+        debug_assert!(self.entries[start..].iter().all(|e| e.0 < self.cols));
+        self.ptr.push(self.entries.len());
     }
 
     /// Number of rows.
@@ -73,16 +67,14 @@ impl SparseRows {
         self.ptr.len() - 1
     }
 
-    /// Row i's column indices and values.
-    pub(crate) fn row(&self, i: usize) -> (&[usize], &[f64]) {
-        let range = self.ptr[i]..self.ptr[i + 1];
-        (&self.idx[range.clone()], &self.val[range])
+    /// Row i's (column, value) entries.
+    pub(crate) fn row(&self, i: usize) -> &[(usize, f64)] {
+        &self.entries[self.ptr[i]..self.ptr[i + 1]]
     }
 
     /// Row i against a dense vector.
     pub(crate) fn dot(&self, i: usize, x: &[f64]) -> f64 {
-        let (idx, val) = self.row(i);
-        idx.iter().zip(val).map(|(&j, v)| v * x[j]).sum()
+        self.row(i).iter().map(|&(j, v)| v * x[j]).sum()
     }
 
     /// The rows of B given as the columns of Bᵀ (exact zeros left out).
@@ -99,8 +91,7 @@ impl SparseRows {
     pub(crate) fn dense_transposed(&self) -> DMatrix<f64> {
         let mut bt = DMatrix::zeros(self.cols, self.rows());
         for i in 0..self.rows() {
-            let (idx, val) = self.row(i);
-            for (&j, &v) in idx.iter().zip(val) {
+            for &(j, v) in self.row(i) {
                 bt[(j, i)] = v;
             }
         }
@@ -109,7 +100,7 @@ impl SparseRows {
 
     /// ‖B‖_F.
     pub(crate) fn norm(&self) -> f64 {
-        self.val.iter().map(|v| v * v).sum::<f64>().sqrt()
+        self.entries.iter().map(|e| e.1 * e.1).sum::<f64>().sqrt()
     }
 }
 
@@ -126,6 +117,8 @@ pub(crate) struct SelectedRowsWork {
     by_col_ptr: Vec<usize>,
     by_col_row: Vec<usize>,
     by_col_val: Vec<f64>,
+    /// Scratch of the counting sort into `by_col_*`.
+    by_col_next: Vec<usize>,
     /// G = B_S B_Sᵀ (r × r, lower triangle).
     g_dense: DMatrix<f64>,
     /// L_G, the Cholesky factor of G on its pattern (closures sharing no coordinate do not
@@ -199,7 +192,7 @@ pub(crate) fn solve_selected_rows(
     work.by_col_ptr.clear();
     work.by_col_ptr.resize(nf + 1, 0);
     for &i in selected {
-        for &j in b.row(i).0 {
+        for &(j, _) in b.row(i) {
             work.by_col_ptr[j + 1] += 1;
         }
     }
@@ -212,10 +205,10 @@ pub(crate) fn solve_selected_rows(
     work.by_col_val.clear();
     work.by_col_val.resize(entries, 0.0);
     {
-        let mut next = work.by_col_ptr.clone();
+        let next = &mut work.by_col_next;
+        next.clone_from(&work.by_col_ptr);
         for (k, &i) in selected.iter().enumerate() {
-            let (idx, val) = b.row(i);
-            for (&j, &v) in idx.iter().zip(val) {
+            for &(j, v) in b.row(i) {
                 work.by_col_row[next[j]] = k;
                 work.by_col_val[next[j]] = v;
                 next[j] += 1;
@@ -226,8 +219,7 @@ pub(crate) fn solve_selected_rows(
     // out[k] = b_i · b_{S_k} for every k, over row i's columns and the selected rows there.
     let products = |i: usize, out: &mut [f64]| {
         out.fill(0.0);
-        let (idx, val) = b.row(i);
-        for (&j, &v) in idx.iter().zip(val) {
+        for &(j, v) in b.row(i) {
             for e in by_ptr[j]..by_ptr[j + 1] {
                 out[by_row[e]] += v * by_val[e];
             }
@@ -287,7 +279,7 @@ pub(crate) fn solve_selected_rows(
     work.rest.resize(nf, 0.0);
     let mut outside = 0.0;
     for (a, &i) in work.others.iter().enumerate() {
-        if b.row(i).0.is_empty() {
+        if b.row(i).is_empty() {
             continue;
         }
         work.coupled.push(a);
@@ -295,14 +287,12 @@ pub(crate) fn solve_selected_rows(
         products(i, coef);
         work.g.solve(coef);
         // R_D's row i = b_i − Σ_k c_k b_{S_k}, on the union of their patterns.
-        let (idx, val) = b.row(i);
-        for (&j, &v) in idx.iter().zip(val) {
+        for &(j, v) in b.row(i) {
             work.rest[j] = v;
         }
         for (k, &ck) in coef.iter().enumerate() {
             if ck != 0.0 {
-                let (idx, val) = b.row(selected[k]);
-                for (&j, &v) in idx.iter().zip(val) {
+                for &(j, v) in b.row(selected[k]) {
                     work.rest[j] -= ck * v;
                 }
             }
@@ -312,10 +302,10 @@ pub(crate) fn solve_selected_rows(
             outside += work.rest[j] * work.rest[j];
             work.rest[j] = 0.0;
         };
-        idx.iter().for_each(|&j| take(j));
+        b.row(i).iter().for_each(|&(j, _)| take(j));
         for (k, &ck) in coef.iter().enumerate() {
             if ck != 0.0 {
-                b.row(selected[k]).0.iter().for_each(|&j| take(j));
+                b.row(selected[k]).iter().for_each(|&(j, _)| take(j));
             }
         }
     }
@@ -332,8 +322,7 @@ pub(crate) fn solve_selected_rows(
     dz.resize_vertically_mut(nf, 0.0);
     dz.fill(0.0);
     for (k, &i) in selected.iter().enumerate() {
-        let (idx, val) = b.row(i);
-        for (&j, &v) in idx.iter().zip(val) {
+        for &(j, v) in b.row(i) {
             dz[j] += work.y[k] * v;
         }
     }
