@@ -228,18 +228,24 @@ impl Dynamics {
         self.rows_full.clear(n);
         // The closures hold consecutive rows in their order (`Closure::first_row`, `rows`); their
         // patterns depend on the tree alone and are found once.
-        if self.closure_paths.len() != model.closures.len() {
+        let known = self.closure_paths.len() == model.closures.len()
+            && model
+                .closures
+                .iter()
+                .zip(&self.closure_paths)
+                .all(|(cl, (interface, _))| cl.interface == *interface);
+        if !known {
             self.closure_paths = model
                 .closures
                 .iter()
                 .map(|cl| {
                     let mut path = Vec::new();
                     frame_paths(model, cl.interface, &mut path);
-                    path
+                    (cl.interface, path)
                 })
                 .collect();
         }
-        for (cl, path) in model.closures.iter().zip(&self.closure_paths) {
+        for (cl, (_, path)) in model.closures.iter().zip(&self.closure_paths) {
             debug_assert_eq!(cl.first_row, self.rows_full.rows());
             for i in cl.first_row..cl.first_row + cl.rows {
                 let scale = self.row_scale[i];

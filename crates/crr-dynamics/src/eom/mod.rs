@@ -152,8 +152,9 @@ pub struct Dynamics {
     /// uses), a row's free pattern, an interface's frame paths, a dense rate row.
     spread: Vec<f64>,
     pattern: Vec<usize>,
-    /// Each closure's rows' pattern: its frames' paths to the ground (found once per model).
-    closure_paths: Vec<Vec<usize>>,
+    /// Each closure's interface and its rows' pattern, its frames' paths to the ground (found
+    /// once per model).
+    closure_paths: Vec<(usize, Vec<usize>)>,
     path: Vec<usize>,
     dense_row: DVector<f64>,
     /// r = Q + F_extra − h at the last evaluation (N m).
