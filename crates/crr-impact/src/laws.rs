@@ -398,31 +398,13 @@ pub(crate) fn momentum_law_projected(
     jacobians(model, kin);
     crr_kinematics::velocities(model, kin, qdot_minus);
     let kinetic_before = crr_kinematics::body_kinetic_energy(model, kin);
-    let (vc, wv) = (&mut ws.linear, &mut ws.angular);
-    with_len(vc, kin.com_jacobian.nrows());
-    with_len(wv, kin.angular_jacobian.nrows());
-    kin.com_jacobian.mul_to(qdot_minus, vc);
-    kin.angular_jacobian.mul_to(qdot_minus, wv);
+    body_velocities(kin, qdot_minus, ws);
     // The `after` chain: M⁺, Φ_q⁺ and J⁺ at the same q.
     work.pivots.clone_from(after);
     work.seated.clear();
     work.evaluate(model, ground, t, q, qdot_minus);
-    let plus = &mut work.kin;
-    jacobians(model, plus);
-    for (bi, body) in model.bodies.iter().enumerate() {
-        let i_w = world_inertia(body, &plus.rot_ops[model.body_coord[bi]]);
-        let w = i_w * Vector3::new(wv[3 * bi], wv[3 * bi + 1], wv[3 * bi + 2]);
-        for r in 0..3 {
-            vc[3 * bi + r] *= body.mass;
-            wv[3 * bi + r] = w[r];
-        }
-    }
-    let n = model.dof();
-    with_len(&mut ws.momentum, n);
-    with_len(&mut ws.part, n);
-    plus.com_jacobian.tr_mul_to(vc, &mut ws.momentum);
-    plus.angular_jacobian.tr_mul_to(wv, &mut ws.part);
-    ws.momentum += &ws.part;
+    jacobians(model, &mut work.kin);
+    generalized_momentum(model, &work.kin, ws);
     let qdot = match work.solve_impulse(model, t, &ws.momentum) {
         Ok(qdot) => qdot.clone(),
         Err(_) => return momentum_law_with(model, kin, ws, q, qdot_minus, before, after),
@@ -449,12 +431,26 @@ fn pre_impact_momentum(
     ws: &mut LawWorkspace,
 ) {
     evaluate_chain_holding(model, kin, q, before, held, &mut ws.minus);
+    body_velocities(kin, qdot_minus, ws);
+    evaluate_chain_holding(model, kin, q, after, held, &mut ws.plus);
+    generalized_momentum(model, kin, ws);
+}
+
+/// The bodies' velocities V = J q̇ (J of the chain evaluated in `kin`) into `ws.linear` (ċ) and
+/// `ws.angular` (ω).
+fn body_velocities(kin: &Data, qdot: &DVector<f64>, ws: &mut LawWorkspace) {
     let (vc, wv) = (&mut ws.linear, &mut ws.angular);
     with_len(vc, kin.com_jacobian.nrows());
     with_len(wv, kin.angular_jacobian.nrows());
-    kin.com_jacobian.mul_to(qdot_minus, vc);
-    kin.angular_jacobian.mul_to(qdot_minus, wv);
-    evaluate_chain_holding(model, kin, q, after, held, &mut ws.plus);
+    kin.com_jacobian.mul_to(qdot, vc);
+    kin.angular_jacobian.mul_to(qdot, wv);
+}
+
+/// The bodies' momenta (m ċ, I ω) from the velocities in `ws.linear`, `ws.angular` (in place),
+/// as a generalized momentum Jᵀ𝕄V of the chain evaluated in `kin` (its Jacobians and Γ's), into
+/// `ws.momentum`.
+fn generalized_momentum(model: &Model, kin: &Data, ws: &mut LawWorkspace) {
+    let (vc, wv) = (&mut ws.linear, &mut ws.angular);
     // In place: body bi's entries are read before they are overwritten.
     for (bi, body) in model.bodies.iter().enumerate() {
         let i_w = world_inertia(body, &kin.rot_ops[model.body_coord[bi]]);

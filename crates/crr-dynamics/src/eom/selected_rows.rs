@@ -144,10 +144,11 @@ pub(crate) struct SelectedRowsWork {
 /// constraint residual at z_free), and, when `min_norm`, the minimum-norm multipliers over all
 /// rows, Bᵀλ = dz (otherwise λ_S = y, λ_D = 0: another solution of the same equations). Returns
 /// false (use the SVD) unless the rank decision is provably the SVD's, within [`RANK_MARGIN`]:
-/// σ_min(B_S) must exceed the SVD's threshold (certified by the Cholesky factorisation of
-/// G − (margin·threshold)² I succeeding) max(`relative`·σ_max(B), `floor`) (bounded above by `relative`·‖B‖_F; the equations of motion
-/// use √RANK_TOLERANCE, the projections RANK_TOLERANCE), so the SVD keeps r = |S| singular
-/// values; and the rows D not selected must lie in the span of B_S:
+/// σ_min(B_S) must exceed the margin times the SVD's threshold max(`relative`·σ_max(B),
+/// `floor`) (‖B‖_F standing for σ_max(B), which it bounds above; the equations of motion use
+/// √RANK_TOLERANCE, the projections RANK_TOLERANCE), certified by the Cholesky factorisation of
+/// G − (margin·threshold)² I succeeding, so the SVD keeps r = |S| singular values; and the rows
+/// D not selected must lie in the span of B_S:
 /// B_D = C B_S + R_D with ‖R_D‖_F ≤ [`DEPENDENT_ROW_TOLERANCE`]·‖B‖_F, which bounds
 /// σ_{r+1}(B) ≤ ‖R_D‖₂ far below the threshold, so the SVD drops the rest.
 ///
@@ -158,9 +159,11 @@ pub(crate) struct SelectedRowsWork {
 /// rows enter I + C Cᵀ.
 ///
 /// Rows of B are sparse (a closure row touches the coordinates of its loop, and L⁻¹ spreads it
-/// to their ancestors only): every product runs over a row's nonzeros, and G's factor over its
-/// pattern (banded on a row of columns), against O(m r n_f + r³) dense; finding the nonzeros is
-/// a scan of Bᵀ, O(m n_f).
+/// to their ancestors only; [`SparseRows`]): every product runs over a row's nonzeros, G is
+/// accumulated column by column of B over the pairs of selected rows there, and factorised on
+/// its pattern (banded on a row of columns), against O(m r n_f + r³) dense. What is still
+/// O(r²): G's dense storage and the scan for its pattern, and C's r entries per row not
+/// selected.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_selected_rows(
     work: &mut SelectedRowsWork,
