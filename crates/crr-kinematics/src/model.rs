@@ -700,6 +700,80 @@ impl Model {
         })
     }
 
+    /// The chain left when the loop-closing interfaces `open` (indices into
+    /// [`Model::interfaces`]) lift off: the same bodies, tree and coordinates q, without those
+    /// interfaces, their closure rows and their slots. The interfaces kept are renumbered in
+    /// their order (so are the closures, their rows and the closure slots after the tree's);
+    /// tree slots and coordinates keep their indices, so a state q, q̇ of this model is one of
+    /// `self` and the other way round. A tree interface cannot be dropped this way (the chain
+    /// would have to be re-rooted): that is an error naming it.
+    pub fn without_loop_closures(&self, open: &[usize]) -> Result<Model, ModelError> {
+        if let Some(&k) = open.iter().find(|&&k| {
+            self.interfaces
+                .get(k)
+                .is_none_or(|i| !matches!(i.role, Role::Closure { .. }))
+        }) {
+            let name = self
+                .interfaces
+                .get(k)
+                .map_or_else(|| format!("#{k}"), |i| i.name.clone());
+            return Err(ModelError::new(
+                quoted("interface", &name),
+                "is not a loop closure of the model: opening it would need the chain re-rooted",
+            ));
+        }
+        let kept: Vec<usize> = (0..self.interfaces.len())
+            .filter(|k| !open.contains(k))
+            .collect();
+        let mut new_index = vec![usize::MAX; self.interfaces.len()];
+        for (new, &old) in kept.iter().enumerate() {
+            new_index[old] = new;
+        }
+        let tree_slots = self.dof();
+        let (mut closures, mut row, mut slot) = (Vec::new(), 0, tree_slots);
+        let mut interfaces = Vec::with_capacity(kept.len());
+        for &old in &kept {
+            let mut iface = self.interfaces[old].clone();
+            if let Role::Closure { index } = iface.role {
+                let rows = self.closures[index].rows;
+                iface.role = Role::Closure {
+                    index: closures.len(),
+                };
+                iface.slots = slot..slot + iface.kind.angle_count();
+                slot += iface.kind.angle_count();
+                closures.push(Closure {
+                    interface: interfaces.len(),
+                    first_row: row,
+                    rows,
+                });
+                row += rows;
+            }
+            interfaces.push(iface);
+        }
+        let coords = self
+            .coords
+            .iter()
+            .map(|c| Coordinate {
+                interface: new_index[c.interface],
+                ..c.clone()
+            })
+            .collect();
+        Ok(Model {
+            name: self.name.clone(),
+            gravity: self.gravity,
+            bodies: self.bodies.clone(),
+            interfaces,
+            coords,
+            closures,
+            body_coord: self.body_coord.clone(),
+            symmetries: self.symmetries.clone(),
+            closure_rows: row,
+            constraint_rows: row + self.symmetries.len(),
+            slot_count: slot,
+            size: self.size,
+        })
+    }
+
     /// DOF(1): the number of tree coordinates.
     pub fn dof(&self) -> usize {
         self.coords.len()
