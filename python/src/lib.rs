@@ -271,9 +271,10 @@ impl PyRun {
                         Some(SlotState::Seated) => 0,
                         Some(SlotState::Positive) => 1,
                         Some(SlotState::Negative) => 2,
-                        None => 3,
+                        Some(SlotState::Open) => 3,
+                        None => 4,
                     };
-                    key.wrapping_mul(4).wrapping_add(digit)
+                    key.wrapping_mul(5).wrapping_add(digit)
                 });
                 if let Some((k, code)) = last[i]
                     && k == key

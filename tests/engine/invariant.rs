@@ -92,7 +92,8 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
                 let past = match state {
                     SlotState::Positive => -angles[slot],
                     SlotState::Negative => angles[slot],
-                    SlotState::Seated => continue,
+                    // No pivot: crates/crr-impact/tests/open_loops.rs checks an open face's gap instead.
+                    SlotState::Seated | SlotState::Open => continue,
                 };
                 largest = largest.max(past);
                 assert!(

@@ -114,6 +114,7 @@ fn arch_switches_to_the_mirrored_mechanism_and_loses_energy() {
                 SlotState::Positive => 1.0,
                 SlotState::Negative => -1.0,
                 SlotState::Seated => 0.0,
+                SlotState::Open => panic!("a tree slot never opens: only loop-closing faces do"),
             };
             assert!(
                 side * smp.q[k] >= -1e-9,

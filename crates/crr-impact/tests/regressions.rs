@@ -55,6 +55,7 @@ fn assert_no_penetration(traj: &Trajectory) {
                 SlotState::Positive => 1.0,
                 SlotState::Negative => -1.0,
                 SlotState::Seated => 0.0,
+                SlotState::Open => panic!("a tree slot never opens: only loop-closing faces do"),
             };
             assert!(
                 side * q >= -1e-9,

@@ -344,6 +344,8 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
                 pivots.sides[slot] = match code {
                     "+" => Side::Positive,
                     "-" => Side::Negative,
+                    // A loop-closing face that lifted off: no pivot, and its side places no body.
+                    "open" => Side::Positive,
                     "seated" => {
                         // A seated tree angle is 0: either side gives the same pose.
                         let angle = match iface.role {
@@ -354,7 +356,7 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
                     }
                     other => {
                         return Err(self.error(format!(
-                            "line {line_no}: column `{}` holds `{other}`, not +, - or seated",
+                            "line {line_no}: column `{}` holds `{other}`, not +, -, seated or open",
                             header[c]
                         )));
                     }

@@ -43,6 +43,9 @@ pub(super) struct SegmentEvents<'b> {
     /// Regularised-law zones |φ| < ε/2 (slot, ε/2): their edges stop the integration so that the
     /// narrow δ_ε is resolved by a fresh step-size selection.
     pub(super) zones: Vec<(usize, f64)>,
+    /// The open faces ([`super::open_loops`]): each point's gap over the model size, plus
+    /// [`ROCKING_EVENT_MARGIN`], falls through 0 when the point touches again.
+    pub(super) open_faces: &'b [super::open_loops::OpenFace],
 }
 
 impl SegmentEvents<'_> {
@@ -54,6 +57,27 @@ impl SegmentEvents<'_> {
     }
     pub(super) fn first_zone_index(&self) -> usize {
         self.rocking.len() + 1 + usize::from(self.uplift.is_some())
+    }
+    pub(super) fn first_gap_index(&self) -> usize {
+        self.first_zone_index() + 2 * self.zones.len()
+    }
+    /// The (face, point) of gap event `j` (0-based over the gaps).
+    pub(super) fn gap_point(&self, mut j: usize) -> (usize, usize) {
+        for (f, face) in self.open_faces.iter().enumerate() {
+            if j < face.len() {
+                return (f, j);
+            }
+            j -= face.len();
+        }
+        unreachable!("a gap event's index is within the open faces' points")
+    }
+    fn gap_count(&self) -> usize {
+        self.open_faces.iter().map(|f| f.len()).sum()
+    }
+    /// Gap event `j` (needs [`Self::load_state`]).
+    fn gap_value(&self, j: usize) -> f64 {
+        let (f, i) = self.gap_point(j);
+        self.open_faces[f].gap(self.model, &self.kin, i) / self.model.size + ROCKING_EVENT_MARGIN
     }
 }
 
@@ -116,7 +140,7 @@ impl SegmentEvents<'_> {
 
 impl EventFunctions for SegmentEvents<'_> {
     fn count(&self) -> usize {
-        self.first_zone_index() + 2 * self.zones.len()
+        self.first_gap_index() + self.gap_count()
     }
 
     fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
@@ -131,6 +155,10 @@ impl EventFunctions for SegmentEvents<'_> {
         let z0 = self.first_zone_index();
         for j in 0..2 * self.zones.len() {
             g[z0 + j] = self.zone_value(j);
+        }
+        let g0 = self.first_gap_index();
+        for j in 0..self.gap_count() {
+            g[g0 + j] = self.gap_value(j);
         }
     }
 
@@ -151,14 +179,16 @@ impl EventFunctions for SegmentEvents<'_> {
             self.collapse_value()
         } else if self.uplift.is_some() && i == self.uplift_index() {
             self.uplift_value(t)
-        } else {
+        } else if i < self.first_gap_index() {
             self.zone_value(i - self.first_zone_index())
+        } else {
+            self.gap_value(i - self.first_gap_index())
         }
     }
 
     fn direction(&self, i: usize) -> Direction {
         // Impacts (sign(side)·φ + margin) and collapse (U past its threshold) fall through 0.
-        if i < self.rocking.len() || i == self.collapse_index() {
+        if i < self.rocking.len() || i == self.collapse_index() || i >= self.first_gap_index() {
             Direction::Falling
         } else if self.uplift.is_some() && i == self.uplift_index() {
             Direction::Rising

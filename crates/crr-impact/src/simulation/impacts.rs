@@ -10,6 +10,26 @@ pub(super) struct Regularised {
     pub(super) angles: Vec<f64>,
 }
 
+impl Regularised {
+    /// The regularised Dirac laws of `model`'s slots (None when it has none).
+    pub(super) fn of(model: &Model) -> Option<Self> {
+        let slots: Vec<RegularisedSlot> = (0..model.slot_count)
+            .filter_map(
+                |slot| match model.interfaces[slot_interface(model, slot)].impact {
+                    ImpactLaw::DiracRegularised { r, c, width } => {
+                        Some(RegularisedSlot { slot, r, c, width })
+                    }
+                    _ => None,
+                },
+            )
+            .collect();
+        (!slots.is_empty()).then(|| Regularised {
+            slots,
+            angles: vec![0.0; model.slot_count],
+        })
+    }
+}
+
 impl GeneralizedForce for Regularised {
     fn add(
         &mut self,
@@ -140,7 +160,8 @@ impl Simulation<'_> {
         if self.impacts.len() >= self.params.max_impacts {
             return Err(SimulationError::TooManyImpacts(self.params.max_impacts));
         }
-        let model = self.model;
+        let model = Arc::clone(&self.model);
+        let model = &*model;
         let (t, n) = (self.t, model.dof());
         // Workspaces of the run (given back below; an error return only costs a reallocation).
         let mut kin = self
@@ -368,7 +389,7 @@ impl Simulation<'_> {
         };
         self.dissipated_at_impacts += lost;
         self.book_snap(u_snap);
-        self.impacts.push(record);
+        self.push_impact(record);
         self.reset_solver();
         // The joints that open right after the impact open before the post-impact sample, so
         // that its contact forces are those of the motion that follows (with the impact's

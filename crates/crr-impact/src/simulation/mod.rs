@@ -19,6 +19,8 @@
 //! [`Parameters::min_impact_interval`] before, is seated with a plastic impulse on that angle alone
 //! (its rate set to 0, the other generalized momenta kept); the run continues seated until uplift.
 
+use std::sync::Arc;
+
 use nalgebra::DVector;
 use serde::Serialize;
 
@@ -44,6 +46,7 @@ use crate::laws::{
 
 mod events;
 mod impacts;
+mod open_loops;
 mod opening_qp;
 mod output;
 mod samples;
@@ -53,6 +56,7 @@ mod uplift_from_rest;
 
 use events::*;
 use impacts::*;
+use open_loops::OpenLoops;
 pub use opening_qp::{
     OpeningDecision, OpeningQpError, QP_OPENING_TOLERANCE, offers_both_pivots, opening_qp,
 };
@@ -150,15 +154,19 @@ pub enum SlotState {
     Positive,
     /// Rocking about P⁻.
     Negative,
+    /// A loop-closing interface lifted off: its face is open, no pivot and no angle (its loop is
+    /// released until a corner touches again).
+    Open,
 }
 
 impl SlotState {
-    /// `seated`, `+` or `-` (the history file's codes).
+    /// `seated`, `+`, `-` or `open` (the history file's codes).
     pub fn code(self) -> &'static str {
         match self {
             SlotState::Seated => "seated",
             SlotState::Positive => "+",
             SlotState::Negative => "-",
+            SlotState::Open => "open",
         }
     }
 }
@@ -379,7 +387,14 @@ const INITIAL_IMPACT_ROOM: usize = 256;
 
 /// An event-driven simulation of one structure under one ground motion.
 pub struct Simulation<'a> {
-    model: &'a Model,
+    /// The dynamic chain integrated now: the file's model without the loop-closing interfaces
+    /// that lifted off ([`Model::without_loop_closures`]); the same tree and q as `original`.
+    model: Arc<Model>,
+    /// The file's model: the outputs' slots (samples, impacts) are numbered as its slots.
+    original: &'a Model,
+    /// The loops released: which interfaces of `original` are open, the slots' maps between
+    /// the two models and the open faces watched for a corner touching again.
+    open: OpenLoops,
     ground: &'a GroundMotion,
     params: Parameters,
     dynamics: Dynamics,
@@ -490,6 +505,32 @@ struct Workspaces {
     invariant_angles: Vec<f64>,
     invariant_q: DVector<f64>,
     constraint_scale: DVector<f64>,
+}
+
+impl Workspaces {
+    /// Fresh workspaces of a run on `model` (`trial` a copy of its dynamics).
+    fn new(model: &Model, trial: Dynamics, pivots: &ActivePivots) -> Self {
+        Self {
+            events_kin: Some(Box::new(Data::new(model))),
+            trial: Some(Box::new(trial)),
+            segment: None,
+            settle: None,
+            monitor: Dynamics::new(model, pivots.clone()),
+            sample_q: DVector::zeros(model.dof()),
+            sample_qdot: DVector::zeros(model.dof()),
+            sample_states: Vec::with_capacity(model.slot_count),
+            pending: Vec::new(),
+            forces: Default::default(),
+            self_stress: Default::default(),
+            rest: RestCache::default(),
+            system: Default::default(),
+            impact: ImpactBuffers::default(),
+            laws: Default::default(),
+            invariant_angles: Vec::with_capacity(model.slot_count),
+            invariant_q: DVector::zeros(model.dof()),
+            constraint_scale: crr_dynamics::eom::constraint_row_scale(model),
+        }
+    }
 }
 
 /// Largest `seat_rate` as a fraction of the structure's rate scale √(g/L): a joint rocking at a
@@ -639,20 +680,7 @@ impl<'a> Simulation<'a> {
         // with the minimum-norm multipliers.
         dynamics.min_norm_multipliers = false;
         dynamics.seated = (0..model.slot_count).filter(|&s| seated[s]).collect();
-        let regularised_slots: Vec<RegularisedSlot> = (0..model.slot_count)
-            .filter_map(
-                |slot| match model.interfaces[slot_interface(model, slot)].impact {
-                    ImpactLaw::DiracRegularised { r, c, width } => {
-                        Some(RegularisedSlot { slot, r, c, width })
-                    }
-                    _ => None,
-                },
-            )
-            .collect();
-        let regularised = (!regularised_slots.is_empty()).then(|| Regularised {
-            slots: regularised_slots,
-            angles: vec![0.0; model.slot_count],
-        });
+        let regularised = Regularised::of(model);
         let mut solver = Solver::new(params.method, params.options, 2 * n + 2)?;
         let y = ConstrainedSystem::pack(&initial.q, &initial.qdot, 0.0, 0.0);
         solver.reset(0.0, &y);
@@ -665,33 +693,16 @@ impl<'a> Simulation<'a> {
         let sample_room = regular_samples + regular_samples / 4;
         let impact_room = params.max_impacts.min(INITIAL_IMPACT_ROOM);
         let mut sim = Self {
-            model,
+            model: Arc::new(model.clone()),
+            original: model,
+            open: OpenLoops::none(model),
             ground,
             params,
             dynamics,
             solver,
             regularised,
             out_kin: Data::new(model),
-            spare: Workspaces {
-                events_kin: Some(Box::new(Data::new(model))),
-                trial: Some(Box::new(trial)),
-                segment: None,
-                settle: None,
-                monitor: Dynamics::new(model, initial.pivots.clone()),
-                sample_q: DVector::zeros(n),
-                sample_qdot: DVector::zeros(n),
-                sample_states: Vec::with_capacity(model.slot_count),
-                pending: Vec::new(),
-                forces: Default::default(),
-                self_stress: Default::default(),
-                rest: RestCache::default(),
-                system: Default::default(),
-                impact: ImpactBuffers::default(),
-                laws: Default::default(),
-                invariant_angles: Vec::with_capacity(model.slot_count),
-                invariant_q: DVector::zeros(model.dof()),
-                constraint_scale: crr_dynamics::eom::constraint_row_scale(model),
-            },
+            spare: Workspaces::new(model, trial, &initial.pivots),
             parts: model.parts(),
             y,
             t: 0.0,
@@ -756,15 +767,18 @@ impl<'a> Simulation<'a> {
         DVector::from_column_slice(&self.y[n..2 * n])
     }
 
-    /// Current state of every slot.
+    /// Current state of every slot of the file's model.
     pub fn states(&self) -> Vec<SlotState> {
-        (0..self.model.slot_count)
+        (0..self.original.slot_count)
             .map(|s| self.slot_state(s))
             .collect()
     }
 
-    /// The state of slot `s`.
+    /// The state of slot `s` of the file's model.
     fn slot_state(&self, s: usize) -> SlotState {
+        let Some(s) = self.open.active_slot(s) else {
+            return SlotState::Open;
+        };
         if self.seated[s] {
             SlotState::Seated
         } else if self.dynamics.pivots.sides[s] == Side::Positive {
@@ -774,7 +788,8 @@ impl<'a> Simulation<'a> {
         }
     }
 
-    /// The current dynamic chain.
+    /// The current dynamic chain: the active pivot of every slot of the chain integrated now
+    /// (the file's model without the loops that are open, whose slots are numbered after it).
     pub fn pivots(&self) -> &ActivePivots {
         &self.dynamics.pivots
     }
@@ -787,7 +802,7 @@ impl<'a> Simulation<'a> {
     /// Takes the samples recorded since the last call, so that a long run can stream them to a
     /// file and keep its memory flat; the peaks and the energy balance still cover every sample.
     pub fn drain_samples(&mut self) -> Samples {
-        let empty = Samples::new(self.model.dof(), self.model.slot_count);
+        let empty = Samples::new(self.original.dof(), self.original.slot_count);
         std::mem::replace(&mut self.samples, empty)
     }
 
@@ -849,7 +864,8 @@ impl<'a> Simulation<'a> {
     /// row-scaled closures). A rocking angle past its pivot means an impact was missed (a step
     /// too long for the tolerances); the run's results from there on would be wrong.
     pub fn check_invariant(&mut self) -> Result<(), SimulationError> {
-        let model = self.model;
+        let model = Arc::clone(&self.model);
+        let model = &*model;
         let n = model.dof();
         let tol = (100.0 * self.params.simultaneity).clamp(1e-5, 1e-3);
         let mut angles = std::mem::take(&mut self.spare.invariant_angles);
@@ -878,6 +894,18 @@ impl<'a> Simulation<'a> {
                     self.remedy()
                 )));
             }
+        }
+        let q = DVector::from_column_slice(&self.y[..n]);
+        if let Some((gap, name)) = self.deepest_open_point(&q)
+            && (gap.is_nan() || gap < -open_loops::GAP_TOLERANCE * model.size)
+        {
+            self.spare.invariant_angles = angles;
+            return Err(SimulationError::Invariant(format!(
+                "at t = {} s a corner of the open face of \"{name}\" is {:.3e} m inside its support: its landing was missed; {}",
+                self.t,
+                -gap,
+                self.remedy()
+            )));
         }
         let mut broken = None;
         for s in 0..model.slot_count {
@@ -924,7 +952,11 @@ impl<'a> Simulation<'a> {
             return Ok(StopReason::End(self.t));
         }
         let lift_off = self.settle_resting_joints()?;
-        let model = self.model;
+        while let Some((face, point)) = self.settled_open_face() {
+            self.recontact(face, point)?;
+        }
+        let model = Arc::clone(&self.model);
+        let model = &*model;
         let n = model.dof();
         let t_stop = self.segment_end(lift_off);
         if lift_off.is_none()
@@ -1000,6 +1032,7 @@ impl<'a> Simulation<'a> {
                         .collect()
                 })
                 .unwrap_or_default(),
+            open_faces: &self.open.faces,
         };
         // Dense-output sampling and peak detection, on copies so that the system can borrow the
         // dynamics.
@@ -1059,6 +1092,12 @@ impl<'a> Simulation<'a> {
             Ok(Stop::Event { index, .. }) => events.rocking.get(*index).map(|r| r.0),
             _ => None,
         };
+        let landing = match &stop {
+            Ok(Stop::Event { index, .. }) if *index >= events.first_gap_index() => {
+                Some(events.gap_point(index - events.first_gap_index()))
+            }
+            _ => None,
+        };
         let SegmentEvents {
             kin: events_kin,
             trial,
@@ -1088,6 +1127,9 @@ impl<'a> Simulation<'a> {
         let stop = stop?;
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());
+        if let Some((face, point)) = landing {
+            return self.recontact(face, point).map(StopReason::Impact);
+        }
         self.stop_reason(
             stop,
             event_slot,
@@ -1126,7 +1168,8 @@ impl<'a> Simulation<'a> {
     /// The longest step of this segment: the user's `max_step`, capped while joints are seated
     /// under a ground motion and inside a regularised δ zone.
     fn step_cap(&mut self) -> f64 {
-        let model = self.model;
+        let model = Arc::clone(&self.model);
+        let model = &*model;
         // Inside a regularised δ zone the step is limited to an eighth of the zone's crossing time,
         // so that the bump is resolved by the steps and their dense output.
         let mut h_max = self.params.options.h_max;
@@ -1219,7 +1262,7 @@ impl<'a> Simulation<'a> {
 
     fn collapse_record(&mut self) -> Collapse {
         let q = self.q();
-        forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        forward_kinematics(&self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
         let (b, _) = self
             .model
             .bodies
@@ -1268,7 +1311,12 @@ impl<'a> Simulation<'a> {
             lost: self.lost_at_impacts(),
         });
         Trajectory {
-            coordinates: self.model.coords.iter().map(|c| c.name.clone()).collect(),
+            coordinates: self
+                .original
+                .coords
+                .iter()
+                .map(|c| c.name.clone())
+                .collect(),
             samples: self.samples,
             impacts: self.impacts,
             peaks: self.peaks,

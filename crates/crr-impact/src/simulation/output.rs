@@ -43,7 +43,7 @@ impl Simulation<'_> {
             d.pivots.clone_from(&self.dynamics.pivots);
             d.seated.clone_from(&self.dynamics.seated);
             let work = &mut self.spare.forces;
-            if crate::monitor::contact_forces_into(self.model, d, self.ground, t, &q, &qdot, work)
+            if crate::monitor::contact_forces_into(&self.model, d, self.ground, t, &q, &qdot, work)
                 .is_ok()
             {
                 let (forces, edges) = (&work.forces, &work.edges);
@@ -57,12 +57,12 @@ impl Simulation<'_> {
                     || edges.iter().any(|e| e.near.min(e.far) < -tol);
                 let mut none = None;
                 let (states, correction) = if tension {
-                    self.spare.self_stress.states(self.model, d, &q, edges)
+                    self.spare.self_stress.states(&self.model, d, &q, edges)
                 } else {
                     (None, &mut none)
                 };
                 self.violation = crate::monitor::check_from(
-                    self.model,
+                    &self.model,
                     forces,
                     edges,
                     states,
@@ -84,21 +84,21 @@ impl Simulation<'_> {
         let kin = if monitor_kin {
             &self.spare.monitor.kin
         } else {
-            forward_kinematics(self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
-            crr_kinematics::velocities(self.model, &mut self.out_kin, &qdot);
+            forward_kinematics(&self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
+            crr_kinematics::velocities(&self.model, &mut self.out_kin, &qdot);
             &self.out_kin
         };
         let taken = Taken {
             t,
-            kinetic: crr_kinematics::body_kinetic_energy(self.model, kin),
-            potential: potential_energy(self.model, kin) - self.u_rest,
+            kinetic: crr_kinematics::body_kinetic_energy(&self.model, kin),
+            potential: potential_energy(&self.model, kin) - self.u_rest,
             work_in: y[2 * n],
             dissipated: self.dissipated_at_impacts + y[2 * n + 1],
         };
         (self.spare.sample_q, self.spare.sample_qdot) = (q, qdot);
         let mut states = std::mem::take(&mut self.spare.sample_states);
         states.clear();
-        states.extend((0..self.model.slot_count).map(|s| self.slot_state(s)));
+        states.extend((0..self.original.slot_count).map(|s| self.slot_state(s)));
         self.spare.sample_states = states;
         taken
     }

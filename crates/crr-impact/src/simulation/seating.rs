@@ -860,7 +860,7 @@ impl Simulation<'_> {
         let mut trial = self.take_trial();
         self.spare.rest.lift_off = None;
         let mode = opening_mode_in(
-            self.model,
+            &self.model,
             self.ground,
             &self.dynamics,
             &mut trial,
@@ -872,9 +872,15 @@ impl Simulation<'_> {
         );
         self.spare.trial = Some(trial);
         if let Some(interfaces) = self.spare.rest.lift_off.take() {
+            let in_flight = bodies_without_support(&self.model, &interfaces);
+            // Faces that close loops open and the chain without them decides again; a tree
+            // face, or a body left without support, is outside the model.
+            if in_flight.is_empty() && self.release_loops(&interfaces)? {
+                return self.release_once();
+            }
             return Err(SimulationError::LiftOff {
                 t: self.t,
-                in_flight: bodies_without_support(self.model, &interfaces),
+                in_flight,
                 interfaces,
             });
         }
@@ -886,7 +892,7 @@ impl Simulation<'_> {
             let from_rest = self.seated.iter().all(|&s| s);
             let n = self.model.dof();
             let twisting_flip = mode.iter().any(|&(s, side)| {
-                side != self.dynamics.pivots.sides[s] && is_twisting_closure_slot(self.model, s)
+                side != self.dynamics.pivots.sides[s] && is_twisting_closure_slot(&self.model, s)
             });
             for &(s, side) in mode {
                 self.dynamics.pivots.sides[s] = side;
@@ -924,7 +930,8 @@ impl Simulation<'_> {
         &mut self,
         released: &[usize],
     ) -> Result<(), SimulationError> {
-        let model = self.model;
+        let model = Arc::clone(&self.model);
+        let model = &*model;
         let n = model.dof();
         let (mut q, mut qdot) = (self.q(), self.qdot());
         let seated = self.seated.clone();
@@ -972,7 +979,8 @@ impl Simulation<'_> {
         &mut self,
         t_stop: f64,
     ) -> Result<Option<StopReason>, SimulationError> {
-        let model = self.model;
+        let model = Arc::clone(&self.model);
+        let model = &*model;
         let n = model.dof();
         if !self.seated[..n].iter().all(|&s| s) || self.t >= t_stop {
             return Ok(None);
@@ -1055,7 +1063,7 @@ impl Simulation<'_> {
             .spare
             .events_kin
             .take()
-            .unwrap_or_else(|| Box::new(Data::new(self.model)));
+            .unwrap_or_else(|| Box::new(Data::new(&self.model)));
         let mut d = self.take_trial();
         let mut buffers = self.spare.settle.take().unwrap_or_default();
         let result = self.settle_resting_joints_in(&mut d, &mut kin, &mut buffers);
@@ -1073,7 +1081,8 @@ impl Simulation<'_> {
         kin: &mut Data,
         buffers: &mut SettleBuffers,
     ) -> Result<Option<f64>, SimulationError> {
-        let model = self.model;
+        let model = Arc::clone(&self.model);
+        let model = &*model;
         let n = model.dof();
         let SettleBuffers {
             q,

@@ -1,0 +1,422 @@
+//! Loops released in motion: a loop-closing interface whose whole face lifts off (a block leaving
+//! one of its two supports while the other holds it) is dropped from the dynamic chain, and its
+//! face is watched until a corner touches again.
+//!
+//! - **Release.** When the contact program finds that some faces open entirely and every body
+//!   keeps a support through the others, and every such face closes a loop, the run goes on with
+//!   the file's model without those interfaces ([`Model::without_loop_closures`]): the same tree
+//!   and coordinates q, fewer closure rows. Their slots are reported `open`. A face of the tree
+//!   that lifts off would need the chain re-rooted: the run stops with
+//!   [`SimulationError::LiftOff`] as before.
+//! - **Gap.** Each open face's contact points (a hinge's two pivot lines, a rocking base's four
+//!   corners) carry the normal gap g = n_p·(x_c − x_p): the child's point less the parent's,
+//!   along the parent's face normal turned with it. g is an event function of the segments;
+//!   g < 0 beyond the event's overshoot is a missed contact, caught by the run's invariant.
+//! - **Re-contact.** When a point's gap falls through 0 the loop closes again on the pivot at
+//!   that point: the positions are closed by the least change of the tree coordinates not seated
+//!   (a snap, its change of T + U booked like the impacts' snaps), and the velocities by a
+//!   plastic impulse on the loop's rows and the seated slots (Gauss' principle of impulsive
+//!   motion: the contact is perfectly plastic, T falls by the energy of the relative velocity
+//!   the rows remove), recorded as an impact of that interface.
+
+use super::*;
+use crr_dynamics::closed_chain::project_positions;
+use crr_kinematics::{ContactFace, Role};
+use nalgebra::Vector3;
+
+/// Largest penetration of an open face's point (a fraction of the model size) the run's
+/// invariant accepts: above the gap event's location error (1e-13 of the size at its margin),
+/// far below any visible overlap.
+pub(super) const GAP_TOLERANCE: f64 = 1e-6;
+
+/// One open face: an interface of the file's model whose loop is released.
+#[derive(Clone, Debug)]
+pub(super) struct OpenFace {
+    /// Index into the file's model's interfaces.
+    pub(super) interface: usize,
+    /// The parent body (None: the ground) and the child.
+    parent: Option<usize>,
+    child: usize,
+    /// The face's normal at rest, into the child.
+    normal: Vector3<f64>,
+    /// The contact points at rest, and for each the sides of the interface's angles whose pivot
+    /// it is.
+    points: Vec<Vector3<f64>>,
+    pub(super) point_sides: Vec<Vec<Side>>,
+}
+
+impl OpenFace {
+    fn of(model: &Model, k: usize) -> Self {
+        let iface = &model.interfaces[k];
+        let face = ContactFace::of_interface(model, k);
+        let count = iface.kind.angle_count();
+        let choices: Vec<Vec<Side>> = (0..1usize << count)
+            .map(|bits| {
+                (0..count)
+                    .map(|c| {
+                        if bits >> c & 1 == 0 {
+                            Side::Positive
+                        } else {
+                            Side::Negative
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let point_sides = face
+            .points
+            .iter()
+            .map(|p| {
+                choices
+                    .iter()
+                    .min_by(|a, b| {
+                        let d = |s: &Vec<Side>| (iface.kind.pivot(s) - p).norm();
+                        d(a).total_cmp(&d(b))
+                    })
+                    .expect("at least one choice of sides")
+                    .clone()
+            })
+            .collect();
+        Self {
+            interface: k,
+            parent: match iface.parent {
+                crr_kinematics::Parent::Body(b) => Some(b),
+                crr_kinematics::Parent::Ground => None,
+            },
+            child: iface.child,
+            normal: face.normal,
+            points: face.points,
+            point_sides,
+        }
+    }
+
+    /// Number of contact points.
+    pub(super) fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// The normal gap of point `i` (m) in the poses of `kin` ([`forward_kinematics`] of a chain
+    /// with the same tree as `model`).
+    pub(super) fn gap(&self, model: &Model, kin: &Data, i: usize) -> f64 {
+        let p = &self.points[i];
+        let child = crr_kinematics::body_point(model, kin, self.child, p);
+        let (parent, normal) = match self.parent {
+            None => (*p, self.normal),
+            Some(b) => {
+                let k = model.body_coord[b];
+                (
+                    crr_kinematics::body_point(model, kin, b, p),
+                    kin.rot_ops[k] * self.normal,
+                )
+            }
+        };
+        normal.dot(&(child - parent))
+    }
+}
+
+/// The loops released now: which interfaces of the file's model are open, and the slots' maps
+/// between it and the chain integrated.
+#[derive(Clone, Debug)]
+pub(super) struct OpenLoops {
+    /// The open faces, in the file's interface order.
+    pub(super) faces: Vec<OpenFace>,
+    /// Slot of the chain → slot of the file's model.
+    to_original: Vec<usize>,
+    /// Slot of the file's model → slot of the chain (None: its interface is open).
+    to_active: Vec<Option<usize>>,
+}
+
+impl OpenLoops {
+    /// No loop released.
+    pub(super) fn none(model: &Model) -> Self {
+        Self {
+            faces: Vec::new(),
+            to_original: (0..model.slot_count).collect(),
+            to_active: (0..model.slot_count).map(Some).collect(),
+        }
+    }
+
+    /// The interfaces `open` of `original` released: the maps and the chain.
+    fn with(original: &Model, open: &[usize]) -> Result<(Self, Model), crr_kinematics::ModelError> {
+        let chain = original.without_loop_closures(open)?;
+        let mut to_active = vec![None; original.slot_count];
+        let mut to_original = vec![0; chain.slot_count];
+        let kept = (0..original.interfaces.len()).filter(|k| !open.contains(k));
+        for (new, old) in kept.enumerate() {
+            let slots = original.interfaces[old].slots.clone();
+            for (a, b) in slots.zip(chain.interfaces[new].slots.clone()) {
+                to_active[a] = Some(b);
+                to_original[b] = a;
+            }
+        }
+        let mut sorted = open.to_vec();
+        sorted.sort_unstable();
+        let faces = sorted.iter().map(|&k| OpenFace::of(original, k)).collect();
+        Ok((
+            Self {
+                faces,
+                to_original,
+                to_active,
+            },
+            chain,
+        ))
+    }
+
+    /// The chain's slot of the file's slot `s` (None: open).
+    pub(super) fn active_slot(&self, s: usize) -> Option<usize> {
+        self.to_active[s]
+    }
+
+    /// The file's slot of the chain's slot `s`.
+    pub(super) fn original_slot(&self, s: usize) -> usize {
+        self.to_original[s]
+    }
+
+    /// The open interfaces of the file's model.
+    pub(super) fn interfaces(&self) -> Vec<usize> {
+        self.faces.iter().map(|f| f.interface).collect()
+    }
+}
+
+impl Simulation<'_> {
+    /// Appends an impact of the chain integrated, its slots numbered as the file's.
+    pub(super) fn push_impact(&mut self, mut record: ImpactRecord) {
+        for s in record.slots.iter_mut().chain(record.seated.iter_mut()) {
+            *s = self.open.original_slot(*s);
+        }
+        self.impacts.push(record);
+    }
+
+    /// The faces `lifting` (names of the chain's interfaces) open entirely: when each closes a
+    /// loop, their loops are released and true is returned; false when one is a tree interface
+    /// (the chain would have to be re-rooted).
+    pub(super) fn release_loops(&mut self, lifting: &[String]) -> Result<bool, SimulationError> {
+        let chain = Arc::clone(&self.model);
+        let closes_a_loop = |name: &String| {
+            chain
+                .interfaces
+                .iter()
+                .find(|i| &i.name == name)
+                .is_some_and(|i| matches!(i.role, Role::Closure { .. }))
+        };
+        if !lifting.iter().all(closes_a_loop) {
+            return Ok(false);
+        }
+        let mut open = self.open.interfaces();
+        open.extend(
+            lifting
+                .iter()
+                .filter_map(|name| self.original.interface_index(name)),
+        );
+        self.switch_chain(&open, &[])?;
+        Ok(true)
+    }
+
+    /// Integrates from now on the file's model without the interfaces `open`: the state q, q̇
+    /// is kept (the tree is the same); every slot keeps its side, seat and last impact, and a
+    /// slot that was open takes its side from `closing` (file slot, side) and rocks.
+    fn switch_chain(
+        &mut self,
+        open: &[usize],
+        closing: &[(usize, Side)],
+    ) -> Result<(), SimulationError> {
+        let original = self.original;
+        let (loops, chain) = OpenLoops::with(original, open)
+            .map_err(|e| SimulationError::Invariant(format!("cannot release the loops: {e}")))?;
+        let mut pivots = ActivePivots::uniform(&chain, Side::Positive);
+        let mut seated = vec![false; chain.slot_count];
+        let mut last_impact = vec![self.t; chain.slot_count];
+        for (b, side) in pivots.sides.iter_mut().enumerate() {
+            let file_slot = loops.original_slot(b);
+            if let Some(a) = self.open.active_slot(file_slot) {
+                *side = self.dynamics.pivots.sides[a];
+                seated[b] = self.seated[a];
+                last_impact[b] = self.last_impact[a];
+            } else if let Some(&(_, s)) = closing.iter().find(|c| c.0 == file_slot) {
+                *side = s;
+            }
+        }
+        let mut dynamics = Dynamics::new(&chain, pivots);
+        dynamics.min_norm_multipliers = false;
+        let trial = dynamics.clone();
+        self.spare = Workspaces::new(&chain, trial, &dynamics.pivots);
+        self.dynamics = dynamics;
+        self.regularised = Regularised::of(&chain);
+        self.parts = chain.parts();
+        self.seated = seated;
+        self.last_impact = last_impact;
+        self.model = Arc::new(chain);
+        self.open = loops;
+        self.set_seated(std::iter::empty());
+        self.reset_solver();
+        Ok(())
+    }
+
+    /// Point `point` of open face `face` touches: its loop closes again on the pivot there,
+    /// positions by the least change (booked as a snap) and velocities by a plastic impulse
+    /// (recorded as an impact). Returns the impact's index.
+    pub(super) fn recontact(
+        &mut self,
+        face: usize,
+        point: usize,
+    ) -> Result<usize, SimulationError> {
+        if self.impacts.len() >= self.params.max_impacts {
+            return Err(SimulationError::TooManyImpacts(self.params.max_impacts));
+        }
+        let t = self.t;
+        let landing = self.open.faces[face].clone();
+        let original = self.original;
+        let iface = &original.interfaces[landing.interface];
+        let closing: Vec<(usize, Side)> = iface
+            .slots
+            .clone()
+            .zip(landing.point_sides[point].iter().copied())
+            .collect();
+        self.record_current_sample(t);
+        let energy_before = self.mechanical_energy();
+        let mut open = self.open.interfaces();
+        open.retain(|&k| k != landing.interface);
+        self.switch_chain(&open, &closing)?;
+        let model = Arc::clone(&self.model);
+        let model = &*model;
+        let n = model.dof();
+        let slots: Vec<usize> = closing
+            .iter()
+            .filter_map(|&(s, _)| self.open.active_slot(s))
+            .collect();
+        // Positions: the loop closed by the least change of the tree coordinates not seated.
+        let mut q = self.q();
+        let qdot = self.qdot();
+        let free: Vec<usize> = (0..n).filter(|&k| !self.seated[k]).collect();
+        let mut kin = Data::new(model);
+        project_positions(model, &mut kin, &self.dynamics.pivots, &mut q, Some(&free))
+            .map_err(|source| SimulationError::Dynamics { t, source })?;
+        let (t_minus, u_snapped) =
+            state_energies(model, &mut kin, &self.dynamics.pivots, &q, &qdot);
+        let mut rates_before = vec![0.0; model.slot_count];
+        slot_rates(model, &kin, &qdot, &mut rates_before);
+        // Velocities: the plastic impulse on the loop's rows and the seated slots.
+        let held: Vec<usize> = (0..model.slot_count).filter(|&s| self.seated[s]).collect();
+        let mut work = self.take_trial();
+        let pivots = self.dynamics.pivots.clone();
+        let (mut qdot_after, mut t_plus) =
+            plastic_projection(model, &mut work, self.ground, t, &q, &qdot, &pivots, &held)?;
+        // The landing slots' angles and rates: a slot brought to rest, or sent into its closed
+        // side, seats (as at an impact).
+        let mut angles = vec![0.0; model.slot_count];
+        slot_angles(model, &mut kin, &q, &pivots, &mut angles);
+        crr_kinematics::velocities(model, &mut kin, &qdot_after);
+        let mut rates = vec![0.0; model.slot_count];
+        slot_rates(model, &kin, &qdot_after, &mut rates);
+        let to_seat: Vec<usize> = slots
+            .iter()
+            .copied()
+            .filter(|&s| {
+                angles[s].abs() <= self.params.simultaneity
+                    && (rates[s].abs() < self.params.seat_rate
+                        || pivots.sides[s].sign() * rates[s] < 0.0)
+            })
+            .collect();
+        if !to_seat.is_empty() {
+            let all: Vec<usize> = held.iter().chain(&to_seat).copied().collect();
+            (qdot_after, t_plus) = plastic_projection(
+                model,
+                &mut work,
+                self.ground,
+                t,
+                &q,
+                &qdot_after,
+                &pivots,
+                &all,
+            )?;
+            crr_kinematics::velocities(model, &mut kin, &qdot_after);
+            slot_rates(model, &kin, &qdot_after, &mut rates);
+        }
+        self.spare.trial = Some(work);
+        self.y[..n].copy_from_slice(q.as_slice());
+        self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
+        let lost = t_minus - t_plus;
+        // The snap: T + U before the positions moved less T + U after them (with q̇⁻).
+        self.book_snap(energy_before - (t_minus + u_snapped));
+        self.dissipated_at_impacts += lost;
+        self.set_seated(to_seat.iter().map(|&s| (s, true)));
+        let record = ImpactRecord {
+            t,
+            interfaces: vec![iface.name.clone()],
+            slots: slots.clone(),
+            rates_before: slots.iter().map(|&s| rates_before[s]).collect(),
+            rates_after: slots.iter().map(|&s| rates[s]).collect(),
+            energy_lost: lost,
+            energy_gain: lost < -1e-12 * t_minus.abs().max(1e-300),
+            seated: to_seat,
+        };
+        for &s in &slots {
+            self.last_impact[s] = t;
+        }
+        self.push_impact(record);
+        self.reset_solver();
+        // A face that lands and must open again, or joints the landing releases, open before
+        // the sample after it.
+        self.release_if_opening()?;
+        self.record_current_sample(t);
+        Ok(self.impacts.len() - 1)
+    }
+
+    /// An open face resting on its support: every slot of the chain seated and still (the
+    /// seating snaps set the tree coordinates to exactly 0, which can put a lifted block back
+    /// on its support without its gap event: the face is touching, with no relative velocity).
+    /// Returns (face, point) of its lowest point, gap within 1e-9 of the model size.
+    pub(super) fn settled_open_face(&mut self) -> Option<(usize, usize)> {
+        if self.open.faces.is_empty() || self.seated.iter().any(|s| !s) {
+            return None;
+        }
+        let n = self.model.dof();
+        let rate_scale = (self.model.gravity / self.model.size).sqrt();
+        if self.y[n..2 * n]
+            .iter()
+            .any(|v| v.abs() > 1e-12 * rate_scale)
+        {
+            return None;
+        }
+        let model = Arc::clone(&self.model);
+        let q = self.q();
+        forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        for (f, face) in self.open.faces.iter().enumerate() {
+            let (point, gap) = (0..face.len())
+                .map(|i| (i, face.gap(&model, &self.out_kin, i)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))?;
+            if gap <= 1e-9 * model.size {
+                return Some((f, point));
+            }
+        }
+        None
+    }
+
+    /// T + U at the current state on the chain integrated (J).
+    fn mechanical_energy(&mut self) -> f64 {
+        let model = Arc::clone(&self.model);
+        let (q, qdot) = (self.q(), self.qdot());
+        let (t, u) = state_energies(&model, &mut self.out_kin, &self.dynamics.pivots, &q, &qdot);
+        t + u
+    }
+
+    /// The open faces' largest penetration (m) at q, with the face's interface name: the run's
+    /// invariant ([`GAP_TOLERANCE`]).
+    pub(super) fn deepest_open_point(&mut self, q: &DVector<f64>) -> Option<(f64, String)> {
+        if self.open.faces.is_empty() {
+            return None;
+        }
+        let model = Arc::clone(&self.model);
+        forward_kinematics(&model, &mut self.out_kin, q, &self.dynamics.pivots);
+        let mut deepest: Option<(f64, String)> = None;
+        for face in &self.open.faces {
+            for i in 0..face.len() {
+                let g = face.gap(&model, &self.out_kin, i);
+                if deepest.as_ref().is_none_or(|d| g < d.0) {
+                    deepest = Some((g, self.original.interfaces[face.interface].name.clone()));
+                }
+            }
+        }
+        deepest
+    }
+}
