@@ -662,7 +662,12 @@ impl Model {
             body_coord,
             mut roles,
             mut slots,
-        } = tree_coordinates(spec, &ends, &order, bodies.len());
+        } = tree_coordinates(
+            |k, comp| coordinate_name(&spec.interface[k].name, ends[k].2.angle_count(), comp),
+            &ends,
+            &order,
+            bodies.len(),
+        );
         let (closures, row, slot) =
             loop_closures(&ends, &in_tree, &mut roles, &mut slots, coords.len());
         let symmetries = symmetry_rows(spec, &coords)?;
@@ -772,6 +777,92 @@ impl Model {
             slot_count: slot,
             size: self.size,
         })
+    }
+
+    /// The chain left when the interfaces `open` (indices into [`Model::interfaces`], of a
+    /// model built from a file) lift off, whichever they are: the same bodies, the interfaces
+    /// kept (renumbered in their order), and a spanning tree grown again from the ground: the
+    /// file's tree where it still reaches every body, and otherwise
+    /// interfaces turned round ([`reversed_kind`]) to reach the bodies that hung from an open
+    /// one (a capital left on the entablature when its column's neck opens). An interface
+    /// turned round carries the file's names; a rocking base's tilts swap (its first coordinate
+    /// is the file's `<name>.2`). Symmetry rows between two coordinates still in the tree are
+    /// kept, the others dropped. Also returns, per interface kept, whether it was turned round.
+    /// Errors: a body left with no support (a flight), or a twisting seat that would have to
+    /// enter the tree.
+    pub fn with_open_interfaces(&self, open: &[usize]) -> Result<(Model, Vec<bool>), ModelError> {
+        let kept: Vec<usize> = (0..self.interfaces.len())
+            .filter(|k| !open.contains(k))
+            .collect();
+        let names: Vec<String> = kept
+            .iter()
+            .map(|&k| self.interfaces[k].name.clone())
+            .collect();
+        let mut ends: Vec<InterfaceEnds> = kept
+            .iter()
+            .map(|&k| {
+                let i = &self.interfaces[k];
+                (i.parent, i.child, i.kind.clone())
+            })
+            .collect();
+        let (order, in_tree, turned) = rooted_tree(&mut ends, &self.bodies, &names)?;
+        let TreeCoordinates {
+            coords,
+            body_coord,
+            mut roles,
+            mut slots,
+        } = tree_coordinates(
+            |k, comp| {
+                let count = ends[k].2.angle_count();
+                let file_comp = if turned[k] { count - 1 - comp } else { comp };
+                coordinate_name(&names[k], count, file_comp)
+            },
+            &ends,
+            &order,
+            self.bodies.len(),
+        );
+        let (closures, row, slot) =
+            loop_closures(&ends, &in_tree, &mut roles, &mut slots, coords.len());
+        let find = |name: &str| coords.iter().position(|c| c.name == name);
+        let symmetries: Vec<(usize, usize, f64)> = self
+            .symmetries
+            .iter()
+            .filter_map(|&(a, b, sign)| {
+                Some((
+                    find(&self.coords[a].name)?,
+                    find(&self.coords[b].name)?,
+                    sign,
+                ))
+            })
+            .collect();
+        let interfaces = ends
+            .into_iter()
+            .enumerate()
+            .map(|(j, (parent, child, kind))| Interface {
+                name: names[j].clone(),
+                parent,
+                child,
+                kind,
+                impact: self.interfaces[kept[j]].impact,
+                role: roles[j],
+                slots: slots[j].clone(),
+            })
+            .collect();
+        let model = Model {
+            name: self.name.clone(),
+            gravity: self.gravity,
+            bodies: self.bodies.clone(),
+            interfaces,
+            coords,
+            closures,
+            body_coord,
+            closure_rows: row,
+            constraint_rows: row + symmetries.len(),
+            symmetries,
+            slot_count: slot,
+            size: self.size,
+        };
+        Ok((model, turned))
     }
 
     /// DOF(1): the number of tree coordinates.
@@ -1224,7 +1315,7 @@ struct TreeCoordinates {
 /// The tree's coordinates in the order of `order` (one per hinge, two per rocking base), the
 /// coordinate each body moves with, and the tree interfaces' roles and slots.
 fn tree_coordinates(
-    spec: &StructureSpec,
+    name: impl Fn(usize, usize) -> String,
     ends: &[InterfaceEnds],
     order: &[usize],
     n_bodies: usize,
@@ -1243,13 +1334,8 @@ fn tree_coordinates(
         };
         let n = kind.angle_count();
         for comp in 0..n {
-            let name = if n == 1 {
-                spec.interface[k].name.clone()
-            } else {
-                format!("{}.{}", spec.interface[k].name, comp + 1)
-            };
             coords.push(Coordinate {
-                name,
+                name: name(k, comp),
                 interface: k,
                 component: comp,
                 axis: kind.axis(comp),
@@ -1267,6 +1353,118 @@ fn tree_coordinates(
         roles,
         slots,
     }
+}
+
+/// The name of component `comp` of an interface `name` with `count` angles: the interface's
+/// name for a hinge, `<name>.1` / `<name>.2` for a rocking base's tilts.
+fn coordinate_name(name: &str, count: usize, comp: usize) -> String {
+    if count == 1 {
+        name.to_string()
+    } else {
+        format!("{name}.{}", comp + 1)
+    }
+}
+
+/// An interface turned round: its child becomes its parent. The relative motion of the file's
+/// parent seen from its child is the inverse rotation about the same pivots: a hinge R(u, φ)
+/// about P becomes R(−u, φ) about P; a rocking base R(e₁, θ₁)R(e₂, θ₂) becomes
+/// R(−e₂, θ₂)R(−e₁, θ₁), so its first tilt is the file's second about −e₂ and its second the
+/// file's first about −e₁; the normal, into the new child, is −n. Angles and pivot sides keep
+/// their values (a positive tilt about −e₂ pivots on the edge of greatest e₁·x, as a positive
+/// tilt about e₂ did).
+pub fn reversed_kind(kind: &InterfaceKind) -> InterfaceKind {
+    match kind {
+        InterfaceKind::Hinge {
+            axis,
+            pivot_positive,
+            pivot_negative,
+        } => InterfaceKind::Hinge {
+            axis: -axis,
+            pivot_positive: *pivot_positive,
+            pivot_negative: *pivot_negative,
+        },
+        InterfaceKind::RockingBase {
+            corners,
+            normal,
+            e1,
+            e2,
+            twist,
+        } => InterfaceKind::RockingBase {
+            corners: *corners,
+            normal: -normal,
+            e1: -e2,
+            e2: -e1,
+            twist: *twist,
+        },
+    }
+}
+
+/// A spanning tree: the tree interfaces in coordinate order, which interfaces are in it, and
+/// which were turned round.
+type RootedTree = (Vec<usize>, Vec<bool>, Vec<bool>);
+
+/// The spanning tree of [`spanning_tree`] when some bodies can only be reached through an
+/// interface from its child to its parent: the tree grows from the ground along interfaces from
+/// parent to child (file order, breadth first, as the file's own tree); when bodies remain, the
+/// first interface (file order) from a body reached to an unreached parent is turned round
+/// ([`reversed_kind`]) and the growth goes on from there. With every body reachable from parent
+/// to child it is the file's tree. Returns the order, the tree flags and which interfaces were
+/// turned round (their `ends` are turned in place).
+fn rooted_tree(
+    ends: &mut [InterfaceEnds],
+    bodies: &[Body],
+    names: &[String],
+) -> Result<RootedTree, ModelError> {
+    let n_i = ends.len();
+    let mut in_tree = vec![false; n_i];
+    let mut turned = vec![false; n_i];
+    let mut reached = vec![false; bodies.len()];
+    let mut order = Vec::new();
+    let mut queue = VecDeque::from([Parent::Ground]);
+    loop {
+        while let Some(node) = queue.pop_front() {
+            for (k, (p, c, _)) in ends.iter().enumerate() {
+                if *p == node && !reached[*c] {
+                    reached[*c] = true;
+                    in_tree[k] = true;
+                    order.push(k);
+                    queue.push_back(Parent::Body(*c));
+                }
+            }
+        }
+        if reached.iter().all(|&r| r) {
+            break;
+        }
+        let turn = ends.iter().position(|(p, c, _)| match p {
+            Parent::Body(b) => reached[*c] && !reached[*b],
+            Parent::Ground => false,
+        });
+        let Some(k) = turn else {
+            let b = reached.iter().position(|r| !r).expect("a body not reached");
+            return Err(ModelError::new(
+                quoted("body", &bodies[b].name),
+                "has no support left: no interface that stays closed joins it to the ground",
+            ));
+        };
+        let (p, c, kind) = &ends[k];
+        let Parent::Body(b) = *p else {
+            unreachable!("the ground is never turned round")
+        };
+        if matches!(kind, InterfaceKind::RockingBase { twist: true, .. }) {
+            return Err(ModelError::new(
+                quoted("interface", &names[k]),
+                "may twist (`twist = true`) and would have to carry the chain to its parent, \
+                 which needs a third coordinate",
+            ));
+        }
+        ends[k] = (Parent::Body(*c), b, reversed_kind(kind));
+        turned[k] = true;
+        reached[b] = true;
+        in_tree[k] = true;
+        order.push(k);
+        queue.push_back(Parent::Body(b));
+    }
+    Ok((order, in_tree, turned))
 }
 
 /// The loop closures of the interfaces outside the tree (5 rows for a hinge, 4 for a rocking
