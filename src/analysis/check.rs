@@ -395,7 +395,7 @@ pub fn to_text(r: &CheckReport) -> String {
                     let lifting = with(crr_impact::statics::Motion::LiftsOff);
                     if !lifting.is_empty() {
                         s += &format!(
-                            "    lifting off: {} (a block leaves a support: `crr simulate` releases the loop of a face that closes one and stops at a face of the spanning tree)\n",
+                            "    lifting off: {} (a block leaves a support: `crr simulate` takes these faces out of the dynamic chain until they land)\n",
                             lifting.join(", ")
                         );
                     }

@@ -59,16 +59,17 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
             ..Default::default()
         };
         let run = crr::run(&input, &opts).unwrap();
-        // ×1.8 runs to the end; ×3.0 stops when a block lifts off a support (outside the CRR
-        // chain): not a failure of the invariant, and the samples before are checked.
-        if scale < 2.0 {
-            assert!(run.completed(), "×{scale}: {:?}", run.summary.error);
-            assert!(run.trajectory.impacts.len() > 100, "×{scale}");
-        } else {
-            let e = run.summary.error.as_deref().unwrap_or("it completed");
-            assert!(e.contains("v5_on_v4 lift(s) off"), "×{scale}: {e}");
-            assert!(run.trajectory.impacts.len() > 50, "×{scale}");
-        }
+        // Both run to the end; under ×3.0 blocks lift off a support (v5 off v4 first, at
+        // 1.86 s), and the run goes on with those faces out of the chain (docs/simulation.md,
+        // "Faces that open"; an open face has no pivot, so its slot is not checked below).
+        assert!(run.completed(), "×{scale}: {:?}", run.summary.error);
+        assert!(run.trajectory.impacts.len() > 100, "×{scale}");
+        let opened = run
+            .trajectory
+            .samples
+            .iter()
+            .any(|s| s.states.contains(&SlotState::Open));
+        assert_eq!(opened, scale > 2.0, "×{scale}: faces open only under ×3");
         let model = &run.model;
         let mut kin = crr::kinematics::Data::new(model);
         let mut angles = vec![0.0; model.slot_count];

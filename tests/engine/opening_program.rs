@@ -337,6 +337,7 @@ fn a_colonnade_rocking_when_the_ground_falls_faster_than_gravity_stops_with_a_li
         t,
         interfaces,
         in_flight,
+        ..
     } = &failure.error
     else {
         panic!("{}", failure.error);

@@ -4,7 +4,7 @@
 //! simulation's own uplift test, which at rest with every joint seated also consults the same
 //! global program where the local search over pivot sides finds nothing. Where the mechanism
 //! lifts a block off a support through faces that close loops, the run releases those loops
-//! (their slots `open`, docs/simulation.md "Loops that open") instead of leaving the structure at
+//! (their slots `open`, docs/simulation.md "Faces that open") instead of leaving the structure at
 //! rest; a face of the spanning tree would stop it with `SimulationError::LiftOff`.
 //!
 //! 1 % is far outside both tests' thresholds (1e-9 g/size on accelerations, 1e-9 relative on λ).
@@ -55,6 +55,7 @@ fn run_from_rest(model: &Model, a: Vector3<f64>) -> Outcome {
             interfaces,
             t,
             in_flight,
+            ..
         }) => {
             assert_eq!(t, 0.0);
             // A mechanism at λ turns blocks about other contacts: none flies.

@@ -787,10 +787,16 @@ impl Model {
     /// one (a capital left on the entablature when its column's neck opens). An interface
     /// turned round carries the file's names; a rocking base's tilts swap (its first coordinate
     /// is the file's `<name>.2`). Symmetry rows between two coordinates still in the tree are
-    /// kept, the others dropped. Also returns, per interface kept, whether it was turned round.
-    /// Errors: a body left with no support (a flight), or a twisting seat that would have to
-    /// enter the tree.
-    pub fn with_open_interfaces(&self, open: &[usize]) -> Result<(Model, Vec<bool>), ModelError> {
+    /// kept, the others dropped. Interfaces in `last_resort` enter the tree only where the
+    /// others cannot reach a body (a face that has just landed stays a loop closure, so that
+    /// its landing is an impulse on the loop's rows). Also returns, per interface kept, whether
+    /// it was turned round. Errors: a body left with no support (a flight), or a twisting seat
+    /// that would have to enter the tree.
+    pub fn with_open_interfaces(
+        &self,
+        open: &[usize],
+        last_resort: &[usize],
+    ) -> Result<(Model, Vec<bool>), ModelError> {
         let kept: Vec<usize> = (0..self.interfaces.len())
             .filter(|k| !open.contains(k))
             .collect();
@@ -805,7 +811,8 @@ impl Model {
                 (i.parent, i.child, i.kind.clone())
             })
             .collect();
-        let (order, in_tree, turned) = rooted_tree(&mut ends, &self.bodies, &names)?;
+        let last: Vec<bool> = kept.iter().map(|k| last_resort.contains(k)).collect();
+        let (order, in_tree, turned) = rooted_tree(&mut ends, &self.bodies, &names, &last)?;
         let TreeCoordinates {
             coords,
             body_coord,
@@ -1407,40 +1414,67 @@ type RootedTree = (Vec<usize>, Vec<bool>, Vec<bool>);
 /// interface from its child to its parent: the tree grows from the ground along interfaces from
 /// parent to child (file order, breadth first, as the file's own tree); when bodies remain, the
 /// first interface (file order) from a body reached to an unreached parent is turned round
-/// ([`reversed_kind`]) and the growth goes on from there. With every body reachable from parent
-/// to child it is the file's tree. Returns the order, the tree flags and which interfaces were
-/// turned round (their `ends` are turned in place).
+/// ([`reversed_kind`]) and the growth goes on from there. Interfaces marked `last_resort` enter
+/// the tree only when the others cannot reach every body; a seat that may twist never does
+/// (it would need a third coordinate). With every body reachable from parent to child it is
+/// the file's tree. Returns the order, the tree flags and which interfaces were turned round
+/// (their `ends` are turned in place).
 fn rooted_tree(
     ends: &mut [InterfaceEnds],
     bodies: &[Body],
     names: &[String],
+    last_resort: &[bool],
 ) -> Result<RootedTree, ModelError> {
     let n_i = ends.len();
+    let twists =
+        |kind: &InterfaceKind| matches!(kind, InterfaceKind::RockingBase { twist: true, .. });
     let mut in_tree = vec![false; n_i];
     let mut turned = vec![false; n_i];
     let mut reached = vec![false; bodies.len()];
     let mut order = Vec::new();
     let mut queue = VecDeque::from([Parent::Ground]);
+    let mut tier = 0;
     loop {
+        let usable =
+            |k: usize, ends: &[InterfaceEnds]| !twists(&ends[k].2) && (tier > 0 || !last_resort[k]);
         while let Some(node) = queue.pop_front() {
-            for (k, (p, c, _)) in ends.iter().enumerate() {
-                if *p == node && !reached[*c] {
-                    reached[*c] = true;
+            for k in 0..n_i {
+                let (p, c, _) = &ends[k];
+                if *p == node && !reached[*c] && usable(k, ends) {
+                    let c = *c;
+                    reached[c] = true;
                     in_tree[k] = true;
                     order.push(k);
-                    queue.push_back(Parent::Body(*c));
+                    queue.push_back(Parent::Body(c));
                 }
             }
         }
         if reached.iter().all(|&r| r) {
             break;
         }
-        let turn = ends.iter().position(|(p, c, _)| match p {
-            Parent::Body(b) => reached[*c] && !reached[*b],
+        let turn = (0..n_i).find(|&k| match ends[k].0 {
+            Parent::Body(b) => reached[ends[k].1] && !reached[b] && usable(k, ends),
             Parent::Ground => false,
         });
         let Some(k) = turn else {
+            if tier == 0 {
+                // The interfaces kept for last: grow again from every body reached.
+                tier = 1;
+                queue.push_back(Parent::Ground);
+                queue.extend((0..bodies.len()).filter(|&b| reached[b]).map(Parent::Body));
+                continue;
+            }
             let b = reached.iter().position(|r| !r).expect("a body not reached");
+            if let Some(k) = (0..n_i).find(|&k| {
+                twists(&ends[k].2)
+                    && (reached[ends[k].1] != matches!(ends[k].0, Parent::Body(p) if reached[p]))
+            }) {
+                return Err(ModelError::new(
+                    quoted("interface", &names[k]),
+                    "may twist (`twist = true`) and would have to enter the spanning tree to \
+                     support a body, which needs a third coordinate",
+                ));
+            }
             return Err(ModelError::new(
                 quoted("body", &bodies[b].name),
                 "has no support left: no interface that stays closed joins it to the ground",
@@ -1450,13 +1484,6 @@ fn rooted_tree(
         let Parent::Body(b) = *p else {
             unreachable!("the ground is never turned round")
         };
-        if matches!(kind, InterfaceKind::RockingBase { twist: true, .. }) {
-            return Err(ModelError::new(
-                quoted("interface", &names[k]),
-                "may twist (`twist = true`) and would have to carry the chain to its parent, \
-                 which needs a third coordinate",
-            ));
-        }
         ends[k] = (Parent::Body(*c), b, reversed_kind(kind));
         turned[k] = true;
         reached[b] = true;

@@ -85,14 +85,14 @@ fn opening_loop_closures_keeps_the_files_tree() {
     ] {
         let model = Model::from_spec(&spec).unwrap();
         for cl in &model.closures {
-            let (general, turned) = model.with_open_interfaces(&[cl.interface]).unwrap();
+            let (general, turned) = model.with_open_interfaces(&[cl.interface], &[]).unwrap();
             assert_eq!(
                 general,
                 model.without_loop_closures(&[cl.interface]).unwrap()
             );
             assert!(turned.iter().all(|t| !t));
         }
-        let (same, _) = model.with_open_interfaces(&[]).unwrap();
+        let (same, _) = model.with_open_interfaces(&[], &[]).unwrap();
         assert_eq!(same, model);
     }
 }
@@ -130,7 +130,7 @@ fn a_chain_grown_again_moves_every_tree_interface_as_the_file_defines_it() {
     ] {
         let file = Model::from_spec(&spec).unwrap();
         for k in 0..file.interfaces.len() {
-            let Ok((chain, turned)) = file.with_open_interfaces(&[k]) else {
+            let Ok((chain, turned)) = file.with_open_interfaces(&[k], &[]) else {
                 continue;
             };
             turned_round += turned.iter().filter(|&&t| t).count();

@@ -278,12 +278,12 @@ pub enum SimulationError {
     #[error("{0}")]
     Invariant(String),
     /// The contact program finds that blocks lift off a support (at rest: the mechanism the load
-    /// opens; in motion: the motion of least Gauss function), which the CRR chain (every
-    /// interface on a pivot) cannot follow.
+    /// opens; in motion: the motion of least Gauss function) and the chain cannot go on without
+    /// those interfaces: a body left with no support (a flight), or no spanning tree left that
+    /// the CRR model can integrate (docs/simulation.md, "Faces that open").
     #[error(
-        "at t = {t} s the contact faces' program finds a motion in which {} lift(s) off a support ({}): outside the CRR model, which keeps every interface on a pivot",
-        interfaces.join(", "),
-        flight_words(in_flight)
+        "at t = {t} s the contact faces' program finds a motion in which {} lift(s) off a support: {reason}; outside the CRR model, which keeps every interface on a pivot",
+        interfaces.join(", ")
     )]
     LiftOff {
         /// Time (s).
@@ -291,9 +291,10 @@ pub enum SimulationError {
         /// The interfaces that open entirely.
         interfaces: Vec<String>,
         /// The bodies left with no path to the ground through the contacts that stay closed: a
-        /// flight. Empty when every body keeps a support (a block leaving one of its supports
-        /// while another holds it: the loop would have to be released or the chain re-rooted).
+        /// flight. Empty when every body keeps a support.
         in_flight: Vec<String>,
+        /// Why the run cannot follow it, in words.
+        reason: String,
     },
 }
 
@@ -315,16 +316,8 @@ pub struct SnapsAndLosses {
 }
 
 /// The words of [`SimulationError::LiftOff`] on the bodies it leaves without support.
-fn flight_words(in_flight: &[String]) -> String {
-    if in_flight.is_empty() {
-        "every body keeps a support through other contacts: following it needs the loop \
-         released or the chain re-rooted, which crr does not do; at rest this happens when the \
-         ground acceleration exceeds the collapse multiplier of such a mechanism, which `crr \
-         check` reports"
-            .to_string()
-    } else {
-        format!("{} lose(s) every support: a flight", in_flight.join(", "))
-    }
+pub(crate) fn flight_words(in_flight: &[String]) -> String {
+    format!("{} lose(s) every support: a flight", in_flight.join(", "))
 }
 
 /// The bodies with no path to the ground through the interfaces other than `lifting` (each
@@ -392,9 +385,16 @@ pub struct Simulation<'a> {
     model: Arc<Model>,
     /// The file's model: the outputs' slots (samples, impacts) are numbered as its slots.
     original: &'a Model,
-    /// The loops released: which interfaces of `original` are open, the slots' maps between
-    /// the two models and the open faces watched for a corner touching again.
+    /// The faces open: which interfaces of `original` are open, the slots' maps between the
+    /// two models and the open faces watched for a corner touching again.
     open: OpenLoops,
+    /// q and q̇ of the sample being taken in the file's coordinates, when the chain's tree is
+    /// not the file's (`OpenLoops::files_tree`).
+    file_q: Vec<f64>,
+    file_qdot: Vec<f64>,
+    /// Counts the changes of chain: a workspace taken before a call that may change it is
+    /// given back only if the chain is still the same.
+    chain_changes: u64,
     ground: &'a GroundMotion,
     params: Parameters,
     dynamics: Dynamics,
@@ -696,6 +696,9 @@ impl<'a> Simulation<'a> {
             model: Arc::new(model.clone()),
             original: model,
             open: OpenLoops::none(model),
+            file_q: vec![0.0; model.dof()],
+            file_qdot: vec![0.0; model.dof()],
+            chain_changes: 0,
             ground,
             params,
             dynamics,
@@ -756,13 +759,30 @@ impl<'a> Simulation<'a> {
         self.t
     }
 
-    /// Current q.
+    /// Current q, in the file's coordinates (docs/simulation.md, "Faces that open": a
+    /// coordinate whose face is open is the angle of its bodies' relative rotation).
     pub fn q(&self) -> DVector<f64> {
+        self.file_state().0
+    }
+
+    /// Current q̇, in the file's coordinates (as [`Self::q`]).
+    pub fn qdot(&self) -> DVector<f64> {
+        self.file_state().1
+    }
+
+    /// The model integrated now: the file's, or the file's without the faces that are open
+    /// (its spanning tree grown again where one of them was in it).
+    pub fn chain(&self) -> &Model {
+        &self.model
+    }
+
+    /// q of [`Self::chain`].
+    pub fn chain_q(&self) -> DVector<f64> {
         DVector::from_column_slice(&self.y[..self.model.dof()])
     }
 
-    /// Current q̇.
-    pub fn qdot(&self) -> DVector<f64> {
+    /// q̇ of [`Self::chain`].
+    pub fn chain_qdot(&self) -> DVector<f64> {
         let n = self.model.dof();
         DVector::from_column_slice(&self.y[n..2 * n])
     }
@@ -788,8 +808,7 @@ impl<'a> Simulation<'a> {
         }
     }
 
-    /// The current dynamic chain: the active pivot of every slot of the chain integrated now
-    /// (the file's model without the loops that are open, whose slots are numbered after it).
+    /// The current dynamic chain: the active pivot of every slot of [`Self::chain`].
     pub fn pivots(&self) -> &ActivePivots {
         &self.dynamics.pivots
     }
@@ -1115,7 +1134,16 @@ impl<'a> Simulation<'a> {
         self.spare.trial = Some(trial);
         self.spare.rest = rest;
         self.next_sample = next_sample;
-        self.peaks.extend_from_slice(&peaks);
+        // In the file's coordinates (a coordinate of a re-rooted chain that closes a loop of
+        // the file has no peak to report).
+        let file_dof = self.original.dof();
+        self.peaks.extend(peaks.iter().filter_map(|p| {
+            let k = self.open.original_slot(p.coordinate);
+            (k < file_dof).then_some(Peak {
+                coordinate: k,
+                ..*p
+            })
+        }));
         (seg.rocking, seg.pivots, seg.angles, seg.q, seg.qdot) = (rocking, pivots, angles, q, qdot);
         (seg.peaks, seg.rocking_coords, seg.y) = (peaks, rocking_coords, buf);
         self.spare.segment = Some(seg);
@@ -1184,7 +1212,7 @@ impl<'a> Simulation<'a> {
         }
         if let Some(r) = &self.regularised {
             let mut angles = vec![0.0; model.slot_count];
-            let (q, qdot) = (self.q(), self.qdot());
+            let (q, qdot) = (self.chain_q(), self.chain_qdot());
             slot_angles(
                 model,
                 &mut self.out_kin,
@@ -1231,7 +1259,7 @@ impl<'a> Simulation<'a> {
                     debug_assert!(index < rocking_len);
                     self.impact(slot).map(StopReason::Impact)
                 } else if index == collapse_index {
-                    let (q, qdot) = (self.q(), self.qdot());
+                    let (q, qdot) = (self.chain_q(), self.chain_qdot());
                     if q.dot(&qdot) > 0.0 {
                         let c = self.collapse_record();
                         self.collapse = Some(c.clone());
@@ -1261,7 +1289,7 @@ impl<'a> Simulation<'a> {
     }
 
     fn collapse_record(&mut self) -> Collapse {
-        let q = self.q();
+        let q = self.chain_q();
         forward_kinematics(&self.model, &mut self.out_kin, &q, &self.dynamics.pivots);
         let (b, _) = self
             .model

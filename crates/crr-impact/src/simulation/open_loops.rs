@@ -21,7 +21,7 @@
 
 use super::*;
 use crr_dynamics::closed_chain::project_positions;
-use crr_kinematics::{ContactFace, Role};
+use crr_kinematics::ContactFace;
 use nalgebra::Vector3;
 
 /// Largest penetration of an open face's point (a fraction of the model size) the run's
@@ -114,12 +114,14 @@ impl OpenFace {
     }
 }
 
-/// The loops released now: which interfaces of the file's model are open, and the slots' maps
+/// The faces open now: which interfaces of the file's model are open, and the slots' maps
 /// between it and the chain integrated.
 #[derive(Clone, Debug)]
 pub(super) struct OpenLoops {
     /// The open faces, in the file's interface order.
     pub(super) faces: Vec<OpenFace>,
+    /// The chain's tree coordinates are the file's (q needs no mapping for the outputs).
+    pub(super) files_tree: bool,
     /// Slot of the chain → slot of the file's model.
     to_original: Vec<usize>,
     /// Slot of the file's model → slot of the chain (None: its interface is open).
@@ -127,24 +129,37 @@ pub(super) struct OpenLoops {
 }
 
 impl OpenLoops {
-    /// No loop released.
+    /// No face open.
     pub(super) fn none(model: &Model) -> Self {
         Self {
             faces: Vec::new(),
+            files_tree: true,
             to_original: (0..model.slot_count).collect(),
             to_active: (0..model.slot_count).map(Some).collect(),
         }
     }
 
-    /// The interfaces `open` of `original` released: the maps and the chain.
-    fn with(original: &Model, open: &[usize]) -> Result<(Self, Model), crr_kinematics::ModelError> {
-        let chain = original.without_loop_closures(open)?;
+    /// The interfaces `open` of `original` released, those in `last_resort` kept out of the
+    /// tree where the others reach every body: the maps and the chain
+    /// ([`Model::with_open_interfaces`]). A rocking base turned round has its tilts in the other
+    /// order.
+    fn with(
+        original: &Model,
+        open: &[usize],
+        last_resort: &[usize],
+    ) -> Result<(Self, Model), crr_kinematics::ModelError> {
+        let (chain, turned) = original.with_open_interfaces(open, last_resort)?;
         let mut to_active = vec![None; original.slot_count];
         let mut to_original = vec![0; chain.slot_count];
         let kept = (0..original.interfaces.len()).filter(|k| !open.contains(k));
         for (new, old) in kept.enumerate() {
-            let slots = original.interfaces[old].slots.clone();
-            for (a, b) in slots.zip(chain.interfaces[new].slots.clone()) {
+            let file_slots: Vec<usize> = original.interfaces[old].slots.clone().collect();
+            for (c, b) in chain.interfaces[new].slots.clone().enumerate() {
+                let a = file_slots[if turned[new] {
+                    file_slots.len() - 1 - c
+                } else {
+                    c
+                }];
                 to_active[a] = Some(b);
                 to_original[b] = a;
             }
@@ -152,9 +167,12 @@ impl OpenLoops {
         let mut sorted = open.to_vec();
         sorted.sort_unstable();
         let faces = sorted.iter().map(|&k| OpenFace::of(original, k)).collect();
+        let files_tree =
+            chain.dof() == original.dof() && (0..chain.dof()).all(|k| to_original[k] == k);
         Ok((
             Self {
                 faces,
+                files_tree,
                 to_original,
                 to_active,
             },
@@ -187,42 +205,31 @@ impl Simulation<'_> {
         self.impacts.push(record);
     }
 
-    /// The faces `lifting` (names of the chain's interfaces) open entirely: when each closes a
-    /// loop, their loops are released and true is returned; false when one is a tree interface
-    /// (the chain would have to be re-rooted).
-    pub(super) fn release_loops(&mut self, lifting: &[String]) -> Result<bool, SimulationError> {
-        let chain = Arc::clone(&self.model);
-        let closes_a_loop = |name: &String| {
-            chain
-                .interfaces
-                .iter()
-                .find(|i| &i.name == name)
-                .is_some_and(|i| matches!(i.role, Role::Closure { .. }))
-        };
-        if !lifting.iter().all(closes_a_loop) {
-            return Ok(false);
-        }
+    /// The faces `lifting` (names of the chain's interfaces) open entirely: the chain goes on
+    /// without them, its spanning tree grown again where one of them was in it. Returns why
+    /// not when no spanning tree is left (a twisting seat would have to enter it).
+    pub(super) fn release_faces(&mut self, lifting: &[String]) -> Option<String> {
         let mut open = self.open.interfaces();
         open.extend(
             lifting
                 .iter()
                 .filter_map(|name| self.original.interface_index(name)),
         );
-        self.switch_chain(&open, &[])?;
-        Ok(true)
+        match OpenLoops::with(self.original, &open, &[]) {
+            Ok(built) => {
+                self.switch_chain(built, &[]);
+                None
+            }
+            Err(e) => Some(e.to_string()),
+        }
     }
 
-    /// Integrates from now on the file's model without the interfaces `open`: the state q, q̇
-    /// is kept (the tree is the same); every slot keeps its side, seat and last impact, and a
-    /// slot that was open takes its side from `closing` (file slot, side) and rocks.
-    fn switch_chain(
-        &mut self,
-        open: &[usize],
-        closing: &[(usize, Side)],
-    ) -> Result<(), SimulationError> {
-        let original = self.original;
-        let (loops, chain) = OpenLoops::with(original, open)
-            .map_err(|e| SimulationError::Invariant(format!("cannot release the loops: {e}")))?;
+    /// Integrates from now on `chain`, the file's model with the faces of `loops` open: the
+    /// state is mapped through the slots' angles and rates; every slot keeps its side, seat and
+    /// last impact, and a slot that was open takes its side from `closing` (file slot, side)
+    /// and rocks.
+    fn switch_chain(&mut self, (loops, chain): (OpenLoops, Model), closing: &[(usize, Side)]) {
+        let (q, qdot) = self.state_on(&chain, &loops);
         let mut pivots = ActivePivots::uniform(&chain, Side::Positive);
         let mut seated = vec![false; chain.slot_count];
         let mut last_impact = vec![self.t; chain.slot_count];
@@ -245,11 +252,44 @@ impl Simulation<'_> {
         self.parts = chain.parts();
         self.seated = seated;
         self.last_impact = last_impact;
+        self.out_kin = Data::new(&chain);
         self.model = Arc::new(chain);
         self.open = loops;
+        self.chain_changes += 1;
+        let n = self.model.dof();
+        self.y[..n].copy_from_slice(q.as_slice());
+        self.y[n..2 * n].copy_from_slice(qdot.as_slice());
         self.set_seated(std::iter::empty());
         self.reset_solver();
-        Ok(())
+    }
+
+    /// The current state in the coordinates of `chain` (its maps `loops`): each of its tree
+    /// coordinates is the angle (rate) of the same file slot in the chain integrated now, where
+    /// it is closed (a landing keeps the tree, and a release grows it from interfaces that stay
+    /// closed).
+    fn state_on(&mut self, chain: &Model, loops: &OpenLoops) -> (DVector<f64>, DVector<f64>) {
+        let model = Arc::clone(&self.model);
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        let mut angles = vec![0.0; model.slot_count];
+        let mut rates = vec![0.0; model.slot_count];
+        slot_angles(
+            &model,
+            &mut self.out_kin,
+            &q,
+            &self.dynamics.pivots,
+            &mut angles,
+        );
+        crr_kinematics::velocities(&model, &mut self.out_kin, &qdot);
+        slot_rates(&model, &self.out_kin, &qdot, &mut rates);
+        let old = |k: usize| {
+            self.open
+                .active_slot(loops.original_slot(k))
+                .expect("a tree interface of the new chain is closed in the old one")
+        };
+        (
+            DVector::from_fn(chain.dof(), |k, _| angles[old(k)]),
+            DVector::from_fn(chain.dof(), |k, _| rates[old(k)]),
+        )
     }
 
     /// Point `point` of open face `face` touches: its loop closes again on the pivot there,
@@ -276,7 +316,21 @@ impl Simulation<'_> {
         let energy_before = self.mechanical_energy();
         let mut open = self.open.interfaces();
         open.retain(|&k| k != landing.interface);
-        self.switch_chain(&open, &closing)?;
+        // The tree stays: every interface outside it (the landing one too) only closes loops.
+        let chain = Arc::clone(&self.model);
+        let outside_tree: Vec<usize> = (0..original.interfaces.len())
+            .filter(|&k| {
+                chain
+                    .interfaces
+                    .iter()
+                    .find(|i| i.name == original.interfaces[k].name)
+                    .is_none_or(|i| !matches!(i.role, crr_kinematics::Role::Tree { .. }))
+            })
+            .collect();
+        let built = OpenLoops::with(original, &open, &outside_tree).map_err(|e| {
+            SimulationError::Invariant(format!("cannot close the landing face's loop: {e}"))
+        })?;
+        self.switch_chain(built, &closing);
         let model = Arc::clone(&self.model);
         let model = &*model;
         let n = model.dof();
@@ -285,8 +339,8 @@ impl Simulation<'_> {
             .filter_map(|&(s, _)| self.open.active_slot(s))
             .collect();
         // Positions: the loop closed by the least change of the tree coordinates not seated.
-        let mut q = self.q();
-        let qdot = self.qdot();
+        let mut q = self.chain_q();
+        let qdot = self.chain_qdot();
         let free: Vec<usize> = (0..n).filter(|&k| !self.seated[k]).collect();
         let mut kin = Data::new(model);
         project_positions(model, &mut kin, &self.dynamics.pivots, &mut q, Some(&free))
@@ -379,7 +433,7 @@ impl Simulation<'_> {
             return None;
         }
         let model = Arc::clone(&self.model);
-        let q = self.q();
+        let q = self.chain_q();
         forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
         for (f, face) in self.open.faces.iter().enumerate() {
             let (point, gap) = (0..face.len())
@@ -392,10 +446,45 @@ impl Simulation<'_> {
         None
     }
 
+    /// Fills `file_q`, `file_qdot` with the state (q, q̇ of the chain) in the file's
+    /// coordinates ([`file_coordinates`]).
+    pub(super) fn file_coordinates(&mut self, q: &DVector<f64>, qdot: &DVector<f64>) {
+        file_coordinates(
+            self.original,
+            &self.model,
+            &self.open,
+            &mut self.out_kin,
+            &self.dynamics.pivots,
+            (q, qdot),
+            (&mut self.file_q, &mut self.file_qdot),
+        );
+    }
+
+    /// The current state in the file's coordinates.
+    pub(super) fn file_state(&self) -> (DVector<f64>, DVector<f64>) {
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        if self.open.files_tree {
+            return (q, qdot);
+        }
+        let n = self.original.dof();
+        let (mut fq, mut fqdot) = (vec![0.0; n], vec![0.0; n]);
+        let mut kin = Data::new(&self.model);
+        file_coordinates(
+            self.original,
+            &self.model,
+            &self.open,
+            &mut kin,
+            &self.dynamics.pivots,
+            (&q, &qdot),
+            (&mut fq, &mut fqdot),
+        );
+        (DVector::from_vec(fq), DVector::from_vec(fqdot))
+    }
+
     /// T + U at the current state on the chain integrated (J).
     fn mechanical_energy(&mut self) -> f64 {
         let model = Arc::clone(&self.model);
-        let (q, qdot) = (self.q(), self.qdot());
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
         let (t, u) = state_energies(&model, &mut self.out_kin, &self.dynamics.pivots, &q, &qdot);
         t + u
     }
@@ -418,5 +507,82 @@ impl Simulation<'_> {
             }
         }
         deepest
+    }
+}
+
+/// The angles of the relative rotation of an open interface's child to its parent (the file's
+/// convention, [`crr_kinematics::relative_angles`]) and their rates from the relative angular
+/// velocity ω = ω_c − ω_p, in the parent's rest frame Γ_pᵀω = θ̇₁a₁ (+ θ̇₂a₂): a₁ = u for a
+/// hinge (θ̇ = uᵀΓ_pᵀω), a₁ = e₁ and a₂ = R(e₁, θ₁)e₂ for a rocking base (least squares: an open
+/// face turns freely, also about its normal). `kin` holds the chain's poses and velocities.
+fn open_face_motion(
+    model: &Model,
+    kin: &Data,
+    iface: &crr_kinematics::Interface,
+) -> ([f64; 2], [f64; 2]) {
+    let frame = |b: usize| model.body_coord[b];
+    let spin = |b: usize| -> Vector3<f64> {
+        kin.spatial_velocity[frame(b)]
+            .fixed_rows::<3>(0)
+            .into_owned()
+    };
+    let (rc, wc) = (kin.rot_ops[frame(iface.child)], spin(iface.child));
+    let (rp, wp) = match iface.parent {
+        crr_kinematics::Parent::Ground => (nalgebra::Matrix3::identity(), Vector3::zeros()),
+        crr_kinematics::Parent::Body(b) => (kin.rot_ops[frame(b)], spin(b)),
+    };
+    let mut angles = [0.0; 2];
+    crr_kinematics::relative_angles(&iface.kind, &(rp.transpose() * rc), &mut angles);
+    let w = rp.transpose() * (wc - wp);
+    let mut rates = [0.0; 2];
+    if iface.kind.angle_count() == 1 {
+        rates[0] = iface.kind.axis(0).dot(&w);
+    } else {
+        let a1 = iface.kind.axis(0);
+        let turn =
+            nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(a1), angles[0]);
+        let a = nalgebra::Matrix3x2::from_columns(&[a1, turn * iface.kind.axis(1)]);
+        if let Some(inv) = (a.transpose() * a).try_inverse() {
+            let r = inv * (a.transpose() * w);
+            rates = [r[0], r[1]];
+        }
+    }
+    (angles, rates)
+}
+
+/// The state (q, q̇ of `chain`, the file's model `original` with the faces of `open` open) in the
+/// file's coordinates: a coordinate whose interface is closed is that slot's angle and rate in
+/// the chain; one whose face is open is the angle of the relative rotation of its bodies
+/// ([`crr_kinematics::relative_angles`], the translation off the pivot left out) and its rate
+/// from their relative angular velocity ([`open_face_motion`]).
+fn file_coordinates(
+    original: &Model,
+    chain: &Model,
+    open: &OpenLoops,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    (q, qdot): (&DVector<f64>, &DVector<f64>),
+    (file_q, file_qdot): (&mut [f64], &mut [f64]),
+) {
+    let mut angles = vec![0.0; chain.slot_count];
+    let mut rates = vec![0.0; chain.slot_count];
+    slot_angles(chain, kin, q, pivots, &mut angles);
+    crr_kinematics::velocities(chain, kin, qdot);
+    slot_rates(chain, kin, qdot, &mut rates);
+    for k in 0..original.dof() {
+        if let Some(a) = open.active_slot(k) {
+            file_q[k] = angles[a];
+            file_qdot[k] = rates[a];
+        }
+    }
+    for face in &open.faces {
+        let iface = &original.interfaces[face.interface];
+        let crr_kinematics::Role::Tree { first_coord } = iface.role else {
+            continue;
+        };
+        let (angles, rates) = open_face_motion(chain, kin, iface);
+        let count = iface.kind.angle_count();
+        file_q[first_coord..first_coord + count].copy_from_slice(&angles[..count]);
+        file_qdot[first_coord..first_coord + count].copy_from_slice(&rates[..count]);
     }
 }

@@ -95,6 +95,9 @@ impl Simulation<'_> {
             work_in: y[2 * n],
             dissipated: self.dissipated_at_impacts + y[2 * n + 1],
         };
+        if !self.open.files_tree {
+            self.file_coordinates(&q, &qdot);
+        }
         (self.spare.sample_q, self.spare.sample_qdot) = (q, qdot);
         let mut states = std::mem::take(&mut self.spare.sample_states);
         states.clear();
@@ -123,7 +126,15 @@ impl Simulation<'_> {
     /// Records the sample [`Self::sample_at`] has just taken (its scalars `s`, its q, q̇ and
     /// slot states from the workspace) and updates the running peaks and energy balance.
     pub(super) fn record_sample(&mut self, s: Taken) {
-        let q = self.spare.sample_q.as_slice();
+        // In the file's coordinates: the chain's own when its tree is the file's.
+        let (q, qdot) = if self.open.files_tree {
+            (
+                self.spare.sample_q.as_slice(),
+                self.spare.sample_qdot.as_slice(),
+            )
+        } else {
+            (self.file_q.as_slice(), self.file_qdot.as_slice())
+        };
         for (p, q) in self.peak_abs.iter_mut().zip(q) {
             *p = p.max(q.abs());
         }
@@ -134,7 +145,7 @@ impl Simulation<'_> {
         self.samples.push(Sample {
             t: s.t,
             q,
-            qdot: self.spare.sample_qdot.as_slice(),
+            qdot,
             kinetic: s.kinetic,
             potential: s.potential,
             work_in: s.work_in,

@@ -856,7 +856,7 @@ impl Simulation<'_> {
         if self.dynamics.seated.is_empty() {
             return Ok(None);
         }
-        let (q, qdot) = (self.q(), self.qdot());
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
         let mut trial = self.take_trial();
         self.spare.rest.lift_off = None;
         let mode = opening_mode_in(
@@ -873,15 +873,24 @@ impl Simulation<'_> {
         self.spare.trial = Some(trial);
         if let Some(interfaces) = self.spare.rest.lift_off.take() {
             let in_flight = bodies_without_support(&self.model, &interfaces);
-            // Faces that close loops open and the chain without them decides again; a tree
-            // face, or a body left without support, is outside the model.
-            if in_flight.is_empty() && self.release_loops(&interfaces)? {
-                return self.release_once();
-            }
+            // The faces open and the chain without them (its tree grown again where needed)
+            // decides again; a body left without support is outside the model.
+            let reason = if in_flight.is_empty() {
+                match self.release_faces(&interfaces) {
+                    None => return self.release_once(),
+                    Some(why) => format!(
+                        "every body keeps a support through other contacts, but no chain of \
+                         the CRR model is left without them ({why})"
+                    ),
+                }
+            } else {
+                super::flight_words(&in_flight)
+            };
             return Err(SimulationError::LiftOff {
                 t: self.t,
                 in_flight,
                 interfaces,
+                reason,
             });
         }
         if let Some(mode) = &mode {
@@ -933,7 +942,7 @@ impl Simulation<'_> {
         let model = Arc::clone(&self.model);
         let model = &*model;
         let n = model.dof();
-        let (mut q, mut qdot) = (self.q(), self.qdot());
+        let (mut q, mut qdot) = (self.chain_q(), self.chain_qdot());
         let seated = self.seated.clone();
         let mut kin = self
             .spare
@@ -990,7 +999,7 @@ impl Simulation<'_> {
             self.y[k] = 0.0;
             self.y[n + k] = 0.0;
         }
-        let (q, qdot) = (self.q(), self.qdot());
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
         let mut trial = self.take_trial();
         let mut rest = std::mem::take(&mut self.spare.rest);
         let (ground, template, parts) = (self.ground, &self.dynamics, &self.parts.of_slot);
@@ -1066,10 +1075,14 @@ impl Simulation<'_> {
             .unwrap_or_else(|| Box::new(Data::new(&self.model)));
         let mut d = self.take_trial();
         let mut buffers = self.spare.settle.take().unwrap_or_default();
+        let chain = self.chain_changes;
         let result = self.settle_resting_joints_in(&mut d, &mut kin, &mut buffers);
-        self.spare.events_kin = Some(kin);
-        self.spare.trial = Some(d);
-        self.spare.settle = Some(buffers);
+        // A face that opened in there changed the chain and its workspaces.
+        if self.chain_changes == chain {
+            self.spare.events_kin = Some(kin);
+            self.spare.trial = Some(d);
+            self.spare.settle = Some(buffers);
+        }
         result
     }
 
@@ -1169,7 +1182,7 @@ impl Simulation<'_> {
         // snap of their residual angles (below `simultaneity`) to exactly 0, with the loops
         // closed again, positions then velocities, changes T + U further: booked too, and
         // tallied as a snap.
-        let (mut q_new, mut qd_new) = (self.q(), qd);
+        let (mut q_new, mut qd_new) = (self.chain_q(), qd);
         let seated = &self.seated;
         let (t_after, u_after) = snap_to_seats(
             model,
