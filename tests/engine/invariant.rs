@@ -59,17 +59,12 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
             ..Default::default()
         };
         let run = crr::run(&input, &opts).unwrap();
-        // Both run to the end; under ×3.0 blocks lift off a support (v5 off v4 first, at
-        // 1.86 s), and the run goes on with those faces out of the chain (docs/simulation.md,
-        // "Faces that open"; an open face has no pivot, so its slot is not checked below).
+        // Both run to the end. Under ×3.0 the contact program finds v5 lifting off v4 (1.86 s),
+        // which the arch's chain without that face contradicts (it drives the face back into
+        // its support), so it stays closed (docs/simulation.md, "Faces that open"); an open
+        // face would have no pivot, and its slot is not checked below.
         assert!(run.completed(), "×{scale}: {:?}", run.summary.error);
         assert!(run.trajectory.impacts.len() > 100, "×{scale}");
-        let opened = run
-            .trajectory
-            .samples
-            .iter()
-            .any(|s| s.states.contains(&SlotState::Open));
-        assert_eq!(opened, scale > 2.0, "×{scale}: faces open only under ×3");
         let model = &run.model;
         let mut kin = crr::kinematics::Data::new(model);
         let mut angles = vec![0.0; model.slot_count];

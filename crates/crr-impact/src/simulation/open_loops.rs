@@ -29,6 +29,16 @@ use nalgebra::Vector3;
 /// far below any visible overlap.
 pub(super) const GAP_TOLERANCE: f64 = 1e-6;
 
+/// What became of faces the contact program lifts off ([`Simulation::release_faces`]).
+pub(super) enum FaceRelease {
+    /// They are out of the chain.
+    Released,
+    /// The chain without them drives one into its support: they stay closed.
+    Contradicted,
+    /// No chain of the CRR model is left without them (why).
+    Impossible(String),
+}
+
 /// One open face: an interface of the file's model whose loop is released.
 #[derive(Clone, Debug)]
 pub(super) struct OpenFace {
@@ -206,31 +216,84 @@ impl Simulation<'_> {
     }
 
     /// The faces `lifting` (names of the chain's interfaces) open entirely: the chain goes on
-    /// without them, its spanning tree grown again where one of them was in it. Returns why
-    /// not when no spanning tree is left (a twisting seat would have to enter it).
-    pub(super) fn release_faces(&mut self, lifting: &[String]) -> Option<String> {
+    /// without them, its spanning tree grown again where one of them was in it
+    /// ([`FaceRelease::Released`]) — when the chain without them confirms it
+    /// ([`Self::faces_separate`]). Otherwise the faces stay closed
+    /// ([`FaceRelease::Contradicted`]), or no spanning tree is left (a twisting seat would have
+    /// to enter it: [`FaceRelease::Impossible`] with why).
+    pub(super) fn release_faces(&mut self, lifting: &[String]) -> FaceRelease {
         let mut open = self.open.interfaces();
-        open.extend(
-            lifting
-                .iter()
-                .filter_map(|name| self.original.interface_index(name)),
-        );
-        match OpenLoops::with(self.original, &open, &[]) {
-            Ok(built) => {
+        let opening: Vec<usize> = lifting
+            .iter()
+            .filter_map(|name| self.original.interface_index(name))
+            .collect();
+        open.extend(&opening);
+        let built = match OpenLoops::with(self.original, &open, &[]) {
+            Ok(built) => built,
+            Err(e) => return FaceRelease::Impossible(e.to_string()),
+        };
+        match self.faces_separate(&built, &opening) {
+            Ok(true) => {
                 self.switch_chain(built, &[]);
-                None
+                FaceRelease::Released
             }
-            Err(e) => Some(e.to_string()),
+            _ => FaceRelease::Contradicted,
         }
     }
 
-    /// Integrates from now on `chain`, the file's model with the faces of `loops` open: the
-    /// state is mapped through the slots' angles and rates; every slot keeps its side, seat and
-    /// last impact, and a slot that was open takes its side from `closing` (file slot, side)
-    /// and rocks.
-    fn switch_chain(&mut self, (loops, chain): (OpenLoops, Model), closing: &[(usize, Side)]) {
-        let (q, qdot) = self.state_on(&chain, &loops);
-        let mut pivots = ActivePivots::uniform(&chain, Side::Positive);
+    /// Whether the faces `opening` (interfaces of the file) leave their supports in the motion
+    /// of the chain without them (`built`), by its own equations at the current state, as the
+    /// contact program's releases are checked: every point of those faces that touches (gap
+    /// within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a gap acceleration
+    /// above −1e-6 g. The gap's rate and acceleration are its central differences over the
+    /// states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain without the faces): exact to
+    /// O(h²) for ġ and O(h) for g̈. A face the program lifts off but that these equations drive
+    /// into its support (the program's decision and the chain's differ near a threshold) stays
+    /// closed: opening it would make it land at once, over and over.
+    fn faces_separate(
+        &mut self,
+        (loops, chain): &(OpenLoops, Model),
+        opening: &[usize],
+    ) -> Result<bool, SimulationError> {
+        let (q, qdot) = self.state_on(chain, loops);
+        let (mut d, _, _) = self.dynamics_on(chain, loops, &[]);
+        d.accelerations(chain, self.ground, self.t, &q, &qdot)
+            .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
+        let (g, size) = (chain.gravity, chain.size);
+        let h = 1e-4 * (size / g).sqrt();
+        let mut kin = Data::new(chain);
+        let mut gaps = |q: &DVector<f64>| -> Vec<f64> {
+            forward_kinematics(chain, &mut kin, q, &d.pivots);
+            loops
+                .faces
+                .iter()
+                .filter(|f| opening.contains(&f.interface))
+                .flat_map(|f| {
+                    (0..f.len())
+                        .map(|i| f.gap(chain, &kin, i))
+                        .collect::<Vec<_>>()
+                })
+                .collect()
+        };
+        let step = |sign: f64| &q + &qdot * (sign * h) + &d.qddot * (0.5 * h * h);
+        let (before, now, after) = (gaps(&step(-1.0)), gaps(&q), gaps(&step(1.0)));
+        Ok((0..now.len()).all(|i| {
+            let rate = (after[i] - before[i]) / (2.0 * h);
+            let acceleration = (after[i] - 2.0 * now[i] + before[i]) / (h * h);
+            now[i] > 1e-9 * size || (rate > -1e-9 * (g * size).sqrt() && acceleration > -1e-6 * g)
+        }))
+    }
+
+    /// The dynamics of `chain` (its maps `loops`) at the current state: every slot keeps its
+    /// side and seat, a slot that was open takes its side from `closing` (file slot, side);
+    /// also the seats and last impacts per slot.
+    fn dynamics_on(
+        &self,
+        chain: &Model,
+        loops: &OpenLoops,
+        closing: &[(usize, Side)],
+    ) -> (Dynamics, Vec<bool>, Vec<f64>) {
+        let mut pivots = ActivePivots::uniform(chain, Side::Positive);
         let mut seated = vec![false; chain.slot_count];
         let mut last_impact = vec![self.t; chain.slot_count];
         for (b, side) in pivots.sides.iter_mut().enumerate() {
@@ -243,8 +306,19 @@ impl Simulation<'_> {
                 *side = s;
             }
         }
-        let mut dynamics = Dynamics::new(&chain, pivots);
+        let mut dynamics = Dynamics::new(chain, pivots);
         dynamics.min_norm_multipliers = false;
+        dynamics.seated = (0..chain.slot_count).filter(|&s| seated[s]).collect();
+        (dynamics, seated, last_impact)
+    }
+
+    /// Integrates from now on `chain`, the file's model with the faces of `loops` open: the
+    /// state is mapped through the slots' angles and rates; every slot keeps its side, seat and
+    /// last impact, and a slot that was open takes its side from `closing` (file slot, side)
+    /// and rocks.
+    fn switch_chain(&mut self, (loops, chain): (OpenLoops, Model), closing: &[(usize, Side)]) {
+        let (q, qdot) = self.state_on(&chain, &loops);
+        let (dynamics, seated, last_impact) = self.dynamics_on(&chain, &loops, closing);
         let trial = dynamics.clone();
         self.spare = Workspaces::new(&chain, trial, &dynamics.pivots);
         self.dynamics = dynamics;

@@ -1,6 +1,7 @@
 //! Seating and uplift: the opening mode of seated joints (a small complementarity problem solved
 //! by single releases and an active set), releasing them, and seating joints that come to rest.
 
+use super::open_loops::FaceRelease;
 use super::*;
 use crr_kinematics::Interface;
 use crr_kinematics::kinematics::frame_point;
@@ -871,27 +872,45 @@ impl Simulation<'_> {
             &qdot,
         );
         self.spare.trial = Some(trial);
+        let mut mode = mode;
         if let Some(interfaces) = self.spare.rest.lift_off.take() {
             let in_flight = bodies_without_support(&self.model, &interfaces);
             // The faces open and the chain without them (its tree grown again where needed)
             // decides again; a body left without support is outside the model.
             let reason = if in_flight.is_empty() {
                 match self.release_faces(&interfaces) {
-                    None => return self.release_once(),
-                    Some(why) => format!(
+                    FaceRelease::Released => return self.release_once(),
+                    FaceRelease::Impossible(why) => Some(format!(
                         "every body keeps a support through other contacts, but no chain of \
                          the CRR model is left without them ({why})"
-                    ),
+                    )),
+                    FaceRelease::Contradicted => None,
                 }
             } else {
-                super::flight_words(&in_flight)
+                Some(super::flight_words(&in_flight))
             };
-            return Err(SimulationError::LiftOff {
-                t: self.t,
-                in_flight,
-                interfaces,
-                reason,
-            });
+            if let Some(reason) = reason {
+                return Err(SimulationError::LiftOff {
+                    t: self.t,
+                    in_flight,
+                    interfaces,
+                    reason,
+                });
+            }
+            // The faces stay closed: the program's other releases stand, theirs do not.
+            let model = Arc::clone(&self.model);
+            let lifting = |s: usize| {
+                interfaces
+                    .iter()
+                    .any(|name| model.interfaces[slot_interface(&model, s)].name == *name)
+            };
+            mode = mode
+                .map(|m| {
+                    m.into_iter()
+                        .filter(|&(s, _)| !lifting(s))
+                        .collect::<Vec<_>>()
+                })
+                .filter(|m| !m.is_empty());
         }
         if let Some(mode) = &mode {
             // The structure leaves rest only when every joint was seated: a joint seated at an
