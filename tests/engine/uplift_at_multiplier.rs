@@ -3,9 +3,8 @@
 //! asked. λ comes from the contact faces' linear program (`crr check`); the run decides with the
 //! simulation's own uplift test, which at rest with every joint seated also consults the same
 //! global program where the local search over pivot sides finds nothing. Where the mechanism
-//! lifts a block off a support through faces that close loops, the run releases those loops
-//! (their slots `open`, docs/simulation.md "Faces that open") instead of leaving the structure at
-//! rest; a face of the spanning tree would stop it with `SimulationError::LiftOff`.
+//! lifts a block off a support, the run takes those faces out of the dynamic chain (their slots
+//! `open`, docs/simulation.md "Faces that open") instead of leaving the structure at rest.
 //!
 //! 1 % is far outside both tests' thresholds (1e-9 g/size on accelerations, 1e-9 relative on λ).
 use nalgebra::Vector3;

@@ -114,7 +114,8 @@ fn arch_switches_to_the_mirrored_mechanism_and_loses_energy() {
                 SlotState::Positive => 1.0,
                 SlotState::Negative => -1.0,
                 SlotState::Seated => 0.0,
-                SlotState::Open => panic!("a tree slot never opens: only loop-closing faces do"),
+                // No pivot while its face is open: nothing to check.
+                SlotState::Open => continue,
             };
             assert!(
                 side * smp.q[k] >= -1e-9,

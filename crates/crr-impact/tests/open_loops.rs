@@ -79,7 +79,7 @@ fn face_points(
 }
 
 /// A running-bond wall of 4 courses of 3 blocks under a one-sine pulse of 8 m/s² (0.5 s): two
-/// blocks leave one of their supports, one lands again, and the run goes to its end.
+/// blocks leave one of their supports, both land again, and the run goes to its end.
 #[test]
 fn a_wall_releases_its_loops_and_lands_on_them_again() {
     let model = Model::from_spec(&running_bond_wall(4, 3, 0.6, 0.25, 0.3)).unwrap();

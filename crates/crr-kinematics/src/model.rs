@@ -1466,8 +1466,11 @@ fn rooted_tree(
             }
             let b = reached.iter().position(|r| !r).expect("a body not reached");
             if let Some(k) = (0..n_i).find(|&k| {
-                twists(&ends[k].2)
-                    && (reached[ends[k].1] != matches!(ends[k].0, Parent::Body(p) if reached[p]))
+                let parent_reached = match ends[k].0 {
+                    Parent::Ground => true,
+                    Parent::Body(p) => reached[p],
+                };
+                twists(&ends[k].2) && reached[ends[k].1] != parent_reached
             }) {
                 return Err(ModelError::new(
                     quoted("interface", &names[k]),

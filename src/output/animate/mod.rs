@@ -344,7 +344,9 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
                 pivots.sides[slot] = match code {
                     "+" => Side::Positive,
                     "-" => Side::Negative,
-                    // A loop-closing face that lifted off: no pivot, and its side places no body.
+                    // A face that lifted off has no pivot. A loop-closing one places no body; on a
+                    // tree interface of the file q is its bodies' relative rotation, drawn about
+                    // P⁺ (docs/simulation.md, "Faces that open": not where they are).
                     "open" => Side::Positive,
                     "seated" => {
                         // A seated tree angle is 0: either side gives the same pose.

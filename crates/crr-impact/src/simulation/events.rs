@@ -46,6 +46,10 @@ pub(super) struct SegmentEvents<'b> {
     /// The open faces ([`super::open_loops`]): each point's gap over the model size, plus
     /// [`ROCKING_EVENT_MARGIN`], falls through 0 when the point touches again.
     pub(super) open_faces: &'b [super::open_loops::OpenFace],
+    /// Per gap event, its seat: 0, or where it starts when it starts below −margin (a snap of
+    /// another landing or an impact left that point a hair inside its support), as
+    /// [`rocking_seats`] does for angles: the event then fires when the point moves further in.
+    pub(super) gap_seats: Vec<f64>,
 }
 
 impl SegmentEvents<'_> {
@@ -77,7 +81,8 @@ impl SegmentEvents<'_> {
     /// Gap event `j` (needs [`Self::load_state`]).
     fn gap_value(&self, j: usize) -> f64 {
         let (f, i) = self.gap_point(j);
-        self.open_faces[f].gap(self.model, &self.kin, i) / self.model.size + ROCKING_EVENT_MARGIN
+        self.open_faces[f].gap(self.model, &self.kin, i) / self.model.size - self.gap_seats[j]
+            + ROCKING_EVENT_MARGIN
     }
 }
 

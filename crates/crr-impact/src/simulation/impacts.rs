@@ -72,7 +72,9 @@ pub(super) fn plastic_projection(
     d.seated.clear();
     d.evaluate(model, ground, t, q, qdot);
     let kinetic = |m: &nalgebra::DMatrix<f64>, v: &DVector<f64>| 0.5 * v.dot(&(m * v));
-    if slots.is_empty() {
+    // Nothing to hold and no loop: q̇ stands. With loops the rows are applied even with no slot
+    // held (a face that lands closes its loop on a velocity that leaves it).
+    if slots.is_empty() && model.constraint_rows == 0 {
         return Ok((qdot.clone(), kinetic(&d.kin.mass_matrix, qdot)));
     }
     d.seated.extend_from_slice(slots);

@@ -154,8 +154,8 @@ pub enum SlotState {
     Positive,
     /// Rocking about P⁻.
     Negative,
-    /// A loop-closing interface lifted off: its face is open, no pivot and no angle (its loop is
-    /// released until a corner touches again).
+    /// The whole face lifted off: no pivot, the interface out of the dynamic chain until a
+    /// point of its face lands (docs/simulation.md, "Faces that open").
     Open,
 }
 
@@ -380,8 +380,9 @@ const INITIAL_IMPACT_ROOM: usize = 256;
 
 /// An event-driven simulation of one structure under one ground motion.
 pub struct Simulation<'a> {
-    /// The dynamic chain integrated now: the file's model without the loop-closing interfaces
-    /// that lifted off ([`Model::without_loop_closures`]); the same tree and q as `original`.
+    /// The dynamic chain integrated now: the file's model without the interfaces whose faces
+    /// lifted off ([`Model::with_open_interfaces`]), its tree grown again where one of
+    /// them was in it.
     model: Arc<Model>,
     /// The file's model: the outputs' slots (samples, impacts) are numbered as its slots.
     original: &'a Model,
@@ -1019,6 +1020,7 @@ impl<'a> Simulation<'a> {
                 .is_some_and(|r| r.slots.iter().any(|z| z.slot == slot))
         };
         rocking_seats(&seg.rocking, &seg.angles, regularised, &mut seats);
+        let gap_seats = self.gap_seats();
         let mut events = SegmentEvents {
             model,
             ground: self.ground,
@@ -1052,6 +1054,7 @@ impl<'a> Simulation<'a> {
                 })
                 .unwrap_or_default(),
             open_faces: &self.open.faces,
+            gap_seats,
         };
         // Dense-output sampling and peak detection, on copies so that the system can borrow the
         // dynamics.

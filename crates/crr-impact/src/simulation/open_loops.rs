@@ -1,23 +1,23 @@
-//! Loops released in motion: a loop-closing interface whose whole face lifts off (a block leaving
-//! one of its two supports while the other holds it) is dropped from the dynamic chain, and its
-//! face is watched until a corner touches again.
+//! Faces that open in motion: an interface whose whole face lifts off (a block leaving one of
+//! its supports while others hold it) is dropped from the dynamic chain, and its face is watched
+//! until a point touches again (docs/simulation.md, "Faces that open").
 //!
-//! - **Release.** When the contact program finds that some faces open entirely and every body
-//!   keeps a support through the others, and every such face closes a loop, the run goes on with
-//!   the file's model without those interfaces ([`Model::without_loop_closures`]): the same tree
-//!   and coordinates q, fewer closure rows. Their slots are reported `open`. A face of the tree
-//!   that lifts off would need the chain re-rooted: the run stops with
-//!   [`SimulationError::LiftOff`] as before.
+//! - **Release.** When the contact program finds faces that open entirely, every body keeps a
+//!   support through the others, and the chain without them confirms it
+//!   ([`Simulation::faces_separate`]), the run goes on with the file's model without those
+//!   interfaces ([`Model::with_open_interfaces`]): the same tree where they closed loops, a tree
+//!   grown again (interfaces turned round) where they were in it. The state is mapped through
+//!   the slots' angles and rates; their slots are reported `open`. A body left with no support,
+//!   or a tree that would need a twisting seat, stops the run with [`SimulationError::LiftOff`].
 //! - **Gap.** Each open face's contact points (a hinge's two pivot lines, a rocking base's four
 //!   corners) carry the normal gap g = n_p·(x_c − x_p): the child's point less the parent's,
 //!   along the parent's face normal turned with it. g is an event function of the segments;
 //!   g < 0 beyond the event's overshoot is a missed contact, caught by the run's invariant.
-//! - **Re-contact.** When a point's gap falls through 0 the loop closes again on the pivot at
-//!   that point: the positions are closed by the least change of the tree coordinates not seated
-//!   (a snap, its change of T + U booked like the impacts' snaps), and the velocities by a
-//!   plastic impulse on the loop's rows and the seated slots (Gauss' principle of impulsive
-//!   motion: the contact is perfectly plastic, T falls by the energy of the relative velocity
-//!   the rows remove), recorded as an impact of that interface.
+//! - **Landing.** When a point's gap falls through 0 the face closes again on the pivot at that
+//!   point, as a loop closure of the same tree: the positions are closed by the least change of
+//!   the tree coordinates not seated (a snap, its change of T + U booked like the impacts'
+//!   snaps), and the velocities by a plastic impulse on the loops' rows and the seated slots
+//!   (Gauss' principle of impulsive motion), recorded as an impact of that interface.
 
 use super::*;
 use crr_dynamics::closed_chain::project_positions;
@@ -233,23 +233,24 @@ impl Simulation<'_> {
             Err(e) => return FaceRelease::Impossible(e.to_string()),
         };
         match self.faces_separate(&built, &opening) {
-            Ok(true) => {
-                self.switch_chain(built, &[]);
-                FaceRelease::Released
-            }
+            Ok(true) => match self.switch_chain(built, &[]) {
+                Ok(()) => FaceRelease::Released,
+                Err(e) => FaceRelease::Impossible(e.to_string()),
+            },
             _ => FaceRelease::Contradicted,
         }
     }
 
     /// Whether the faces `opening` (interfaces of the file) leave their supports in the motion
-    /// of the chain without them (`built`), by its own equations at the current state, as the
-    /// contact program's releases are checked: every point of those faces that touches (gap
+    /// of the chain without them (`built`), by its own equations at the current state with
+    /// every other slot as it is (seated slots held): every point of those faces that touches (gap
     /// within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a gap acceleration
     /// above −1e-6 g. The gap's rate and acceleration are its central differences over the
-    /// states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain without the faces): exact to
-    /// O(h²) for ġ and O(h) for g̈. A face the program lifts off but that these equations drive
-    /// into its support (the program's decision and the chain's differ near a threshold) stays
-    /// closed: opening it would make it land at once, over and over.
+    /// states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain without the faces). A face the
+    /// program lifts off but that these equations drive into its support (the program's
+    /// decision and the chain's differ near a threshold) stays closed: opening it would make it
+    /// land at once, over and over. A chain whose equations cannot be solved counts as a
+    /// contradiction (the faces stay closed).
     fn faces_separate(
         &mut self,
         (loops, chain): &(OpenLoops, Model),
@@ -316,8 +317,17 @@ impl Simulation<'_> {
     /// state is mapped through the slots' angles and rates; every slot keeps its side, seat and
     /// last impact, and a slot that was open takes its side from `closing` (file slot, side)
     /// and rocks.
-    fn switch_chain(&mut self, (loops, chain): (OpenLoops, Model), closing: &[(usize, Side)]) {
+    /// A tree grown again can have another number of coordinates (a hinge, one angle, in the
+    /// place of a rocking base, two): the state vector [q, q̇, W, D] and the integrator are then
+    /// made anew for it, W and D carried over.
+    fn switch_chain(
+        &mut self,
+        (loops, chain): (OpenLoops, Model),
+        closing: &[(usize, Side)],
+    ) -> Result<(), SimulationError> {
         let (q, qdot) = self.state_on(&chain, &loops);
+        let n_old = self.model.dof();
+        let (work_in, dissipated) = (self.y[2 * n_old], self.y[2 * n_old + 1]);
         let (dynamics, seated, last_impact) = self.dynamics_on(&chain, &loops, closing);
         let trial = dynamics.clone();
         self.spare = Workspaces::new(&chain, trial, &dynamics.pivots);
@@ -331,10 +341,16 @@ impl Simulation<'_> {
         self.open = loops;
         self.chain_changes += 1;
         let n = self.model.dof();
+        if n != n_old {
+            self.y = vec![0.0; 2 * n + 2];
+            self.solver = Solver::new(self.params.method, self.params.options, 2 * n + 2)?;
+        }
         self.y[..n].copy_from_slice(q.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot.as_slice());
+        (self.y[2 * n], self.y[2 * n + 1]) = (work_in, dissipated);
         self.set_seated(std::iter::empty());
         self.reset_solver();
+        Ok(())
     }
 
     /// The current state in the coordinates of `chain` (its maps `loops`): each of its tree
@@ -404,7 +420,7 @@ impl Simulation<'_> {
         let built = OpenLoops::with(original, &open, &outside_tree).map_err(|e| {
             SimulationError::Invariant(format!("cannot close the landing face's loop: {e}"))
         })?;
-        self.switch_chain(built, &closing);
+        self.switch_chain(built, &closing)?;
         let model = Arc::clone(&self.model);
         let model = &*model;
         let n = model.dof();
@@ -553,6 +569,30 @@ impl Simulation<'_> {
             (&mut fq, &mut fqdot),
         );
         (DVector::from_vec(fq), DVector::from_vec(fqdot))
+    }
+
+    /// The seats of the open faces' gap events at the current state ([`SegmentEvents::gap_seats`]).
+    pub(super) fn gap_seats(&mut self) -> Vec<f64> {
+        if self.open.faces.is_empty() {
+            return Vec::new();
+        }
+        let model = Arc::clone(&self.model);
+        let model = &*model;
+        let q = self.chain_q();
+        forward_kinematics(model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        let kin = &self.out_kin;
+        self.open
+            .faces
+            .iter()
+            .flat_map(|f| (0..f.len()).map(move |i| f.gap(model, kin, i) / model.size))
+            .map(|start| {
+                if start < -events::ROCKING_EVENT_MARGIN {
+                    start
+                } else {
+                    0.0
+                }
+            })
+            .collect()
     }
 
     /// T + U at the current state on the chain integrated (J).
