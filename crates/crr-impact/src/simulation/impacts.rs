@@ -414,12 +414,15 @@ mod tests {
     /// pseudo-inverse (C: the row-scaled closure rows and the held slots' rate rows, built here
     /// from Φ_q and [`slot_row`]), to 1e-10 of |q̇| (condition numbers below 1e4 here); the held
     /// slots and the loops end at rate 0 and T never grows. Held slots include tree coordinates
-    /// (eliminated by the sparse form, rows in the dense one) and closure angles.
+    /// (eliminated by the sparse form, rows in the dense one) and closure angles, or none (the
+    /// loops' rows alone).
     #[test]
     fn the_plastic_projection_is_the_dense_pseudo_inverse_formula() {
-        let cases: [(_, &[usize]); 5] = [
+        let cases: [(_, &[usize]); 6] = [
             (single_block(0.2, 1.0, 2500.0), &[0]),
             (voussoir_arch(7, 2.0, 2.4, 0.6), &[1, 3]),
+            // Nothing held: the loops' rows alone (a face landing with no joint seated).
+            (voussoir_arch(7, 2.0, 2.4, 0.6), &[]),
             (colonnade_row(3, 3), &[0, 4, 9]),
             (random_chain(5, 6, 2), &[2]),
             (random_chain(17, 7, 3), &[1, 5]),
