@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use crr_dynamics::ground_motion::{Axis, ComponentSpec, GroundMotion, SignalSpec, SineSpec};
-use crr_dynamics::{InitialSpec, solve_initial};
+use crr_dynamics::{InitialSpec, InitialState, solve_initial};
 use crr_impact::{Parameters, Sample, Simulation, SlotState};
 use crr_kinematics::fixtures::running_bond_wall;
 use crr_kinematics::{ActivePivots, Data, InterfaceKind, Model, Parent, Side, forward_kinematics};
@@ -27,6 +27,21 @@ fn sine_pulse(amplitude: f64, period: f64) -> GroundMotion {
             Path::new("."),
         )
         .unwrap()
+}
+
+/// A running-bond wall of `courses` × `blocks` (blocks 0.6 × 0.25 m, 0.3 m deep) at rest under a
+/// one-sine pulse of 8 m/s² along x (0.5 s), and 2 s of simulation.
+fn wall_under_a_pulse(
+    courses: usize,
+    blocks: usize,
+) -> (Model, GroundMotion, InitialState, Parameters) {
+    let model = Model::from_spec(&running_bond_wall(courses, blocks, 0.6, 0.25, 0.3)).unwrap();
+    let init = solve_initial(&model, &InitialSpec::default()).unwrap();
+    let params = Parameters {
+        duration: 2.0,
+        ..Parameters::default()
+    };
+    (model, sine_pulse(8.0, 0.5), init, params)
 }
 
 /// The normal gap and the relative velocity (child − parent) of both contact points of hinge
@@ -82,13 +97,7 @@ fn face_points(
 /// blocks leave one of their supports, both land again, and the run goes to its end.
 #[test]
 fn a_wall_releases_its_loops_and_lands_on_them_again() {
-    let model = Model::from_spec(&running_bond_wall(4, 3, 0.6, 0.25, 0.3)).unwrap();
-    let init = solve_initial(&model, &InitialSpec::default()).unwrap();
-    let params = Parameters {
-        duration: 2.0,
-        ..Parameters::default()
-    };
-    let ground = sine_pulse(8.0, 0.5);
+    let (model, ground, init, params) = wall_under_a_pulse(4, 3);
     let traj = Simulation::new(&model, &ground, &init, params)
         .unwrap()
         .run()
@@ -191,13 +200,7 @@ fn a_wall_releases_its_loops_and_lands_on_them_again() {
 /// goes below its support, and the energy balance holds.
 #[test]
 fn a_wall_whose_tree_faces_lift_off_goes_on_with_its_chain_grown_again() {
-    let model = Model::from_spec(&running_bond_wall(5, 4, 0.6, 0.25, 0.3)).unwrap();
-    let init = solve_initial(&model, &InitialSpec::default()).unwrap();
-    let params = Parameters {
-        duration: 2.0,
-        ..Parameters::default()
-    };
-    let ground = sine_pulse(8.0, 0.5);
+    let (model, ground, init, params) = wall_under_a_pulse(5, 4);
     let mut sim = Simulation::new(&model, &ground, &init, params).unwrap();
     let mut regrown = 0;
     loop {

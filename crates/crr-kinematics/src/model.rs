@@ -727,56 +727,9 @@ impl Model {
                 "is not a loop closure of the model: opening it would need the chain re-rooted",
             ));
         }
-        let kept: Vec<usize> = (0..self.interfaces.len())
-            .filter(|k| !open.contains(k))
-            .collect();
-        let mut new_index = vec![usize::MAX; self.interfaces.len()];
-        for (new, &old) in kept.iter().enumerate() {
-            new_index[old] = new;
-        }
-        let tree_slots = self.dof();
-        let (mut closures, mut row, mut slot) = (Vec::new(), 0, tree_slots);
-        let mut interfaces = Vec::with_capacity(kept.len());
-        for &old in &kept {
-            let mut iface = self.interfaces[old].clone();
-            if let Role::Closure { index } = iface.role {
-                let rows = self.closures[index].rows;
-                iface.role = Role::Closure {
-                    index: closures.len(),
-                };
-                iface.slots = slot..slot + iface.kind.angle_count();
-                slot += iface.kind.angle_count();
-                closures.push(Closure {
-                    interface: interfaces.len(),
-                    first_row: row,
-                    rows,
-                });
-                row += rows;
-            }
-            interfaces.push(iface);
-        }
-        let coords = self
-            .coords
-            .iter()
-            .map(|c| Coordinate {
-                interface: new_index[c.interface],
-                ..c.clone()
-            })
-            .collect();
-        Ok(Model {
-            name: self.name.clone(),
-            gravity: self.gravity,
-            bodies: self.bodies.clone(),
-            interfaces,
-            coords,
-            closures,
-            body_coord: self.body_coord.clone(),
-            symmetries: self.symmetries.clone(),
-            closure_rows: row,
-            constraint_rows: row + self.symmetries.len(),
-            slot_count: slot,
-            size: self.size,
-        })
+        // With only loop closures open the file's tree still reaches every body, so the
+        // general construction keeps it (and turns nothing round).
+        Ok(self.with_open_interfaces(open, &[])?.0)
     }
 
     /// The chain left when the interfaces `open` (indices into [`Model::interfaces`], of a

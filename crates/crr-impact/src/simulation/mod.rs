@@ -915,8 +915,12 @@ impl<'a> Simulation<'a> {
                 )));
             }
         }
-        let q = DVector::from_column_slice(&self.y[..n]);
-        if let Some((gap, name)) = self.deepest_open_point(&q)
+        let deepest = if self.open.faces.is_empty() {
+            None
+        } else {
+            self.deepest_open_point(&DVector::from_column_slice(&self.y[..n]))
+        };
+        if let Some((gap, name)) = deepest
             && (gap.is_nan() || gap < -open_loops::GAP_TOLERANCE * model.size)
         {
             self.spare.invariant_angles = angles;
