@@ -493,7 +493,9 @@ fn the_monitor_at_rest_agrees_with_the_static_theorem() {
     use crr::dynamics::ground_motion::{
         Axis, ComponentSpec, ConstantSpec, GroundMotion, SignalSpec,
     };
-    use crr::impact::monitor::{ForceWork, check, contact_forces_into, self_stress_normals};
+    use crr::impact::monitor::{
+        ForceWork, check, check_distribution, contact_forces_into, self_stress_normals,
+    };
     use crr::kinematics::{ActivePivots, Side};
     use nalgebra::{DVector, Vector3};
     let (_, model) =
@@ -523,6 +525,13 @@ fn the_monitor_at_rest_agrees_with_the_static_theorem() {
             0.0,
             None,
             tol,
+        );
+        // The simulation's check on the faces decides the same.
+        let on_faces = check_distribution(&model, &d, &work, 0.0, None, tol);
+        assert_eq!(
+            v.is_some(),
+            on_faces.is_some(),
+            "{a:?}: {v:?} against {on_faces:?}"
         );
         (least_norm_pulls, v)
     };

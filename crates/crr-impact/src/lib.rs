@@ -9,6 +9,8 @@
 //!   ones in loops), seating in the Zeno limit, uplift from rest, collapse, and the trajectory with
 //!   its impact log and energy balance.
 //! - [`monitor`]: the hypotheses monitor (compressive contacts, friction demand).
+//! - [`face_forces`]: the most compressive distribution of a hyperstatic structure's contact
+//!   forces on its faces in motion, one sparse linear program (the monitor's check).
 //! - [`statics`]: the collapse multiplier at rest by the static theorem, one linear program on
 //!   the contact faces, and its mechanism.
 //!
@@ -41,6 +43,7 @@
 //! assert!(run.collapse.is_none());
 //! ```
 
+pub mod face_forces;
 pub mod laws;
 pub mod least_distance;
 pub mod monitor;

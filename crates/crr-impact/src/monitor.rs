@@ -139,10 +139,11 @@ pub fn contact_forces(
 /// forces at every output sample).
 #[derive(Clone, Debug, Default)]
 pub struct ForceWork {
-    /// Total spatial acceleration of every coordinate's frame.
-    acc: Vec<Vector6<f64>>,
+    /// Total spatial acceleration of every coordinate's frame (left empty by the
+    /// one-coordinate path).
+    pub(crate) acc: Vec<Vector6<f64>>,
     /// Net force of every body beyond its load, m (a_c − g_eff).
-    body_force: Vec<Vector3<f64>>,
+    pub(crate) body_force: Vec<Vector3<f64>>,
     /// Point forces of the closures on their two sides: (frame, force on it).
     closure_on: Vec<(Option<usize>, Vector3<f64>)>,
     /// Force and contact normal of every interface (None for plain hinges).
@@ -469,58 +470,6 @@ pub fn self_stress_normals(
     Some(d)
 }
 
-/// What the self-stress states depend on: the seated slots, the pivots, q and the slots whose
-/// edges are monitored (the rows of the states' matrix).
-type StressKey = (
-    Vec<usize>,
-    Vec<crr_kinematics::Side>,
-    DVector<f64>,
-    Vec<usize>,
-);
-
-/// The self-stress states of the last state the monitor saw, with the seated set, pivots and
-/// q they were found for, and the last least-distance correction: a structure at rest keeps them
-/// from sample to sample (their decomposition is the monitor's main cost on hyperstatic
-/// structures).
-#[derive(Clone, Debug, Default)]
-pub struct SelfStressCache {
-    key: Option<StressKey>,
-    states: Option<DMatrix<f64>>,
-    /// The last correction ν of [`check_from`].
-    pub correction: Option<DVector<f64>>,
-}
-
-impl SelfStressCache {
-    /// The states of [`self_stress_normals`] at `q` with `dynamics`' seated slots and pivots
-    /// (computed again only when one of them changed), and the last correction.
-    pub fn states(
-        &mut self,
-        model: &Model,
-        dynamics: &Dynamics,
-        q: &DVector<f64>,
-        edges: &[SeatEdges],
-    ) -> (Option<&DMatrix<f64>>, &mut Option<DVector<f64>>) {
-        let edge_slots = edges.iter().map(|e| e.slot);
-        let same = self.key.as_ref().is_some_and(|(seated, sides, at, slots)| {
-            seated == &dynamics.seated
-                && sides == &dynamics.pivots.sides
-                && at == q
-                && slots.iter().copied().eq(edge_slots.clone())
-        });
-        if !same {
-            self.states = self_stress_normals(model, dynamics, edges);
-            self.key = Some((
-                dynamics.seated.clone(),
-                dynamics.pivots.sides.clone(),
-                q.clone(),
-                edge_slots.collect(),
-            ));
-            self.correction = None;
-        }
-        (self.states.as_ref(), &mut self.correction)
-    }
-}
-
 /// A pivot's normal force counts as tension (flight) below −TENSION_TOLERANCE W, W the
 /// structure's weight: a tension of a thousandth of the weight is within what the rigid-contact
 /// idealisation resolves (the drum column's pivots dip to −2e-4 W at impact instants), and the
@@ -614,6 +563,65 @@ pub fn check_from(
             }
         }
     }
+    judge(model, forces, edges, &values, t, friction, tolerance)
+}
+
+/// The hypotheses check of a hyperstatic structure at the state solved in `dynamics`, with its
+/// least-norm forces and the bodies' accelerations in `work` ([`contact_forces_into`]): a
+/// tension counts only if no distribution of the contact forces on the faces in equilibrium with
+/// the motion keeps every touching point above −tolerance/2
+/// ([`crate::face_forces::most_compressive`]); it is then reported on the contact that limits
+/// the distribution, as `"tension"` when its normal force is negative and `"outside_face"` when
+/// only some of its points pull. Sliding is judged on the given tangential forces against μ times
+/// the normal forces of the compressive distribution. When the program does not solve, the
+/// least-norm forces are judged.
+pub fn check_distribution(
+    model: &Model,
+    dynamics: &Dynamics,
+    work: &ForceWork,
+    t: f64,
+    friction: Option<f64>,
+    tolerance: f64,
+) -> Option<Violation> {
+    let (forces, edges) = (&work.forces, &work.edges);
+    let Some(best) = crate::face_forces::most_compressive(model, dynamics, work) else {
+        return check(model, forces, edges, None, t, friction, tolerance);
+    };
+    if best.min_normal < -0.5 * tolerance {
+        let i = best.limiting?;
+        let normal = best.normals[i];
+        let (kind, reported) = if normal < 0.0 {
+            ("tension", normal)
+        } else {
+            ("outside_face", best.min_normal)
+        };
+        return Some(Violation {
+            t,
+            interface: model.interfaces[i].name.clone(),
+            kind: kind.into(),
+            normal: reported,
+            friction_demand: forces[i].map_or(f64::INFINITY, |f| f.friction_demand()),
+        });
+    }
+    // Compressive: every edge split reads as its smallest point force.
+    let mut values = best.normals;
+    values.extend(edges.iter().flat_map(|_| [best.min_normal; 2]));
+    judge(model, forces, edges, &values, t, friction, tolerance)
+}
+
+/// The first violation among the forces and edges, read from `values` where it has them (every
+/// interface's normal force, then (far, near) of each edge split: a distribution other than the
+/// given one), from the given forces otherwise: tension, then a resultant outside the face, then
+/// sliding (the given tangential force against μ times the normal force read).
+pub(crate) fn judge(
+    model: &Model,
+    forces: &[Option<ContactForce>],
+    edges: &[SeatEdges],
+    values: &[f64],
+    t: f64,
+    friction: Option<f64>,
+    tolerance: f64,
+) -> Option<Violation> {
     let value = |i: usize, given: f64| values.get(i).copied().unwrap_or(given);
     let violation = |i: usize, kind: &str, normal: f64, f: &ContactForce| Violation {
         t,

@@ -514,10 +514,12 @@ fn seated_edges_in_motion_against_articulated_wrench() {
 /// least-norm forces, their self-stress states and the edges, must report nothing at κ = 0.98 λ_c
 /// and a violation at 1.02 λ_c, along ±x; on the planar trilithon (hinges, one loop) and on a
 /// 3D portal (rocking bases, a twisting loop-closing seat). At rest the least-norm forces alone
-/// show an edge in tension on the portal, which the self-stress states resolve.
+/// show an edge in tension on the portal, which the self-stress states resolve. The check the
+/// simulation runs, the most compressive distribution on the faces (`check_distribution`, body
+/// equilibria, not the self-stress states), must decide the same.
 #[test]
 fn hyperstatic_edges_against_the_static_theorem() {
-    use crr_impact::monitor::{check, self_stress_normals};
+    use crr_impact::monitor::{check, check_distribution, self_stress_normals};
     use crr_impact::statics::{StaticsOptions, collapse_multiplier};
     use nalgebra::Vector3;
     let (a, c) = (0.2, 0.2);
@@ -566,6 +568,12 @@ fn hyperstatic_edges_against_the_static_theorem() {
             "{} at rest",
             model.name
         );
+        assert_eq!(
+            check_distribution(&model, &d, &work, 0.0, None, tol),
+            None,
+            "{} at rest, on the faces",
+            model.name
+        );
         for sign in [1.0, -1.0] {
             let dir = Vector3::new(sign, 0.0, 0.0);
             let lambda = collapse_multiplier(&model, dir, &StaticsOptions::default())
@@ -589,6 +597,13 @@ fn hyperstatic_edges_against_the_static_theorem() {
                     v.is_some(),
                     fails,
                     "{}: {factor} λ_c = {lambda} along {sign:+}x: {v:?}",
+                    model.name
+                );
+                let v = check_distribution(&model, &d, &work, 0.0, None, tol);
+                assert_eq!(
+                    v.is_some(),
+                    fails,
+                    "{} on the faces: {factor} λ_c = {lambda} along {sign:+}x: {v:?}",
                     model.name
                 );
             }

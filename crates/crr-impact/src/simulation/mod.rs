@@ -491,8 +491,6 @@ struct Workspaces {
     pending: Vec<f64>,
     /// Buffers of the monitor's contact forces.
     forces: crate::monitor::ForceWork,
-    /// The monitor's self-stress states and last correction ([`crate::monitor::SelfStressCache`]).
-    self_stress: crate::monitor::SelfStressCache,
     /// The q and q̇ buffers of the segments' right-hand sides ([`ConstrainedSystem::with_buffers`]).
     system: (DVector<f64>, DVector<f64>),
     /// The uplift test's factorisations at rest ([`RestCache`]).
@@ -522,7 +520,6 @@ impl Workspaces {
             sample_states: Vec::with_capacity(model.slot_count),
             pending: Vec::new(),
             forces: Default::default(),
-            self_stress: Default::default(),
             rest: RestCache::default(),
             system: Default::default(),
             impact: ImpactBuffers::default(),

@@ -51,26 +51,30 @@ impl Simulation<'_> {
                 let tol = crate::monitor::TENSION_TOLERANCE
                     * self.model.total_mass()
                     * self.model.gravity;
-                // A tension in a hyperstatic structure: is there a compressive distribution?
-                // (The self-stress states cost a decomposition, made only then.)
+                // A tension in the least-norm forces of a hyperstatic structure: is there a
+                // compressive distribution? (One linear program on the faces, only then.)
                 let tension = forces.iter().any(|f| f.is_some_and(|f| f.normal < -tol))
                     || edges.iter().any(|e| e.near.min(e.far) < -tol);
-                let mut none = None;
-                let (states, correction) = if tension {
-                    self.spare.self_stress.states(&self.model, d, &q, edges)
+                self.violation = if tension && self.model.constraint_rows > 0 {
+                    crate::monitor::check_distribution(
+                        &self.model,
+                        d,
+                        work,
+                        t,
+                        self.params.friction,
+                        tol,
+                    )
                 } else {
-                    (None, &mut none)
+                    crate::monitor::check(
+                        &self.model,
+                        forces,
+                        edges,
+                        None,
+                        t,
+                        self.params.friction,
+                        tol,
+                    )
                 };
-                self.violation = crate::monitor::check_from(
-                    &self.model,
-                    forces,
-                    edges,
-                    states,
-                    t,
-                    self.params.friction,
-                    tol,
-                    correction,
-                );
                 if self.violation.is_some() {
                     self.snaps_at_violation = Some(super::SnapsAndLosses {
                         t,
