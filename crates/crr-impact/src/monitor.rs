@@ -574,7 +574,7 @@ pub fn check_from(
 /// the distribution, as `"tension"` when its normal force is negative and `"outside_face"` when
 /// only some of its points pull. Sliding is judged on the given tangential forces against μ times
 /// the normal forces of the compressive distribution. When the program does not solve, the
-/// least-norm forces are judged.
+/// self-stress states of the tree coordinates decide ([`check`] with [`self_stress_normals`]).
 pub fn check_distribution(
     model: &Model,
     dynamics: &Dynamics,
@@ -583,9 +583,56 @@ pub fn check_distribution(
     friction: Option<f64>,
     tolerance: f64,
 ) -> Option<Violation> {
+    let best = crate::face_forces::most_compressive(model, dynamics, work);
+    judge_distribution(model, dynamics, work, best, t, friction, tolerance)
+}
+
+/// [`check_distribution`] in a simulation: the program's answers at rest are carried from
+/// sample to sample in `faces` ([`crate::face_forces::RestFaces`]: the last distribution, moved
+/// with the change of the effective gravity `g_eff`, answers while every point keeps more than
+/// −tolerance/4, which cannot be a violation); the program keeps a margin of tolerance/2 where
+/// it can (s ≤ tolerance/2), so that a structure at rest under a record seldom needs it again.
+#[allow(clippy::too_many_arguments)]
+pub fn check_distribution_at(
+    faces: &mut crate::face_forces::RestFaces,
+    model: &Model,
+    dynamics: &Dynamics,
+    work: &ForceWork,
+    (q, qdot): (&DVector<f64>, &DVector<f64>),
+    g_eff: Vector3<f64>,
+    t: f64,
+    friction: Option<f64>,
+    tolerance: f64,
+) -> Option<Violation> {
+    let bounds = (-0.25 * tolerance, 0.5 * tolerance);
+    let best = faces.most_compressive(model, dynamics, work, q, qdot, g_eff, bounds);
+    judge_distribution(model, dynamics, work, best, t, friction, tolerance)
+}
+
+/// The violation [`check_distribution`] reads from the program's answer `best`; when there is
+/// none (the program did not solve), the tree-coordinate family decides: the least-norm forces
+/// and the self-stress states ([`self_stress_normals`], [`check`]).
+fn judge_distribution(
+    model: &Model,
+    dynamics: &Dynamics,
+    work: &ForceWork,
+    best: Option<crate::face_forces::MostCompressive>,
+    t: f64,
+    friction: Option<f64>,
+    tolerance: f64,
+) -> Option<Violation> {
     let (forces, edges) = (&work.forces, &work.edges);
-    let Some(best) = crate::face_forces::most_compressive(model, dynamics, work) else {
-        return check(model, forces, edges, None, t, friction, tolerance);
+    let Some(best) = best else {
+        let states = self_stress_normals(model, dynamics, edges);
+        return check(
+            model,
+            forces,
+            edges,
+            states.as_ref(),
+            t,
+            friction,
+            tolerance,
+        );
     };
     if best.min_normal < -0.5 * tolerance {
         let i = best.limiting?;
@@ -603,9 +650,9 @@ pub fn check_distribution(
             friction_demand: forces[i].map_or(f64::INFINITY, |f| f.friction_demand()),
         });
     }
-    // Compressive: every edge split reads as its smallest point force.
+    // Compressive: every edge split reads as its smallest point force (at most 0).
     let mut values = best.normals;
-    values.extend(edges.iter().flat_map(|_| [best.min_normal; 2]));
+    values.extend(edges.iter().flat_map(|_| [best.min_normal.min(0.0); 2]));
     judge(model, forces, edges, &values, t, friction, tolerance)
 }
 

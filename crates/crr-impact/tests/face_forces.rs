@@ -237,3 +237,78 @@ fn wall_distribution_against_self_stress_family() {
     // Both outcomes are exercised.
     assert!(compared.0 >= 3 && compared.1 >= 3, "{compared:?}");
 }
+
+/// The monitor's carried distributions at rest (`face_forces::RestFaces`): the 4 × 3 wall at rest
+/// with every slot seated under a ground acceleration that grows from 0 to 2.4 g in steps of
+/// 0.02 g, sampled in order as a simulation would. Each answer must decide as the program solved
+/// afresh (s* below −tolerance/2 or not, the monitor's rule, tolerance 1e-3 W), and every
+/// distribution it returns, carried (no limiting contact named) or solved, must be in
+/// equilibrium with the new loads: the ground's faces carry the weight, to 1e-7 W. Where the
+/// wall holds, most samples must be answered without a program.
+#[test]
+fn carried_distributions_at_rest_decide_as_the_program() {
+    use crr_impact::face_forces::RestFaces;
+    let model = Model::from_spec(&running_bond_wall(4, 3, 0.6, 0.25, 0.3)).unwrap();
+    let weight = model.total_mass() * model.gravity;
+    let tol = 1e-3 * weight;
+    let n = model.dof();
+    let zero = DVector::zeros(n);
+    let seated: Vec<usize> = (0..model.slot_count).collect();
+    let on_ground: Vec<usize> = (0..model.interfaces.len())
+        .filter(|&i| matches!(model.interfaces[i].parent, crr_kinematics::Parent::Ground))
+        .collect();
+    let mut faces = RestFaces::default();
+    let (mut carried, mut solved_count, mut failing) = (0, 0, 0);
+    for step in 0..=120 {
+        let ax = 0.02 * step as f64 * model.gravity;
+        let ground = constant_ground(ax, 0.0);
+        let pivots = ActivePivots::uniform(&model, Side::Positive);
+        let (work, d) = solved(&model, &ground, pivots, &seated, &zero, &zero);
+        let g_eff = nalgebra::Vector3::new(-ax, 0.0, -model.gravity);
+        let answer = faces
+            .most_compressive(
+                &model,
+                &d,
+                &work,
+                &zero,
+                &zero,
+                g_eff,
+                (-0.25 * tol, 0.5 * tol),
+            )
+            .expect("answers");
+        let fresh = most_compressive(&model, &d, &work).expect("solves");
+        let fails = |s: f64| s < -0.5 * tol;
+        assert_eq!(
+            fails(answer.min_normal),
+            fails(fresh.min_normal),
+            "a_x = {ax}: {} against {}",
+            answer.min_normal,
+            fresh.min_normal
+        );
+        if fails(fresh.min_normal) {
+            failing += 1;
+        }
+        // The ground carries the weight under any distribution in equilibrium (no vertical
+        // acceleration): the normal forces on the ground's faces sum to W (their normals are
+        // vertical).
+        let ground_sum: f64 = on_ground.iter().map(|&i| answer.normals[i]).sum();
+        assert!(
+            (ground_sum - weight).abs() < 1e-7 * weight,
+            "a_x = {ax}: {ground_sum} against {weight}"
+        );
+        if !fails(fresh.min_normal) {
+            if answer.limiting.is_none() {
+                carried += 1;
+            } else {
+                solved_count += 1;
+            }
+        }
+    }
+    // Where the wall holds, most samples are answered by a carried distribution; both outcomes
+    // occur.
+    assert!(
+        carried > solved_count,
+        "{carried} carried, {solved_count} solved"
+    );
+    assert!(failing > 0 && failing < 121, "{failing}");
+}

@@ -491,6 +491,8 @@ struct Workspaces {
     pending: Vec<f64>,
     /// Buffers of the monitor's contact forces.
     forces: crate::monitor::ForceWork,
+    /// The monitor's distribution on the faces carried across samples at rest.
+    faces: crate::face_forces::RestFaces,
     /// The q and q̇ buffers of the segments' right-hand sides ([`ConstrainedSystem::with_buffers`]).
     system: (DVector<f64>, DVector<f64>),
     /// The uplift test's factorisations at rest ([`RestCache`]).
@@ -520,6 +522,7 @@ impl Workspaces {
             sample_states: Vec::with_capacity(model.slot_count),
             pending: Vec::new(),
             forces: Default::default(),
+            faces: Default::default(),
             rest: RestCache::default(),
             system: Default::default(),
             impact: ImpactBuffers::default(),

@@ -56,10 +56,13 @@ impl Simulation<'_> {
                 let tension = forces.iter().any(|f| f.is_some_and(|f| f.normal < -tol))
                     || edges.iter().any(|e| e.near.min(e.far) < -tol);
                 self.violation = if tension && self.model.constraint_rows > 0 {
-                    crate::monitor::check_distribution(
+                    crate::monitor::check_distribution_at(
+                        &mut self.spare.faces,
                         &self.model,
                         d,
                         work,
+                        (&q, &qdot),
+                        crr_dynamics::eom::effective_gravity(&self.model, self.ground, t),
                         t,
                         self.params.friction,
                         tol,
