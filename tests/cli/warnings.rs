@@ -165,7 +165,8 @@ fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
 /// Every bundled model runs without a warning except two whose monitor reports a flight: the
 /// drum column's and the temple's. The temple's run stops (results kept) when the first column's
 /// capital lifts off its neck, a motion outside the CRR chain (docs/simulation.md, limitations),
-/// and its monitor reports the bed below pulling at that instant. The 3D arch used to be flagged too, a springing held seated with an edge of its
+/// and its monitor reports that instant: no distribution of the contact forces keeps the
+/// entablature's seat on that capital compressive (the capital would hang from it). The 3D arch used to be flagged too, a springing held seated with an edge of its
 /// face pulling at 2.68 s, after a snap of seated angles whose change of energy went unbooked
 /// (1.3e-3 J of energy-balance error; 4.4e-6 J since the snaps are made at the impacts).
 #[test]
@@ -202,8 +203,8 @@ fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
         let flagged = match stem.as_str() {
             "drum_column" => Some("\"bed_3\" would need tension"),
             // At 2.054 s, where the first column's capital lifts off its neck and the run
-            // stops, the bed below it would pull (tests/engine/temple.rs).
-            "temple" => Some("\"c11_bed_3\" would need tension"),
+            // stops, the entablature's seat on it would pull (tests/engine/temple.rs).
+            "temple" => Some("\"entablature_on_c11\" would need tension"),
             _ => None,
         };
         if let Some(words) = flagged {

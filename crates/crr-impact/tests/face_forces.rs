@@ -312,3 +312,90 @@ fn carried_distributions_at_rest_decide_as_the_program() {
     );
     assert!(failing > 0 && failing < 121, "{failing}");
 }
+
+/// The carried distributions in motion: the 4 × 3 wall with a few slots free (as in
+/// `wall_distribution_against_self_stress_family`), moving along the mechanism they leave at a
+/// rate growing from 0 to 0.3 rad/s while the ground acceleration grows from 0.05 to 2.55 g,
+/// sampled in order with one `RestFaces` as the monitor does. Each answer must decide as the
+/// program solved afresh (the monitor's rule, tolerance 1e-3 W); answers carried in motion (no
+/// limiting contact named, equilibrium checked inside to 1e-9 W) and violations must both occur.
+#[test]
+fn carried_distributions_in_motion_decide_as_the_program() {
+    use crr_impact::face_forces::RestFaces;
+    let model = Model::from_spec(&running_bond_wall(4, 3, 0.6, 0.25, 0.3)).unwrap();
+    let weight = model.total_mass() * model.gravity;
+    let tol = 1e-3 * weight;
+    let n = model.dof();
+    let pivots = ActivePivots::uniform(&model, Side::Positive);
+    let zero = DVector::zeros(n);
+    // The first choice of free slots that leaves a mechanism.
+    let (seated, modes) = (0..40)
+        .map(|choice| {
+            let seated: Vec<usize> = (0..model.slot_count)
+                .filter(|&k| wobble(11 * choice + k) < 0.8)
+                .collect();
+            let (_, d0) = solved(
+                &model,
+                &GroundMotion::none(),
+                pivots.clone(),
+                &seated,
+                &zero,
+                &zero,
+            );
+            let mut b = DMatrix::zeros(model.constraint_rows + seated.len(), n);
+            for i in 0..model.constraint_rows {
+                b.row_mut(i).copy_from(&d0.kin.phi_q.row(i));
+            }
+            let mut row = DVector::zeros(n);
+            for (r, &k) in seated.iter().enumerate() {
+                crr_dynamics::eom::slot_row(&model, &d0.kin, k, &mut row);
+                b.row_mut(model.constraint_rows + r)
+                    .copy_from(&row.transpose());
+            }
+            (seated, crr_dynamics::linalg::null_space(&b))
+        })
+        .find(|(_, modes)| modes.ncols() > 0)
+        .expect("a mechanism");
+    let mode = modes.column(0) / modes.column(0).amax();
+    let mut faces = RestFaces::default();
+    let (mut carried, mut failing) = (0, 0);
+    for step in 0..=60 {
+        let f = step as f64 / 60.0;
+        let qdot = &mode * (0.3 * f);
+        let ax = (0.05 + 2.5 * f) * model.gravity;
+        let ground = constant_ground(ax, 0.0);
+        let (work, d) = solved(&model, &ground, pivots.clone(), &seated, &zero, &qdot);
+        let g_eff = crr_dynamics::eom::effective_gravity(&model, &ground, 0.0);
+        let answer = faces
+            .most_compressive(
+                &model,
+                &d,
+                &work,
+                &zero,
+                &qdot,
+                g_eff,
+                (-0.25 * tol, 0.5 * tol),
+            )
+            .expect("answers");
+        let fresh = most_compressive(&model, &d, &work).expect("solves");
+        let fails = |s: f64| s < -0.5 * tol;
+        assert_eq!(
+            fails(answer.min_normal),
+            fails(fresh.min_normal),
+            "step {step}: {} against {}",
+            answer.min_normal,
+            fresh.min_normal
+        );
+        if step > 0 && answer.limiting.is_none() {
+            carried += 1;
+        }
+        if fails(fresh.min_normal) {
+            failing += 1;
+        }
+    }
+    // Both outcomes occur, and where the wall holds most answers are carried.
+    assert!(
+        carried > 10 && failing > 10,
+        "{carried} carried, {failing} failing"
+    );
+}
