@@ -197,13 +197,15 @@ fn a_wall_releases_its_loops_and_lands_on_them_again() {
 /// supports (interfaces turned round). Checked at every step from the chain's own poses: every
 /// body of the file stays where the file's definition of each closed interface puts it (its
 /// two bodies meet at the file's pivot for the angles the outputs report), no open face's point
-/// goes below its support, and the energy balance holds.
+/// goes below its support, every uplift names the file's slots (seated before, rocking on the
+/// reported side after; two happen on a chain grown again), and the energy balance holds.
 #[test]
 fn a_wall_whose_tree_faces_lift_off_goes_on_with_its_chain_grown_again() {
     let (model, ground, init, params) = wall_under_a_pulse(5, 4);
     let mut sim = Simulation::new(&model, &ground, &init, params).unwrap();
-    let mut regrown = 0;
+    let (mut regrown, mut uplifts_on_regrown) = (0, 0);
     loop {
+        let before = sim.states();
         let stop = sim.step().unwrap();
         let chain = sim.chain().clone();
         let mut data = Data::new(&chain);
@@ -218,6 +220,23 @@ fn a_wall_whose_tree_faces_lift_off_goes_on_with_its_chain_grown_again() {
             regrown += 1;
         }
         let (file_q, states) = (sim.q(), sim.states());
+        // An uplift names the file's slots: each was seated and now rocks on the side it
+        // reports.
+        if let crr_impact::StopReason::Uplift(_, mode) = &stop {
+            for &(slot, side) in mode {
+                let rocking = match side {
+                    Side::Positive => SlotState::Positive,
+                    Side::Negative => SlotState::Negative,
+                };
+                assert_eq!(before[slot], SlotState::Seated, "slot {slot} of the file");
+                assert_eq!(states[slot], rocking, "slot {slot} of the file");
+            }
+            if chain.slot_count != model.slot_count
+                || (0..model.dof()).any(|k| model.coords[k].name != chain.coords[k].name)
+            {
+                uplifts_on_regrown += 1;
+            }
+        }
         for iface in &model.interfaces {
             let InterfaceKind::Hinge {
                 axis,
@@ -266,6 +285,10 @@ fn a_wall_whose_tree_faces_lift_off_goes_on_with_its_chain_grown_again() {
         }
     }
     assert!(regrown > 0, "the chain was grown again");
+    assert!(
+        uplifts_on_regrown > 0,
+        "joints open while the chain is grown again"
+    );
     let traj = sim.into_trajectory();
     assert_eq!(traj.end_time, 2.0);
     let scale = model.total_mass() * model.gravity * model.size;

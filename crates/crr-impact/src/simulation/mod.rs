@@ -219,7 +219,8 @@ pub enum StopReason {
     Breakpoint(f64),
     /// An impact (index into [`Simulation::impacts`]).
     Impact(usize),
-    /// Seated interfaces uplifted: (slot, side).
+    /// Seated interfaces uplifted: (slot, side), slots in the file's numbering and sides as the
+    /// slot states report them ([`Simulation::states`]).
     Uplift(f64, Vec<(usize, Side)>),
     /// The structure collapsed.
     Collapse(Collapse),
@@ -795,6 +796,13 @@ impl<'a> Simulation<'a> {
             .collect()
     }
 
+    /// The chain's releases `mode` with their slots in the file's numbering.
+    fn file_slots(&self, mode: Vec<(usize, Side)>) -> Vec<(usize, Side)> {
+        mode.into_iter()
+            .map(|(k, side)| (self.open.original_slot(k), side))
+            .collect()
+    }
+
     /// The state of slot `s` of the file's model.
     fn slot_state(&self, s: usize) -> SlotState {
         let Some(s) = self.open.active_slot(s) else {
@@ -1284,7 +1292,7 @@ impl<'a> Simulation<'a> {
                 } else {
                     let mode = self.release_if_opening()?;
                     Ok(match mode {
-                        Some(m) => StopReason::Uplift(self.t, m),
+                        Some(m) => StopReason::Uplift(self.t, self.file_slots(m)),
                         None => {
                             self.reset_solver();
                             StopReason::Breakpoint(self.t)

@@ -1069,7 +1069,7 @@ impl Simulation<'_> {
         if found.is_some()
             && let Some(mode) = self.release_if_opening()?
         {
-            return Ok(Some(StopReason::Uplift(self.t, mode)));
+            return Ok(Some(StopReason::Uplift(self.t, self.file_slots(mode))));
         }
         if self.t >= self.params.duration {
             self.finished = true;
