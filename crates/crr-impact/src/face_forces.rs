@@ -227,12 +227,7 @@ impl FaceProgram {
     /// cap's).
     fn solve(&self, loads: &[f64], cap: f64) -> Option<(Vec<f64>, Vec<f64>)> {
         let equilibrium = 6 * self.bodies;
-        let (mut ri, mut ci, mut vi) = (Vec::new(), Vec::new(), Vec::new());
-        for &(r, c, v) in &self.entries {
-            ri.push(r);
-            ci.push(c);
-            vi.push(v);
-        }
+        let (mut ri, mut ci, mut vi) = self.triplets();
         let mut b = loads.to_vec();
         // fₙ ≥ s at every unilateral point (s − fₙ ≤ 0), and s ≤ cap.
         let mut row = equilibrium;
@@ -271,12 +266,7 @@ impl FaceProgram {
     /// equilibrium rows; column 0 unused, left 0).
     fn particular(&self, loads: &[f64]) -> Option<Vec<f64>> {
         let columns = 1 + self.unknowns.len();
-        let (mut ri, mut ci, mut vi) = (Vec::new(), Vec::new(), Vec::new());
-        for &(r, c, v) in &self.entries {
-            ri.push(r);
-            ci.push(c);
-            vi.push(v);
-        }
+        let (ri, ci, vi) = self.triplets();
         let a = CscMatrix::new_from_triplets(6 * self.bodies, columns, ri, ci, vi);
         let p = CscMatrix::new_from_triplets(
             columns,
@@ -328,6 +318,14 @@ impl FaceProgram {
                 .map(|column| column.iter().map(|&(r, v)| v * y[r]).sum())
                 .collect(),
         )
+    }
+
+    /// The equilibrium rows' entries as (rows, columns, values).
+    fn triplets(&self) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+        let rows = self.entries.iter().map(|e| e.0).collect();
+        let columns = self.entries.iter().map(|e| e.1).collect();
+        let values = self.entries.iter().map(|e| e.2).collect();
+        (rows, columns, values)
     }
 
     /// Largest violation of the equilibrium rows by `x` (W).
