@@ -384,3 +384,83 @@ fn carried_distributions_in_motion_decide_as_the_program() {
         "{carried} carried, {failing} failing"
     );
 }
+
+/// The contact program of the simulation (`simulation::opening_qp`, Gauss' principle over the
+/// seated faces in acceleration space) against the static theorem on the faces (this module's
+/// program, in force space): where a distribution keeps every touching point of the held motion
+/// above δ = 1e-5 W (seated slots on both pivots; rocking pivots too, which the contact program
+/// does not even ask), the held motion is the program's unique minimum, and it must open nothing;
+/// at rest with every slot seated, where no distribution keeps every point above −δ, the held
+/// motion is not its minimum, and it must open something. The 4 × 3 wall, at rest under 0 to
+/// 2.4 g, and in motion along the mechanisms of random free sets under 0.05 to 2.5 g, in steps
+/// fine enough that many contacts carry small forces: the interior point's complementary pairs
+/// read against the opening tolerance alone opened joints here that the faces hold.
+#[test]
+fn contact_program_decides_as_the_static_theorem() {
+    use crr_impact::simulation::opening_qp;
+    let model = Model::from_spec(&running_bond_wall(4, 3, 0.6, 0.25, 0.3)).unwrap();
+    let weight = model.total_mass() * model.gravity;
+    let delta = 1e-5 * weight;
+    let n = model.dof();
+    let zero = DVector::zeros(n);
+    let pivots = ActivePivots::uniform(&model, Side::Positive);
+    let all: Vec<usize> = (0..model.slot_count).collect();
+    // (seated, q̇) families: at rest, and moving along the mechanisms of free sets.
+    let mut cases: Vec<(Vec<usize>, DVector<f64>)> = vec![(all.clone(), zero.clone())];
+    for choice in 0..40 {
+        let seated: Vec<usize> = all
+            .iter()
+            .copied()
+            .filter(|&k| wobble(13 * choice + k) < 0.8)
+            .collect();
+        let modes = mechanism(&model, &pivots, &seated);
+        if modes.ncols() > 0 {
+            let mode = modes.column(0) / modes.column(0).amax();
+            cases.push((seated, mode * 0.2));
+        }
+        if cases.len() == 5 {
+            break;
+        }
+    }
+    let (mut held, mut opened, mut undecided) = (0, 0, 0);
+    for (seated, qdot) in &cases {
+        for step in 0..=120 {
+            let ax = (0.05 + 2.4 * step as f64 / 120.0) * model.gravity;
+            let ground = constant_ground(ax, 0.0);
+            let (work, d) = solved(&model, &ground, pivots.clone(), seated, &zero, qdot);
+            // A fresh program with s ≤ 10δ (most_compressive caps s at 0).
+            let g_eff = crr_dynamics::eom::effective_gravity(&model, &ground, 0.0);
+            let best = crr_impact::face_forces::RestFaces::default()
+                .most_compressive(&model, &d, &work, &zero, qdot, g_eff, (0.0, 10.0 * delta))
+                .expect("solves");
+            let decision = opening_qp(&model, &d).expect("the contact program solves");
+            let opens = !decision.releases.is_empty() || !decision.lifting_off.is_empty();
+            if best.min_normal >= delta {
+                assert!(
+                    !opens,
+                    "{} seated, a_x = {ax:.3}: the faces hold with {:.3e} W, the program opens \
+                     {:?}, lifts {:?}",
+                    seated.len(),
+                    best.min_normal / weight,
+                    decision.releases,
+                    decision.lifting_off
+                );
+                held += 1;
+            } else if best.min_normal <= -delta && seated.len() == model.slot_count {
+                assert!(
+                    opens,
+                    "a_x = {ax:.3}: no distribution holds ({:.3e} W), the program opens nothing",
+                    best.min_normal / weight
+                );
+                opened += 1;
+            } else {
+                undecided += 1;
+            }
+        }
+    }
+    assert!(cases.len() >= 3, "{} families", cases.len());
+    assert!(
+        held > 100 && opened > 10,
+        "{held} held, {opened} opened, {undecided} near 0"
+    );
+}

@@ -157,11 +157,37 @@ pub(super) struct ImpactBuffers {
 }
 
 impl Simulation<'_> {
-    /// Handles an impact fired by `slot` at the current time.
-    pub(super) fn impact(&mut self, slot: usize) -> Result<usize, SimulationError> {
+    /// Before an impact: the run stops when it has had `max_impacts`, or when its last
+    /// [`CHATTER_IMPACTS`] impacts came less than `min_impact_interval` apart on average
+    /// ([`SimulationError::Chatter`]).
+    pub(super) fn check_impact_room(&self) -> Result<(), SimulationError> {
         if self.impacts.len() >= self.params.max_impacts {
             return Err(SimulationError::TooManyImpacts(self.params.max_impacts));
         }
+        let Some(first) = self.impacts.len().checked_sub(CHATTER_IMPACTS) else {
+            return Ok(());
+        };
+        let span = self.t - self.impacts[first].t;
+        if span >= CHATTER_IMPACTS as f64 * self.params.min_impact_interval {
+            return Ok(());
+        }
+        let mut interfaces: Vec<String> = Vec::new();
+        for name in self.impacts[first..].iter().flat_map(|i| &i.interfaces) {
+            if !interfaces.contains(name) {
+                interfaces.push(name.clone());
+            }
+        }
+        Err(SimulationError::Chatter {
+            t: self.t,
+            count: CHATTER_IMPACTS,
+            span,
+            interfaces,
+        })
+    }
+
+    /// Handles an impact fired by `slot` at the current time.
+    pub(super) fn impact(&mut self, slot: usize) -> Result<usize, SimulationError> {
+        self.check_impact_room()?;
         let model = Arc::clone(&self.model);
         let model = &*model;
         let (t, n) = (self.t, model.dof());

@@ -253,6 +253,25 @@ pub enum SimulationError {
     /// Too many impacts.
     #[error("more than {0} impacts: raise analysis.max_impacts or check the seating parameters")]
     TooManyImpacts(usize),
+    /// Impacts chatter: the last [`CHATTER_IMPACTS`] impacts came less than
+    /// `min_impact_interval` apart on average, among a few interfaces. Single impacts in
+    /// sequence that do not settle (a block landing on one support and then on the other, each
+    /// landing lifting it off the first again) are a simultaneous contact the event-driven model
+    /// does not resolve; the run stops instead of spending hours of impacts on microseconds.
+    #[error(
+        "at t = {t} s the last {count} impacts came within {span:.3e} s, among {}: single impacts in sequence that do not settle (a body landing on its supports in turn); outside what the event-driven model resolves (docs/simulation.md, \"Limitations\")",
+        interfaces.join(", ")
+    )]
+    Chatter {
+        /// Time (s).
+        t: f64,
+        /// The impacts counted.
+        count: usize,
+        /// Time from the first of them to the last (s).
+        span: f64,
+        /// The interfaces they involve.
+        interfaces: Vec<String>,
+    },
     /// More output samples in memory than the caller allows.
     #[error(
         "more than {max} output samples in memory at t = {t} s: raise output_interval, or the \
@@ -543,6 +562,12 @@ pub const SEAT_RATE_MAX: f64 = 0.1;
 /// hundredth of it apart are the Zeno limit of a joint coming to rest, farther apart they are
 /// rocking.
 pub const MIN_IMPACT_INTERVAL_MAX: f64 = 0.01;
+
+/// Impacts that, coming less than `min_impact_interval` apart on average, stop a run as
+/// [`SimulationError::Chatter`]: the Zeno sequences of rocking (a joint's impacts closer and
+/// closer until it seats) seat a joint after its first impact within the interval, so a
+/// sequence of hundreds is no rocking.
+pub const CHATTER_IMPACTS: usize = 200;
 
 /// Largest `collapse_drop` (a fraction of weight × model size): a structure whose potential
 /// energy has dropped by half its weight times its size has fallen.
@@ -1557,5 +1582,81 @@ mod flight_tests {
         let second = chain.interfaces[1].name.clone();
         let above: Vec<String> = chain.bodies[1..].iter().map(|b| b.name.clone()).collect();
         assert_eq!(bodies_without_support(&chain, &[second]), above);
+    }
+}
+
+#[cfg(test)]
+mod chatter_tests {
+    //! The stop on impacts that chatter, on a record of impacts written by hand into a run of a
+    //! single block: 200 impacts less than `min_impact_interval` apart on average stop it,
+    //! naming their interfaces; the Zeno sequence of a rocking block (intervals shrinking
+    //! geometrically until one falls below the interval) and a steady sequence at the interval
+    //! do not.
+    use crr_dynamics::ground_motion::GroundMotion;
+    use crr_dynamics::{InitialSpec, solve_initial};
+    use crr_kinematics::Model;
+    use crr_kinematics::fixtures::single_block;
+
+    use super::{CHATTER_IMPACTS, ImpactRecord, Parameters, Simulation, SimulationError};
+
+    fn record(t: f64, interface: &str) -> ImpactRecord {
+        ImpactRecord {
+            t,
+            interfaces: vec![interface.to_string()],
+            slots: vec![0],
+            rates_before: vec![1e-6],
+            rates_after: vec![0.0],
+            energy_lost: 0.0,
+            energy_gain: false,
+            seated: vec![],
+        }
+    }
+
+    #[test]
+    fn impacts_closer_than_the_interval_on_average_stop_the_run() {
+        let model = Model::from_spec(&single_block(0.2, 1.0, 2500.0)).unwrap();
+        let initial = solve_initial(&model, &InitialSpec::default()).unwrap();
+        let ground = GroundMotion::none();
+        let params = Parameters::default();
+        let interval = params.min_impact_interval;
+        let mut sim = Simulation::new(&model, &ground, &initial, params).unwrap();
+        // Two supports landing in turn every 0.88 interval (the 10 × 10 wall's 0.88 µs).
+        let names = ["left_seat", "right_seat"];
+        for i in 0..CHATTER_IMPACTS {
+            sim.impacts
+                .push(record(0.5 + 0.44 * interval * i as f64, names[i % 2]));
+        }
+        sim.t = 0.5 + 0.44 * interval * CHATTER_IMPACTS as f64;
+        match sim.check_impact_room() {
+            Err(SimulationError::Chatter {
+                count, interfaces, ..
+            }) => {
+                assert_eq!(count, CHATTER_IMPACTS);
+                assert_eq!(interfaces, names);
+            }
+            other => panic!("{other:?}"),
+        }
+        // One impact fewer: not yet.
+        sim.impacts.remove(0);
+        assert!(sim.check_impact_room().is_ok());
+        // A rocking block's Zeno sequence: intervals shrinking by r² = 0.81 from 0.1 s; the
+        // seating rule ends it at its first interval below min_impact_interval, some 60 impacts
+        // in, and even 200 of them span far more than 200 intervals.
+        sim.impacts.clear();
+        let (mut t, mut gap): (f64, f64) = (0.0, 0.1);
+        for _ in 0..CHATTER_IMPACTS {
+            sim.impacts.push(record(t, "base"));
+            t += gap.max(interval);
+            gap *= 0.81;
+        }
+        sim.t = t;
+        assert!(sim.check_impact_room().is_ok());
+        // A steady sequence exactly at the interval is not below it.
+        sim.impacts.clear();
+        for i in 0..=CHATTER_IMPACTS {
+            sim.impacts.push(record(interval * i as f64, "base"));
+        }
+        sim.t = interval * (CHATTER_IMPACTS + 1) as f64;
+        assert!(sim.check_impact_room().is_ok());
     }
 }

@@ -390,9 +390,7 @@ impl Simulation<'_> {
         face: usize,
         point: usize,
     ) -> Result<usize, SimulationError> {
-        if self.impacts.len() >= self.params.max_impacts {
-            return Err(SimulationError::TooManyImpacts(self.params.max_impacts));
-        }
+        self.check_impact_room()?;
         let t = self.t;
         let landing = self.open.faces[face].clone();
         let original = self.original;

@@ -169,13 +169,13 @@ pub fn opening_qp(model: &Model, d: &Dynamics) -> Result<OpeningDecision, Openin
         a[(rows + d.seated.len() + l, n + l)] = -1.0;
     }
 
-    let x = solve(
+    let solution = solve(
         &scale.apply(p, c, a, b),
         rows,
         d.seated.len() + lifts.len(),
         &scale,
     )?;
-    Ok(decide(model, d, &lifts, &rate_rows, &x, &scale))
+    Ok(decide(model, d, &lifts, &rate_rows, &solution, &scale))
 }
 
 /// The units of the program: rates in g / size, Gauss' function in m_total g² size⁰.
@@ -312,13 +312,38 @@ fn add_lift_metric(
     }
 }
 
-/// The interior point on the scaled program; returns x (unscaled, rad/s²).
+/// The interior point's tolerance on the gap and the residuals of the scaled program. At its
+/// end every complementary pair has sᵢzᵢ of the order of the gap over the rows. On the 6 × 6
+/// wall under its pulse (`examples/wall_pulse.rs 6 1.5`), pairs with both members above 1e-7:
+/// 1105 with 1e-9 (1417 solves, all Solved); 429 with 1e-11 (all Solved, one or two
+/// iterations more); with 1e-12 clarabel stopped short (AlmostSolved) in 29 of 1336 solves.
+const SOLVER_TOLERANCE: f64 = 1e-11;
+
+/// The program's minimum: x (unscaled, rad/s²) and, for each inequality row (the seated slots'
+/// αₖ⁺ rows, then the lifts' ℓₖ rows), whether the interior point holds it.
+struct Solution {
+    x: DVector<f64>,
+    held: Vec<bool>,
+}
+
+/// The interior point on the scaled program.
+///
+/// Which contacts hold is read from the complementary pairs (slack sᵢ, the row's rate in g/size;
+/// dual zᵢ, its contact's moment in W·size). The interior point ends with sᵢzᵢ of the order of
+/// its tolerance on every row, so a contact that carries a force keeps a small slack rate: with
+/// a tolerance of 1e-9, the 6 × 6 wall under its pulse had 583 rows with rates above
+/// `QP_OPENING_TOLERANCE` whose forces were 1e-4 to 1e-6 W (products sᵢzᵢ from 3e-13 to 6e-10).
+/// Read against the tolerance alone, such rows opened joints and lifted faces that the static
+/// theorem holds (the faces' program proved margins of 6e-4 W there). A row holds when
+/// zᵢ ≥ sᵢ, the indicator of the active set of interior points (El-Bakry, Tapia and Zhang
+/// 1994): both are of order one in these units, and the converged member of a pair is the
+/// larger.
 fn solve(
     s: &Scaled,
     equalities: usize,
     inequalities: usize,
     scale: &Scale,
-) -> Result<DVector<f64>, OpeningQpError> {
+) -> Result<Solution, OpeningQpError> {
     let nv = s.p.ncols();
     let p = dense_to_csc(&s.p, true);
     let a = dense_to_csc(&s.a, false);
@@ -331,9 +356,9 @@ fn solve(
     }
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
-        .tol_gap_abs(1e-9)
-        .tol_gap_rel(1e-9)
-        .tol_feas(1e-9)
+        .tol_gap_abs(SOLVER_TOLERANCE)
+        .tol_gap_rel(SOLVER_TOLERANCE)
+        .tol_feas(SOLVER_TOLERANCE)
         .tol_ktratio(1e-7)
         .max_iter(200)
         .build()
@@ -344,10 +369,15 @@ fn solve(
         .map_err(|e| OpeningQpError(format!("{e:?}")))?;
     solver.solve();
     match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(DVector::from_iterator(
-            nv,
-            solver.solution.x.iter().map(|x| x * scale.rate),
-        )),
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+            let (slack, dual) = (&solver.solution.s, &solver.solution.z);
+            Ok(Solution {
+                x: DVector::from_iterator(nv, solver.solution.x.iter().map(|x| x * scale.rate)),
+                held: (equalities..equalities + inequalities)
+                    .map(|r| dual[r] >= slack[r])
+                    .collect(),
+            })
+        }
         other => Err(OpeningQpError(format!("{other:?}"))),
     }
 }
@@ -379,14 +409,22 @@ fn decide(
     d: &Dynamics,
     lifts: &[Lift],
     rate_rows: &[(DVector<f64>, f64)],
-    x: &DVector<f64>,
+    solution: &Solution,
     scale: &Scale,
 ) -> OpeningDecision {
     let n = model.dof();
+    let x = &solution.x;
     let qddot = x.rows(0, n).into_owned();
     let mut lift_of = vec![0.0; d.seated.len()];
+    // Whether the interior point holds each seated slot's pivot (αₖ⁺) and other pivot (ℓₖ; held
+    // where it is not offered).
+    let mut held: Vec<(bool, bool)> = solution.held[..d.seated.len()]
+        .iter()
+        .map(|&h| (h, true))
+        .collect();
     for (l, lift) in lifts.iter().enumerate() {
         lift_of[lift.seated_index] = x[n + l].max(0.0);
+        held[lift.seated_index].1 = solution.held[d.seated.len() + l];
     }
     let rates: Vec<(f64, f64)> = d
         .seated
@@ -418,13 +456,17 @@ fn decide(
             [i] => {
                 let k = d.seated[i];
                 let side = d.pivots.sides[k];
-                match (rates[i].0 > tol, rates[i].1 > tol) {
+                let opens = |rate: f64, held: bool| rate > tol && !held;
+                match (opens(rates[i].0, held[i].0), opens(rates[i].1, held[i].1)) {
                     (true, true) => decision.lifting_off.push(index),
                     (true, false) => decision.releases.push((k, side)),
                     (false, true) => decision.releases.push((k, side.flipped())),
                     (false, false) => {}
                 }
             }
+            // A base whose every corner the interior point holds stays (its corners' normal
+            // accelerations are then the slacks' round-off).
+            _ if seated.iter().all(|&i| held[i].0 && held[i].1) => {}
             _ => base_decision(model, d, index, &seated, &decision.qddot, &lift_of, tol)
                 .apply(index, &mut decision),
         }
