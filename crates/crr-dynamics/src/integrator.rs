@@ -124,6 +124,14 @@ pub trait EventFunctions {
         self.eval(t, y, g);
         g[i]
     }
+    /// Evaluates the functions again at `(t, y)` after the projection moved the state of an
+    /// accepted step by its constraint drift; `g` holds their values before the projection. The
+    /// default evaluates them all; an implementation may keep a function whose value is a
+    /// decision rather than a distance (a sign that round-off of the state cannot move except
+    /// at a threshold, where the next step's end decides as well) and that costs a solve.
+    fn eval_after_projection(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
+        self.eval(t, y, g);
+    }
     /// Allowed crossing direction of function `i`.
     fn direction(&self, i: usize) -> Direction;
 }
@@ -757,7 +765,7 @@ impl Solver {
     fn carry_events(&mut self, events: &mut impl EventFunctions, projected: bool) {
         std::mem::swap(&mut self.g_prev, &mut self.g_new);
         if projected {
-            events.eval(self.t, &self.y, &mut self.g_prev);
+            events.eval_after_projection(self.t, &self.y, &mut self.g_prev);
         }
         for i in 0..self.zero_start.len() {
             self.zero_start[i] = self.zero_start[i] && self.g_prev[i].abs() <= EVENT_ZERO_TOL;
