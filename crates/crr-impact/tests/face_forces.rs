@@ -391,9 +391,9 @@ fn carried_distributions_in_motion_decide_as_the_program() {
 /// above δ = 1e-5 W (seated slots on both pivots; rocking pivots too, which the contact program
 /// does not even ask), the held motion is the program's unique minimum, and it must open nothing;
 /// at rest with every slot seated, where no distribution keeps every point above −δ, the held
-/// motion is not its minimum, and it must open something. The 4 × 3 wall, at rest under 0 to
-/// 2.4 g, and in motion along the mechanisms of random free sets under 0.05 to 2.5 g, in steps
-/// fine enough that many contacts carry small forces: the interior point's complementary pairs
+/// motion is not its minimum, and it must open something. The 4 × 3 wall, at rest and in motion
+/// along the mechanisms of random free sets, under 0.05 to 2.45 g in steps of 0.02 g, fine
+/// enough that many contacts carry small forces: the interior point's complementary pairs
 /// read against the opening tolerance alone opened joints here that the faces hold.
 #[test]
 fn contact_program_decides_as_the_static_theorem() {

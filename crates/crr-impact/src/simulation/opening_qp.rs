@@ -44,9 +44,11 @@ use crr_kinematics::{InterfaceKind, Model, Side};
 use super::seating::other_pivot_rest;
 
 /// Relative size (of g / size) below which an opening rate counts as zero in the program's
-/// answer: above the interior point's accuracy (1e-10 of the scaled problem), so that round-off
-/// of the solver is never read as an opening; a true opening below it grows with the load and is
-/// found a moment later, and the answer is checked by the chain's exact solve anyway.
+/// answer. A rate above it opens only when it also exceeds its contact's force (module
+/// `solve`): with the product of the two of the order of the solver's tolerance, the rates
+/// that open are in effect above max(1e-7, √(sᵢzᵢ)), some 1e-7 to 1e-6 g / size. A true opening
+/// below that grows with the load and is found a moment later, and the answer is checked by the
+/// chain's exact solve anyway.
 pub const QP_OPENING_TOLERANCE: f64 = 1e-7;
 
 /// What the contact program decides at a state.
@@ -369,12 +371,15 @@ fn solve(
         .map_err(|e| OpeningQpError(format!("{e:?}")))?;
     solver.solve();
     match solver.solution.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+        status @ (SolverStatus::Solved | SolverStatus::AlmostSolved) => {
             let (slack, dual) = (&solver.solution.s, &solver.solution.z);
+            // An answer only almost solved (clarabel's reduced tolerances, a gap up to 5e-5)
+            // leaves pairs whose product is too large to read: its rates decide alone.
+            let solved = status == SolverStatus::Solved;
             Ok(Solution {
                 x: DVector::from_iterator(nv, solver.solution.x.iter().map(|x| x * scale.rate)),
                 held: (equalities..equalities + inequalities)
-                    .map(|r| dual[r] >= slack[r])
+                    .map(|r| solved && dual[r] >= slack[r])
                     .collect(),
             })
         }
@@ -467,8 +472,15 @@ fn decide(
             // A base whose every corner the interior point holds stays (its corners' normal
             // accelerations are then the slacks' round-off).
             _ if seated.iter().all(|&i| held[i].0 && held[i].1) => {}
-            _ => base_decision(model, d, index, &seated, &decision.qddot, &lift_of, tol)
-                .apply(index, &mut decision),
+            _ => {
+                // The held rows' rates are the interior point's round-off: read as 0.
+                let opening = |i: usize| {
+                    let plus = if held[i].0 { 0.0 } else { rates[i].0 };
+                    let minus = if held[i].1 { 0.0 } else { rates[i].1 };
+                    (plus, minus)
+                };
+                base_decision(model, d, index, &seated, opening, tol).apply(index, &mut decision)
+            }
         }
     }
     decision
@@ -493,14 +505,14 @@ impl BaseMotion {
 
 /// The normal accelerations of a seated base's four pivot corners under the program's motion
 /// (the child's relative to the parent: Σ ψ̈ⱼ wⱼ × (C − P) + Σ τₗℓₗ, along the face normal), and the
-/// corners that stay down.
+/// corners that stay down. `opening(i)` is the seated slot i's (αᵢ⁺, αᵢ⁻) as read (a held row's
+/// rate as 0), from which ψ̈ᵢ = σᵢ(αᵢ⁺ − αᵢ⁻) and ℓᵢ = αᵢ⁻.
 fn base_decision(
     model: &Model,
     d: &Dynamics,
     index: usize,
     seated: &[usize],
-    qddot: &DVector<f64>,
-    lift_of: &[f64],
+    opening: impl Fn(usize) -> (f64, f64),
     tol: f64,
 ) -> BaseMotion {
     let kin = &d.kin;
@@ -513,17 +525,16 @@ fn base_decision(
     let n_world = rot * normal;
     let current = d.pivots.of_interface(model, index).to_vec();
     let pivot = frame_point(kin, parent, &iface.kind.pivot(&current));
-    let mut slot = DVector::zeros(model.dof());
     let mut turn = Vector3::zeros();
     let mut lift = Vector3::zeros();
     for &i in seated {
         let k = d.seated[i];
-        let psi = slot_row(model, kin, k, &mut slot) + slot.dot(qddot);
         let sigma = d.pivots.sides[k].sign();
+        let (plus, minus) = opening(i);
         let w = world_axis(model, d, index, k);
-        turn += w * psi;
+        turn += w * (sigma * (plus - minus));
         let other = frame_point(kin, parent, &other_pivot_rest(iface, &d.pivots, k));
-        lift += sigma * w.cross(&(other - pivot)) * lift_of[i];
+        lift += sigma * w.cross(&(other - pivot)) * minus;
     }
     let down: Vec<[Side; 2]> = [Side::Positive, Side::Negative]
         .into_iter()
