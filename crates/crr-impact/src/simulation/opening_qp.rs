@@ -448,6 +448,12 @@ fn decide(
         complete: lifts.len() == d.seated.len(),
         ..OpeningDecision::default()
     };
+    // The rates as read: a held row's rate is the interior point's round-off, read as 0.
+    let opening = |i: usize| {
+        let plus = if held[i].0 { 0.0 } else { rates[i].0 };
+        let minus = if held[i].1 { 0.0 } else { rates[i].1 };
+        (plus, minus)
+    };
     for (index, iface) in model.interfaces.iter().enumerate() {
         let seated: Vec<usize> = d
             .seated
@@ -461,26 +467,16 @@ fn decide(
             [i] => {
                 let k = d.seated[i];
                 let side = d.pivots.sides[k];
-                let opens = |rate: f64, held: bool| rate > tol && !held;
-                match (opens(rates[i].0, held[i].0), opens(rates[i].1, held[i].1)) {
+                let (plus, minus) = opening(i);
+                match (plus > tol, minus > tol) {
                     (true, true) => decision.lifting_off.push(index),
                     (true, false) => decision.releases.push((k, side)),
                     (false, true) => decision.releases.push((k, side.flipped())),
                     (false, false) => {}
                 }
             }
-            // A base whose every corner the interior point holds stays (its corners' normal
-            // accelerations are then the slacks' round-off).
-            _ if seated.iter().all(|&i| held[i].0 && held[i].1) => {}
-            _ => {
-                // The held rows' rates are the interior point's round-off: read as 0.
-                let opening = |i: usize| {
-                    let plus = if held[i].0 { 0.0 } else { rates[i].0 };
-                    let minus = if held[i].1 { 0.0 } else { rates[i].1 };
-                    (plus, minus)
-                };
-                base_decision(model, d, index, &seated, opening, tol).apply(index, &mut decision)
-            }
+            // A base whose every row is held has every corner down: it holds.
+            _ => base_decision(model, d, index, &seated, opening, tol).apply(index, &mut decision),
         }
     }
     decision
