@@ -2,7 +2,9 @@
 //! 0.5 m deep) under a one-sine pulse along x of amplitude `factor` × its collapse multiplier
 //! λ g (period 0.5 s), 3 s (or the duration given third): blocks lift off one of their supports and land again
 //! (docs/simulation.md, "Faces that open"). Prints DOF, loops, λ, impacts, faces opened, steps,
-//! the end, the energy-balance error and the wall time. For profiling:
+//! the end, the energy-balance error and the wall time; the landings of open faces (and how many
+//! came within 10 µs of their opening) and the hypotheses monitor's first violation, if any. For
+//! profiling:
 //!
 //! ```sh
 //! cargo build --profile bench --example wall_pulse
@@ -59,6 +61,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         traj.end_time,
         traj.energy_balance_error
     );
+    // Faces that land again within 10 µs of opening (a lift-off the chain did not follow).
+    let mut opened_at = vec![f64::NEG_INFINITY; model.slot_count];
+    let (mut landings, mut at_once) = (0usize, 0usize);
+    let samples: Vec<_> = traj.samples.iter().collect();
+    for pair in samples.windows(2) {
+        for s in 0..model.slot_count {
+            let (was, is) = (pair[0].states[s], pair[1].states[s]);
+            if is == SlotState::Open && was != SlotState::Open {
+                opened_at[s] = pair[1].t;
+            }
+            if was == SlotState::Open && is != SlotState::Open {
+                landings += 1;
+                if pair[1].t - opened_at[s] < 1e-5 {
+                    at_once += 1;
+                }
+            }
+        }
+    }
+    println!("{landings} landings of open faces, {at_once} of them within 10 µs of the opening");
+    if let Some(v) = &traj.violation {
+        println!(
+            "hypotheses monitor: at t = {:.4} s, interface {}: {} (normal force {:.1} N)",
+            v.t, v.interface, v.kind, v.normal
+        );
+    }
     if let Some(e) = error {
         println!("stopped: {e}");
     }

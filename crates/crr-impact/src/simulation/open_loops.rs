@@ -242,15 +242,18 @@ impl Simulation<'_> {
     }
 
     /// Whether the faces `opening` (interfaces of the file) leave their supports in the motion
-    /// of the chain without them (`built`), by its own equations at the current state with
-    /// every other slot as it is (seated slots held): every point of those faces that touches (gap
-    /// within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a gap acceleration
-    /// above −1e-6 g. The gap's rate and acceleration are its central differences over the
-    /// states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain without the faces). A face the
-    /// program lifts off but that these equations drive into its support (the program's
-    /// decision and the chain's differ near a threshold) stays closed: opening it would make it
-    /// land at once, over and over. A chain whose equations cannot be solved counts as a
-    /// contradiction (the faces stay closed).
+    /// of the chain without them (`built`), by its own equations at the current state, with the
+    /// other slots as that chain's own uplift test sets them (its contact program, checked by
+    /// its exact solve; seated slots it does not release held): every point of those faces that
+    /// touches (gap within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a gap
+    /// acceleration above −1e-6 g. The gap's rate and acceleration are its central differences
+    /// over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain without the faces).
+    ///
+    /// The program's own motion cannot be trusted for this: a face it lifts off keeps its slip
+    /// rows there (no tangential acceleration relative to its support, module `opening_qp`), a
+    /// force the face cannot carry once it is off. A face that the chain without it drives into
+    /// its support stays closed: opening it would make it land at once, over and over. A chain
+    /// whose equations cannot be solved counts as a contradiction (the faces stay closed).
     fn faces_separate(
         &mut self,
         (loops, chain): &(OpenLoops, Model),
@@ -258,6 +261,29 @@ impl Simulation<'_> {
     ) -> Result<bool, SimulationError> {
         let (q, qdot) = self.state_on(chain, loops);
         let (mut d, _, _) = self.dynamics_on(chain, loops, &[]);
+        // The chain's own decision at this state (its releases only: a further lift-off is
+        // decided once it integrates).
+        let mut trial = d.clone();
+        let mut rest = super::uplift_from_rest::RestCache::default();
+        let parts = chain.parts();
+        let releases = super::seating::opening_mode_in(
+            chain,
+            self.ground,
+            &d,
+            &mut trial,
+            &mut rest,
+            &parts.of_slot,
+            self.t,
+            &q,
+            &qdot,
+        );
+        let lifting_too = rest.lift_off.is_some();
+        for &(k, side) in releases.iter().flatten() {
+            if !lifting_too {
+                d.pivots.sides[k] = side;
+                d.seated.retain(|&s| s != k);
+            }
+        }
         d.accelerations(chain, self.ground, self.t, &q, &qdot)
             .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
         let (g, size) = (chain.gravity, chain.size);

@@ -245,7 +245,36 @@ fn loop_opening(
         );
         return Some(Some(decision.releases));
     }
-    let mut releases = decision.releases;
+    confirmed_releases(
+        model,
+        ground,
+        template,
+        trial,
+        decision.releases,
+        t,
+        q,
+        qdot,
+        tol,
+    )
+}
+
+/// The releases `releases` (the contact program's) checked by the chain's exact solve: they are
+/// solved together and every one must open on its side by more than `tol`; one that does not
+/// (the program's round-off near a threshold, or a release that came with a lift-off the chain
+/// does not confirm) goes back to its seat and the rest are solved again. Some(None) when
+/// nothing opens; None when a solve fails.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn confirmed_releases(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    mut releases: Vec<(usize, Side)>,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    tol: f64,
+) -> Option<Option<Vec<(usize, Side)>>> {
     let mut row = DVector::zeros(model.dof());
     while !releases.is_empty() {
         trial.pivots.clone_from(&template.pivots);
@@ -897,20 +926,35 @@ impl Simulation<'_> {
                     reason,
                 });
             }
-            // The faces stay closed: the program's other releases stand, theirs do not.
+            // The faces stay closed. The program's other releases belong to the motion in which
+            // they lift off (its lifted faces still hold their slip rows, module `opening_qp`):
+            // with the faces closed they stand only where the chain's exact solve opens them.
             let model = Arc::clone(&self.model);
             let lifting = |s: usize| {
                 interfaces
                     .iter()
                     .any(|name| model.interfaces[slot_interface(&model, s)].name == *name)
             };
-            mode = mode
-                .map(|m| {
-                    m.into_iter()
-                        .filter(|&(s, _)| !lifting(s))
-                        .collect::<Vec<_>>()
-                })
-                .filter(|m| !m.is_empty());
+            let others: Vec<(usize, Side)> = mode
+                .unwrap_or_default()
+                .into_iter()
+                .filter(|&(s, _)| !lifting(s))
+                .collect();
+            let tol = 1e-9 * model.gravity / model.size;
+            let mut trial = self.take_trial();
+            mode = confirmed_releases(
+                &model,
+                self.ground,
+                &self.dynamics,
+                &mut trial,
+                others,
+                self.t,
+                &q,
+                &qdot,
+                tol,
+            )
+            .flatten();
+            self.spare.trial = Some(trial);
         }
         if let Some(mode) = &mode {
             // The structure leaves rest only when every joint was seated: a joint seated at an
