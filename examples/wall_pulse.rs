@@ -81,9 +81,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     println!("{landings} landings of open faces, {at_once} of them within 10 µs of the opening");
     if let Some(v) = &traj.violation {
+        let force = if v.kind == "lift_off" {
+            String::new()
+        } else {
+            format!(" (normal force {:.1} N)", v.normal)
+        };
         println!(
-            "hypotheses monitor: at t = {:.4} s, interface {}: {} (normal force {:.1} N)",
-            v.t, v.interface, v.kind, v.normal
+            "first hypothesis violation: at t = {:.4} s, interface {}: {}{force}",
+            v.t, v.interface, v.kind
         );
     }
     if let Some(e) = error {

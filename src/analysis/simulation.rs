@@ -765,6 +765,11 @@ fn warnings(
                  engine's choice of the joints that open missed",
                 v.normal
             )
+        } else if v.kind == "lift_off" {
+            "is lifted off its support by the contact program, but the model without it drives \
+             it back into its support, and with it closed no joint opens: the motion would need \
+             it to slide or to pull"
+                .to_string()
         } else {
             format!(
                 "needs friction |F_t|/N = {:.4} above μ: it slides",

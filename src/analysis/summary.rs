@@ -185,7 +185,9 @@ pub struct ViolationSummary {
     pub time: f64,
     /// The interface.
     pub interface: String,
-    /// `tension` (flight), `outside_face` (a seated joint that should be rocking) or `sliding`.
+    /// `tension` (flight), `outside_face` (a seated joint that should be rocking), `sliding`, or
+    /// `lift_off` (a face the contact program lifts off that the model cannot follow; no force
+    /// is computed: its normal force is then 0 and its friction demand `None`).
     pub kind: String,
     /// Its normal force (N); for `outside_face`, the force of the edge that would pull.
     pub normal_force: f64,

@@ -76,7 +76,9 @@ pub(super) fn opening_mode_in(
         || template.seated.len() < model.slot_count
         || qdot.amax() > 1e-12 * rate_scale
     {
-        return opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot);
+        return opening_mode_local(
+            model, ground, template, trial, rest, slot_part, t, q, qdot, true,
+        );
     }
     let a = ground.acceleration(t);
     // The linear program decides first: a load inside the collapse set holds (static theorem: a
@@ -88,14 +90,16 @@ pub(super) fn opening_mode_in(
         Ok(None) => return None,
         Ok(Some(collapse)) => collapse.clone(),
         Err(_) => {
-            return opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot);
+            return opening_mode_local(
+                model, ground, template, trial, rest, slot_part, t, q, qdot, true,
+            );
         }
     };
     // Beyond the multiplier the local test gives the opening accelerations' own mode when it
     // finds one; the mechanism's sides open otherwise.
-    if let Some(local) =
-        opening_mode_local(model, ground, template, trial, rest, slot_part, t, q, qdot)
-    {
+    if let Some(local) = opening_mode_local(
+        model, ground, template, trial, rest, slot_part, t, q, qdot, true,
+    ) {
         return Some(local);
     }
     let lifting: Vec<String> = collapse.lifting_off().map(|i| i.name.clone()).collect();
@@ -115,11 +119,35 @@ pub(super) fn opening_mode_in(
     for &(slot, side) in &sides {
         start.pivots.sides[slot] = side;
     }
-    opening_mode_local(model, ground, &start, trial, rest, slot_part, t, q, qdot).or(Some(sides))
+    opening_mode_local(
+        model, ground, &start, trial, rest, slot_part, t, q, qdot, true,
+    )
+    .or(Some(sides))
+}
+
+/// The chain's own decision with every closed face kept closed: the single releases and the
+/// active set (and Gauss' principle over the sides at rest) on the chain's exact solves, without
+/// the contact program. For a state where the program lifts a face off that the chain without
+/// it does not confirm, and the program's other releases do not open with the face closed.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn opening_mode_of_the_chain(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    rest: &mut RestCache,
+    slot_part: &[usize],
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<Vec<(usize, Side)>> {
+    opening_mode_local(
+        model, ground, template, trial, rest, slot_part, t, q, qdot, false,
+    )
 }
 
 /// The local test of [`opening_mode_in`]: single releases, the active set, and Gauss' principle
-/// over the sides at rest.
+/// over the sides at rest; on loops the contact program first when `with_program`.
 #[allow(clippy::too_many_arguments)]
 fn opening_mode_local(
     model: &Model,
@@ -131,6 +159,7 @@ fn opening_mode_local(
     t: f64,
     q: &DVector<f64>,
     qdot: &DVector<f64>,
+    with_program: bool,
 ) -> Option<Vec<(usize, Side)>> {
     let seated = template.seated.clone();
     if seated.is_empty() {
@@ -149,7 +178,10 @@ fn opening_mode_local(
         trial.pivots.clone_from(&template.pivots);
         trial.seated.clone_from(&seated);
         trial.evaluate(model, ground, t, q, qdot);
-        if let Some(mode) = loop_opening(model, ground, template, trial, rest, t, q, qdot, tol) {
+        if let Some(mode) = with_program
+            .then(|| loop_opening(model, ground, template, trial, rest, t, q, qdot, tol))
+            .flatten()
+        {
             return mode;
         }
         if let Some(mode) = opening_from_rest(model, ground, template, trial, rest, t, q, qdot, tol)
@@ -179,7 +211,7 @@ fn opening_mode_local(
     // With loops, one convex program over the seated faces decides (opening_qp.rs); the single
     // releases and the active set below remain for open chains (where single releases are
     // exact) and for a program that fails. At rest it has run above, on the same state.
-    if model.constraint_rows > 0 && !at_rest {
+    if with_program && model.constraint_rows > 0 && !at_rest {
         if may_open.is_none() {
             trial.evaluate(model, ground, t, q, qdot);
         }
@@ -940,6 +972,9 @@ impl Simulation<'_> {
                 .into_iter()
                 .filter(|&(s, _)| !lifting(s))
                 .collect();
+            // Where none does, the chain decides alone with the faces closed (single releases
+            // and the active set): the state cannot hold, and without a release nothing would
+            // ask again while the program keeps its answer (the uplift event stays on).
             let tol = 1e-9 * model.gravity / model.size;
             let mut trial = self.take_trial();
             mode = confirmed_releases(
@@ -953,8 +988,24 @@ impl Simulation<'_> {
                 &qdot,
                 tol,
             )
-            .flatten();
+            .flatten()
+            .or_else(|| {
+                opening_mode_of_the_chain(
+                    &model,
+                    self.ground,
+                    &self.dynamics,
+                    &mut trial,
+                    &mut self.spare.rest,
+                    &self.parts.of_slot,
+                    self.t,
+                    &q,
+                    &qdot,
+                )
+            });
             self.spare.trial = Some(trial);
+            if mode.is_none() {
+                self.record_undecided_lift_off(&interfaces);
+            }
         }
         if let Some(mode) = &mode {
             // The structure leaves rest only when every joint was seated: a joint seated at an
@@ -987,6 +1038,33 @@ impl Simulation<'_> {
             self.reset_solver();
         }
         Ok(mode)
+    }
+
+    /// The contact program lifts `interfaces` off, the chain without them drives them back into
+    /// their supports, and with them closed no joint opens: no motion of the CRR model keeps
+    /// every contact compressive (the lift-off would need the faces to slide, or to pull). The
+    /// run goes on with the faces closed, as after a hypotheses monitor's violation, and this is
+    /// recorded as its first violation if none came before (kind `lift_off`, the first face;
+    /// no force is computed: N = 0, |F_t|/N undefined, infinite as for a tension).
+    fn record_undecided_lift_off(&mut self, interfaces: &[String]) {
+        if self.violation.is_some() {
+            return;
+        }
+        let Some(first) = interfaces.first() else {
+            return;
+        };
+        self.violation = Some(crate::monitor::Violation {
+            t: self.t,
+            interface: first.clone(),
+            kind: "lift_off".to_string(),
+            normal: 0.0,
+            friction_demand: f64::INFINITY,
+        });
+        self.snaps_at_violation = Some(super::SnapsAndLosses {
+            t: self.t,
+            snaps: self.energy_at_snaps,
+            lost: self.lost_at_impacts(),
+        });
     }
 
     /// A seat that may twist, turned to its other pivot corner: the child's face has turned
