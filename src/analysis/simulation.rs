@@ -767,8 +767,9 @@ fn warnings(
             )
         } else if v.kind == "lift_off" {
             "is lifted off its support by the contact program, but the model without it drives \
-             it back into its support, and with it closed no joint opens: the motion would need \
-             it to slide or to pull"
+             it back into its support, and with it closed no joint opens: crr finds no motion \
+             that keeps every contact compressive (the program's own needs the face to slide \
+             while it lifts)"
                 .to_string()
         } else {
             format!(

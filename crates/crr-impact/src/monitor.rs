@@ -93,7 +93,8 @@ pub struct Violation {
     /// its face: one of its edges would pull, the joint should rock), `"sliding"` (|F_t| > μN),
     /// or `"lift_off"` (recorded by the simulation, not the monitor: a face the contact program
     /// lifts off, that the chain without it drives back into its support, while with it closed
-    /// no joint opens; `normal` is then 0 and `friction_demand` infinite: no force is computed).
+    /// no release the engine tries opens; `normal` is then 0 and `friction_demand` infinite: no
+    /// force is computed).
     pub kind: String,
     /// N at that time (N); for `"outside_face"` the normal force of the edge that would pull.
     pub normal: f64,

@@ -383,4 +383,12 @@ fn faces_that_lift_off_do_not_land_again_at_once() {
         "the run goes on to {} s",
         traj.end_time
     );
+    let face = model.interface_index(&v.interface).unwrap();
+    let after = samples
+        .iter()
+        .find(|x| x.t > v.t)
+        .expect("a sample after the violation");
+    for s in model.interfaces[face].slots.clone() {
+        assert_ne!(after.states[s], SlotState::Open, "t = {} s", after.t);
+    }
 }

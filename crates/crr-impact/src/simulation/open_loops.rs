@@ -35,6 +35,8 @@ pub(super) enum FaceRelease {
     Released,
     /// The chain without them drives one into its support: they stay closed.
     Contradicted,
+    /// The chain without them could not be solved at this state: they stay closed, undecided.
+    Unsolved,
     /// No chain of the CRR model is left without them (why).
     Impossible(String),
 }
@@ -237,14 +239,16 @@ impl Simulation<'_> {
                 Ok(()) => FaceRelease::Released,
                 Err(e) => FaceRelease::Impossible(e.to_string()),
             },
-            _ => FaceRelease::Contradicted,
+            Ok(false) => FaceRelease::Contradicted,
+            Err(_) => FaceRelease::Unsolved,
         }
     }
 
     /// Whether the faces `opening` (interfaces of the file) leave their supports in the motion
     /// of the chain without them (`built`), by its own equations at the current state, with the
-    /// other slots as that chain's own uplift test sets them (its contact program, checked by
-    /// its exact solve; seated slots it does not release held): every point of those faces that
+    /// other slots as that chain's own uplift test sets them (its releases, outside faces it
+    /// would lift off too, where its exact solve opens them; seated slots it does not release
+    /// held): every point of those faces that
     /// touches (gap within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a gap
     /// acceleration above −1e-6 g. The gap's rate and acceleration are its central differences
     /// over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain without the faces).
@@ -261,12 +265,13 @@ impl Simulation<'_> {
     ) -> Result<bool, SimulationError> {
         let (q, qdot) = self.state_on(chain, loops);
         let (mut d, _, _) = self.dynamics_on(chain, loops, &[]);
-        // The chain's own decision at this state (its releases only: a further lift-off is
-        // decided once it integrates).
+        // The chain's own decision at this state: the releases of its uplift test, those of
+        // faces it would lift off too left out (decided once it integrates), kept where its
+        // exact solve opens them.
         let mut trial = d.clone();
         let mut rest = super::uplift_from_rest::RestCache::default();
         let parts = chain.parts();
-        let releases = super::seating::opening_mode_in(
+        let decided = super::seating::opening_mode_in(
             chain,
             self.ground,
             &d,
@@ -277,12 +282,31 @@ impl Simulation<'_> {
             &q,
             &qdot,
         );
-        let lifting_too = rest.lift_off.is_some();
+        let lifting_further = rest.lift_off.unwrap_or_default();
+        let candidates: Vec<(usize, Side)> = decided
+            .unwrap_or_default()
+            .into_iter()
+            .filter(|&(k, _)| {
+                let name = &chain.interfaces[slot_interface(chain, k)].name;
+                !lifting_further.contains(name)
+            })
+            .collect();
+        let tol = 1e-9 * chain.gravity / chain.size;
+        let releases = super::seating::confirmed_releases(
+            chain,
+            self.ground,
+            &d,
+            &mut trial,
+            candidates,
+            self.t,
+            &q,
+            &qdot,
+            tol,
+        )
+        .flatten();
         for &(k, side) in releases.iter().flatten() {
-            if !lifting_too {
-                d.pivots.sides[k] = side;
-                d.seated.retain(|&s| s != k);
-            }
+            d.pivots.sides[k] = side;
+            d.seated.retain(|&s| s != k);
         }
         d.accelerations(chain, self.ground, self.t, &q, &qdot)
             .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;

@@ -938,6 +938,7 @@ impl Simulation<'_> {
             let in_flight = bodies_without_support(&self.model, &interfaces);
             // The faces open and the chain without them (its tree grown again where needed)
             // decides again; a body left without support is outside the model.
+            let mut contradicted = false;
             let reason = if in_flight.is_empty() {
                 match self.release_faces(&interfaces) {
                     FaceRelease::Released => return self.release_once(),
@@ -945,7 +946,11 @@ impl Simulation<'_> {
                         "every body keeps a support through other contacts, but no chain of \
                          the CRR model is left without them ({why})"
                     )),
-                    FaceRelease::Contradicted => None,
+                    FaceRelease::Contradicted => {
+                        contradicted = true;
+                        None
+                    }
+                    FaceRelease::Unsolved => None,
                 }
             } else {
                 Some(super::flight_words(&in_flight))
@@ -973,8 +978,9 @@ impl Simulation<'_> {
                 .filter(|&(s, _)| !lifting(s))
                 .collect();
             // Where none does, the chain decides alone with the faces closed (single releases
-            // and the active set): the state cannot hold, and without a release nothing would
-            // ask again while the program keeps its answer (the uplift event stays on).
+            // and the active set; at rest Gauss' principle over the sides), the faces' own
+            // slots held: without a release nothing would ask again while the program keeps its
+            // answer (the uplift event stays on).
             let tol = 1e-9 * model.gravity / model.size;
             let mut trial = self.take_trial();
             mode = confirmed_releases(
@@ -1001,9 +1007,15 @@ impl Simulation<'_> {
                     &q,
                     &qdot,
                 )
+                .map(|m| {
+                    m.into_iter()
+                        .filter(|&(s, _)| !lifting(s))
+                        .collect::<Vec<_>>()
+                })
+                .filter(|m| !m.is_empty())
             });
             self.spare.trial = Some(trial);
-            if mode.is_none() {
+            if mode.is_none() && contradicted {
                 self.record_undecided_lift_off(&interfaces);
             }
         }
@@ -1041,11 +1053,13 @@ impl Simulation<'_> {
     }
 
     /// The contact program lifts `interfaces` off, the chain without them drives them back into
-    /// their supports, and with them closed no joint opens: no motion of the CRR model keeps
-    /// every contact compressive (the lift-off would need the faces to slide, or to pull). The
-    /// run goes on with the faces closed, as after a hypotheses monitor's violation, and this is
-    /// recorded as its first violation if none came before (kind `lift_off`, the first face;
-    /// no force is computed: N = 0, |F_t|/N undefined, infinite as for a tension).
+    /// their supports, and with them closed no release the engine tries opens (the program's
+    /// others, the chain's single releases and active set): the engine finds no motion that
+    /// keeps every contact compressive, and the program's own needs the faces to slide along
+    /// their supports while they lift. The run goes on with the faces closed, as after a
+    /// hypotheses monitor's violation, and this is recorded as its first violation if none came
+    /// before (kind `lift_off`, the first face; no force is computed: N = 0, |F_t|/N undefined,
+    /// infinite as for a tension).
     fn record_undecided_lift_off(&mut self, interfaces: &[String]) {
         if self.violation.is_some() {
             return;
