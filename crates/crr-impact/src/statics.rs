@@ -763,13 +763,21 @@ impl Program {
 /// The global test of a structure at rest with every joint seated: does it hold under a ground
 /// acceleration a? The loads a structure at rest carries form a convex set containing 0 (static
 /// theorem), so it holds under a iff |a| < λ_c(a/|a|)·g. The multipliers along ±x, ±y, ±z are
-/// computed once; a load inside their convex hull (the octahedron Σ|a_k|/(λ_k g) < 1) holds
-/// without a program; outside it, the program runs along a's direction (its answers kept by
-/// direction, so that a constant load or a one-component record costs one program per sense).
+/// computed when first needed, each once; a load inside their convex hull (the octahedron
+/// Σ|a_k|/(λ_k g) < 1, over the axes a has a component along) holds without a program; outside
+/// it, the program runs along a's direction (its answers kept by direction, so that a constant
+/// load or a one-component record costs one program per sense).
+///
+/// Whether the structure stands under its own weight is read from both senses of the first axis
+/// computed (±x under no load): the loads it holds form a convex set, and where that set does
+/// not contain 0 it meets the axis line on one side of 0 only, or not at all, so one sense (or
+/// both) has no λ ≥ 0. A structure under a one-component pulse costs two programs, not six.
+/// Each chain a run switches to (a face that opens or lands) starts its own.
 #[derive(Clone, Debug, Default)]
 pub struct RestStatics {
-    /// λ along +x, −x, +y, −y, +z, −z (capped at [`LAMBDA_MAX`]); `None` until first asked.
-    axes: Option<[f64; 6]>,
+    /// λ along +x, −x, +y, −y, +z, −z (capped at [`LAMBDA_MAX`]; 0 for a structure that cannot
+    /// stand); `None` until first needed.
+    axes: [Option<f64>; 6],
     /// Answers along directions asked before (exact bits of the unit direction).
     by_direction: Vec<([u64; 3], Collapse)>,
 }
@@ -789,52 +797,31 @@ impl RestStatics {
     ) -> Result<Option<&Collapse>, StaticsError> {
         let g = model.gravity;
         let magnitude = a.norm();
-        // The axes first: a structure that cannot stand under its own weight has no collapse
-        // set to be inside of, even under no load (the caller's local test decides then).
-        let axes = match self.axes {
-            Some(axes) => axes,
-            None => {
-                let mut axes = [LAMBDA_MAX; 6];
-                for (k, d) in [
-                    Vector3::x(),
-                    -Vector3::x(),
-                    Vector3::y(),
-                    -Vector3::y(),
-                    Vector3::z(),
-                    -Vector3::z(),
-                ]
-                .into_iter()
-                .enumerate()
-                {
-                    // A structure that cannot stand: 0 (kept, so the programs run once).
-                    axes[k] = match collapse_multiplier(model, d, &StaticsOptions::default()) {
-                        Ok(c) => c.lambda.unwrap_or(LAMBDA_MAX),
-                        Err(StaticsError::DoesNotHold(_)) => 0.0,
-                        Err(e) => return Err(e),
-                    };
+        // The axes a has a component along (+x under no load): a structure that cannot stand
+        // under its own weight has no collapse set to be inside of, even under no load (the
+        // caller's local test decides then).
+        let needed: Vec<usize> = (0..3)
+            .filter(|&k| a[k] != 0.0)
+            .map(|k| 2 * k + usize::from(a[k] < 0.0))
+            .collect();
+        let needed = if needed.is_empty() { vec![0] } else { needed };
+        let mut hull = 0.0;
+        for k in needed {
+            // Both senses of the axis: the loads a structure holds form a convex set, and one
+            // that cannot stand under no load (0 outside the set) meets the axis line on one
+            // side of 0 only, or not at all; the other sense (or both) then has no λ ≥ 0.
+            for j in [k, k ^ 1] {
+                if self.axis(model, j)? <= 0.0 {
+                    return Err(StaticsError::DoesNotHold(
+                        "the structure does not stand under its own weight".into(),
+                    ));
                 }
-                self.axes = Some(axes);
-                axes
             }
-        };
-        if axes.iter().any(|&l| l <= 0.0) {
-            return Err(StaticsError::DoesNotHold(
-                "the structure does not stand under its own weight".into(),
-            ));
+            hull += a[k / 2].abs() / (self.axis(model, k)? * g);
         }
         if magnitude == 0.0 || !magnitude.is_finite() {
             return Ok(None);
         }
-        let hull: f64 = (0..3)
-            .map(|k| {
-                let lambda = if a[k] >= 0.0 {
-                    axes[2 * k]
-                } else {
-                    axes[2 * k + 1]
-                };
-                a[k].abs() / (lambda * g)
-            })
-            .sum();
         if hull < 1.0 {
             return Ok(None);
         }
@@ -856,5 +843,23 @@ impl RestStatics {
             Some(l) if magnitude > l * g * (1.0 + 1e-9) => Some(collapse),
             _ => None,
         })
+    }
+
+    /// λ along axis `k` (+x, −x, +y, −y, +z, −z), computed once: capped at [`LAMBDA_MAX`], 0
+    /// for a structure that cannot stand (kept, so that its program runs once).
+    fn axis(&mut self, model: &Model, k: usize) -> Result<f64, StaticsError> {
+        if let Some(lambda) = self.axes[k] {
+            return Ok(lambda);
+        }
+        let sign = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let mut d = Vector3::zeros();
+        d[k / 2] = sign;
+        let lambda = match collapse_multiplier(model, d, &StaticsOptions::default()) {
+            Ok(c) => c.lambda.unwrap_or(LAMBDA_MAX),
+            Err(StaticsError::DoesNotHold(_)) => 0.0,
+            Err(e) => return Err(e),
+        };
+        self.axes[k] = Some(lambda);
+        Ok(lambda)
     }
 }
