@@ -254,8 +254,8 @@ pub enum SimulationError {
     #[error("more than {0} impacts: raise analysis.max_impacts or check the seating parameters")]
     TooManyImpacts(usize),
     /// Impacts chatter: the last [`CHATTER_IMPACTS`] impacts came less than
-    /// `min_impact_interval` apart on average, among at most a tenth as many interfaces. Single impacts in
-    /// sequence that do not settle (a block landing on one support and then on the other, each
+    /// `min_impact_interval` apart on average, among at most a tenth as many interfaces. Single
+    /// impacts in sequence that do not settle (a block landing on one support and then on the other, each
     /// landing lifting it off the first again) are a simultaneous contact the event-driven model
     /// does not resolve; the run stops instead of spending hours of impacts on microseconds.
     #[error(

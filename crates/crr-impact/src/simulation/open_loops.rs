@@ -248,16 +248,17 @@ impl Simulation<'_> {
     /// of the chain without them (`built`), by its own equations at the current state, with the
     /// other slots as that chain's own uplift test sets them (its releases, outside faces it
     /// would lift off too, where its exact solve opens them; seated slots it does not release
-    /// held): every point of those faces that
-    /// touches (gap within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a gap
-    /// acceleration above −1e-6 g. The gap's rate and acceleration are its central differences
-    /// over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain without the faces).
+    /// held): every point of those faces that touches (gap within 1e-9 of the model size) has a
+    /// gap rate above −1e-9 √(g L) and a gap acceleration above −1e-6 g. The gap's rate and
+    /// acceleration are its central differences over the states q ± h q̇ + ½h² q̈
+    /// (h = 1e-4 √(L/g), q̈ of the chain without the faces).
     ///
     /// The program's own motion cannot be trusted for this: a face it lifts off keeps its slip
     /// rows there (no tangential acceleration relative to its support, module `opening_qp`), a
     /// force the face cannot carry once it is off. A face that the chain without it drives into
     /// its support stays closed: opening it would make it land at once, over and over. A chain
-    /// whose equations cannot be solved counts as a contradiction (the faces stay closed).
+    /// whose equations cannot be solved is an error here ([`FaceRelease::Unsolved`]: the faces
+    /// stay closed, undecided).
     fn faces_separate(
         &mut self,
         (loops, chain): &(OpenLoops, Model),

@@ -125,31 +125,12 @@ pub(super) fn opening_mode_in(
     .or(Some(sides))
 }
 
-/// The chain's own decision with every closed face kept closed: the single releases and the
-/// active set (and Gauss' principle over the sides at rest) on the chain's exact solves, without
-/// the contact program. For a state where the program lifts a face off that the chain without
-/// it does not confirm, and the program's other releases do not open with the face closed.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn opening_mode_of_the_chain(
-    model: &Model,
-    ground: &GroundMotion,
-    template: &Dynamics,
-    trial: &mut Dynamics,
-    rest: &mut RestCache,
-    slot_part: &[usize],
-    t: f64,
-    q: &DVector<f64>,
-    qdot: &DVector<f64>,
-) -> Option<Vec<(usize, Side)>> {
-    opening_mode_local(
-        model, ground, template, trial, rest, slot_part, t, q, qdot, false,
-    )
-}
-
 /// The local test of [`opening_mode_in`]: single releases, the active set, and Gauss' principle
-/// over the sides at rest; on loops the contact program first when `with_program`.
+/// over the sides at rest; on loops the contact program first when `with_program`. Without it,
+/// the chain's own decision with every closed face kept closed (for a lift-off of the program
+/// that the chain without the face does not confirm, [`Simulation::release_once`]).
 #[allow(clippy::too_many_arguments)]
-fn opening_mode_local(
+pub(super) fn opening_mode_local(
     model: &Model,
     ground: &GroundMotion,
     template: &Dynamics,
@@ -996,7 +977,8 @@ impl Simulation<'_> {
             )
             .flatten()
             .or_else(|| {
-                opening_mode_of_the_chain(
+                let with_program = false;
+                opening_mode_local(
                     &model,
                     self.ground,
                     &self.dynamics,
@@ -1006,6 +988,7 @@ impl Simulation<'_> {
                     self.t,
                     &q,
                     &qdot,
+                    with_program,
                 )
                 .map(|m| {
                     m.into_iter()
@@ -1058,13 +1041,15 @@ impl Simulation<'_> {
     /// keeps every contact compressive, and the program's own needs the faces to slide along
     /// their supports while they lift. The run goes on with the faces closed, as after a
     /// hypotheses monitor's violation, and this is recorded as its first violation if none came
-    /// before (kind `lift_off`, the first face; no force is computed: N = 0, |F_t|/N undefined,
+    /// before (kind `lift_off`, the face first by name; no force is computed: N = 0, |F_t|/N undefined,
     /// infinite as for a tension).
     fn record_undecided_lift_off(&mut self, interfaces: &[String]) {
         if self.violation.is_some() {
             return;
         }
-        let Some(first) = interfaces.first() else {
+        // The first name in alphabetical order: the same face whatever order the file lists
+        // the lifting faces in.
+        let Some(first) = interfaces.iter().min() else {
             return;
         };
         self.violation = Some(crate::monitor::Violation {
