@@ -11,9 +11,9 @@
 use nalgebra::Vector3;
 
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
-use crr::kinematics::Model;
 use crr::kinematics::fixtures::{SplitMix, running_bond_wall, running_bond_wall_3d, voussoir_arch};
 use crr::kinematics::spec::StructureSpec;
+use crr::kinematics::{Model, Role};
 
 use crate::common::mirrored_x;
 
@@ -153,5 +153,65 @@ fn a_mirrored_file_gives_the_mirrored_multipliers() {
             let (a, b) = (lambda(&spec, d), lambda(&mirror, reflected));
             assert!(same(a, b), "{name} {d:?}: {a} against the mirror's {b}");
         }
+    }
+}
+
+/// The simulation keeps the rest statics' axis multipliers of a chain for any chain over the
+/// same interfaces (`crr::impact::statics::AxisMemory`): a chain that a run returns to after
+/// faces opened and landed may have another spanning tree (interfaces that closed loops now in
+/// the tree, some turned round), but the same faces. The multiplier is a property of the faces
+/// and the bodies, so it must not change with the tree: checked here by building chains with
+/// other trees (every second tree interface pushed out of the tree, so that the tree grows
+/// again through former loop closures, or only the first) and solving each from scratch.
+#[test]
+fn the_chain_s_tree_changes_no_multiplier() {
+    let cases: Vec<(String, StructureSpec)> = vec![
+        ("wall".into(), bundled_spec("wall")),
+        (
+            "running bond 5×4".into(),
+            running_bond_wall(5, 4, 1.0, 0.5, 0.5),
+        ),
+        (
+            "3D wall 3×3".into(),
+            running_bond_wall_3d(3, 3, 1.0, 0.5, 0.5),
+        ),
+        ("arch of 9".into(), voussoir_arch(9, 2.0, 2.5, 1.0)),
+    ];
+    for (name, spec) in &cases {
+        let model = Model::from_spec(spec).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let tree: Vec<usize> = (0..model.interfaces.len())
+            .filter(|&k| matches!(model.interfaces[k].role, Role::Tree { .. }))
+            .collect();
+        let mut moved_any = false;
+        let pushed_sets: [Vec<usize>; 2] =
+            [tree.iter().copied().step_by(2).collect(), vec![tree[0]]];
+        for (offset, pushed) in pushed_sets.iter().enumerate() {
+            let (chain, _turned) = model
+                .with_open_interfaces(&[], pushed)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let moved = chain
+                .interfaces
+                .iter()
+                .zip(&model.interfaces)
+                .filter(|(a, b)| {
+                    matches!(a.role, Role::Tree { .. }) != matches!(b.role, Role::Tree { .. })
+                })
+                .count();
+            moved_any |= moved > 0;
+            for d in [Vector3::x(), -Vector3::x(), Vector3::new(0.6, 0.8, 0.0)] {
+                let of = |m: &Model| {
+                    collapse_multiplier(m, d, &StaticsOptions::default())
+                        .unwrap_or_else(|e| panic!("{name}: {e}"))
+                        .lambda
+                        .unwrap_or(f64::INFINITY)
+                };
+                let (file, other) = (of(&model), of(&chain));
+                assert!(
+                    same(file, other),
+                    "{name} {d:?}, tree {offset} ({moved} interfaces moved): {file} against {other}"
+                );
+            }
+        }
+        assert!(moved_any, "{name}: every chain kept the file's tree");
     }
 }

@@ -772,7 +772,8 @@ impl Program {
 /// computed (±x under no load): the loads it holds form a convex set, and where that set does
 /// not contain 0 it meets the axis line on one side of 0 only, or not at all, so one sense (or
 /// both) has no λ ≥ 0. A structure under a one-component pulse costs two programs, not six.
-/// Each chain a run switches to (a face that opens or lands) starts its own.
+/// Each chain a run switches to (a face that opens or lands) starts its own, from the axes
+/// [`AxisMemory`] kept for the same interfaces.
 #[derive(Clone, Debug, Default)]
 pub struct RestStatics {
     /// λ along +x, −x, +y, −y, +z, −z (capped at [`LAMBDA_MAX`]; 0 for a structure that cannot
@@ -861,5 +862,66 @@ impl RestStatics {
         };
         self.axes[k] = Some(lambda);
         Ok(lambda)
+    }
+}
+
+/// The axis multipliers of the structures one run has met, by the set of their interfaces'
+/// names, so that a chain the run returns to (a face that lands where it had opened, the whole
+/// structure seated again) does not solve its programs again.
+///
+/// The multipliers depend only on which faces are present: the programs are posed on the
+/// faces of the structure at its reference pose (every joint seated, so every block where the
+/// file puts it), and two chains over the same interfaces differ only in their tree and loops
+/// (which interfaces close loops, which sense a re-rooted interface is written in), not in the
+/// faces or the bodies. The mechanisms (slots of one chain) are not kept.
+#[derive(Clone, Debug, Default)]
+pub struct AxisMemory {
+    entries: Vec<(Vec<String>, [Option<f64>; 6])>,
+}
+
+/// Most structures an [`AxisMemory`] keeps (the oldest is dropped beyond).
+const AXIS_MEMORY: usize = 64;
+
+impl AxisMemory {
+    /// The structure's key: its interfaces' names, sorted (a chain's order is its own).
+    fn key(model: &Model) -> Vec<String> {
+        let mut names: Vec<String> = model.interfaces.iter().map(|i| i.name.clone()).collect();
+        names.sort_unstable();
+        names
+    }
+
+    /// Rest statics for `model` that start from the axes known for its interfaces.
+    pub fn statics_for(&self, model: &Model) -> RestStatics {
+        let key = Self::key(model);
+        let axes = self
+            .entries
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map_or([None; 6], |(_, axes)| *axes);
+        RestStatics {
+            axes,
+            by_direction: Vec::new(),
+        }
+    }
+
+    /// Keeps the axes `statics` has computed for `model` (none computed: nothing to keep).
+    pub fn remember(&mut self, model: &Model, statics: &RestStatics) {
+        if statics.axes.iter().all(Option::is_none) {
+            return;
+        }
+        let key = Self::key(model);
+        match self.entries.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, axes)) => {
+                for (kept, new) in axes.iter_mut().zip(statics.axes) {
+                    *kept = kept.or(new);
+                }
+            }
+            None => {
+                if self.entries.len() >= AXIS_MEMORY {
+                    self.entries.remove(0);
+                }
+                self.entries.push((key, statics.axes));
+            }
+        }
     }
 }

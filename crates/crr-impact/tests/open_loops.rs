@@ -9,7 +9,9 @@ use crr_dynamics::ground_motion::{Axis, ComponentSpec, GroundMotion, SignalSpec,
 use crr_dynamics::{InitialSpec, InitialState, solve_initial};
 use crr_impact::{Parameters, Sample, Simulation, SlotState};
 use crr_kinematics::fixtures::running_bond_wall;
-use crr_kinematics::{ActivePivots, Data, InterfaceKind, Model, Parent, Side, forward_kinematics};
+use crr_kinematics::{
+    ActivePivots, Data, InterfaceKind, Model, Parent, Role, Side, forward_kinematics,
+};
 use nalgebra::{DVector, Vector3};
 
 fn sine_pulse(amplitude: f64, period: f64) -> GroundMotion {
@@ -390,5 +392,128 @@ fn faces_that_lift_off_do_not_land_again_at_once() {
         .expect("a sample after the violation");
     for s in model.interfaces[face].slots.clone() {
         assert_ne!(after.states[s], SlotState::Open, "t = {} s", after.t);
+    }
+}
+
+/// Faces that rest on their supports at one instant, the structure still, close together: one
+/// impact record names all of them, and the decision that follows is taken once, on the
+/// structure with every one of them closed (docs/simulation.md, "Faces that open"). The 5 × 5
+/// running-bond wall of `examples/wall_pulse.rs` under a one-sine pulse of 1.2 λ g (0.5 s)
+/// comes to rest at 0.2703 s with two faces open and touching; one at a time, the first landing
+/// decided the openings on a structure with the other face still open. Checked here from the
+/// bodies' poses and velocities: at that instant every coordinate is still, and a named face
+/// that closes a loop of the file's tree touches its support at one of its points with no
+/// relative velocity (the samples' coordinates give its bodies' poses exactly); one of the
+/// file's tree is turned back to its seat (the samples carry its relative rotation only).
+#[test]
+fn faces_resting_at_one_instant_land_together() {
+    use crr_dynamics::ground_motion::PulseSpec;
+    use crr_impact::statics::{StaticsOptions, collapse_multiplier};
+    let model = Model::from_spec(&running_bond_wall(5, 5, 1.0, 0.5, 0.5)).unwrap();
+    let lambda = collapse_multiplier(&model, Vector3::x(), &StaticsOptions::default())
+        .unwrap()
+        .lambda
+        .unwrap();
+    let ground = GroundMotion::none()
+        .with_component(
+            Axis::X,
+            &ComponentSpec::new(SignalSpec::OneSinePulse(PulseSpec {
+                amplitude: 1.2 * lambda * model.gravity,
+                period: 0.5,
+                start: 0.0,
+            })),
+            Path::new("."),
+        )
+        .unwrap();
+    let init = solve_initial(&model, &InitialSpec::default()).unwrap();
+    let params = Parameters {
+        duration: 0.35,
+        ..Parameters::default()
+    };
+    let traj = Simulation::new(&model, &ground, &init, params)
+        .unwrap()
+        .run()
+        .unwrap();
+    let samples: Vec<Sample> = traj.samples.iter().collect();
+    let mut data = Data::new(&model);
+    let open_in = |s: &Sample, name: &str| {
+        let k = model.interface_index(name).unwrap();
+        model.interfaces[k]
+            .slots
+            .clone()
+            .all(|slot| s.states[slot] == SlotState::Open)
+    };
+    // A landing at rest: no kinetic energy lost.
+    let at_rest: Vec<_> = traj
+        .impacts
+        .iter()
+        .filter(|i| i.energy_lost == 0.0)
+        .collect();
+    let together = at_rest
+        .iter()
+        .find(|i| i.interfaces.len() >= 2)
+        .expect("faces landing together at rest");
+    assert!(
+        (together.t - 0.2703).abs() < 1e-3,
+        "they land at {} s",
+        together.t
+    );
+    for other in &at_rest {
+        assert!(
+            std::ptr::eq(*other, *together) || other.t != together.t,
+            "two landings at rest at {} s: {:?} and {:?}",
+            together.t,
+            together.interfaces,
+            other.interfaces
+        );
+    }
+    // The sample just before the landing (same instant): every body still, each face open and
+    // touching at a point.
+    let before = samples
+        .iter()
+        .rev()
+        .filter(|s| s.t == together.t)
+        .find(|s| together.interfaces.iter().all(|name| open_in(s, name)))
+        .expect("a sample of the instant with the faces open");
+    let rate_scale = (model.gravity / model.size).sqrt();
+    assert!(
+        before.qdot.iter().all(|v| v.abs() <= 1e-12 * rate_scale),
+        "the wall is still"
+    );
+    let mut closures = 0;
+    for name in &together.interfaces {
+        let k = model.interface_index(name).unwrap();
+        if let Role::Tree { first_coord } = model.interfaces[k].role {
+            // The samples give an open tree face's relative rotation, not its translation
+            // off the pivot: it is turned back to its seat.
+            assert_eq!(before.q[first_coord], 0.0, "{name}");
+            continue;
+        }
+        closures += 1;
+        let points = face_points(&model, &mut data, before, k);
+        let lowest = points.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+        assert!(
+            lowest.abs() <= 1e-9 * model.size,
+            "{name}: lowest gap {lowest:e} m"
+        );
+        for (_, v) in points {
+            assert!(v.norm() <= 1e-12, "{name}: relative velocity {v}");
+        }
+    }
+    assert!(
+        closures >= 1,
+        "a face that closes a loop of the file's tree"
+    );
+    // Just after: none of them open.
+    let after = samples
+        .iter()
+        .rev()
+        .find(|s| s.t == together.t)
+        .expect("a sample after the landing");
+    for name in &together.interfaces {
+        let k = model.interface_index(name).unwrap();
+        for slot in model.interfaces[k].slots.clone() {
+            assert_ne!(after.states[slot], SlotState::Open, "{name}");
+        }
     }
 }

@@ -416,6 +416,8 @@ pub struct Simulation<'a> {
     /// Counts the changes of chain: a workspace taken before a call that may change it is
     /// given back only if the chain is still the same.
     chain_changes: u64,
+    /// The rest statics' axis multipliers of the chains met so far, by their interfaces.
+    axis_memory: crate::statics::AxisMemory,
     ground: &'a GroundMotion,
     params: Parameters,
     dynamics: Dynamics,
@@ -726,6 +728,7 @@ impl<'a> Simulation<'a> {
             file_q: vec![0.0; model.dof()],
             file_qdot: vec![0.0; model.dof()],
             chain_changes: 0,
+            axis_memory: Default::default(),
             ground,
             params,
             dynamics,
@@ -1009,8 +1012,12 @@ impl<'a> Simulation<'a> {
             return Ok(StopReason::End(self.t));
         }
         let lift_off = self.settle_resting_joints()?;
-        while let Some((face, point)) = self.settled_open_face() {
-            self.recontact(face, point)?;
+        loop {
+            let settled = self.settled_open_faces();
+            if settled.is_empty() {
+                break;
+            }
+            self.recontact(&settled)?;
         }
         let model = Arc::clone(&self.model);
         let model = &*model;
@@ -1196,7 +1203,7 @@ impl<'a> Simulation<'a> {
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());
         if let Some((face, point)) = landing {
-            return self.recontact(face, point).map(StopReason::Impact);
+            return self.recontact(&[(face, point)]).map(StopReason::Impact);
         }
         self.stop_reason(
             stop,

@@ -271,6 +271,7 @@ impl Simulation<'_> {
         // exact solve opens them.
         let mut trial = d.clone();
         let mut rest = super::uplift_from_rest::RestCache::default();
+        rest.global = self.axis_memory.statics_for(chain);
         let parts = chain.parts();
         let decided = super::seating::opening_mode_in(
             chain,
@@ -283,6 +284,7 @@ impl Simulation<'_> {
             &q,
             &qdot,
         );
+        self.axis_memory.remember(chain, &rest.global);
         let lifting_further = rest.lift_off.unwrap_or_default();
         let candidates: Vec<(usize, Side)> = decided
             .unwrap_or_default()
@@ -381,7 +383,10 @@ impl Simulation<'_> {
         let (work_in, dissipated) = (self.y[2 * n_old], self.y[2 * n_old + 1]);
         let (dynamics, seated, last_impact) = self.dynamics_on(&chain, &loops, closing);
         let trial = dynamics.clone();
+        self.axis_memory
+            .remember(&self.model, &self.spare.rest.global);
         self.spare = Workspaces::new(&chain, trial, &dynamics.pivots);
+        self.spare.rest.global = self.axis_memory.statics_for(&chain);
         self.dynamics = dynamics;
         self.regularised = Regularised::of(&chain);
         self.parts = chain.parts();
@@ -433,28 +438,38 @@ impl Simulation<'_> {
         )
     }
 
-    /// Point `point` of open face `face` touches: its loop closes again on the pivot there,
-    /// positions by the least change (booked as a snap) and velocities by a plastic impulse
-    /// (recorded as an impact). Returns the impact's index.
+    /// Open faces touch, each at one point (`landings`: (face, point)): their loops close again
+    /// on the pivots there, positions by the least change (booked as a snap) and velocities by a
+    /// plastic impulse (recorded as one impact). Returns the impact's index.
+    ///
+    /// A face's gap event lands one face; faces resting on their supports at rest land together
+    /// ([`Simulation::settled_open_faces`]), so that the decision that follows (which joints and
+    /// faces open again) is taken once, on the structure with all of them closed.
     pub(super) fn recontact(
         &mut self,
-        face: usize,
-        point: usize,
+        landings: &[(usize, usize)],
     ) -> Result<usize, SimulationError> {
         self.check_impact_room()?;
         let t = self.t;
-        let landing = self.open.faces[face].clone();
         let original = self.original;
-        let iface = &original.interfaces[landing.interface];
-        let closing: Vec<(usize, Side)> = iface
-            .slots
-            .clone()
-            .zip(landing.point_sides[point].iter().copied())
+        let landing: Vec<usize> = landings
+            .iter()
+            .map(|&(face, _)| self.open.faces[face].interface)
+            .collect();
+        let closing: Vec<(usize, Side)> = landings
+            .iter()
+            .flat_map(|&(face, point)| {
+                let face = &self.open.faces[face];
+                original.interfaces[face.interface]
+                    .slots
+                    .clone()
+                    .zip(face.point_sides[point].iter().copied())
+            })
             .collect();
         self.record_current_sample(t);
         let energy_before = self.mechanical_energy();
         let mut open = self.open.interfaces();
-        open.retain(|&k| k != landing.interface);
+        open.retain(|k| !landing.contains(k));
         // The tree stays: every interface outside it (the landing one too) only closes loops.
         let chain = Arc::clone(&self.model);
         let outside_tree: Vec<usize> = (0..original.interfaces.len())
@@ -535,7 +550,10 @@ impl Simulation<'_> {
         self.set_seated(to_seat.iter().map(|&s| (s, true)));
         let record = ImpactRecord {
             t,
-            interfaces: vec![iface.name.clone()],
+            interfaces: landing
+                .iter()
+                .map(|&k| original.interfaces[k].name.clone())
+                .collect(),
             slots: slots.clone(),
             rates_before: slots.iter().map(|&s| rates_before[s]).collect(),
             rates_after: slots.iter().map(|&s| rates[s]).collect(),
@@ -558,10 +576,11 @@ impl Simulation<'_> {
     /// An open face resting on its support: every slot of the chain seated and still (the
     /// seating snaps set the tree coordinates to exactly 0, which can put a lifted block back
     /// on its support without its gap event: the face is touching, with no relative velocity).
-    /// Returns (face, point) of its lowest point, gap within 1e-9 of the model size.
-    pub(super) fn settled_open_face(&mut self) -> Option<(usize, usize)> {
+    /// Returns (face, point) of each such face's lowest point, gap within 1e-9 of the model
+    /// size.
+    pub(super) fn settled_open_faces(&mut self) -> Vec<(usize, usize)> {
         if self.open.faces.is_empty() || self.seated.iter().any(|s| !s) {
-            return None;
+            return Vec::new();
         }
         let n = self.model.dof();
         let rate_scale = (self.model.gravity / self.model.size).sqrt();
@@ -569,20 +588,23 @@ impl Simulation<'_> {
             .iter()
             .any(|v| v.abs() > 1e-12 * rate_scale)
         {
-            return None;
+            return Vec::new();
         }
         let model = Arc::clone(&self.model);
         let q = self.chain_q();
         forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
-        for (f, face) in self.open.faces.iter().enumerate() {
-            let (point, gap) = (0..face.len())
-                .map(|i| (i, face.gap(&model, &self.out_kin, i)))
-                .min_by(|a, b| a.1.total_cmp(&b.1))?;
-            if gap <= 1e-9 * model.size {
-                return Some((f, point));
-            }
-        }
-        None
+        let kin = &self.out_kin;
+        self.open
+            .faces
+            .iter()
+            .enumerate()
+            .filter_map(|(f, face)| {
+                let (point, gap) = (0..face.len())
+                    .map(|i| (i, face.gap(&model, kin, i)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))?;
+                (gap <= 1e-9 * model.size).then_some((f, point))
+            })
+            .collect()
     }
 
     /// Fills `file_q`, `file_qdot` with the state (q, q̇ of the chain) in the file's
