@@ -162,7 +162,9 @@ fn a_mirrored_file_gives_the_mirrored_multipliers() {
 /// the tree, some turned round), but the same faces. The multiplier is a property of the faces
 /// and the bodies, so it must not change with the tree: checked here by building chains with
 /// other trees (every second tree interface pushed out of the tree, so that the tree grows
-/// again through former loop closures, or only the first) and solving each from scratch.
+/// again through former loop closures, or only the first; each structure has a chain with
+/// interfaces turned round, child and parent swapped) and solving each from scratch along the
+/// six axes and an oblique direction.
 #[test]
 fn the_chain_s_tree_changes_no_multiplier() {
     let cases: Vec<(String, StructureSpec)> = vec![
@@ -182,11 +184,11 @@ fn the_chain_s_tree_changes_no_multiplier() {
         let tree: Vec<usize> = (0..model.interfaces.len())
             .filter(|&k| matches!(model.interfaces[k].role, Role::Tree { .. }))
             .collect();
-        let mut moved_any = false;
+        let (mut moved_any, mut turned_any) = (false, false);
         let pushed_sets: [Vec<usize>; 2] =
             [tree.iter().copied().step_by(2).collect(), vec![tree[0]]];
         for (offset, pushed) in pushed_sets.iter().enumerate() {
-            let (chain, _turned) = model
+            let (chain, turned) = model
                 .with_open_interfaces(&[], pushed)
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             let moved = chain
@@ -198,7 +200,16 @@ fn the_chain_s_tree_changes_no_multiplier() {
                 })
                 .count();
             moved_any |= moved > 0;
-            for d in [Vector3::x(), -Vector3::x(), Vector3::new(0.6, 0.8, 0.0)] {
+            turned_any |= turned.iter().any(|&t| t);
+            for d in [
+                Vector3::x(),
+                -Vector3::x(),
+                Vector3::y(),
+                -Vector3::y(),
+                Vector3::z(),
+                -Vector3::z(),
+                Vector3::new(0.6, 0.8, 0.0),
+            ] {
                 let of = |m: &Model| {
                     collapse_multiplier(m, d, &StaticsOptions::default())
                         .unwrap_or_else(|e| panic!("{name}: {e}"))
@@ -213,5 +224,6 @@ fn the_chain_s_tree_changes_no_multiplier() {
             }
         }
         assert!(moved_any, "{name}: every chain kept the file's tree");
+        assert!(turned_any, "{name}: no chain turned an interface round");
     }
 }
