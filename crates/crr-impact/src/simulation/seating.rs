@@ -917,12 +917,25 @@ impl Simulation<'_> {
         let mut mode = mode;
         if let Some(interfaces) = self.spare.rest.lift_off.take() {
             let in_flight = bodies_without_support(&self.model, &interfaces);
+            // The proposal's other joints and sides, by the file's slots (the chain changes).
+            let proposal: Vec<(usize, Side)> = mode
+                .iter()
+                .flatten()
+                .map(|&(s, side)| (self.open.original_slot(s), side))
+                .collect();
+            let from_rest = self.at_rest();
             // The faces open and the chain without them (its tree grown again where needed)
             // decides again; a body left without support is outside the model.
             let mut contradicted = false;
             let reason = if in_flight.is_empty() {
                 match self.release_faces(&interfaces) {
-                    FaceRelease::Released => return self.release_once(),
+                    FaceRelease::Released => {
+                        let released = self.release_once()?;
+                        if released.is_some() || !from_rest {
+                            return Ok(released);
+                        }
+                        return self.release_mechanism(&proposal);
+                    }
                     FaceRelease::Impossible(why) => Some(format!(
                         "every body keeps a support through other contacts, but no chain of \
                          the CRR model is left without them ({why})"
@@ -1003,36 +1016,75 @@ impl Simulation<'_> {
             }
         }
         if let Some(mode) = &mode {
-            // The structure leaves rest only when every joint was seated: a joint seated at an
-            // impact and released at once while others rock (the end of free rocking) is no
-            // uplift of the structure (`uplift_time` stays null for a run released from rest
-            // angles).
-            let from_rest = self.seated.iter().all(|&s| s);
-            let n = self.model.dof();
-            let twisting_flip = mode.iter().any(|&(s, side)| {
-                side != self.dynamics.pivots.sides[s] && is_twisting_closure_slot(&self.model, s)
-            });
-            for &(s, side) in mode {
-                self.dynamics.pivots.sides[s] = side;
-                // A seated angle leaves its seat from exactly 0: the state can still carry the
-                // round-off of the step that seated it (−1.9e-9 rad on the drum column), which
-                // on the other pivot would be the wrong side of it.
-                if s < n {
-                    self.y[s] = 0.0;
-                    self.y[n + s] = 0.0;
-                }
-            }
-            self.set_seated(mode.iter().map(|&(s, _)| (s, false)));
-            if twisting_flip {
-                let released: Vec<usize> = mode.iter().map(|&(s, _)| s).collect();
-                self.close_loops_after_a_twisting_flip(&released)?;
-            }
-            if from_rest {
-                self.uplift_time.get_or_insert(self.t);
-            }
-            self.reset_solver();
+            self.apply_release(mode)?;
         }
         Ok(mode)
+    }
+
+    /// Every slot seated and every rate zero: the structure at rest.
+    fn at_rest(&self) -> bool {
+        let n = self.model.dof();
+        let rate_scale = (self.model.gravity / self.model.size).sqrt();
+        self.seated.iter().all(|&s| s)
+            && self.y[n..2 * n]
+                .iter()
+                .all(|v| v.abs() <= 1e-12 * rate_scale)
+    }
+
+    /// Faces that lifted off from rest at the crossing of the collapse multiplier, where the
+    /// chain without them finds no opening of its own: the load is 1e-9 of λ_c above the
+    /// structure's multiplier, and the chain's own test (the same mechanism, its λ equal to
+    /// round-off) keeps the threshold's margin. The mechanism's other joints open on their
+    /// sides (`proposal`, by the file's slots), as they do at the crossing without a lift-off
+    /// ([`opening_mode_in`]); otherwise nothing moves, the faces rest on their supports, close
+    /// again, and lift off again at the same instant, over and over.
+    fn release_mechanism(
+        &mut self,
+        proposal: &[(usize, Side)],
+    ) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
+        let mode: Vec<(usize, Side)> = proposal
+            .iter()
+            .filter_map(|&(file_slot, side)| Some((self.open.active_slot(file_slot)?, side)))
+            .filter(|&(s, _)| self.seated[s])
+            .collect();
+        if mode.is_empty() {
+            return Ok(None);
+        }
+        self.apply_release(&mode)?;
+        Ok(Some(mode))
+    }
+
+    /// Releases the slots of `mode` on their sides (see [`Self::release_once`]).
+    fn apply_release(&mut self, mode: &[(usize, Side)]) -> Result<(), SimulationError> {
+        // The structure leaves rest only when every joint was seated: a joint seated at an
+        // impact and released at once while others rock (the end of free rocking) is no
+        // uplift of the structure (`uplift_time` stays null for a run released from rest
+        // angles).
+        let from_rest = self.seated.iter().all(|&s| s);
+        let n = self.model.dof();
+        let twisting_flip = mode.iter().any(|&(s, side)| {
+            side != self.dynamics.pivots.sides[s] && is_twisting_closure_slot(&self.model, s)
+        });
+        for &(s, side) in mode {
+            self.dynamics.pivots.sides[s] = side;
+            // A seated angle leaves its seat from exactly 0: the state can still carry the
+            // round-off of the step that seated it (−1.9e-9 rad on the drum column), which
+            // on the other pivot would be the wrong side of it.
+            if s < n {
+                self.y[s] = 0.0;
+                self.y[n + s] = 0.0;
+            }
+        }
+        self.set_seated(mode.iter().map(|&(s, _)| (s, false)));
+        if twisting_flip {
+            let released: Vec<usize> = mode.iter().map(|&(s, _)| s).collect();
+            self.close_loops_after_a_twisting_flip(&released)?;
+        }
+        if from_rest {
+            self.uplift_time.get_or_insert(self.t);
+        }
+        self.reset_solver();
+        Ok(())
     }
 
     /// The contact program lifts `interfaces` off, the chain without them drives them back into
