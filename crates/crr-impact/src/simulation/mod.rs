@@ -1203,7 +1203,18 @@ impl<'a> Simulation<'a> {
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());
         if let Some((face, point)) = landing {
-            return self.recontact(&[(face, point)]).map(StopReason::Impact);
+            let mut landings = vec![(face, point)];
+            landings.extend(self.open_faces_touching(Some(face)));
+            return self.recontact(&landings).map(StopReason::Impact);
+        }
+        // A rocking joint's impact with open faces touching at the same instant: the faces land
+        // first (their loops close with a plastic impulse); the joint's impact, if it still
+        // moves into its seat, follows at once from the next segment's start.
+        if event_slot.is_some() {
+            let touching = self.open_faces_touching(None);
+            if !touching.is_empty() {
+                return self.recontact(&touching).map(StopReason::Impact);
+            }
         }
         self.stop_reason(
             stop,
