@@ -8,6 +8,9 @@
 //!   ground motion, initial state and `[analysis]` from the file; no output written);
 //! - `colonnade_row`: how a run with loops grows: planar colonnades of 2 to 32 columns of three
 //!   drums under architraves, 6 s of the bundled record, with the fitted exponent printed;
+//! - `wall_pulse`: how a run with faces that lift off grows: planar running-bond walls of n × n
+//!   blocks (1.0 × 0.5 m, 0.5 m deep) under a one-sine pulse of 1.2 λ g (0.5 s), 3 s, with the
+//!   fitted exponent printed;
 //! - `many_bodies`: how a run grows with the number of bodies: a stack of n drums standing
 //!   seated for 0.5 s, and n free-standing blocks of distinct sizes under one sine pulse for 1 s.
 //!
@@ -554,6 +557,84 @@ fn colonnade_row_growth(c: &mut Criterion) {
     group.finish();
 }
 
+/// Loops with faces that lift off, as they grow: planar running-bond walls of n × n blocks
+/// (`fixtures::running_bond_wall`, blocks 1.0 × 0.5 m, 0.5 m deep; the walls of
+/// `examples/wall_pulse.rs`) under a one-sine pulse along x of 1.2 λ g and 0.5 s, λ each wall's
+/// collapse multiplier along +x, 3 s. Each wall lifts a wedge off a stepped crack, lands it
+/// whole, then its mirror image in the pulse's second half (two impacts, about 370 steps). Each
+/// size is run once outside criterion and its wall time per step printed, with the exponent p of
+/// cost per step ∝ DOF^p fitted over the sizes and between the two largest (the issue asks for
+/// the 10 × 10 wall in ≤ 10 s and p ≤ 1.5). n = 8 and 10 are printed, not timed by criterion
+/// (about 3 and 6.5 s a run).
+fn wall_pulse_growth(c: &mut Criterion) {
+    use crr_impact::statics::{StaticsOptions, collapse_multiplier};
+    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    if filter.is_some_and(|f| !"wall_pulse".contains(f.as_str()) && !f.contains("wall_pulse")) {
+        return;
+    }
+    let mut group = c.benchmark_group("wall_pulse");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(200))
+        .measurement_time(Duration::from_secs(5));
+    let params = Parameters {
+        duration: 3.0,
+        ..Parameters::default()
+    };
+    let mut points = Vec::new();
+    for n in [4, 6, 8, 10] {
+        let model = Model::from_spec(&crr_kinematics::fixtures::running_bond_wall(
+            n, n, 1.0, 0.5, 0.5,
+        ))
+        .expect("valid wall");
+        let lambda = collapse_multiplier(&model, Vector3::x(), &StaticsOptions::default())
+            .expect("the wall's multiplier")
+            .lambda
+            .expect("a finite multiplier");
+        let pulse = ComponentSpec::new(SignalSpec::OneSinePulse(PulseSpec {
+            amplitude: 1.2 * lambda * model.gravity,
+            period: 0.5,
+            start: 0.0,
+        }));
+        let ground = GroundMotion::none()
+            .with_component(Axis::X, &pulse, Path::new("."))
+            .expect("the pulse");
+        let init = at_rest(&model);
+        let start = std::time::Instant::now();
+        let traj = run(&model, &ground, &init, params.clone());
+        let seconds = start.elapsed().as_secs_f64();
+        check(&format!("wall_pulse/{n}"), &traj, Some(false));
+        let per_step = seconds / traj.solver_stats.steps as f64;
+        eprintln!(
+            "wall_pulse/{n}: DOF {}, {} steps, {seconds:.2} s, {:.2} ms per step",
+            model.dof(),
+            traj.solver_stats.steps,
+            per_step * 1e3
+        );
+        points.push(((model.dof() as f64).ln(), per_step.ln()));
+        if n <= 6 {
+            group.bench_function(BenchmarkId::from_parameter(n), |b| {
+                b.iter(|| black_box(run(&model, &ground, black_box(&init), params.clone())));
+            });
+        }
+    }
+    let count = points.len() as f64;
+    let (mx, my) = (
+        points.iter().map(|p| p.0).sum::<f64>() / count,
+        points.iter().map(|p| p.1).sum::<f64>() / count,
+    );
+    let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    eprintln!("wall_pulse: cost per step ∝ DOF^{slope:.2} (DOF 18 to 105)");
+    if let [.., a, b] = points[..] {
+        eprintln!(
+            "wall_pulse: DOF^{:.2} between the two largest sizes",
+            (b.1 - a.1) / (b.0 - a.0)
+        );
+    }
+    group.finish();
+}
+
 // The Poincaré section and study benches share this binary (one LTO link fewer each in CI).
 #[path = "groups/poincare.rs"]
 mod poincare_group;
@@ -568,6 +649,7 @@ criterion_group!(
     bundled_models,
     many_bodies,
     colonnade_row_growth,
+    wall_pulse_growth,
     poincare_group::section_200_periods,
     study_group::bench_study
 );
