@@ -1204,16 +1204,24 @@ impl<'a> Simulation<'a> {
         copy_short(&mut self.y, self.solver.y());
         if let Some((face, point)) = landing {
             let mut landings = vec![(face, point)];
-            landings.extend(self.open_faces_touching(Some(face)));
+            landings.extend(self.open_faces_touching(Some(face))?);
             return self.recontact(&landings).map(StopReason::Impact);
         }
         // A rocking joint's impact with open faces touching at the same instant: the faces land
-        // first (their loops close with a plastic impulse); the joint's impact, if it still
-        // moves into its seat, follows at once from the next segment's start.
-        if event_slot.is_some() {
-            let touching = self.open_faces_touching(None);
+        // first (their loops close with a plastic impulse, which may stop the joint: a wedge
+        // landing on its whole crack stops at its toe too); the joint's impact follows at once
+        // if it still moves into its seat.
+        if let Some(slot) = event_slot {
+            let touching = self.open_faces_touching(None)?;
             if !touching.is_empty() {
-                return self.recontact(&touching).map(StopReason::Impact);
+                let file_slot = self.open.original_slot(slot);
+                let landed = self.recontact(&touching)?;
+                return match self.open.active_slot(file_slot) {
+                    Some(s) if !self.seated[s] && self.moves_into_its_seat(s) => {
+                        self.impact(s).map(StopReason::Impact)
+                    }
+                    _ => Ok(StopReason::Impact(landed)),
+                };
             }
         }
         self.stop_reason(
@@ -1223,6 +1231,19 @@ impl<'a> Simulation<'a> {
             first_zone_index,
             rocking_len,
         )
+    }
+
+    /// Whether slot `s` turns into its seat (against its side) faster than round-off, 1e-12 of
+    /// the rate scale √(g/L).
+    fn moves_into_its_seat(&mut self, s: usize) -> bool {
+        let model = Arc::clone(&self.model);
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        crr_kinematics::velocities(&model, &mut self.out_kin, &qdot);
+        let mut rates = vec![0.0; model.slot_count];
+        slot_rates(&model, &self.out_kin, &qdot, &mut rates);
+        let rate_scale = (model.gravity / model.size).sqrt();
+        self.dynamics.pivots.sides[s].sign() * rates[s] < -1e-12 * rate_scale
     }
 
     /// Where this segment ends at the latest: the duration, the ground motion's next breakpoint,

@@ -574,20 +574,34 @@ impl Simulation<'_> {
     }
 
     /// The open faces touching their supports now, other than `except`: each whose lowest point
-    /// is within `simultaneity` × the model size of its support and not moving away from it
-    /// (gap rate ≤ 0), with that point. They land with a face whose gap event fires, and with a
-    /// rocking joint's impact: a rigid wedge rocking back about its toe closes every joint of
-    /// its crack, and its toe, at one instant. Their events fire one at a time, and an impulse on
-    /// the first alone, the others a hair inside their supports (1e-13 m on the 7 × 7 wall under
-    /// 1.01 λ g at 0.1587 s), threw the blocks along the crack off their other supports.
-    pub(super) fn open_faces_touching(&mut self, except: Option<usize>) -> Vec<(usize, usize)> {
+    /// is within `simultaneity` × the model size of its support and not leaving it, with that
+    /// point. Not leaving: its gap rate below −1e-12 √(g L), or within ±1e-12 √(g L) with a gap
+    /// acceleration at most 1e-9 g (q̈ of the chain now): a face that has just opened leaves with
+    /// a zero rate and a positive acceleration, and closing it again would repeat at the same
+    /// instant. They land with a face whose gap event fires, and with a rocking joint's impact: a
+    /// rigid wedge rocking back about its toe closes every joint of its crack, and its toe, at
+    /// one instant. Their events fire one at a time, and an impulse on the first alone, the
+    /// others a hair inside their supports (1e-13 m on the 7 × 7 wall under 1.01 λ g at
+    /// 0.1587 s), threw the blocks along the crack off their other supports.
+    pub(super) fn open_faces_touching(
+        &mut self,
+        except: Option<usize>,
+    ) -> Result<Vec<(usize, usize)>, SimulationError> {
         if self.open.faces.is_empty() {
-            return Vec::new();
+            return Ok(Vec::new());
         }
         let model = Arc::clone(&self.model);
         let (q, qdot) = (self.chain_q(), self.chain_qdot());
         let tol = self.params.simultaneity * model.size;
-        let h = 1e-6 * (model.size / model.gravity).sqrt();
+        let h = 1e-4 * (model.size / model.gravity).sqrt();
+        let still = 1e-12 * (model.gravity * model.size).sqrt();
+        let mut d = self.take_trial();
+        d.pivots.clone_from(&self.dynamics.pivots);
+        d.seated.clone_from(&self.dynamics.seated);
+        let solved = d.accelerations(&model, self.ground, self.t, &q, &qdot);
+        let qddot = d.qddot.clone();
+        self.spare.trial = Some(d);
+        solved.map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
         let pivots = &self.dynamics.pivots;
         let kin = &mut self.out_kin;
         let mut gaps_at = |q: &DVector<f64>| -> Vec<Vec<f64>> {
@@ -598,17 +612,20 @@ impl Simulation<'_> {
                 .map(|f| (0..f.len()).map(|i| f.gap(&model, kin, i)).collect())
                 .collect()
         };
-        let now = gaps_at(&q);
-        let after = gaps_at(&(&q + &qdot * h));
-        let before = gaps_at(&(&q - &qdot * h));
-        (0..now.len())
+        let step = |sign: f64| &q + &qdot * (sign * h) + &qddot * (0.5 * h * h);
+        let (before, now, after) = (gaps_at(&step(-1.0)), gaps_at(&q), gaps_at(&step(1.0)));
+        Ok((0..now.len())
             .filter(|&f| Some(f) != except)
             .filter_map(|f| {
                 let gaps = &now[f];
                 let i = (0..gaps.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]))?;
-                (gaps[i] <= tol && after[f][i] - before[f][i] <= 0.0).then_some((f, i))
+                let rate = (after[f][i] - before[f][i]) / (2.0 * h);
+                let acceleration = (after[f][i] - 2.0 * gaps[i] + before[f][i]) / (h * h);
+                let not_leaving =
+                    rate < -still || (rate <= still && acceleration <= 1e-9 * model.gravity);
+                (gaps[i] <= tol && not_leaving).then_some((f, i))
             })
-            .collect()
+            .collect())
     }
 
     /// An open face resting on its support: every slot of the chain seated and still (the

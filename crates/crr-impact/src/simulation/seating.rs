@@ -1031,25 +1031,43 @@ impl Simulation<'_> {
                 .all(|v| v.abs() <= 1e-12 * rate_scale)
     }
 
-    /// Faces that lifted off from rest at the crossing of the collapse multiplier, where the
-    /// chain without them finds no opening of its own: the load is 1e-9 of λ_c above the
-    /// structure's multiplier, and the chain's own test (the same mechanism, its λ equal to
-    /// round-off) keeps the threshold's margin. The mechanism's other joints open on their
-    /// sides (`proposal`, by the file's slots), as they do at the crossing without a lift-off
+    /// Faces that lifted off from rest where the chain without them finds no opening of its own:
+    /// at the crossing of the collapse multiplier the load is 1e-9 of λ_c above the structure's
+    /// multiplier, and the chain's own test (the same mechanism, its multiplier equal to the
+    /// structure's to round-off) keeps the threshold's margin. The mechanism's other joints
+    /// (`proposal`, by the file's slots) open on their sides where the chain's exact solve opens
+    /// them by any positive acceleration, as they do at the crossing without a lift-off
     /// ([`opening_mode_in`]); otherwise nothing moves, the faces rest on their supports, close
     /// again, and lift off again at the same instant, over and over.
     fn release_mechanism(
         &mut self,
         proposal: &[(usize, Side)],
     ) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
-        let mode: Vec<(usize, Side)> = proposal
+        let proposed: Vec<(usize, Side)> = proposal
             .iter()
             .filter_map(|&(file_slot, side)| Some((self.open.active_slot(file_slot)?, side)))
             .filter(|&(s, _)| self.seated[s])
             .collect();
-        if mode.is_empty() {
+        // Checked by the chain's exact solve without the margin: each must open on its side
+        // (by any positive acceleration); one that the chain holds goes back to its seat.
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        let mut trial = self.take_trial();
+        let mode = confirmed_releases(
+            &self.model,
+            self.ground,
+            &self.dynamics,
+            &mut trial,
+            proposed,
+            self.t,
+            &q,
+            &qdot,
+            0.0,
+        )
+        .flatten();
+        self.spare.trial = Some(trial);
+        let Some(mode) = mode else {
             return Ok(None);
-        }
+        };
         self.apply_release(&mode)?;
         Ok(Some(mode))
     }
