@@ -539,6 +539,14 @@ fn colonnade_row_growth(c: &mut Criterion) {
             });
         }
     }
+    print_growth("colonnade_row", &points);
+    group.finish();
+}
+
+/// Prints the exponent p of cost per step ∝ DOF^p fitted (least squares in log–log) over the
+/// sizes' points (ln DOF, ln seconds per step), and between the two largest alone: the exponent
+/// the largest sizes tend to.
+fn print_growth(group: &str, points: &[(f64, f64)]) {
     let n = points.len() as f64;
     let (mx, my) = (
         points.iter().map(|p| p.0).sum::<f64>() / n,
@@ -546,15 +554,18 @@ fn colonnade_row_growth(c: &mut Criterion) {
     );
     let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
         / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
-    eprintln!("colonnade_row: cost per step ∝ DOF^{slope:.2} (DOF 7 to 127)");
-    // The last doubling alone: the exponent the largest sizes tend to.
-    if let [.., a, b] = points[..] {
+    let dof = |x: f64| x.exp().round();
+    if let ([first, ..], [.., a, b]) = (points, points) {
         eprintln!(
-            "colonnade_row: DOF^{:.2} between the two largest sizes",
+            "{group}: cost per step ∝ DOF^{slope:.2} (DOF {} to {})",
+            dof(first.0),
+            dof(b.0)
+        );
+        eprintln!(
+            "{group}: DOF^{:.2} between the two largest sizes",
             (b.1 - a.1) / (b.0 - a.0)
         );
     }
-    group.finish();
 }
 
 /// Loops with faces that lift off, as they grow: planar running-bond walls of n × n blocks
@@ -618,20 +629,7 @@ fn wall_pulse_growth(c: &mut Criterion) {
             });
         }
     }
-    let count = points.len() as f64;
-    let (mx, my) = (
-        points.iter().map(|p| p.0).sum::<f64>() / count,
-        points.iter().map(|p| p.1).sum::<f64>() / count,
-    );
-    let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
-        / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
-    eprintln!("wall_pulse: cost per step ∝ DOF^{slope:.2} (DOF 18 to 105)");
-    if let [.., a, b] = points[..] {
-        eprintln!(
-            "wall_pulse: DOF^{:.2} between the two largest sizes",
-            (b.1 - a.1) / (b.0 - a.0)
-        );
-    }
+    print_growth("wall_pulse", &points);
     group.finish();
 }
 

@@ -314,27 +314,16 @@ impl Simulation<'_> {
         d.accelerations(chain, self.ground, self.t, &q, &qdot)
             .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
         let (g, size) = (chain.gravity, chain.size);
-        let h = 1e-4 * (size / g).sqrt();
+        let faces: Vec<&OpenFace> = loops
+            .faces
+            .iter()
+            .filter(|f| opening.contains(&f.interface))
+            .collect();
         let mut kin = Data::new(chain);
-        let mut gaps = |q: &DVector<f64>| -> Vec<f64> {
-            forward_kinematics(chain, &mut kin, q, &d.pivots);
-            loops
-                .faces
-                .iter()
-                .filter(|f| opening.contains(&f.interface))
-                .flat_map(|f| {
-                    (0..f.len())
-                        .map(|i| f.gap(chain, &kin, i))
-                        .collect::<Vec<_>>()
-                })
-                .collect()
-        };
-        let step = |sign: f64| &q + &qdot * (sign * h) + &d.qddot * (0.5 * h * h);
-        let (before, now, after) = (gaps(&step(-1.0)), gaps(&q), gaps(&step(1.0)));
-        Ok((0..now.len()).all(|i| {
-            let rate = (after[i] - before[i]) / (2.0 * h);
-            let acceleration = (after[i] - 2.0 * now[i] + before[i]) / (h * h);
-            now[i] > 1e-9 * size || (rate > -1e-9 * (g * size).sqrt() && acceleration > -1e-6 * g)
+        let motion = gap_motion(chain, &mut kin, &d.pivots, &faces, (&q, &qdot, &d.qddot));
+        Ok(motion.iter().flatten().all(|p| {
+            p.gap > 1e-9 * size
+                || (p.rate > -1e-9 * (g * size).sqrt() && p.acceleration > -1e-6 * g)
         }))
     }
 
@@ -442,9 +431,10 @@ impl Simulation<'_> {
     /// on the pivots there, positions by the least change (booked as a snap) and velocities by a
     /// plastic impulse (recorded as one impact). Returns the impact's index.
     ///
-    /// A face's gap event lands one face; faces resting on their supports at rest land together
-    /// ([`Simulation::settled_open_faces`]), so that the decision that follows (which joints and
-    /// faces open again) is taken once, on the structure with all of them closed.
+    /// A face's gap event lands it with every other face touching then, as does a rocking
+    /// joint's impact ([`Simulation::open_faces_touching`]); faces resting on their supports at
+    /// rest land together ([`Simulation::settled_open_faces`]). The decision that follows (which
+    /// joints and faces open again) is taken once, on the structure with all of them closed.
     pub(super) fn recontact(
         &mut self,
         landings: &[(usize, usize)],
@@ -587,14 +577,28 @@ impl Simulation<'_> {
         &mut self,
         except: Option<usize>,
     ) -> Result<Vec<(usize, usize)>, SimulationError> {
-        if self.open.faces.is_empty() {
+        let model = Arc::clone(&self.model);
+        let tol = self.params.simultaneity * model.size;
+        let q = self.chain_q();
+        // The lowest point of each face; most impacts have none near: no solve then.
+        forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        let lowest: Vec<Option<usize>> = self
+            .open
+            .faces
+            .iter()
+            .enumerate()
+            .map(|(f, face)| {
+                let gaps: Vec<f64> = (0..face.len())
+                    .map(|i| face.gap(&model, &self.out_kin, i))
+                    .collect();
+                let i = (0..gaps.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]))?;
+                (Some(f) != except && gaps[i] <= tol).then_some(i)
+            })
+            .collect();
+        if lowest.iter().all(Option::is_none) {
             return Ok(Vec::new());
         }
-        let model = Arc::clone(&self.model);
-        let (q, qdot) = (self.chain_q(), self.chain_qdot());
-        let tol = self.params.simultaneity * model.size;
-        let h = 1e-4 * (model.size / model.gravity).sqrt();
-        let still = 1e-12 * (model.gravity * model.size).sqrt();
+        let qdot = self.chain_qdot();
         let mut d = self.take_trial();
         d.pivots.clone_from(&self.dynamics.pivots);
         d.seated.clone_from(&self.dynamics.seated);
@@ -602,28 +606,23 @@ impl Simulation<'_> {
         let qddot = d.qddot.clone();
         self.spare.trial = Some(d);
         solved.map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
-        let pivots = &self.dynamics.pivots;
-        let kin = &mut self.out_kin;
-        let mut gaps_at = |q: &DVector<f64>| -> Vec<Vec<f64>> {
-            forward_kinematics(&model, kin, q, pivots);
-            self.open
-                .faces
-                .iter()
-                .map(|f| (0..f.len()).map(|i| f.gap(&model, kin, i)).collect())
-                .collect()
-        };
-        let step = |sign: f64| &q + &qdot * (sign * h) + &qddot * (0.5 * h * h);
-        let (before, now, after) = (gaps_at(&step(-1.0)), gaps_at(&q), gaps_at(&step(1.0)));
-        Ok((0..now.len())
-            .filter(|&f| Some(f) != except)
-            .filter_map(|f| {
-                let gaps = &now[f];
-                let i = (0..gaps.len()).min_by(|&a, &b| gaps[a].total_cmp(&gaps[b]))?;
-                let rate = (after[f][i] - before[f][i]) / (2.0 * h);
-                let acceleration = (after[f][i] - 2.0 * gaps[i] + before[f][i]) / (h * h);
+        let faces: Vec<&OpenFace> = self.open.faces.iter().collect();
+        let motion = gap_motion(
+            &model,
+            &mut self.out_kin,
+            &self.dynamics.pivots,
+            &faces,
+            (&q, &qdot, &qddot),
+        );
+        let still = 1e-12 * (model.gravity * model.size).sqrt();
+        Ok(lowest
+            .iter()
+            .enumerate()
+            .filter_map(|(f, &i)| {
+                let p = motion[f][i?];
                 let not_leaving =
-                    rate < -still || (rate <= still && acceleration <= 1e-9 * model.gravity);
-                (gaps[i] <= tol && not_leaving).then_some((f, i))
+                    p.rate < -still || (p.rate <= still && p.acceleration <= 1e-9 * model.gravity);
+                not_leaving.then_some((f, i?))
             })
             .collect())
     }
@@ -634,15 +633,7 @@ impl Simulation<'_> {
     /// Returns (face, point) of each such face's lowest point, gap within 1e-9 of the model
     /// size.
     pub(super) fn settled_open_faces(&mut self) -> Vec<(usize, usize)> {
-        if self.open.faces.is_empty() || self.seated.iter().any(|s| !s) {
-            return Vec::new();
-        }
-        let n = self.model.dof();
-        let rate_scale = (self.model.gravity / self.model.size).sqrt();
-        if self.y[n..2 * n]
-            .iter()
-            .any(|v| v.abs() > 1e-12 * rate_scale)
-        {
+        if self.open.faces.is_empty() || !self.at_rest() {
             return Vec::new();
         }
         let model = Arc::clone(&self.model);
@@ -825,4 +816,47 @@ fn file_coordinates(
         file_q[first_coord..first_coord + count].copy_from_slice(&angles[..count]);
         file_qdot[first_coord..first_coord + count].copy_from_slice(&rates[..count]);
     }
+}
+
+/// A point's normal gap with its rate and acceleration ([`gap_motion`]).
+#[derive(Clone, Copy, Debug)]
+struct GapMotion {
+    gap: f64,
+    rate: f64,
+    acceleration: f64,
+}
+
+/// The normal gap of every point of `faces` at q, with its rate and acceleration: central
+/// differences over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g)), on `model` with `pivots`.
+fn gap_motion(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    faces: &[&OpenFace],
+    (q, qdot, qddot): (&DVector<f64>, &DVector<f64>, &DVector<f64>),
+) -> Vec<Vec<GapMotion>> {
+    let h = 1e-4 * (model.size / model.gravity).sqrt();
+    let mut gaps = |q: &DVector<f64>| -> Vec<Vec<f64>> {
+        forward_kinematics(model, kin, q, pivots);
+        faces
+            .iter()
+            .map(|f| (0..f.len()).map(|i| f.gap(model, kin, i)).collect())
+            .collect()
+    };
+    let step = |sign: f64| q + qdot * (sign * h) + qddot * (0.5 * h * h);
+    let (before, now, after) = (gaps(&step(-1.0)), gaps(q), gaps(&step(1.0)));
+    now.iter()
+        .enumerate()
+        .map(|(f, points)| {
+            points
+                .iter()
+                .enumerate()
+                .map(|(i, &gap)| GapMotion {
+                    gap,
+                    rate: (after[f][i] - before[f][i]) / (2.0 * h),
+                    acceleration: (after[f][i] - 2.0 * gap + before[f][i]) / (h * h),
+                })
+                .collect()
+        })
+        .collect()
 }

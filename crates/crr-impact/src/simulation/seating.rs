@@ -1021,8 +1021,9 @@ impl Simulation<'_> {
         Ok(mode)
     }
 
-    /// Every slot seated and every rate zero: the structure at rest.
-    fn at_rest(&self) -> bool {
+    /// Every slot seated and every rate within 1e-12 of the rate scale √(g/L): the structure
+    /// at rest.
+    pub(super) fn at_rest(&self) -> bool {
         let n = self.model.dof();
         let rate_scale = (self.model.gravity / self.model.size).sqrt();
         self.seated.iter().all(|&s| s)
