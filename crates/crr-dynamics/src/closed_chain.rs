@@ -11,7 +11,8 @@ use crr_kinematics::{
 };
 
 use crate::eom::{
-    DynamicsError, SelectedRowsWork, SparseRows, constraint_row_scale, solve_selected_rows,
+    DynamicsError, SelectedRowsWork, SparseRows, constraint_row_scale, slot_row,
+    solve_selected_rows,
 };
 use crate::linalg::{JacobiSvd, RANK_TOLERANCE, pinv_solve_in, pivot_columns, rank};
 
@@ -59,6 +60,58 @@ fn scaled(
         s[i] * kin.phi_q[(i, j)]
     });
     (phi, jac)
+}
+
+/// [`scaled`] with one more row per held closure slot (slot ≥ DOF(1), target angle) in `held`:
+/// ψ − target as the residual and the slot's rate row a (ψ̇ = aᵀq̇) as the Jacobian. A seated
+/// closing joint keeps its angle only through these rows: without them a projection's
+/// minimum-norm correction turns it like any free joint (on the voussoir arch of 9 under a pulse,
+/// a joint "seated" 1e-6 rad past its seat, which a later release opened on the wrong side,
+/// moving the bodies by ψ·|P⁺ − P⁻|).
+fn scaled_holding(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+    held: &[(usize, f64)],
+) -> (DVector<f64>, DMatrix<f64>) {
+    let (phi, jac) = scaled(model, kin, q, pivots);
+    if held.is_empty() {
+        return (phi, jac);
+    }
+    let (n, m) = (model.dof(), phi.len());
+    let mut angles = vec![0.0; model.slot_count - n];
+    closure_angles(model, kin, &mut angles);
+    let mut phi = phi.resize_vertically(m + held.len(), 0.0);
+    let mut jac = jac.resize_vertically(m + held.len(), 0.0);
+    let mut row = DVector::zeros(n);
+    for (i, &(s, target)) in held.iter().enumerate() {
+        debug_assert!(s >= n, "held rows are closure slots");
+        phi[m + i] = angles[s - n] - target;
+        slot_row(model, kin, s, &mut row);
+        jac.row_mut(m + i).tr_copy_from(&row);
+    }
+    (phi, jac)
+}
+
+/// The closure slots `held` (≥ DOF(1)) with their angles at q: the targets of
+/// [`project_positions_holding`] that keep them where they are at a closed q (on an open one the
+/// angle between the two frames also takes the loop's gap).
+pub fn held_at(
+    model: &Model,
+    kin: &mut Data,
+    q: &DVector<f64>,
+    pivots: &ActivePivots,
+    held: &[usize],
+) -> Vec<(usize, f64)> {
+    if held.is_empty() {
+        return Vec::new();
+    }
+    let n = model.dof();
+    forward_kinematics(model, kin, q, pivots);
+    let mut angles = vec![0.0; model.slot_count - n];
+    closure_angles(model, kin, &mut angles);
+    held.iter().map(|&s| (s, angles[s - n])).collect()
 }
 
 /// DOF(1), closures, rank of Φ_q and DOF(2) at configuration q with the given pivots.
@@ -172,10 +225,24 @@ pub fn project_positions(
     q: &mut DVector<f64>,
     free: Option<&[usize]>,
 ) -> Result<f64, DynamicsError> {
+    project_positions_holding(model, kin, pivots, q, free, &[])
+}
+
+/// [`project_positions`] that also holds the closure slots of `held` (seated closing joints,
+/// slots ≥ DOF(1)) at their target angles (0 for a joint set on its seat; [`held_at`] a closed
+/// state to keep them where they are): they take no share of the correction.
+pub fn project_positions_holding(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    q: &mut DVector<f64>,
+    free: Option<&[usize]>,
+    held: &[(usize, f64)],
+) -> Result<f64, DynamicsError> {
     let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
     let mut last = f64::INFINITY;
     for _ in 0..NEWTON_ITERATIONS {
-        let (phi, jac) = scaled(model, kin, q, pivots);
+        let (phi, jac) = scaled_holding(model, kin, q, pivots, held);
         let norm = phi.amax();
         if norm <= CLOSURE_TOLERANCE {
             return Ok(norm);
@@ -192,7 +259,7 @@ pub fn project_positions(
         last = norm;
         min_norm_step(&jac, &phi, &cols, q);
     }
-    let (phi, _) = scaled(model, kin, q, pivots);
+    let (phi, _) = scaled_holding(model, kin, q, pivots, held);
     let norm = phi.amax();
     if norm <= 1e-8 {
         Ok(norm)
@@ -223,6 +290,32 @@ pub fn project_velocities(
     free: Option<&[usize]>,
 ) -> f64 {
     project_velocities_with(model, kin, pivots, q, qdot, free, None)
+}
+
+/// [`project_velocities`] that also holds the rates of the closure slots in `held` (seated
+/// closing joints, slots ≥ DOF(1)) at 0: the minimum-norm correction over `free` of
+/// [Φ_q; a_held] q̇ = 0. Returns the residual before projection.
+pub fn project_velocities_holding(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    q: &DVector<f64>,
+    qdot: &mut DVector<f64>,
+    free: Option<&[usize]>,
+    held: &[usize],
+) -> f64 {
+    if held.is_empty() {
+        return project_velocities(model, kin, pivots, q, qdot, free);
+    }
+    let held: Vec<(usize, f64)> = held.iter().map(|&s| (s, 0.0)).collect();
+    let (_, jac) = scaled_holding(model, kin, q, pivots, &held);
+    let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
+    let res = &jac * &*qdot;
+    let (dx, _) = pinv_solve_in(&jac.select_columns(cols.iter()), &res, jac.norm());
+    for (j, &c) in cols.iter().enumerate() {
+        qdot[c] -= dx[j];
+    }
+    res.amax()
 }
 
 /// Independent rows of the row-scaled Φ_q kept between velocity projections

@@ -614,8 +614,10 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
 /// what the integrator's projection does after its next step, done where the caller can book
 /// the change of T + U. The coordinates `keep(k)` (tree coordinates that must stay where they
 /// are, e.g. at exactly 0 on a new pivot) are held too, unless the loops cannot be closed
-/// without them. Seated closure angles are not rows of Φ and keep their residual (below
-/// `simultaneity`). On a heavy structure moving little the change is not negligible: residual
+/// without them. Seated closure angles (not rows of Φ) go to 0 with their rates too, as rows of
+/// the projections beside Φ, where that is well conditioned ([`snap_holding_closures`]);
+/// otherwise they take their share of the least change. On a heavy structure moving little the
+/// change is not negligible: residual
 /// angles of 1e-8 rad under the bundled temple's entablature move U by millijoules, the order
 /// of its impact losses. Returns (T, U) of the state reached ([`state_energies`]).
 pub(super) fn snap_to_seats(
@@ -634,16 +636,96 @@ pub(super) fn snap_to_seats(
         qdot[k] = 0.0;
     }
     if model.constraint_rows > 0 {
+        let (start_q, start_qdot) = (q.clone(), qdot.clone());
+        // The least change of the free coordinates that closes Φ, the kept ones moving only if
+        // the loops cannot close without them.
         let mut free: Vec<usize> = (0..n).filter(|&k| !seated(k) && !keep(k)).collect();
-        let start = q.clone();
-        if project_positions(model, kin, pivots, q, Some(&free)).is_err() {
-            q.copy_from(&start);
-            free = (0..n).filter(|&k| !seated(k)).collect();
-            project_positions(model, kin, pivots, q, Some(&free))?;
-        }
+        let least_closure = match project_positions(model, kin, pivots, q, Some(&free)) {
+            Ok(norm) => norm,
+            Err(_) => {
+                q.copy_from(&start_q);
+                free = (0..n).filter(|&k| !seated(k)).collect();
+                project_positions(model, kin, pivots, q, Some(&free))?
+            }
+        };
         project_velocities(model, kin, pivots, q, qdot, Some(&free));
+        let seated_closures: Vec<usize> = (n..model.slot_count).filter(|&s| seated(s)).collect();
+        if !seated_closures.is_empty()
+            && let Some((held_q, held_qdot)) = snap_holding_closures(
+                model,
+                kin,
+                pivots,
+                (&start_q, &start_qdot),
+                (q, qdot, least_closure),
+                &free,
+                &seated_closures,
+            )
+        {
+            q.copy_from(&held_q);
+            qdot.copy_from(&held_qdot);
+        }
     }
     Ok(state_energies(model, kin, pivots, q, qdot))
+}
+
+/// [`snap_to_seats`] with the seated closure angles `closures` (not rows of Φ) set to 0 and their
+/// rates to 0 as the seated tree coordinates are, as rows of the projections beside Φ, from the
+/// state (q, q̇) `start`; or None when the loops do not close so (Φ and the rows to the closure
+/// tolerance, their rates to round-off), or when it is ill-conditioned: its move of q or of q̇
+/// more than a thousand times that of the least change with Φ alone (`least`) plus the residuals
+/// it removes (the seated angles for q; the rows' rates and Φ_q q̇ for q̇). A row well conditioned removes a residual r by
+/// a move of order r; one the loop all but locks, by r/σ ≫ r (the bundled temple's entablature
+/// seats under the default `simultaneity`: q moved by 1.4e-4 rad to remove 1e-10, and q̇ thrown
+/// to 8.6 rad/s). Without these rows the least change turns a seated closing joint like a free
+/// one: on a 9-voussoir arch under a pulse one was left 1.1e-6 rad past its seat.
+fn snap_holding_closures(
+    model: &Model,
+    kin: &mut Data,
+    pivots: &ActivePivots,
+    (start_q, start_qdot): (&DVector<f64>, &DVector<f64>),
+    (least_q, least_qdot, least_closure): (&DVector<f64>, &DVector<f64>, f64),
+    free: &[usize],
+    closures: &[usize],
+) -> Option<(DVector<f64>, DVector<f64>)> {
+    use crr_dynamics::closed_chain::{
+        CLOSURE_TOLERANCE, held_at, project_positions_holding, project_velocities_holding,
+    };
+    // Moves below this are round-off (rad, rad/s).
+    const FLOOR: f64 = 1e-12;
+    // The largest move per residual removed: measured, up to 1e2 on voussoir arches (whose
+    // three-hinge sub-loops near the closed configuration are near-singular, as are their
+    // seated tree coordinates'), from 3e4 up on the temple's entablature seats.
+    const AMPLIFICATION: f64 = 1e3;
+    let at_seat: Vec<(usize, f64)> = closures.iter().map(|&s| (s, 0.0)).collect();
+    let residual = held_at(model, kin, start_q, pivots, closures)
+        .iter()
+        .fold(0.0_f64, |m, &(_, psi)| m.max(psi.abs()));
+    let mut q = start_q.clone();
+    let closed =
+        project_positions_holding(model, kin, pivots, &mut q, Some(free), &at_seat).ok()?;
+    // Newton may stall on a least-squares compromise when a row is all but dependent on Φ over
+    // the free coordinates: only a solve to the closure tolerance (or as far as the least
+    // change's went) stands.
+    if closed > CLOSURE_TOLERANCE.max(least_closure)
+        || (&q - start_q).amax() > AMPLIFICATION * ((least_q - start_q).amax() + residual) + FLOOR
+    {
+        return None;
+    }
+    let mut qdot = start_qdot.clone();
+    let rate_residual =
+        project_velocities_holding(model, kin, pivots, &q, &mut qdot, Some(free), closures);
+    let least_rate = (least_qdot - start_qdot).amax();
+    if (&qdot - start_qdot).amax() > AMPLIFICATION * (least_rate + rate_residual) + FLOOR {
+        return None;
+    }
+    // The rates the rows hold, after the (single, rank-truncated) solve: what is left outside
+    // the range of the free columns stays, and then the least change stands.
+    let mut check = qdot.clone();
+    let left = project_velocities_holding(model, kin, pivots, &q, &mut check, Some(free), closures);
+    if left > FLOOR * (1.0 + start_qdot.amax()) {
+        return None;
+    }
+    Some((q, qdot))
 }
 
 /// (T, U) at (q, q̇) on `pivots`, T from the bodies' velocities, leaving `kin` evaluated there.
@@ -916,9 +998,11 @@ impl<'a> Simulation<'a> {
     /// The run's invariant, in every build: every slot that rocks has its angle on the side of
     /// its active pivot (σψ ≥ −tol; tol = 100 × `simultaneity` within [1e-5, 1e-3] rad: 1e-5 rad
     /// by default, above the event location's overshoot of a crossing and the band in which a
-    /// joint coming to rest waits to be seated), and the loops are closed (|Φ| ≤ 1e-6 on the
-    /// row-scaled closures). A rocking angle past its pivot means an impact was missed (a step
-    /// too long for the tolerances); the run's results from there on would be wrong.
+    /// joint coming to rest waits to be seated), every seated slot is within tol of 0 (a seated
+    /// closure angle is held by its rows only, and a projection that turned it would leave it
+    /// off its seat unseen), and the loops are closed (|Φ| ≤ 1e-6 on the row-scaled closures). A
+    /// rocking angle past its pivot means an impact was missed (a step too long for the
+    /// tolerances); the run's results from there on would be wrong.
     pub fn check_invariant(&mut self) -> Result<(), SimulationError> {
         let model = Arc::clone(&self.model);
         let model = &*model;
@@ -970,6 +1054,18 @@ impl<'a> Simulation<'a> {
         let mut broken = None;
         for s in 0..model.slot_count {
             if self.seated[s] {
+                // A seated joint is held at 0 (a closure angle keeps at most the residual it
+                // was seated with, within `simultaneity`).
+                let angle = angles[s];
+                if angle.is_nan() || angle.abs() > tol {
+                    self.spare.invariant_angles = angles;
+                    return Err(SimulationError::Invariant(format!(
+                        "at t = {} s the angle \"{}\" is {angle:.6} rad while it is seated: the state has left its seat; {}",
+                        self.t,
+                        model.slot_name(s),
+                        self.remedy()
+                    )));
+                }
                 continue;
             }
             let side = self.dynamics.pivots.sides[s];
@@ -1540,6 +1636,32 @@ mod invariant_tests {
         // A run keeps it: 3 s of free rocking, checked after every step.
         let sim = Simulation::new(&model, &ground, &initial, Parameters::default()).unwrap();
         assert!(sim.run().is_ok());
+    }
+
+    /// A closed state of the trilithon's mechanism (its columns turned by 0.05 rad) with every
+    /// joint flagged seated: the closure angle and the tree angles are off their seats, which
+    /// the invariant refuses, naming a seated angle; the same state rocking passes.
+    #[test]
+    fn a_seated_angle_off_its_seat_is_refused() {
+        let model = Model::from_spec(&trilithon(0.25, 2.0, 2.0, 0.5, 1.0)).unwrap();
+        let initial = released(&model, &model.coords[0].name, 0.05);
+        let ground = GroundMotion::none();
+        let mut sim = Simulation::new(&model, &ground, &initial, Parameters::default()).unwrap();
+        assert!(sim.check_invariant().is_ok());
+        sim.set_seated((0..model.slot_count).map(|s| (s, true)));
+        match sim.check_invariant() {
+            Err(SimulationError::Invariant(m)) => {
+                assert!(m.contains("while it is seated"), "{m}");
+                assert!(m.contains("rad"), "{m}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // Within the tolerance (1e-5 rad by default) a seated angle passes: the same closed
+        // mechanism turned by 0.5e-5 rad.
+        let small = released(&model, &model.coords[0].name, 0.5e-5);
+        let mut sim = Simulation::new(&model, &ground, &small, Parameters::default()).unwrap();
+        sim.set_seated((0..model.slot_count).map(|s| (s, true)));
+        assert!(sim.check_invariant().is_ok());
     }
 
     #[test]
