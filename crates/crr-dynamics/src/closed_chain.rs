@@ -294,7 +294,9 @@ pub fn project_velocities(
 
 /// [`project_velocities`] that also holds the rates of the closure slots in `held` (seated
 /// closing joints, slots ≥ DOF(1)) at 0: the minimum-norm correction over `free` of
-/// [Φ_q; a_held] q̇ = 0. Returns the residual before projection.
+/// [Φ_q; a_held] q̇ = 0 (one truncated pseudo-inverse solve, as a Newton step of
+/// [`project_positions`]). Returns the residual |[Φ_q; a_held] q̇| before the projection and
+/// the one left after it (what lies outside the range of the free columns).
 pub fn project_velocities_holding(
     model: &Model,
     kin: &mut Data,
@@ -303,19 +305,13 @@ pub fn project_velocities_holding(
     qdot: &mut DVector<f64>,
     free: Option<&[usize]>,
     held: &[usize],
-) -> f64 {
-    if held.is_empty() {
-        return project_velocities(model, kin, pivots, q, qdot, free);
-    }
+) -> (f64, f64) {
     let held: Vec<(usize, f64)> = held.iter().map(|&s| (s, 0.0)).collect();
     let (_, jac) = scaled_holding(model, kin, q, pivots, &held);
     let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
-    let res = &jac * &*qdot;
-    let (dx, _) = pinv_solve_in(&jac.select_columns(cols.iter()), &res, jac.norm());
-    for (j, &c) in cols.iter().enumerate() {
-        qdot[c] -= dx[j];
-    }
-    res.amax()
+    let before = (&jac * &*qdot).amax();
+    min_norm_step(&jac, &(&jac * &*qdot), &cols, qdot);
+    (before, (&jac * &*qdot).amax())
 }
 
 /// Independent rows of the row-scaled Φ_q kept between velocity projections

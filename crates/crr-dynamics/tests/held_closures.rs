@@ -7,7 +7,8 @@ use crr_dynamics::closed_chain::{
     held_at, project_positions, project_positions_holding, project_velocities_holding,
 };
 use crr_dynamics::eom::slot_row;
-use crr_kinematics::fixtures::voussoir_arch;
+use crr_dynamics::{InitialSpec, solve_initial};
+use crr_kinematics::fixtures::{colonnade, voussoir_arch};
 use crr_kinematics::{
     ActivePivots, Data, Model, Side, closure_angles, constraint_residual, forward_kinematics,
     velocities,
@@ -35,31 +36,61 @@ fn open_by(model: &Model, kin: &mut Data, q: &DVector<f64>, pivots: &ActivePivot
     kin.phi.amax()
 }
 
-/// ψ̇ = aᵀq̇ for the closing slot, against central differences of its angle along a direction
-/// (the angle from the two frames' poses): the rows the held projections use are the angle's
-/// derivative.
+/// The rate row against central differences of the angle of every closure slot, at q along a
+/// direction.
+fn check_rate_rows(model: &Model, q: &DVector<f64>, pivots: &ActivePivots) {
+    let n = model.dof();
+    let mut kin = Data::new(model);
+    let dir = DVector::from_fn(n, |k, _| (k as f64 * 0.7 + 0.4).cos());
+    let angles_at = |kin: &mut Data, q: &DVector<f64>| {
+        forward_kinematics(model, kin, q, pivots);
+        let mut angles = vec![0.0; model.slot_count - n];
+        closure_angles(model, kin, &mut angles);
+        angles
+    };
+    let h = 1e-6;
+    let plus = angles_at(&mut kin, &(q + h * &dir));
+    let minus = angles_at(&mut kin, &(q - h * &dir));
+    forward_kinematics(model, &mut kin, q, pivots);
+    velocities(model, &mut kin, &dir);
+    let mut row = DVector::zeros(n);
+    for slot in n..model.slot_count {
+        let fd = (plus[slot - n] - minus[slot - n]) / (2.0 * h);
+        slot_row(model, &kin, slot, &mut row);
+        // Central differences: error h² ψ''' ~ 1e-12 relative, and round-off 1e-16/h ~ 1e-10.
+        assert!(
+            (row.dot(&dir) - fd).abs() <= 1e-8 * fd.abs().max(1.0),
+            "slot {slot}: row {} against finite differences {fd}",
+            row.dot(&dir)
+        );
+    }
+}
+
+/// ψ̇ = aᵀq̇ for the closure slots, against central differences of their angles along a
+/// direction (the angles from the two frames' poses): the rows the held projections use are the
+/// angles' derivatives. On the planar arch (a hinge: ψ linear in q) and on the 3D colonnade
+/// (four columns under a slab; rocking-base seats, two tilts each) at a closed state with both
+/// tilts, where the rows are the exact derivatives.
 #[test]
 fn a_closure_angle_s_rate_row_is_its_derivative() {
     let (model, pivots) = arch();
-    let n = model.dof();
-    let slot = n;
-    let mut kin = Data::new(&model);
-    let q = DVector::from_fn(n, |k, _| 1e-3 * (k as f64 * 1.3).sin());
-    let dir = DVector::from_fn(n, |k, _| (k as f64 * 0.7 + 0.4).cos());
-    let h = 1e-6;
-    let plus = closing_angle(&model, &mut kin, &(&q + h * &dir), &pivots);
-    let minus = closing_angle(&model, &mut kin, &(&q - h * &dir), &pivots);
-    let fd = (plus - minus) / (2.0 * h);
-    forward_kinematics(&model, &mut kin, &q, &pivots);
-    velocities(&model, &mut kin, &dir);
-    let mut row = DVector::zeros(n);
-    slot_row(&model, &kin, slot, &mut row);
-    // Central differences: error h² ψ''' ~ 1e-12 relative, and round-off 1e-16/h ~ 1e-10.
-    assert!(
-        (row.dot(&dir) - fd).abs() <= 1e-8 * fd.abs().max(1.0),
-        "row {} against finite differences {fd}",
-        row.dot(&dir)
-    );
+    let q = DVector::from_fn(model.dof(), |k, _| 1e-3 * (k as f64 * 1.3).sin());
+    check_rate_rows(&model, &q, &pivots);
+    let colonnade = Model::from_spec(&colonnade(0.2, 1.5, 1.0, 0.3)).unwrap();
+    let tilted = solve_initial(
+        &colonnade,
+        &InitialSpec {
+            angles: [
+                ("base_1.1".to_string(), 0.03),
+                ("base_1.2".to_string(), -0.02),
+            ]
+            .into(),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(colonnade.slot_count - colonnade.dof() >= 2);
+    check_rate_rows(&colonnade, &tilted.q, &tilted.pivots);
 }
 
 /// A closed state with the closing joint turned by ψ₀, a tree coordinate moved so that the loop

@@ -57,15 +57,16 @@ fn mirrored(name: &str, n: usize) -> String {
     }
 }
 
-/// The 5-voussoir arch under 1.1 λ g: its four-hinge mechanism opens, rebounds and lands within
-/// the first half of the pulse; in the second half the same records come back mirrored, T/2
-/// later, losing the same energies. Before the seated closing joint was held in the projections
-/// at impacts, the second half (whose tree is not the mirror of the first's) ended in a cascade
-/// of some 70 small impacts and a tension violation, the first half in 5 records.
+/// The 5-voussoir arch under 1.1 λ g, run for 2T: its four-hinge mechanism opens, rebounds and
+/// lands within the first half of the pulse; in the second half the same records come back
+/// mirrored, T/2 later, losing the same energies, and the arch is at rest again long before the
+/// end. Before the seated closing joint was held in the projections at impacts, the second half
+/// (where the joint that stays seated is the closing one, a tree coordinate in the first) ended
+/// in a cascade of some 65 more small impacts and a tension violation at 0.506 s.
 #[test]
 fn an_arch_s_second_half_pulse_mirrors_its_first() {
     let n = 5;
-    let (model, traj) = arch_under_pulse(n, 1.1, PERIOD);
+    let (_, traj) = arch_under_pulse(n, 1.1, 2.0 * PERIOD);
     let half = 0.5 * PERIOD;
     let (first, second): (Vec<_>, Vec<_>) = traj.impacts.iter().partition(|i| i.t < half);
     assert!(
@@ -89,6 +90,16 @@ fn an_arch_s_second_half_pulse_mirrors_its_first() {
         );
     }
     assert_eq!(first.len(), second.len(), "as many records in each half");
+    // At rest after the second half's last record, to the end of the run.
+    let last = second.last().unwrap().t;
+    assert!(last < 0.9 * traj.end_time && traj.end_time == 2.0 * PERIOD);
+    for s in traj.samples.iter().filter(|s| s.t > last) {
+        assert!(
+            s.states.iter().all(|x| *x == SlotState::Seated) && s.qdot.iter().all(|v| *v == 0.0),
+            "at rest at {}",
+            s.t
+        );
+    }
     let dissipated: f64 = traj.impacts.iter().map(|i| i.energy_lost).sum();
     for (a, b) in first.iter().zip(&second) {
         // The event times are located to the integrator's tolerance (1e-10 relative): 1e-9 s.
@@ -122,7 +133,6 @@ fn an_arch_s_second_half_pulse_mirrors_its_first() {
         "{} J against {dissipated} J dissipated",
         traj.energy_balance_error
     );
-    assert_eq!(model.closures.len(), 1);
 }
 
 /// The closing joint's angle ψ from the two bodies' rotations: the component along the hinge's
@@ -155,8 +165,8 @@ fn closing_angle(model: &Model, data: &mut Data, q: &[f64], states: &[SlotState]
 
 /// The 9-voussoir arch under 1.1 λ g rattles through some 400 impacts of its six-hinge
 /// mechanisms. Wherever its closing joint is seated, its angle from the bodies' poses stays
-/// within the `simultaneity` (1e-8 rad) that seats a joint: the projections that close the loops
-/// after each impact no longer turn it. Before, one of them left it 1.08e-6 rad past its seat
+/// within a hundredth of the `simultaneity` (1e-8 rad) that seats a joint: the projections that
+/// close the loops after each impact no longer turn it. Before, one of them left it 1.08e-6 rad past its seat
 /// (at 0.5537 s), and the release that followed opened it on that side, moving the bodies by
 /// ψ·|P⁺ − P⁻| and the energy balance by 1.6e-2 J.
 #[test]
@@ -176,8 +186,10 @@ fn a_seated_closing_joint_stays_on_its_seat_through_impacts() {
         worst = worst.max(closing_angle(&model, &mut data, s.q, s.states).abs());
     }
     assert!(seated_samples > 100, "{seated_samples} samples seated");
+    // Set to 0 at each impact to the closure tolerance (measured 1e-13 rad); held by its rate
+    // row in between.
     assert!(
-        worst <= simultaneity,
+        worst <= 1e-2 * simultaneity,
         "the seated closing joint at {worst} rad"
     );
     let dissipated: f64 = traj.impacts.iter().map(|i| i.energy_lost).sum();

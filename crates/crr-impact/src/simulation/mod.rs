@@ -712,17 +712,14 @@ fn snap_holding_closures(
         return None;
     }
     let mut qdot = start_qdot.clone();
-    let rate_residual =
+    let (rate_residual, left) =
         project_velocities_holding(model, kin, pivots, &q, &mut qdot, Some(free), closures);
     let least_rate = (least_qdot - start_qdot).amax();
-    if (&qdot - start_qdot).amax() > AMPLIFICATION * (least_rate + rate_residual) + FLOOR {
-        return None;
-    }
-    // The rates the rows hold, after the (single, rank-truncated) solve: what is left outside
-    // the range of the free columns stays, and then the least change stands.
-    let mut check = qdot.clone();
-    let left = project_velocities_holding(model, kin, pivots, &q, &mut check, Some(free), closures);
-    if left > FLOOR * (1.0 + start_qdot.amax()) {
+    // What the (single, rank-truncated) solve leaves outside the range of the free columns
+    // stays: then the least change stands.
+    if left > FLOOR * (1.0 + start_qdot.amax())
+        || (&qdot - start_qdot).amax() > AMPLIFICATION * (least_rate + rate_residual) + FLOOR
+    {
         return None;
     }
     Some((q, qdot))
