@@ -60,7 +60,7 @@ def assert_same_run(result: crr.Result, out: Path) -> None:
 def test_every_bundled_model_runs_as_the_command_line(model, cli, in_root, tmp_path):
     out = tmp_path / "cli"
     if model.endswith("temple.toml"):
-        # The temple's run stops when a capital lifts off its neck (outside the CRR chain): the
+        # The temple's run stops when the entablature lifts off a capital (outside the CRR chain): the
         # command line writes the partial results and exits with 1, Python raises
         # SimulationError holding the same partial run.
         run_cli(cli, ["simulate", model, "--out", str(out), "--quiet"], expect=1)

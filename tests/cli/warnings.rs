@@ -191,7 +191,10 @@ fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
         ]);
         let err = String::from_utf8_lossy(&o.stderr);
         if stem == "temple" {
-            assert!(err.contains("c11_neck lift(s) off"), "{stem}: {err}");
+            assert!(
+                err.contains("entablature_on_c11 lift(s) off"),
+                "{stem}: {err}"
+            );
         } else {
             assert!(o.status.success(), "{stem}: {err}");
         }

@@ -26,9 +26,10 @@ fn a_loose_tolerance_is_an_error_not_a_false_collapse() {
 /// with v7_on_v8 at +5.1e-4 rad on its − pivot: released at an impact, it passed its seat by
 /// 1.05e-10 rad before another joint's impact ended the segment. Both runs now go on, every
 /// rocking angle on its pivot's side at every sample to 2e-6 rad (5 µm at the extrados: the stones
-/// do not pass through one another), ×1.8 to its end and ×3.0 until v5 lifts off v4 at 1.86 s,
-/// with more than 50 impacts before (the seats' snaps are now made where their energy is
-/// booked, which changes these chaotic histories). An angle that crosses its seat
+/// do not pass through one another), ×1.8 until the four crown voussoirs leave their supports
+/// at 3.995 s (a flight: the run stops there, results kept) and ×3.0 to its end, with more than
+/// 100 impacts each (the seats' snaps are now made where their energy is booked, and faces
+/// rocking on one pivot lift off where it would pull, which change these chaotic histories). An angle that crosses its seat
 /// between two impacts of its neighbours switches pivot at the next one; the run stops with an
 /// error beyond 1e-5 rad.
 #[test]
@@ -59,17 +60,32 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
             ..Default::default()
         };
         let run = crr::run(&input, &opts).unwrap();
-        // Both run to the end. Under ×3.0 the contact program finds v5 lifting off v4 (1.86 s),
-        // which the arch's chain without that face contradicts (it drives the face back into
-        // its support), so it stays closed (docs/simulation.md, "Faces that open"); an open
-        // face would have no pivot, and its slot is not checked below.
-        assert!(run.completed(), "×{scale}: {:?}", run.summary.error);
+        // Neither stops on the invariant. Under ×3.0 the contact program finds v5 lifting off
+        // v4 (1.86 s), which the arch's chain without that face contradicts (it drives the face
+        // back into its support), so it stays closed (docs/simulation.md, "Faces that open").
+        // Under ×1.8 faces rocking on one pivot lift off where it would pull, and at 3.995 s the
+        // four crown voussoirs v3 to v6 leave their supports together: a flight, outside the
+        // model, where the run stops with its results kept. An open face has no pivot, and its
+        // slot is not checked below.
+        if let Some(e) = &run.summary.error {
+            assert!(e.contains("a flight"), "×{scale}: {e}");
+        }
+        println!(
+            "×{scale}: {} impacts to {:?}",
+            run.trajectory.impacts.len(),
+            run.summary.error
+        );
         assert!(run.trajectory.impacts.len() > 100, "×{scale}");
         let model = &run.model;
         let mut kin = crr::kinematics::Data::new(model);
         let mut angles = vec![0.0; model.slot_count];
         let mut largest: f64 = 0.0;
         for s in run.trajectory.samples.iter() {
+            // With a face of the file's tree open, the file's coordinates do not give the poses
+            // (the translation off its pivot is not among them).
+            if s.states[..model.dof()].contains(&SlotState::Open) {
+                continue;
+            }
             let q = nalgebra::DVector::from_column_slice(s.q);
             let pivots = crr::kinematics::ActivePivots {
                 sides: s

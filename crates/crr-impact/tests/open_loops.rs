@@ -634,16 +634,17 @@ fn a_corner_wedge_lifts_off_when_the_pulse_reaches_its_multiplier() {
 /// A landing's snap puts the landing point back on its pivot; an open face's child turns about
 /// a pivot on another support, so its point lands displaced along the face by a slip of second
 /// order in the angle, and the snap that removes it moves the bodies. On the 4 × 4 wall of
-/// `examples/wall_pulse.rs` under a one-sine pulse of 2 λ g the landing of `c3_b1_on_c2_b1` at
-/// 0.4357 s moved q by 4.3e-4 rad and pushed the open face of `c2_b0_on_c1_b0` 1.06e-4 m into
+/// `examples/wall_pulse.rs` under a one-sine pulse of 1.8 λ g the landing of `c3_b1_on_c2_b1` at
+/// 0.4028 s moved q by 1.6e-4 rad and pushed the open face of `c2_b0_on_c1_b0` 7.2e-5 m into
 /// its support: the run stopped there (its landing missed). A face the snap pushes in lands at
 /// the same instant. Checked from the bodies' poses: at every sample with no face of the file's
 /// tree open, no point of an open loop-closing face is inside its support by more than 1e-6 of
-/// the size (the run's invariant);
-/// the run reaches its end; the energy balance closes to 1e-9 of m g L.
+/// the size (the run's invariant); the run reaches its end with no hypothesis violated (at
+/// 71e430b the monitor also found `c2_b0_on_c1_b0` pulling by 912 N at 0.3896 s: a face rocking
+/// on one pivot now lifts off where it would pull); the energy balance closes to 1e-9 of m g L.
 #[test]
 fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
-    let (model, ground, init) = wall_of_wall_pulse(4, 2.0);
+    let (model, ground, init) = wall_of_wall_pulse(4, 1.8);
     let params = Parameters {
         duration: 1.0,
         ..Parameters::default()
@@ -654,6 +655,7 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
         .map_err(|f| f.error)
         .unwrap();
     assert_eq!(traj.end_time, 1.0);
+    assert!(traj.violation.is_none(), "{:?}", traj.violation);
     let scale = model.total_mass() * model.gravity * model.size;
     assert!(
         traj.energy_balance_error.abs() < 1e-9 * scale,
@@ -670,7 +672,7 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
                 && w[1].interfaces.iter().any(|n| n == "c2_b0_on_c1_b0")
         })
         .expect("the pushed face lands with the landing that pushed it");
-    assert!((pair[0].t - 0.4357).abs() < 1e-3, "at {} s", pair[0].t);
+    assert!((pair[0].t - 0.4028).abs() < 1e-3, "at {} s", pair[0].t);
     let mut data = Data::new(&model);
     let loop_faces: Vec<usize> = (0..model.interfaces.len())
         .filter(|&k| model.interfaces[k].slots.start >= model.dof())

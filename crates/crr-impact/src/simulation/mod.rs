@@ -59,6 +59,7 @@ use impacts::*;
 use open_loops::OpenLoops;
 pub use opening_qp::{
     OpeningDecision, OpeningQpError, QP_OPENING_TOLERANCE, offers_both_pivots, opening_qp,
+    opening_qp_holding,
 };
 pub use samples::{Iter as SampleIter, Sample, Samples};
 pub use seating::opening_mode;

@@ -215,6 +215,8 @@ impl Simulation<'_> {
             *s = self.open.original_slot(*s);
         }
         self.impacts.push(record);
+        // Faces kept on their pivots after a contradicted lift-off are offered it again.
+        self.spare.rest.held_faces.clear();
     }
 
     /// The faces `lifting` (names of the chain's interfaces) open entirely: the chain goes on

@@ -75,10 +75,13 @@ pub struct OpeningDecision {
 #[derive(Clone, Debug, PartialEq)]
 pub struct OpeningQpError(pub String);
 
-/// The lift of one seated slot: its translation τₖ and what it moves.
+/// The lift of one seated slot, or of a face rocking on one pivot: its translation τₖ and what
+/// it moves.
 struct Lift {
-    /// Index into `Dynamics::seated`.
-    seated_index: usize,
+    /// Index into `Dynamics::seated`; None for a rocking face's lift.
+    seated_index: Option<usize>,
+    /// The interface whose face lifts.
+    interface: usize,
     /// τₖ = σₖ w × (P′ − P) (m per rad/s² of ℓₖ).
     tau: Vector3<f64>,
     /// A tree coordinate (its subtree translates) or a closure (its point rows relax).
@@ -105,13 +108,26 @@ pub fn offers_both_pivots(model: &Model, d: &Dynamics) -> bool {
 /// Solves the contact program at the state evaluated in `d` ([`Dynamics::evaluate`] with the
 /// current pivots and seated slots: M, h, Q, Φ_q, Φ̇_q q̇, the frames and velocities).
 pub fn opening_qp(model: &Model, d: &Dynamics) -> Result<OpeningDecision, OpeningQpError> {
+    opening_qp_holding(model, d, &[])
+}
+
+/// [`opening_qp`] with the faces rocking on one pivot listed in `held` (interfaces) kept on it:
+/// their lifts are left out (a lift-off the chain without the face contradicted, which the
+/// simulation keeps closed until the chain next changes).
+pub fn opening_qp_holding(
+    model: &Model,
+    d: &Dynamics,
+    held: &[usize],
+) -> Result<OpeningDecision, OpeningQpError> {
     let n = model.dof();
     let kin = &d.kin;
     let mut is_seated = vec![false; model.slot_count];
     for &k in &d.seated {
         is_seated[k] = true;
     }
-    let lifts = lifts(model, d, &is_seated);
+    let mut lifts = lifts(model, d, &is_seated);
+    let complete = lifts.len() == d.seated.len();
+    lifts.extend(rocking_lifts(model, d, &is_seated, held));
     let nv = n + lifts.len();
     let scale = Scale::of(model);
 
@@ -167,7 +183,9 @@ pub fn opening_qp(model: &Model, d: &Dynamics) -> Result<OpeningDecision, Openin
         rate_rows.push((slot.clone(), bias));
     }
     for (l, lift) in lifts.iter().enumerate() {
-        a[(rows + lift.seated_index, n + l)] = -1.0;
+        if let Some(i) = lift.seated_index {
+            a[(rows + i, n + l)] = -1.0;
+        }
         a[(rows + d.seated.len() + l, n + l)] = -1.0;
     }
 
@@ -177,7 +195,9 @@ pub fn opening_qp(model: &Model, d: &Dynamics) -> Result<OpeningDecision, Openin
         d.seated.len() + lifts.len(),
         &scale,
     )?;
-    Ok(decide(model, d, &lifts, &rate_rows, &solution, &scale))
+    let mut decision = decide(model, d, &lifts, &rate_rows, &solution, &scale);
+    decision.complete = complete;
+    Ok(decision)
 }
 
 /// The units of the program: rates in g / size, Gauss' function in m_total g² size⁰.
@@ -259,12 +279,73 @@ fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
             continue;
         }
         lifts.push(Lift {
-            seated_index: i,
+            seated_index: Some(i),
+            interface: index,
             tau: sigma * w.cross(&(other - pivot)),
             moves,
         });
     }
     lifts
+}
+
+/// The lifts of the faces that rock on one pivot (every slot of the interface free, none
+/// seated): one per face, along its normal. A face rocking on P turns freely about P, so a
+/// rotation about its other pivot P′ (on the parent) adds only the translation
+/// τ = σ w × (P′ − P) of the child side (slot k the interface's first, w its axis, σ its side):
+/// the face leaving P along the parent's normal, at any angle, as at the seat. Its contact holds
+/// while the pivot's normal force is compressive; the program lifts it off where that force
+/// would have to pull. Plain hinges (one pivot line, τ = 0) have no lift.
+fn rocking_lifts(model: &Model, d: &Dynamics, is_seated: &[bool], held: &[usize]) -> Vec<Lift> {
+    rocking_faces(model, d, is_seated, held)
+        .map(|(index, k, tau)| Lift {
+            seated_index: None,
+            interface: index,
+            tau,
+            moves: if k < model.dof() {
+                LiftMoves::Subtree(k)
+            } else {
+                LiftMoves::Closure(index)
+            },
+        })
+        .collect()
+}
+
+/// The faces that rock on one pivot and can lift ([`rocking_lifts`]), but those in `held`:
+/// (interface, its first slot k, τ = σ w × (P′ − P)).
+pub(super) fn rocking_faces<'m>(
+    model: &'m Model,
+    d: &'m Dynamics,
+    is_seated: &'m [bool],
+    held: &'m [usize],
+) -> impl Iterator<Item = (usize, usize, Vector3<f64>)> + 'm {
+    let kin = &d.kin;
+    let n = model.dof();
+    model
+        .interfaces
+        .iter()
+        .enumerate()
+        .filter_map(move |(index, iface)| {
+            if iface.slots.is_empty()
+                || iface.slots.clone().any(|k| is_seated[k])
+                || held.contains(&index)
+            {
+                return None;
+            }
+            let k = iface.slots.start;
+            if k >= n && !model.closures.iter().any(|c| c.interface == index) {
+                return None;
+            }
+            let parent = model.frame_of(iface.parent);
+            let pivot = frame_point(
+                kin,
+                parent,
+                &iface.kind.pivot(d.pivots.of_interface(model, index)),
+            );
+            let other = frame_point(kin, parent, &other_pivot_rest(iface, &d.pivots, k));
+            let tau =
+                d.pivots.sides[k].sign() * world_axis(model, d, index, k).cross(&(other - pivot));
+            (tau.norm() > 1e-9 * model.size).then_some((index, k, tau))
+        })
 }
 
 /// Adds the lifts' terms of Gauss' function: per body b, a_b = Σⱼ (wⱼ × (c_b − pⱼ)) q̈ⱼ + bias_b
@@ -427,9 +508,21 @@ fn decide(
         .iter()
         .map(|&h| (h, true))
         .collect();
+    // A rocking face lifts off where its lift is not held and exceeds the tolerance.
+    let mut rocking_off = Vec::new();
     for (l, lift) in lifts.iter().enumerate() {
-        lift_of[lift.seated_index] = x[n + l].max(0.0);
-        held[lift.seated_index].1 = solution.held[d.seated.len() + l];
+        let held_here = solution.held[d.seated.len() + l];
+        match lift.seated_index {
+            Some(i) => {
+                lift_of[i] = x[n + l].max(0.0);
+                held[i].1 = held_here;
+            }
+            None => {
+                if !held_here && x[n + l] > QP_OPENING_TOLERANCE * scale.rate {
+                    rocking_off.push(lift.interface);
+                }
+            }
+        }
     }
     let rates: Vec<(f64, f64)> = d
         .seated
@@ -445,7 +538,7 @@ fn decide(
     let mut decision = OpeningDecision {
         rates: rates.clone(),
         qddot,
-        complete: lifts.len() == d.seated.len(),
+        lifting_off: rocking_off,
         ..OpeningDecision::default()
     };
     // The rates as read: a held row's rate is the interior point's round-off, read as 0.
@@ -479,6 +572,7 @@ fn decide(
             _ => base_decision(model, d, index, &seated, opening, tol).apply(index, &mut decision),
         }
     }
+    decision.lifting_off.sort_unstable();
     decision
 }
 

@@ -186,7 +186,12 @@ pub(super) fn opening_mode_local(
     // Σ αₖσₖrₖ(sₖ) over the slots it opens (αₖ ≥ 0), positive when every σₖrₖ(sₖ) is, so the
     // held motion is the minimum of the Gauss function over the cone of openings (convex), and
     // the active set below could only end where it starts.
-    if model.constraint_rows > 0 && may_open.as_ref().is_some_and(|m| m.iter().all(|&o| !o)) {
+    // The faces rocking on one pivot must press on it too, or the program decides whether they
+    // lift off.
+    if model.constraint_rows > 0
+        && may_open.as_ref().is_some_and(|m| m.iter().all(|&o| !o))
+        && !rocking_face_may_lift(model, template, trial, &rest.held_faces)
+    {
         return None;
     }
     // With loops, one convex program over the seated faces decides (opening_qp.rs); the single
@@ -247,7 +252,7 @@ fn loop_opening(
     if !offers_both_pivots(model, trial) {
         return None;
     }
-    let decision = opening_qp(model, trial).ok()?;
+    let decision = opening_qp_holding(model, trial, &rest.held_faces).ok()?;
     if !decision.lifting_off.is_empty() {
         rest.lift_off = Some(
             decision
@@ -602,6 +607,50 @@ fn releases_that_may_open(
     Some(may_open)
 }
 
+/// Whether a face rocking on one pivot may lift off, from the locked solve in `trial` (that of
+/// [`loop_releases_that_may_open`]): its pivot's normal force, read as the reaction r′ about its
+/// other pivot P′ (on the parent) of a joint that carries no moment about P (r = 0), as for a
+/// seated slot's other side; it may lift where −σ′r′ > −(margin + round-off), σ′ the other side.
+/// Any equilibrium distribution that presses on every pivot certifies that none lifts (the held
+/// structure's forces do positive power on every lift), so the locked solve's own λ serves.
+/// True where the solve gives no λ (the articulated-body path) or a face's reaction is not
+/// known (a seat that may twist): the program decides then.
+fn rocking_face_may_lift(
+    model: &Model,
+    template: &Dynamics,
+    trial: &Dynamics,
+    held: &[usize],
+) -> bool {
+    let mut is_seated = vec![false; model.slot_count];
+    for &k in &template.seated {
+        is_seated[k] = true;
+    }
+    let mut faces = super::opening_qp::rocking_faces(model, trial, &is_seated, held).peekable();
+    if faces.peek().is_none() {
+        return false;
+    }
+    if trial.used_articulated_body() {
+        return true;
+    }
+    let margin = 1e-9 * trial.seat_reactions.amax();
+    let loads = SubtreeLoads::new(model, trial);
+    for (_, k, _) in faces {
+        let (r_other, round_off) = if k < model.dof() {
+            loads.other_side_reaction(model, trial, &template.pivots, k, 0.0)
+        } else {
+            match closure_other_side_reaction(model, trial, &template.pivots, k, 0.0) {
+                Some(x) => x,
+                None => return true,
+            }
+        };
+        let other = template.pivots.sides[k].flipped();
+        if -other.sign() * r_other > -(margin + round_off) {
+            return true;
+        }
+    }
+    false
+}
+
 /// [`releases_that_may_open`] on a structure with loops.
 ///
 /// **Current sides.** With every seated slot held, the seated rows and the closure rows B carry
@@ -942,6 +991,19 @@ impl Simulation<'_> {
                     )),
                     FaceRelease::Contradicted => {
                         contradicted = true;
+                        // A face rocking on one pivot stays on it: the program leaves its
+                        // lift out until the next impact or landing.
+                        for name in &interfaces {
+                            if let Some(k) = self.model.interface_index(name)
+                                && !self.model.interfaces[k]
+                                    .slots
+                                    .clone()
+                                    .any(|s| self.seated[s])
+                                && !self.spare.rest.held_faces.contains(&k)
+                            {
+                                self.spare.rest.held_faces.push(k);
+                            }
+                        }
                         None
                     }
                     FaceRelease::Unsolved => None,
