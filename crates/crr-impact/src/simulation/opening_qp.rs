@@ -15,6 +15,12 @@
 //! rocking base (two tilts, two lifts) the cone of rotations about its four edges, and every
 //! positive combination of both pivots of one slot lifts its face off (both corners open).
 //!
+//! A face **rocking on one pivot** P (no slot of its interface seated) has one lift ℓ ≥ 0 too,
+//! with the translation τ = σ w × (P′ − P) of its first slot (P′ its other pivot, carried by the
+//! parent): it turns freely about P, so a rotation about P′ adds only that translation, along the
+//! parent's face normal, at any angle. Its row is ℓ ≥ 0 alone; its dual is the pivot's normal
+//! force, and the face lifts off where the pivot would have to pull ([`rocking_faces`]).
+//!
 //! **Objective.** Gauss' function of the bodies' accelerations (Gibbs–Appell): with the tree's
 //! part ½q̈ᵀMq̈ − q̈ᵀ(Q − h), plus the lifts' translations of the bodies beyond each seated tree
 //! coordinate: Σ_b m_b(a_b − g_eff)·Σ_{k∋b} τₖℓₖ + ½Σ_b m_b |Σ_{k∋b} τₖℓₖ|². A lift of a seated
