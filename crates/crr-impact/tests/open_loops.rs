@@ -637,9 +637,13 @@ fn a_corner_wedge_lifts_off_when_the_pulse_reaches_its_multiplier() {
 /// `examples/wall_pulse.rs` under a one-sine pulse of 1.8 λ g the landing of `c3_b1_on_c2_b1` at
 /// 0.4028 s moved q by 1.6e-4 rad and pushed the open face of `c2_b0_on_c1_b0` 7.2e-5 m into
 /// its support: the run stopped there (its landing missed). A face the snap pushes in lands at
-/// the same instant. Checked from the bodies' poses: at every sample with no face of the file's
-/// tree open, no point of an open loop-closing face is inside its support by more than 1e-6 of
-/// the size (the run's invariant); the run reaches its end with no hypothesis violated (at
+/// the same instant, as its own impact record after the first, and is closed in the instant's
+/// last sample. That face is one of the file's tree, whose open poses the samples do not carry
+/// (its translation off the pivot is not a coordinate), so the run's invariant (no point of an
+/// open face deeper than 1e-6 of the size, checked at every step) is what guards it; checked
+/// here from the bodies' poses, at every sample with no face of the file's tree open, no point
+/// of an open loop-closing face is inside its support by more than that. The run reaches its
+/// end with no hypothesis violated (at
 /// 71e430b the monitor also found `c2_b0_on_c1_b0` pulling by 912 N at 0.3896 s: a face rocking
 /// on one pivot now lifts off where it would pull); the energy balance closes to 1e-9 of m g L.
 #[test]
@@ -673,6 +677,16 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
         })
         .expect("the pushed face lands with the landing that pushed it");
     assert!((pair[0].t - 0.4028).abs() < 1e-3, "at {} s", pair[0].t);
+    // The pushed face (a face of the file's tree) is closed in the last sample of that instant.
+    let pushed = model.interfaces[model.interface_index("c2_b0_on_c1_b0").unwrap()]
+        .slots
+        .start;
+    let last = traj
+        .samples
+        .iter()
+        .rfind(|x| x.t == pair[1].t)
+        .expect("samples at the landings");
+    assert_ne!(last.states[pushed], SlotState::Open);
     let mut data = Data::new(&model);
     let loop_faces: Vec<usize> = (0..model.interfaces.len())
         .filter(|&k| model.interfaces[k].slots.start >= model.dof())

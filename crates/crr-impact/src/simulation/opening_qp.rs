@@ -355,7 +355,8 @@ pub(super) fn rocking_faces<'m>(
 }
 
 /// Adds the lifts' terms of Gauss' function: per body b, a_b = Σⱼ (wⱼ × (c_b − pⱼ)) q̈ⱼ + bias_b
-/// plus the translations τₖℓₖ of the seated tree coordinates k that carry it.
+/// plus the translations τₖℓₖ of the lifted tree coordinates k that carry it (seated slots, and
+/// the first slots of faces rocking on one pivot).
 fn add_lift_metric(
     model: &Model,
     d: &Dynamics,

@@ -39,9 +39,9 @@ pub(super) struct RestCache {
     /// blocks lift off a support (outside the CRR chain): those interfaces' names.
     pub(super) lift_off: Option<Vec<String>>,
     /// Faces rocking on one pivot (interfaces of the chain) whose lift-off the chain without
-    /// them contradicted: the contact program keeps them on their pivots until the chain next
-    /// changes (an impact, a release, a landing), so that its answer can turn back to "holds"
-    /// and the uplift event fire again for the other joints.
+    /// them contradicted: the contact program keeps them on their pivots until the next impact
+    /// or landing (a release of another joint does not clear them), so that its answer can turn
+    /// back to "holds" and the uplift event fire again for the other joints.
     pub(super) held_faces: Vec<usize>,
 }
 
