@@ -239,7 +239,7 @@ pub fn project_positions_holding(
     free: Option<&[usize]>,
     held: &[(usize, f64)],
 ) -> Result<f64, DynamicsError> {
-    let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
+    let cols = free_columns(model, free);
     let mut last = f64::INFINITY;
     for _ in 0..NEWTON_ITERATIONS {
         let (phi, jac) = scaled_holding(model, kin, q, pivots, held);
@@ -308,10 +308,15 @@ pub fn project_velocities_holding(
 ) -> (f64, f64) {
     let held: Vec<(usize, f64)> = held.iter().map(|&s| (s, 0.0)).collect();
     let (_, jac) = scaled_holding(model, kin, q, pivots, &held);
-    let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
-    let before = (&jac * &*qdot).amax();
-    min_norm_step(&jac, &(&jac * &*qdot), &cols, qdot);
-    (before, (&jac * &*qdot).amax())
+    let cols = free_columns(model, free);
+    let residual = &jac * &*qdot;
+    min_norm_step(&jac, &residual, &cols, qdot);
+    (residual.amax(), (&jac * &*qdot).amax())
+}
+
+/// The coordinates a projection may change: `free`, or every tree coordinate.
+fn free_columns(model: &Model, free: Option<&[usize]>) -> Vec<usize> {
+    free.map_or_else(|| (0..model.dof()).collect(), <[usize]>::to_vec)
 }
 
 /// Independent rows of the row-scaled Φ_q kept between velocity projections
@@ -344,7 +349,7 @@ pub fn project_velocities_with(
     cache: Option<&mut VelocityProjection>,
 ) -> f64 {
     let (_, jac) = scaled(model, kin, q, pivots);
-    let cols: Vec<usize> = free.map_or_else(|| (0..model.dof()).collect(), |f| f.to_vec());
+    let cols = free_columns(model, free);
     let res = &jac * &*qdot;
     let whole = jac.norm();
     // Φ_q over the columns changed, and its transpose (its rows as columns) for the kept rows.

@@ -3,12 +3,14 @@
 //! mirror image of its motion in the first; and a closing joint held on its seat stays there
 //! (its angle from the bodies' poses) whatever the impacts around it do.
 
+mod common;
+
 use std::path::Path;
 
 use crr_dynamics::ground_motion::{Axis, ComponentSpec, GroundMotion, PulseSpec, SignalSpec};
 use crr_dynamics::{InitialSpec, solve_initial};
 use crr_impact::statics::{StaticsOptions, collapse_multiplier};
-use crr_impact::{Parameters, Simulation, SlotState, Trajectory};
+use crr_impact::{Parameters, SlotState, Trajectory};
 use crr_kinematics::fixtures::voussoir_arch;
 use crr_kinematics::{ActivePivots, Data, InterfaceKind, Model, Side, forward_kinematics};
 use nalgebra::{DVector, Vector3};
@@ -42,11 +44,7 @@ fn arch_run(n: usize, factor: f64, duration: f64) -> (Model, GroundMotion, Traje
         duration,
         ..Parameters::default()
     };
-    let traj = Simulation::new(&model, &ground, &init, params)
-        .unwrap()
-        .run()
-        .map_err(|f| f.error)
-        .unwrap();
+    let traj = common::run_to_end(&model, &ground, &init, params);
     (model, ground, traj)
 }
 

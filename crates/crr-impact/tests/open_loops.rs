@@ -3,6 +3,8 @@
 //! a plastic impulse. Checked against facts computed here from the bodies' poses and velocities,
 //! not by the engine's own bookkeeping.
 
+mod common;
+
 use std::path::Path;
 
 use crr_dynamics::ground_motion::{Axis, ComponentSpec, GroundMotion, SignalSpec, SineSpec};
@@ -101,11 +103,7 @@ fn face_points(
 #[test]
 fn a_wall_releases_its_loops_and_lands_on_them_again() {
     let (model, ground, init, params) = wall_under_a_pulse(4, 3);
-    let traj = Simulation::new(&model, &ground, &init, params)
-        .unwrap()
-        .run()
-        .map_err(|f| f.error)
-        .unwrap();
+    let traj = common::run_to_end(&model, &ground, &init, params);
     assert_eq!(traj.end_time, 2.0);
     // The energy balance T + U − W + D = E(0), T from the bodies' velocities: the released
     // phases add no energy (the integrator's tolerance, rtol 1e-10, on W·L).
@@ -481,10 +479,7 @@ fn a_wedge_lands_on_its_whole_crack_at_once() {
         duration: 0.3,
         ..Parameters::default()
     };
-    let traj = Simulation::new(&model, &ground, &init, params)
-        .unwrap()
-        .run()
-        .unwrap();
+    let traj = common::run_to_end(&model, &ground, &init, params);
     assert!(traj.violation.is_none(), "{:?}", traj.violation);
     let samples: Vec<Sample> = traj.samples.iter().collect();
     let slot_of = |name: &str| {
@@ -653,11 +648,7 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
         duration: 1.0,
         ..Parameters::default()
     };
-    let traj = Simulation::new(&model, &ground, &init, params)
-        .unwrap()
-        .run()
-        .map_err(|f| f.error)
-        .unwrap();
+    let traj = common::run_to_end(&model, &ground, &init, params);
     assert_eq!(traj.end_time, 1.0);
     assert!(traj.violation.is_none(), "{:?}", traj.violation);
     let scale = model.total_mass() * model.gravity * model.size;

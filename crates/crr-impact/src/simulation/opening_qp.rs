@@ -246,8 +246,6 @@ impl Scale {
 /// coordinate's axis (a rocking base's other tilt moves its corner along that tilt's axis,
 /// which is fine), twisting seats included.
 fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
-    let kin = &d.kin;
-    let n = model.dof();
     let mut lifts = Vec::new();
     for (i, &k) in d.seated.iter().enumerate() {
         let Some(index) = model.interfaces.iter().position(|f| f.slots.contains(&k)) else {
@@ -255,21 +253,11 @@ fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
         };
         let iface = &model.interfaces[index];
         let sigma = d.pivots.sides[k].sign();
-        let parent = model.frame_of(iface.parent);
-        let moves = if k < n {
-            LiftMoves::Subtree(k)
-        } else if model.closures.iter().any(|c| c.interface == index) {
-            LiftMoves::Closure(index)
-        } else {
+        let Some(moves) = lift_moves(model, index, k) else {
             continue;
         };
         let w = world_axis(model, d, index, k);
-        let pivot = frame_point(
-            kin,
-            parent,
-            &iface.kind.pivot(d.pivots.of_interface(model, index)),
-        );
-        let other = frame_point(kin, parent, &other_pivot_rest(iface, &d.pivots, k));
+        let (pivot, other) = pivot_pair(model, d, index, k);
         // The other pivot must lie on the axis line of every free slot of the interface (a
         // rocking base's other tilt: flipping one tilt moves the corner along the other's
         // axis), or the flip would change that slot's motion too.
@@ -303,17 +291,41 @@ fn lifts(model: &Model, d: &Dynamics, is_seated: &[bool]) -> Vec<Lift> {
 /// would have to pull. Plain hinges (one pivot line, τ = 0) have no lift.
 fn rocking_lifts(model: &Model, d: &Dynamics, is_seated: &[bool], held: &[usize]) -> Vec<Lift> {
     rocking_faces(model, d, is_seated, held)
-        .map(|(index, k, tau)| Lift {
-            seated_index: None,
-            interface: index,
-            tau,
-            moves: if k < model.dof() {
-                LiftMoves::Subtree(k)
-            } else {
-                LiftMoves::Closure(index)
-            },
+        .filter_map(|(index, k, tau)| {
+            Some(Lift {
+                seated_index: None,
+                interface: index,
+                tau,
+                moves: lift_moves(model, index, k)?,
+            })
         })
         .collect()
+}
+
+/// What a lift of slot k of interface `index` moves: the subtree of a tree coordinate, or the
+/// point rows of a loop closure; None for neither.
+fn lift_moves(model: &Model, index: usize, k: usize) -> Option<LiftMoves> {
+    if k < model.dof() {
+        Some(LiftMoves::Subtree(k))
+    } else if model.closures.iter().any(|c| c.interface == index) {
+        Some(LiftMoves::Closure(index))
+    } else {
+        None
+    }
+}
+
+/// The current pivot P of interface `index` and its other pivot P′ with slot k flipped, both
+/// carried by the parent (world).
+fn pivot_pair(model: &Model, d: &Dynamics, index: usize, k: usize) -> (Vector3<f64>, Vector3<f64>) {
+    let iface = &model.interfaces[index];
+    let parent = model.frame_of(iface.parent);
+    let pivot = frame_point(
+        &d.kin,
+        parent,
+        &iface.kind.pivot(d.pivots.of_interface(model, index)),
+    );
+    let other = frame_point(&d.kin, parent, &other_pivot_rest(iface, &d.pivots, k));
+    (pivot, other)
 }
 
 /// The faces that rock on one pivot and can lift ([`rocking_lifts`]), but those in `held`:
@@ -324,8 +336,6 @@ pub(super) fn rocking_faces<'m>(
     is_seated: &'m [bool],
     held: &'m [usize],
 ) -> impl Iterator<Item = (usize, usize, Vector3<f64>)> + 'm {
-    let kin = &d.kin;
-    let n = model.dof();
     model
         .interfaces
         .iter()
@@ -338,16 +348,8 @@ pub(super) fn rocking_faces<'m>(
                 return None;
             }
             let k = iface.slots.start;
-            if k >= n && !model.closures.iter().any(|c| c.interface == index) {
-                return None;
-            }
-            let parent = model.frame_of(iface.parent);
-            let pivot = frame_point(
-                kin,
-                parent,
-                &iface.kind.pivot(d.pivots.of_interface(model, index)),
-            );
-            let other = frame_point(kin, parent, &other_pivot_rest(iface, &d.pivots, k));
+            lift_moves(model, index, k)?;
+            let (pivot, other) = pivot_pair(model, d, index, k);
             let tau =
                 d.pivots.sides[k].sign() * world_axis(model, d, index, k).cross(&(other - pivot));
             (tau.norm() > 1e-9 * model.size).then_some((index, k, tau))

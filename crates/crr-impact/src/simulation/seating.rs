@@ -633,10 +633,10 @@ fn rocking_face_may_lift(
         return true;
     }
     let margin = 1e-9 * trial.seat_reactions.amax();
-    let forces = SubtreeLoads::new(model, trial).subtree_forces(model, trial);
+    let loads = SubtreeLoads::new(model, trial);
     for (_, k, _) in faces {
         let (r_other, round_off) = if k < model.dof() {
-            SubtreeLoads::reaction_with(model, trial, &template.pivots, k, 0.0, &forces[k])
+            loads.other_side_reaction(model, trial, &template.pivots, k, 0.0)
         } else {
             match closure_other_side_reaction(model, trial, &template.pivots, k, 0.0) {
                 Some(x) => x,
@@ -843,39 +843,62 @@ pub(super) fn flip_moves_a_free_axis(
     })
 }
 
-/// The forces of a locked solve that a seated joint passes to its subtree.
+/// mᵢ(aᵢ − g_eff) of every body i at the solve in `trial`, aᵢ its centre of mass' acceleration
+/// Σⱼ (uⱼ × (cᵢ − pⱼ)) q̈ⱼ over the coordinates carrying it plus the bias acceleration of cᵢ (N).
+fn body_forces(model: &Model, trial: &Dynamics) -> Vec<Vector3<f64>> {
+    let kin = &trial.kin;
+    let g_eff = trial.effective_gravity();
+    (0..model.bodies.len())
+        .map(|b| {
+            let frame = model.body_coord[b];
+            let c = kin.com[b];
+            let mut a = point_bias_acceleration(kin, Some(frame), &c);
+            let mut j = Some(frame);
+            while let Some(jj) = j {
+                a += kin.axis[jj].cross(&(c - kin.pivot[jj])) * trial.qddot[jj];
+                j = model.coords[jj].parent;
+            }
+            model.bodies[b].mass * (a - g_eff)
+        })
+        .collect()
+}
+
+/// The forces of a locked solve that each tree joint passes to its subtree.
 pub(super) struct SubtreeLoads {
-    /// mᵢ(aᵢ − g_eff) of every body i, aᵢ its centre of mass' acceleration (N).
-    body_force: Vec<Vector3<f64>>,
+    /// fₖ of every tree coordinate k: the Σ mᵢ(aᵢ − g_eff) of the bodies it carries less the
+    /// closure forces λ on its subtree's side of each loop's point rows (N).
+    subtree: Vec<Vector3<f64>>,
 }
 
 impl SubtreeLoads {
     /// From the solve in `trial` (q̈, λ and the kinematics of its state; not the
     /// articulated-body path, which leaves no bias accelerations).
     pub(super) fn new(model: &Model, trial: &Dynamics) -> Self {
-        let kin = &trial.kin;
-        let g_eff = trial.effective_gravity();
-        // aᵢ = Σⱼ (uⱼ × (cᵢ − pⱼ)) q̈ⱼ over the coordinates carrying body i, plus the bias
-        // acceleration of cᵢ.
-        let body_force = (0..model.bodies.len())
-            .map(|b| {
-                let frame = model.body_coord[b];
-                let c = kin.com[b];
-                let mut a = point_bias_acceleration(kin, Some(frame), &c);
-                let mut j = Some(frame);
-                while let Some(jj) = j {
-                    a += kin.axis[jj].cross(&(c - kin.pivot[jj])) * trial.qddot[jj];
-                    j = model.coords[jj].parent;
-                }
-                model.bodies[b].mass * (a - g_eff)
-            })
-            .collect();
-        Self { body_force }
+        // Every fₖ at once: each body's load added along its frame's path to the ground, each
+        // loop's point force λ along its two frames' paths (−λ on the parent's side, +λ on the
+        // child's; the common part cancels), O((bodies + loops) × depth).
+        let mut subtree = vec![Vector3::zeros(); model.dof()];
+        let mut add_along = |frame: Option<usize>, v: Vector3<f64>| {
+            let mut j = frame;
+            while let Some(jj) = j {
+                subtree[jj] += v;
+                j = model.coords[jj].parent;
+            }
+        };
+        for (b, f) in body_forces(model, trial).iter().enumerate() {
+            add_along(Some(model.body_coord[b]), *f);
+        }
+        for cl in &model.closures {
+            let closing = &model.interfaces[cl.interface];
+            let lambda: Vector3<f64> = trial.lambda.fixed_rows::<3>(cl.first_row).into_owned();
+            add_along(model.frame_of(closing.parent), -lambda);
+            add_along(Some(model.body_coord[closing.child]), lambda);
+        }
+        Self { subtree }
     }
 
-    /// Seated tree coordinate k's reaction rₖ′ on its other pivot P′, from its reaction `r` on
-    /// the current one: rₖ′ = rₖ + t·fₖ, t = u × (P − P′) and fₖ the subtree's Σ mᵢ(aᵢ − g_eff)
-    /// less the closure forces λ on the subtree's side of each loop's point rows. Also returns
+    /// Tree coordinate k's reaction rₖ′ on its other pivot P′, from its reaction `r` on the
+    /// current one (0 for a joint that rocks): rₖ′ = rₖ + t·fₖ, t = u × (P − P′). Also returns
     /// the round-off of the correction (1e-9 |t| |fₖ|).
     pub(super) fn other_side_reaction(
         &self,
@@ -885,60 +908,8 @@ impl SubtreeLoads {
         k: usize,
         r: f64,
     ) -> (f64, f64) {
-        let in_subtree = |frame: Option<usize>| model.carries(k, frame);
-        let mut force = Vector3::zeros();
-        for (b, f) in self.body_force.iter().enumerate() {
-            if in_subtree(Some(model.body_coord[b])) {
-                force += f;
-            }
-        }
-        for cl in &model.closures {
-            let closing = &model.interfaces[cl.interface];
-            let a_side = in_subtree(model.frame_of(closing.parent));
-            let b_side = in_subtree(Some(model.body_coord[closing.child]));
-            let share = f64::from(u8::from(a_side)) - f64::from(u8::from(b_side));
-            if share != 0.0 {
-                force -= share * trial.lambda.fixed_rows::<3>(cl.first_row);
-            }
-        }
-        Self::reaction_with(model, trial, pivots, k, r, &force)
-    }
-
-    /// The force fₖ of [`Self::other_side_reaction`] for every tree coordinate k at once: each
-    /// body's load added along its frame's path to the ground, each loop's point force λ along
-    /// its two frames' paths (−λ on the parent's side, +λ on the child's; the common part
-    /// cancels), in O((bodies + loops) × depth) instead of that per coordinate.
-    pub(super) fn subtree_forces(&self, model: &Model, trial: &Dynamics) -> Vec<Vector3<f64>> {
-        let mut forces = vec![Vector3::zeros(); model.dof()];
-        let mut add_along = |frame: Option<usize>, v: Vector3<f64>| {
-            let mut j = frame;
-            while let Some(jj) = j {
-                forces[jj] += v;
-                j = model.coords[jj].parent;
-            }
-        };
-        for (b, f) in self.body_force.iter().enumerate() {
-            add_along(Some(model.body_coord[b]), *f);
-        }
-        for cl in &model.closures {
-            let closing = &model.interfaces[cl.interface];
-            let lambda: Vector3<f64> = trial.lambda.fixed_rows::<3>(cl.first_row).into_owned();
-            add_along(model.frame_of(closing.parent), -lambda);
-            add_along(Some(model.body_coord[closing.child]), lambda);
-        }
-        forces
-    }
-
-    /// rₖ′ = r + t·fₖ with t = u × (P − P′), and its round-off, from the force fₖ.
-    pub(super) fn reaction_with(
-        model: &Model,
-        trial: &Dynamics,
-        pivots: &ActivePivots,
-        k: usize,
-        r: f64,
-        force: &Vector3<f64>,
-    ) -> (f64, f64) {
         let kin = &trial.kin;
+        let force = &self.subtree[k];
         let coord = &model.coords[k];
         let iface = &model.interfaces[coord.interface];
         let pivot = frame_point(kin, coord.parent, &other_pivot_rest(iface, pivots, k));
@@ -1800,10 +1771,11 @@ mod other_side_tests {
         assert!(partial > 20, "only {partial} with the other tilt free");
     }
 
-    /// The subtree forces of every coordinate at once (loads added along the paths to the
-    /// ground) equal the per-coordinate sums over subtree membership that the reaction on the
-    /// other pivot uses, on random chains with loops and the colonnade at tilted states: the
-    /// reactions agree to 1e-12 of the largest.
+    /// The subtree forces of every tree coordinate, summed at once along the paths to the
+    /// ground, equal their definition summed here per coordinate over subtree membership (the
+    /// bodies it carries, less λ on the point rows of each loop with one side in its subtree),
+    /// on random chains with loops and the colonnade at tilted, moving states, to 1e-12 of the
+    /// largest.
     #[test]
     fn subtree_forces_at_once_match_the_per_coordinate_sums() {
         let mut compared = 0;
@@ -1827,20 +1799,36 @@ mod other_side_tests {
                 continue;
             }
             let loads = SubtreeLoads::new(model, &d);
-            let at_once = loads.subtree_forces(model, &d);
-            let pairs: Vec<(f64, f64)> = (0..n)
+            let body_force = super::body_forces(model, &d);
+            let per_coordinate: Vec<nalgebra::Vector3<f64>> = (0..n)
                 .map(|k| {
-                    let one = loads.other_side_reaction(model, &d, &pivots, k, 0.0).0;
-                    let all =
-                        SubtreeLoads::reaction_with(model, &d, &pivots, k, 0.0, &at_once[k]).0;
-                    (one, all)
+                    let in_subtree = |frame: Option<usize>| model.carries(k, frame);
+                    let mut force = nalgebra::Vector3::zeros();
+                    for (b, f) in body_force.iter().enumerate() {
+                        if in_subtree(Some(model.body_coord[b])) {
+                            force += f;
+                        }
+                    }
+                    for cl in &model.closures {
+                        let closing = &model.interfaces[cl.interface];
+                        let a_side = in_subtree(model.frame_of(closing.parent));
+                        let b_side = in_subtree(Some(model.body_coord[closing.child]));
+                        let share = f64::from(u8::from(a_side)) - f64::from(u8::from(b_side));
+                        force -= share * d.lambda.fixed_rows::<3>(cl.first_row);
+                    }
+                    force
                 })
                 .collect();
-            let largest = pairs.iter().map(|p| p.0.abs()).fold(1e-300, f64::max);
-            for (k, (one, all)) in pairs.iter().enumerate() {
+            let largest = per_coordinate
+                .iter()
+                .map(|f| f.norm())
+                .fold(1e-300, f64::max);
+            for k in 0..n {
                 assert!(
-                    (one - all).abs() <= 1e-12 * largest,
-                    "model {i}, coordinate {k}: {one} against {all}"
+                    (per_coordinate[k] - loads.subtree[k]).norm() <= 1e-12 * largest,
+                    "model {i}, coordinate {k}: {} against {}",
+                    per_coordinate[k],
+                    loads.subtree[k]
                 );
                 compared += 1;
             }

@@ -1,12 +1,29 @@
 //! Shared references for the simulation tests: the exact free-rocking quarter period by
-//! Gauss–Legendre quadrature of the energy integral, and a structure released from rest.
+//! Gauss–Legendre quadrature of the energy integral, a structure released from rest, and a run
+//! to its end.
 // Each test binary uses part of it.
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
 
+use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::{InitialSpec, InitialState, solve_initial};
+use crr_impact::{Parameters, Simulation, Trajectory};
 use crr_kinematics::Model;
+
+/// The run of `model` from `init` under `ground`, to its end: a run that stops with an error
+/// fails the test with that error.
+pub fn run_to_end(
+    model: &Model,
+    ground: &GroundMotion,
+    init: &InitialState,
+    params: Parameters,
+) -> Trajectory {
+    Simulation::new(model, ground, init, params)
+        .unwrap()
+        .run()
+        .unwrap_or_else(|f| panic!("the run stops: {}", f.error))
+}
 
 /// The consistent initial state of `model` released from rest with coordinate `name` at
 /// `angle` (rad), the loops closed by [`solve_initial`].
