@@ -83,6 +83,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(v) = &traj.violation {
         let force = if v.kind == "lift_off" {
             String::new()
+        } else if v.kind == "impulse_tension" {
+            format!(" (normal impulse {:.1} N s)", v.normal)
         } else {
             format!(" (normal force {:.1} N)", v.normal)
         };

@@ -765,6 +765,13 @@ fn warnings(
                  engine's choice of the joints that open missed",
                 v.normal
             )
+        } else if v.kind == "impulse_tension" {
+            format!(
+                "is pulled by the impulse of a landing (a normal impulse of {:.4e} N s at least): \
+                 with every contact unilateral the impulse would release a joint or lift a face \
+                 off, which the engine's plastic landing law holds instead",
+                v.normal
+            )
         } else if v.kind == "lift_off" {
             "is lifted off its support by the contact program, but the model without it drives \
              it back into its support, and with it closed no joint opens: crr finds no motion \

@@ -185,11 +185,14 @@ pub struct ViolationSummary {
     pub time: f64,
     /// The interface.
     pub interface: String,
-    /// `tension` (flight), `outside_face` (a seated joint that should be rocking), `sliding`, or
+    /// `tension` (flight), `outside_face` (a seated joint that should be rocking), `sliding`,
     /// `lift_off` (a face the contact program lifts off that the model cannot follow; no force
-    /// is computed: its normal force is then 0 and its friction demand `None`).
+    /// is computed: its normal force is then 0 and its friction demand `None`), or
+    /// `impulse_tension` (a landing's impulse that pulls: `normal_force` is then the least
+    /// normal impulse, N s, and the friction demand `None`).
     pub kind: String,
-    /// Its normal force (N); for `outside_face`, the force of the edge that would pull.
+    /// Its normal force (N); for `outside_face`, the force of the edge that would pull; for
+    /// `impulse_tension`, the least normal impulse (N s).
     pub normal_force: f64,
     /// |F_t|/N needed; `None` when undefined.
     pub friction_demand: Option<f64>,

@@ -89,6 +89,29 @@ pub fn most_compressive(
     Some(program.answer(&x, Some(&z)))
 }
 
+/// The most compressive distribution of contact impulses that changes each body's momentum by
+/// `momentum_change[b]` = (m_b Δċ_b, I_b Δω_b) (N s; N m s about its centre of mass: the impulse
+/// body b needs from its contacts in an instant, where gravity and the ground's motion give
+/// none), on the touching points of the state in `dynamics` (its kinematics, seated slots and
+/// pivots, as [`most_compressive`]). `min_normal` is then in N s: below 0 when the contacts can
+/// give that change only by pulling somewhere. None when the program does not solve.
+pub fn most_compressive_impulses(
+    model: &Model,
+    dynamics: &Dynamics,
+    momentum_change: &[(Vector3<f64>, Vector3<f64>)],
+) -> Option<MostCompressive> {
+    let program = FaceProgram::build(model, dynamics);
+    let mut loads = vec![0.0; 6 * program.bodies];
+    for (b, (linear, angular)) in momentum_change.iter().enumerate() {
+        for i in 0..3 {
+            loads[6 * b + i] = linear[i] / program.weight;
+            loads[6 * b + 3 + i] = angular[i] / (program.weight * model.size);
+        }
+    }
+    let (x, z) = program.solve(&loads, 0.0)?;
+    Some(program.answer(&x, Some(&z)))
+}
+
 /// The program's matrix at one state: the equilibrium rows of the bodies over the touching
 /// points' forces and the couples, which depend on the configuration, the seated slots and the
 /// pivots, not on the loads.

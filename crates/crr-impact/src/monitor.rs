@@ -91,12 +91,15 @@ pub struct Violation {
     pub interface: String,
     /// `"tension"` (N < 0: flight), `"outside_face"` (a seated joint's resultant beyond an edge of
     /// its face: one of its edges would pull, the joint should rock), `"sliding"` (|F_t| > μN),
-    /// or `"lift_off"` (recorded by the simulation, not the monitor: a face the contact program
+    /// `"lift_off"` (recorded by the simulation, not the monitor: a face the contact program
     /// lifts off, that the chain without it drives back into its support, while with it closed
     /// no release the engine tries opens; `normal` is then 0 and `friction_demand` infinite: no
-    /// force is computed).
+    /// force is computed), or `"impulse_tension"` (recorded by the simulation at a landing whose
+    /// plastic impulse needs tension: `normal` is the least normal impulse of the most
+    /// compressive distribution, N s, and `friction_demand` infinite).
     pub kind: String,
-    /// N at that time (N); for `"outside_face"` the normal force of the edge that would pull.
+    /// N at that time (N); for `"outside_face"` the normal force of the edge that would pull;
+    /// for `"impulse_tension"` an impulse (N s).
     pub normal: f64,
     /// |F_t|/N at that time.
     pub friction_demand: f64,

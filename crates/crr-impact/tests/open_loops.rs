@@ -638,9 +638,10 @@ fn a_corner_wedge_lifts_off_when_the_pulse_reaches_its_multiplier() {
 /// open face deeper than 1e-6 of the size, checked at every step) is what guards it; checked
 /// here from the bodies' poses, at every sample with no face of the file's tree open, no point
 /// of an open loop-closing face is inside its support by more than that. The run reaches its
-/// end with no hypothesis violated (at
-/// 71e430b the monitor also found `c2_b0_on_c1_b0` pulling by 912 N at 0.3896 s: a face rocking
-/// on one pivot now lifts off where it would pull); the energy balance closes to 1e-9 of m g L.
+/// end and the energy balance closes to 1e-9 of m g L. Its first hypothesis violation is the
+/// impulse of an earlier landing, at 0.3896 s, which pulls (`impulse_tension`, module
+/// `simulation::landing_check`; at 71e430b the monitor found `c2_b0_on_c1_b0` pulling by 912 N
+/// at that instant instead: a face rocking on one pivot now lifts off where it would pull).
 #[test]
 fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
     let (model, ground, init) = wall_of_wall_pulse(4, 1.8);
@@ -650,7 +651,13 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
     };
     let traj = common::run_to_end(&model, &ground, &init, params);
     assert_eq!(traj.end_time, 1.0);
-    assert!(traj.violation.is_none(), "{:?}", traj.violation);
+    let v = traj
+        .violation
+        .as_ref()
+        .expect("the impulse at 0.3896 s pulls");
+    assert_eq!(v.kind, "impulse_tension");
+    assert!((v.t - 0.3896).abs() < 1e-4, "at {} s", v.t);
+    assert!(traj.impacts.iter().any(|i| i.t == v.t), "at a landing");
     let scale = model.total_mass() * model.gravity * model.size;
     assert!(
         traj.energy_balance_error.abs() < 1e-9 * scale,
@@ -705,4 +712,45 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
         }
     }
     assert!(deepest.is_finite(), "open loop-closing faces were sampled");
+}
+
+/// A landing whose plastic impulse needs tension is a hypothesis violation (`impulse_tension`,
+/// docs/simulation.md, "The hypotheses monitor"): the 3 × 3 running-bond wall of
+/// `examples/wall_pulse.rs` under a one-sine pulse of 1.5 λ g lifts its corner wedge, which
+/// lands again at 0.3476 s; stopping it with every contact held needs −84.8 N s at the end half
+/// block's bed `c1_b0_on_c0_b0` (the most compressive distribution of the impulses, about 3e-3 of
+/// W √(L/g)). The record is at that landing, and the run goes on to its end with the plastic
+/// impulse (the check records, it changes nothing).
+/// Whether such an impulse pulls is decided by the contact program at the velocity level, and
+/// its verdict agrees with a linear program on the contact points in
+/// `the_impulse_program_holds_exactly_where_compressive_impulses_exist` (unit test).
+#[test]
+fn a_landing_whose_impulse_pulls_is_recorded() {
+    let (model, ground, init) = wall_of_wall_pulse(3, 1.5);
+    let params = Parameters {
+        duration: 1.0,
+        ..Parameters::default()
+    };
+    let traj = common::run_to_end(&model, &ground, &init, params);
+    assert_eq!(traj.end_time, 1.0);
+    let v = traj
+        .violation
+        .as_ref()
+        .expect("the landing's impulse pulls");
+    assert_eq!(v.kind, "impulse_tension");
+    assert_eq!(v.interface, "c1_b0_on_c0_b0");
+    let landing = traj
+        .impacts
+        .iter()
+        .find(|i| i.t == v.t)
+        .expect("recorded at a landing");
+    assert!((landing.t - 0.3476).abs() < 1e-4, "at {} s", landing.t);
+    let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
+    assert!(
+        v.normal < -1e-3 * unit && v.normal > -1e-2 * unit,
+        "normal impulse {} N s of W √(L/g) = {unit} N s",
+        v.normal
+    );
+    let scale = model.total_mass() * model.gravity * model.size;
+    assert!(traj.energy_balance_error.abs() < 1e-9 * scale);
 }

@@ -46,6 +46,7 @@ use crate::laws::{
 
 mod events;
 mod impacts;
+mod landing_check;
 mod open_loops;
 mod opening_qp;
 mod output;
@@ -58,8 +59,8 @@ use events::*;
 use impacts::*;
 use open_loops::OpenLoops;
 pub use opening_qp::{
-    OpeningDecision, OpeningQpError, QP_OPENING_TOLERANCE, offers_both_pivots, opening_qp,
-    opening_qp_holding,
+    IMPULSE_OPENING_TOLERANCE, OpeningDecision, OpeningQpError, QP_OPENING_TOLERANCE, impulse_qp,
+    offers_both_pivots, opening_qp, opening_qp_holding,
 };
 pub use samples::{Iter as SampleIter, Sample, Samples};
 pub use seating::opening_mode;

@@ -44,7 +44,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use crr_dynamics::eom::{Dynamics, slot_row};
 use crr_kinematics::kinematics::frame_point;
-use crr_kinematics::velocity::point_bias_acceleration;
+use crr_kinematics::velocity::{point_bias_acceleration, point_velocity};
 use crr_kinematics::{InterfaceKind, Model, Side};
 
 use super::seating::other_pivot_rest;
@@ -56,6 +56,14 @@ use super::seating::other_pivot_rest;
 /// below that grows with the load and is found a moment later, and the answer is checked by the
 /// chain's exact solve anyway.
 pub const QP_OPENING_TOLERANCE: f64 = 1e-7;
+
+/// Relative size (of the largest rate before an impulse) below which a rate the impulse program
+/// gives counts as zero. At an impact most contacts neither carry an impulse nor open (both
+/// members of their complementary pair vanish), and there the interior point leaves both of the
+/// order of the square root of its tolerance: where the velocities before the impulse already
+/// satisfy every contact, the program's answer differs from them by 1e-6 to 1e-4 of the largest
+/// rate (the landings of the walls of `examples/wall_pulse.rs`, 2026-11-29).
+pub const IMPULSE_OPENING_TOLERANCE: f64 = 1e-3;
 
 /// What the contact program decides at a state.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -125,6 +133,41 @@ pub fn opening_qp_holding(
     d: &Dynamics,
     held: &[usize],
 ) -> Result<OpeningDecision, OpeningQpError> {
+    program(model, d, held, Level::Acceleration)
+}
+
+/// The same program one level down, for an impulse: over q̇⁺ and the lifts' rates, Gauss'
+/// principle of impulsive motion ½(V⁺ − V⁻)ᵀ𝓜(V⁺ − V⁻) over the bodies (Moreau's perfectly
+/// inelastic impact), with the loops' rows Φ_q q̇⁺ = 0 and every seated slot's and rocking
+/// face's contacts unilateral (αₖ⁺ ≥ 0, ℓₖ ≥ 0, now rates; no bias terms). `d` is evaluated at
+/// the impact's state with the velocities before it, `qdot_minus`, and the slots the impulse
+/// holds seated. Its releases and lift-offs are contacts that leave at the impulse: where it
+/// finds any, no distribution of compressive impulses over the contacts (without sliding)
+/// gives the plastic impulse that holds them all, which then pulls somewhere.
+pub fn impulse_qp(
+    model: &Model,
+    d: &Dynamics,
+    qdot_minus: &DVector<f64>,
+) -> Result<OpeningDecision, OpeningQpError> {
+    program(model, d, &[], Level::Velocity(qdot_minus))
+}
+
+/// What the contact program is posed on.
+#[derive(Clone, Copy)]
+enum Level<'a> {
+    /// q̈ at the state evaluated (loads, velocity products and bias terms).
+    Acceleration,
+    /// q̇⁺ after an impulse, from these velocities before it.
+    Velocity(&'a DVector<f64>),
+}
+
+/// The contact program at `level` ([`opening_qp_holding`], [`impulse_qp`]).
+fn program(
+    model: &Model,
+    d: &Dynamics,
+    held: &[usize],
+    level: Level,
+) -> Result<OpeningDecision, OpeningQpError> {
     let n = model.dof();
     let kin = &d.kin;
     let mut is_seated = vec![false; model.slot_count];
@@ -135,7 +178,11 @@ pub fn opening_qp_holding(
     let complete = lifts.len() == d.seated.len();
     lifts.extend(rocking_lifts(model, d, &is_seated, held));
     let nv = n + lifts.len();
-    let scale = Scale::of(model);
+    let scale = Scale::of(model, level);
+    let momentum = match level {
+        Level::Acceleration => None,
+        Level::Velocity(v) => Some(&kin.mass_matrix * v),
+    };
 
     // Objective ½xᵀPx + cᵀx (upper triangle of P).
     let mut p = DMatrix::<f64>::zeros(nv, nv);
@@ -144,9 +191,13 @@ pub fn opening_qp_holding(
         for j in i..n {
             p[(i, j)] = kin.mass_matrix[(i, j)];
         }
-        c[i] = kin.velocity_product[i] - d.load[i];
+        c[i] = match &momentum {
+            None => kin.velocity_product[i] - d.load[i],
+            Some(m) => -m[i],
+        };
     }
-    add_lift_metric(model, d, &lifts, &mut p, &mut c);
+    add_lift_metric(model, d, &lifts, level, &mut p, &mut c);
+    let biased = matches!(level, Level::Acceleration);
 
     // Rows: Ax + s = b, s in the zero cone (loops) then the non-negative cone (openings).
     let rows = model.constraint_rows;
@@ -157,7 +208,9 @@ pub fn opening_qp_holding(
         for j in 0..n {
             a[(r, j)] = row_scale[r] * kin.phi_q[(r, j)];
         }
-        b[r] = -row_scale[r] * kin.phi_bias[r];
+        if biased {
+            b[r] = -row_scale[r] * kin.phi_bias[r];
+        }
     }
     for (l, lift) in lifts.iter().enumerate() {
         for cl in &model.closures {
@@ -180,6 +233,7 @@ pub fn opening_qp_holding(
     let mut rate_rows = Vec::with_capacity(d.seated.len());
     for (i, &k) in d.seated.iter().enumerate() {
         let bias = slot_row(model, kin, k, &mut slot);
+        let bias = if biased { bias } else { 0.0 };
         let sigma = d.pivots.sides[k].sign();
         let r = rows + i;
         for j in 0..n {
@@ -212,6 +266,8 @@ struct Scale {
     rate: f64,
     /// Σ m size² (kg m²).
     inertia: f64,
+    /// The rate above which a contact opens (rad/s² or rad/s).
+    opening: f64,
 }
 
 /// The scaled program's matrices.
@@ -223,10 +279,20 @@ struct Scaled {
 }
 
 impl Scale {
-    fn of(model: &Model) -> Self {
+    /// Accelerations in g / size; velocities in the largest rate before the impulse.
+    fn of(model: &Model, level: Level) -> Self {
         let mass: f64 = model.bodies.iter().map(|b| b.mass).sum();
+        let natural = model.gravity / model.size;
+        let (rate, opening) = match level {
+            Level::Acceleration => (natural, QP_OPENING_TOLERANCE * natural),
+            Level::Velocity(v) => {
+                let rate = v.amax().max(1e-9 * natural.sqrt());
+                (rate, IMPULSE_OPENING_TOLERANCE * rate)
+            }
+        };
         Self {
-            rate: model.gravity / model.size,
+            rate,
+            opening,
             inertia: mass * model.size * model.size,
         }
     }
@@ -363,6 +429,7 @@ fn add_lift_metric(
     model: &Model,
     d: &Dynamics,
     lifts: &[Lift],
+    level: Level,
     p: &mut DMatrix<f64>,
     c: &mut DVector<f64>,
 ) {
@@ -387,7 +454,12 @@ fn add_lift_metric(
         }
         let m = body.mass;
         let com = kin.com[b];
-        let free = g_eff - point_bias_acceleration(kin, Some(frame), &com);
+        // What the lifts' translations are measured against: the acceleration the body would
+        // have from the load and the motion alone, or its velocity before the impulse.
+        let free = match level {
+            Level::Acceleration => g_eff - point_bias_acceleration(kin, Some(frame), &com),
+            Level::Velocity(_) => point_velocity(kin, Some(frame), &com),
+        };
         for (x, &l) in carrying.iter().enumerate() {
             let tau = lifts[l].tau;
             c[n + l] -= m * tau.dot(&free);
@@ -527,7 +599,7 @@ fn decide(
                 held[i].1 = held_here;
             }
             None => {
-                if !held_here && x[n + l] > QP_OPENING_TOLERANCE * scale.rate {
+                if !held_here && x[n + l] > scale.opening {
                     rocking_off.push(lift.interface);
                 }
             }
@@ -543,7 +615,7 @@ fn decide(
             (d.pivots.sides[k].sign() * psi + lift_of[i], lift_of[i])
         })
         .collect();
-    let tol = QP_OPENING_TOLERANCE * scale.rate;
+    let tol = scale.opening;
     let mut decision = OpeningDecision {
         rates: rates.clone(),
         qddot,
