@@ -767,9 +767,9 @@ fn warnings(
             )
         } else if v.kind == "impulse_tension" {
             format!(
-                "is pulled by the impulse of a landing (a normal impulse of {:.4e} N s at least): \
-                 with every contact unilateral the impulse would release a joint or lift a face \
-                 off, which the engine's plastic landing law holds instead",
+                "would need tension in the impulse of a landing or of an impact (a normal \
+                 impulse of {:.4e} N s at least): a contact held through it would leave its \
+                 support (the bodies it holds would jump)",
                 v.normal
             )
         } else if v.kind == "lift_off" {

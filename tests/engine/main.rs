@@ -8,6 +8,7 @@ mod common;
 mod arch_3d;
 mod collapse;
 mod impact_laws_on_chains;
+mod impulse_tension;
 mod initial_state_paths;
 mod invariant;
 mod mirror_invariance;

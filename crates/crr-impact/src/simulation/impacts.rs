@@ -287,7 +287,7 @@ impl Simulation<'_> {
             let (qd, k) = if held.is_empty() {
                 (std::mem::take(&mut result.qdot), result.kinetic_after)
             } else {
-                plastic_projection(
+                let out = plastic_projection(
                     model,
                     &mut work,
                     self.ground,
@@ -296,7 +296,21 @@ impl Simulation<'_> {
                     &result.qdot,
                     &after,
                     &held,
-                )?
+                )?;
+                // Whether the impact's impulse, its seated joints held, pulls (module
+                // `landing_check`): `work` is evaluated at the impact on the chain after it.
+                // Asked of the momentum law only, whose impulse acts at the new pivots: the
+                // restitution and Dirac laws set rates, which no contact impulse need give.
+                let momentum_law = impacting.iter().all(|&s| {
+                    matches!(
+                        model.interfaces[slot_interface(model, s)].impact,
+                        ImpactLaw::Momentum
+                    )
+                });
+                if momentum_law {
+                    self.check_impact_impulse(&work, q, (&before, &qdot), &out.0);
+                }
+                out
             };
             forward_kinematics(model, &mut kin, q, &after);
             crr_kinematics::velocities(model, &mut kin, &qd);

@@ -24,30 +24,62 @@ pub const IMPULSE_TENSION_TOLERANCE: f64 = 1e-3;
 impl Simulation<'_> {
     /// Records an `impulse_tension` violation (the first violation only) when the plastic
     /// impulse of a landing, from `qdot_minus` to `qdot_after` at the state evaluated in `d`
-    /// (the landing's positions, its velocities before the impulse, the slots the impulse holds
-    /// seated), needs tension: Moreau's inelastic impact releases a seated slot or lifts a face
-    /// off there, and the most compressive distribution of its contact impulses over the
-    /// touching points (`face_forces::most_compressive_impulses`, from each body's momentum
-    /// change) has a normal impulse below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g). The record
-    /// names the contact that limits it, with that impulse (N s) as its `normal`.
-    pub(super) fn check_landing_impulse(
+    /// (the landing's positions q, its velocities before the impulse, the slots the impulse
+    /// holds seated), needs tension: Moreau's inelastic impact releases a seated slot or lifts a
+    /// face off there ([`impulse_qp`]), and the most compressive distribution of its contact
+    /// impulses over the touching points ([`least_tension`]) has a normal impulse below
+    /// −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g). The record names the contact that limits it,
+    /// with that impulse (N s) as its `normal`.
+    pub(super) fn check_plastic_impulse(
         &mut self,
         d: &Dynamics,
         q: &DVector<f64>,
         qdot_minus: &DVector<f64>,
         qdot_after: &DVector<f64>,
     ) {
-        let model = Arc::clone(&self.model);
         if self.violation.is_some() {
             return;
         }
+        let model = Arc::clone(&self.model);
         let Ok(decision) = impulse_qp(&model, d, qdot_minus) else {
             return;
         };
         if decision.releases.is_empty() && decision.lifting_off.is_empty() {
             return;
         }
-        let Some(least) = least_tension(&model, d, q, qdot_minus, qdot_after) else {
+        let least = least_tension(&model, d, q, (&d.pivots, qdot_minus), qdot_after);
+        self.record_impulse_tension(&model, least);
+    }
+
+    /// The same record for a rocking joint's impact with seated joints held (module `impacts`):
+    /// the whole impulse, from `qdot_minus` on the chain `pivots_before` to `qdot_after` on the
+    /// chain evaluated in `d` (the pivots after the impact, the seated slots held), over the
+    /// touching points after it (the impacting joints' new pivots among them). The paper's laws
+    /// act at the impacting joints; the engine holds the seated ones through the impact ("the
+    /// other hinges persist"), and this asks whether the contacts can give that without pulling.
+    pub(super) fn check_impact_impulse(
+        &mut self,
+        d: &Dynamics,
+        q: &DVector<f64>,
+        (pivots_before, qdot_minus): (&ActivePivots, &DVector<f64>),
+        qdot_after: &DVector<f64>,
+    ) {
+        if self.violation.is_some() {
+            return;
+        }
+        let model = Arc::clone(&self.model);
+        let least = least_tension(&model, d, q, (pivots_before, qdot_minus), qdot_after);
+        self.record_impulse_tension(&model, least);
+    }
+
+    /// Records `least` as the first violation when its least normal impulse is below the
+    /// tolerance.
+    fn record_impulse_tension(
+        &mut self,
+        model: &Model,
+        least: Option<crate::face_forces::MostCompressive>,
+    ) {
+        let Some(least) = least else {
             return;
         };
         let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
@@ -79,15 +111,18 @@ fn least_tension(
     model: &Model,
     d: &Dynamics,
     q: &DVector<f64>,
-    qdot_minus: &DVector<f64>,
+    (pivots_before, qdot_minus): (&ActivePivots, &DVector<f64>),
     qdot_after: &DVector<f64>,
 ) -> Option<crate::face_forces::MostCompressive> {
-    let mut kin = Data::new(model);
-    forward_kinematics(model, &mut kin, q, &d.pivots);
-    crr_kinematics::jacobians(model, &mut kin);
-    let change = qdot_after - qdot_minus;
-    let dv = &kin.com_jacobian * &change;
-    let dw = &kin.angular_jacobian * &change;
+    let velocities = |pivots: &ActivePivots, qdot: &DVector<f64>| {
+        let mut kin = Data::new(model);
+        forward_kinematics(model, &mut kin, q, pivots);
+        crr_kinematics::jacobians(model, &mut kin);
+        (&kin.com_jacobian * qdot, &kin.angular_jacobian * qdot, kin)
+    };
+    let (v_minus, w_minus, _) = velocities(pivots_before, qdot_minus);
+    let (v_plus, w_plus, kin) = velocities(&d.pivots, qdot_after);
+    let (dv, dw) = (v_plus - v_minus, w_plus - w_minus);
     let changes: Vec<(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)> = model
         .bodies
         .iter()
@@ -164,7 +199,8 @@ mod tests {
             let decision = impulse_qp(&model, &d, &qdot).expect("the impulse program solves");
             let momentum = &d.kin.mass_matrix * &qdot;
             let after = d.solve_impulse(&model, 0.0, &momentum).unwrap().clone();
-            let lp = least_tension(&model, &d, &q, &qdot, &after).expect("the LP solves");
+            let lp =
+                least_tension(&model, &d, &q, (&d.pivots, &qdot), &after).expect("the LP solves");
             let s = lp.min_normal / unit;
             if decision.releases.is_empty() && decision.lifting_off.is_empty() {
                 holds += 1;

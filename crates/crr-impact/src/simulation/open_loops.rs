@@ -515,7 +515,7 @@ impl Simulation<'_> {
             plastic_projection(model, &mut work, self.ground, t, &q, &qdot, &pivots, &held)?;
         // Whether that impulse pulls (module `landing_check`): `work` is evaluated at the
         // landing with q̇⁻ and these slots seated.
-        self.check_landing_impulse(&work, &q, &qdot, &qdot_after);
+        self.check_plastic_impulse(&work, &q, &qdot, &qdot_after);
         // The landing slots' angles and rates: a slot brought to rest, or sent into its closed
         // side, seats (as at an impact).
         let mut angles = vec![0.0; model.slot_count];
