@@ -162,9 +162,10 @@ fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
     assert!(v["normal_force"].as_f64().unwrap() < 0.0);
 }
 
-/// Every bundled model runs without a warning except three whose monitor reports a flight: the
-/// drum column's and the two-block stack's (an impact whose impulse, the seated joints held,
-/// pulls: docs/simulation.md, "Impulses at landings and impacts") and the temple's. The temple's run stops (results kept) when the first column's
+/// Every bundled model runs without a warning except three that report a flight: the drum
+/// column's and the two-block stack's (an impact whose impulse, the seated joints held, pulls,
+/// recorded by the simulation: docs/simulation.md, "Impulses at landings and impacts") and the
+/// temple's (its monitor). The temple's run stops (results kept) when the first column's
 /// capital lifts off its neck, a motion outside the CRR chain (docs/simulation.md, limitations),
 /// and its monitor reports that instant: no distribution of the contact forces keeps the
 /// entablature's seat on that capital compressive (the capital would hang from it). The 3D arch used to be flagged too, a springing held seated with an edge of its

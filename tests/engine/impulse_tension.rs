@@ -9,8 +9,8 @@ use crr::impact::SlotState;
 /// ground, pivots at x = ±0.3 m; a 0.4 × 0.4 × 1.6 m block on it, pivots at x = ±0.2 m, z = 1.5 m)
 /// rocks on its top block after the pulse; the base stays seated through the top block's
 /// impacts (the engine holds it: "the other hinges persist"). At the impact of 1.8045 s the
-/// top block's impulse on the base's top face has a moment about the base's far edge that the
-/// ground can balance only by pulling at the near one.
+/// top block's impulse on the base's top face presses the base's edge under the new pivot and
+/// would lift the other one: the ground can balance it only by pulling at that far edge.
 ///
 /// By hand, from the samples just before and after the impact (the base at rest in both, the
 /// stack at its rest pose, the top block turning about its old pivot P before and its new one
@@ -19,8 +19,9 @@ use crr::impact::SlotState;
 /// (P′ − c) × J = I(ω⁺ − ω⁻) to 1e-9. The base receives −J at P′ and, staying at rest, the ground
 /// gives it J through its two pivot lines G± = (±0.3, 0, 0): the normal impulses n± with
 /// n⁺ + n⁻ = J_z and moments about G⁻, 0.6 n⁺ = r_x J_z − r_z J_x (r = P′ − G⁻). The engine's
-/// record is the least of these normal impulses (and J_z at P′), to 1e-6 of it, below the
-/// tolerance of 1e-3 W √(L/g).
+/// record is the least of these normal impulses (and J_z at P′), to 1e-6 of it (the linear
+/// program's impulses are of order one in its units of W √(L/g), solved to 1e-8 there), below
+/// the tolerance of 1e-3 W √(L/g).
 #[test]
 fn the_two_block_stack_s_impact_pulls_at_its_base_as_computed_by_hand() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -101,15 +101,24 @@ pub fn most_compressive_impulses(
     momentum_change: &[(Vector3<f64>, Vector3<f64>)],
 ) -> Option<MostCompressive> {
     let program = FaceProgram::build(model, dynamics);
+    // Impulses in W·√(L/g), the structure's weight over its time unit, so that the program's
+    // unknowns are of order one as its forces are (its tolerances and proximal term assume it).
+    let time = (model.size / model.gravity).sqrt();
+    let unit = program.weight * time;
     let mut loads = vec![0.0; 6 * program.bodies];
     for (b, (linear, angular)) in momentum_change.iter().enumerate() {
         for i in 0..3 {
-            loads[6 * b + i] = linear[i] / program.weight;
-            loads[6 * b + 3 + i] = angular[i] / (program.weight * model.size);
+            loads[6 * b + i] = linear[i] / unit;
+            loads[6 * b + 3 + i] = angular[i] / (unit * model.size);
         }
     }
     let (x, z) = program.solve(&loads, 0.0)?;
-    Some(program.answer(&x, Some(&z)))
+    let mut answer = program.answer(&x, Some(&z));
+    answer.min_normal *= time;
+    for n in &mut answer.normals {
+        *n *= time;
+    }
+    Some(answer)
 }
 
 /// The program's matrix at one state: the equilibrium rows of the bodies over the touching

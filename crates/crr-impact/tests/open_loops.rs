@@ -717,12 +717,12 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
 /// A landing whose plastic impulse needs tension is a hypothesis violation (`impulse_tension`,
 /// docs/simulation.md, "The hypotheses monitor"): the 3 × 3 running-bond wall of
 /// `examples/wall_pulse.rs` under a one-sine pulse of 1.5 λ g lifts its corner wedge, which
-/// lands again at 0.3476 s; stopping it with every contact held needs −84.8 N s at the end half
-/// block's bed `c1_b0_on_c0_b0` (the most compressive distribution of the impulses, about 3e-3 of
+/// lands again at 0.3476 s; stopping it with every contact held needs −56.5 N s at the end half
+/// block's bed `c1_b0_on_c0_b0` (the most compressive distribution of the impulses, about 2e-3 of
 /// W √(L/g)). The record is at that landing, and the run goes on to its end with the plastic
 /// impulse (the check records, it changes nothing).
-/// Whether such an impulse pulls is decided by the contact program at the velocity level, and
-/// its verdict agrees with a linear program on the contact points in
+/// Whether such an impulse pulls is the linear program's answer on the contact points; the
+/// contact program at the velocity level agrees with it in
 /// `the_impulse_program_holds_exactly_where_compressive_impulses_exist` (unit test).
 #[test]
 fn a_landing_whose_impulse_pulls_is_recorded() {

@@ -287,7 +287,7 @@ impl Simulation<'_> {
             let (qd, k) = if held.is_empty() {
                 (std::mem::take(&mut result.qdot), result.kinetic_after)
             } else {
-                let out = plastic_projection(
+                plastic_projection(
                     model,
                     &mut work,
                     self.ground,
@@ -296,21 +296,7 @@ impl Simulation<'_> {
                     &result.qdot,
                     &after,
                     &held,
-                )?;
-                // Whether the impact's impulse, its seated joints held, pulls (module
-                // `landing_check`): `work` is evaluated at the impact on the chain after it.
-                // Asked of the momentum law only, whose impulse acts at the new pivots: the
-                // restitution and Dirac laws set rates, which no contact impulse need give.
-                let momentum_law = impacting.iter().all(|&s| {
-                    matches!(
-                        model.interfaces[slot_interface(model, s)].impact,
-                        ImpactLaw::Momentum
-                    )
-                });
-                if momentum_law {
-                    self.check_impact_impulse(&work, q, (&before, &qdot), &out.0);
-                }
-                out
+                )?
             };
             forward_kinematics(model, &mut kin, q, &after);
             crr_kinematics::velocities(model, &mut kin, &qd);
@@ -385,6 +371,26 @@ impl Simulation<'_> {
             |k| impacting.contains(&k),
         )
         .map_err(|source| SimulationError::Dynamics { t, source })?;
+        // Whether the impact's whole impulse pulls at a contact (module `landing_check`), on
+        // the chain after it: its new pivots, the joints seated through it or at it. Asked of
+        // the momentum law (the law applied when any impacting interface uses it), whose
+        // impulse acts at the new pivots; the restitution and Dirac laws set the impacting
+        // rates, not an impulse at a point.
+        let momentum_law = impacting.iter().any(|&s| {
+            matches!(
+                model.interfaces[slot_interface(model, s)].impact,
+                ImpactLaw::Momentum
+            )
+        });
+        if momentum_law && self.violation.is_none() {
+            work.pivots.clone_from(&after);
+            work.seated.clear();
+            work.seated.extend(held.iter().chain(&to_seat).copied());
+            work.seated.sort_unstable();
+            work.seated.dedup();
+            work.evaluate(model, self.ground, t, &q_at, &qdot_after);
+            self.check_impulse(&work, &q_at, (&before, &qdot), &qdot_after);
+        }
         let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;
         let record = ImpactRecord {

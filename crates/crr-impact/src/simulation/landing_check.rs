@@ -1,18 +1,23 @@
-//! Whether a landing's impulse pulls: the hypotheses monitor at the instant a face lands.
+//! Whether an impulse pulls: the hypotheses monitor at the instant a face lands or rocking
+//! joints impact.
 //!
 //! A face that lands closes on its touching point, and the perfectly plastic impulse of the
 //! landing (`open_loops`, `plastic_projection`) holds every contact of the chain bilaterally:
-//! the landing face's loop, every seated slot and every face rocking on one pivot. Physically
-//! each of those contacts can only push. Whether some distribution of compressive impulses over
-//! them (without sliding) gives that same impulse is a convex question: Moreau's inelastic
-//! impact, the contact program one level down ([`super::impulse_qp`]). Its answer holds every
-//! contact exactly when the plastic impulse admits compressive contact impulses (its optimality
-//! conditions are then met by them); where it releases a seated slot or lifts a face off
-//! instead, no compressive distribution exists, the plastic impulse pulls there, and the run is
-//! outside its model from that instant: the first such landing is recorded as a hypothesis
-//! violation (`impulse_tension`). The run goes on with the plastic impulse; the velocities
-//! Moreau's impact would leave are not followed (the program's lifted faces keep their slip rows,
-//! and the chain without them contradicts most of its lifts on the walls measured).
+//! the landing face's loop, every seated slot and every face rocking on one pivot. An impact of
+//! the momentum law acts at the impacting joints' new pivots and holds the seated joints
+//! through it (`impacts`). Physically each contact can only push. Whether some distribution of
+//! compressive contact impulses (tangential ones free: no sliding) gives the impulse is a
+//! linear program on the touching points after it, with each body's momentum change as its
+//! load ([`least_tension`], `face_forces::most_compressive_impulses`); the first impulse whose
+//! least normal impulse is below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g) is recorded as a
+//! hypothesis violation (`impulse_tension`). The run goes on with the impulse as it was: the
+//! check records, it changes nothing.
+//!
+//! The same question, posed as Moreau's inelastic impact ([`super::impulse_qp`], the contact
+//! program one level down), answers "holds" exactly where the linear program finds a
+//! compressive distribution (the unit test below, on 400 random impacts). The motion that
+//! impact would leave is not followed: the program's lifted faces keep their slip rows, and on
+//! the walls measured the chain without them drove most of them back into their supports.
 
 use super::*;
 
@@ -22,42 +27,13 @@ use super::*;
 pub const IMPULSE_TENSION_TOLERANCE: f64 = 1e-3;
 
 impl Simulation<'_> {
-    /// Records an `impulse_tension` violation (the first violation only) when the plastic
-    /// impulse of a landing, from `qdot_minus` to `qdot_after` at the state evaluated in `d`
-    /// (the landing's positions q, its velocities before the impulse, the slots the impulse
-    /// holds seated), needs tension: Moreau's inelastic impact releases a seated slot or lifts a
-    /// face off there ([`impulse_qp`]), and the most compressive distribution of its contact
-    /// impulses over the touching points ([`least_tension`]) has a normal impulse below
-    /// −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g). The record names the contact that limits it,
-    /// with that impulse (N s) as its `normal`.
-    pub(super) fn check_plastic_impulse(
-        &mut self,
-        d: &Dynamics,
-        q: &DVector<f64>,
-        qdot_minus: &DVector<f64>,
-        qdot_after: &DVector<f64>,
-    ) {
-        if self.violation.is_some() {
-            return;
-        }
-        let model = Arc::clone(&self.model);
-        let Ok(decision) = impulse_qp(&model, d, qdot_minus) else {
-            return;
-        };
-        if decision.releases.is_empty() && decision.lifting_off.is_empty() {
-            return;
-        }
-        let least = least_tension(&model, d, q, (&d.pivots, qdot_minus), qdot_after);
-        self.record_impulse_tension(&model, least);
-    }
-
-    /// The same record for a rocking joint's impact with seated joints held (module `impacts`):
-    /// the whole impulse, from `qdot_minus` on the chain `pivots_before` to `qdot_after` on the
-    /// chain evaluated in `d` (the pivots after the impact, the seated slots held), over the
-    /// touching points after it (the impacting joints' new pivots among them). The paper's laws
-    /// act at the impacting joints; the engine holds the seated ones through the impact ("the
-    /// other hinges persist"), and this asks whether the contacts can give that without pulling.
-    pub(super) fn check_impact_impulse(
+    /// Records an `impulse_tension` violation (the first violation only) when an impulse needs
+    /// tension: from `qdot_minus` on the chain `pivots_before` to `qdot_after` on the chain
+    /// evaluated in `d` (at q, its pivots and seated slots those after the impulse), the most
+    /// compressive distribution of the contact impulses over the touching points after it
+    /// ([`least_tension`]) has a normal impulse below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g).
+    /// The record names the contact that limits it, with that impulse (N s) as its `normal`.
+    pub(super) fn check_impulse(
         &mut self,
         d: &Dynamics,
         q: &DVector<f64>,

@@ -513,9 +513,6 @@ impl Simulation<'_> {
         let pivots = self.dynamics.pivots.clone();
         let (mut qdot_after, mut t_plus) =
             plastic_projection(model, &mut work, self.ground, t, &q, &qdot, &pivots, &held)?;
-        // Whether that impulse pulls (module `landing_check`): `work` is evaluated at the
-        // landing with q̇⁻ and these slots seated.
-        self.check_plastic_impulse(&work, &q, &qdot, &qdot_after);
         // The landing slots' angles and rates: a slot brought to rest, or sent into its closed
         // side, seats (as at an impact).
         let mut angles = vec![0.0; model.slot_count];
@@ -547,6 +544,9 @@ impl Simulation<'_> {
             crr_kinematics::velocities(model, &mut kin, &qdot_after);
             slot_rates(model, &kin, &qdot_after, &mut rates);
         }
+        // Whether the landing's impulse pulls at a contact (module `landing_check`): `work` is
+        // evaluated at the landing with the slots seated after it.
+        self.check_impulse(&work, &q, (&pivots, &qdot), &qdot_after);
         self.spare.trial = Some(work);
         self.y[..n].copy_from_slice(q.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());

@@ -44,7 +44,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use crr_dynamics::eom::{Dynamics, slot_row};
 use crr_kinematics::kinematics::frame_point;
-use crr_kinematics::velocity::{point_bias_acceleration, point_velocity};
+use crr_kinematics::velocity::point_bias_acceleration;
 use crr_kinematics::{InterfaceKind, Model, Side};
 
 use super::seating::other_pivot_rest;
@@ -140,10 +140,14 @@ pub fn opening_qp_holding(
 /// principle of impulsive motion ½(V⁺ − V⁻)ᵀ𝓜(V⁺ − V⁻) over the bodies (Moreau's perfectly
 /// inelastic impact), with the loops' rows Φ_q q̇⁺ = 0 and every seated slot's and rocking
 /// face's contacts unilateral (αₖ⁺ ≥ 0, ℓₖ ≥ 0, now rates; no bias terms). `d` is evaluated at
-/// the impact's state with the velocities before it, `qdot_minus`, and the slots the impulse
-/// holds seated. Its releases and lift-offs are contacts that leave at the impulse: where it
-/// finds any, no distribution of compressive impulses over the contacts (without sliding)
-/// gives the plastic impulse that holds them all, which then pulls somewhere.
+/// the impulse's positions (its pivots and the slots the impulse holds seated); `qdot_minus`
+/// are the velocities before it on the same chain (an impulse that switches no pivot, as a
+/// landing's: across a pivot switch the momentum before is J⁺ᵀ𝕄J⁻q̇⁻, not M q̇⁻). Its releases
+/// and lift-offs are contacts that leave at the impulse: where it finds any, no distribution
+/// of compressive impulses over the contacts (without sliding) gives the plastic impulse that
+/// holds them all, which then pulls somewhere. The simulation sizes that tension with the
+/// contact points' linear program (`simulation::landing_check`), whose verdict agrees with this
+/// one (its unit test).
 pub fn impulse_qp(
     model: &Model,
     d: &Dynamics,
@@ -458,7 +462,15 @@ fn add_lift_metric(
         // have from the load and the motion alone, or its velocity before the impulse.
         let free = match level {
             Level::Acceleration => g_eff - point_bias_acceleration(kin, Some(frame), &com),
-            Level::Velocity(_) => point_velocity(kin, Some(frame), &com),
+            Level::Velocity(v) => {
+                let mut velocity = Vector3::zeros();
+                let mut j = Some(frame);
+                while let Some(jj) = j {
+                    velocity += kin.axis[jj].cross(&(com - kin.pivot[jj])) * v[jj];
+                    j = model.coords[jj].parent;
+                }
+                velocity
+            }
         };
         for (x, &l) in carrying.iter().enumerate() {
             let tau = lifts[l].tau;
