@@ -133,8 +133,14 @@ fn an_arch_s_second_half_pulse_mirrors_its_first() {
             b.energy_lost
         );
     }
-    let v = traj.violation.as_ref().expect("the impact at 0.2467 s pulls");
-    assert_eq!((v.kind.as_str(), v.interface.as_str()), ("impulse_tension", "joint_1"));
+    let v = traj
+        .violation
+        .as_ref()
+        .expect("the impact at 0.2467 s pulls");
+    assert_eq!(
+        (v.kind.as_str(), v.interface.as_str()),
+        ("impulse_tension", "joint_1")
+    );
     assert!(first.iter().any(|i| i.t == v.t) && (v.t - 0.2467).abs() < 1e-4);
     // T + U − W + D closes to round-off of the energy that went through the impacts.
     assert!(
