@@ -381,6 +381,30 @@ fn wall_of_wall_pulse(n: usize, factor: f64) -> (Model, GroundMotion, InitialSta
     (model, ground, init)
 }
 
+/// The wall of [`wall_of_wall_pulse`] run for `duration` (s) to its end, which it must reach.
+fn run_wall_to_end(n: usize, factor: f64, duration: f64) -> (Model, crr_impact::Trajectory) {
+    let (model, ground, init) = wall_of_wall_pulse(n, factor);
+    let params = Parameters {
+        duration,
+        ..Parameters::default()
+    };
+    let traj = common::run_to_end(&model, &ground, &init, params);
+    (model, traj)
+}
+
+/// The run's first violation: an `impulse_tension` at about `t` (to 1e-4 s), at the instant of
+/// one of its impact records (a landing or an impact).
+fn impulse_tension_at(traj: &crr_impact::Trajectory, t: f64) -> &crr_impact::monitor::Violation {
+    let v = traj.violation.as_ref().expect("an impulse that pulls");
+    assert_eq!(v.kind, "impulse_tension");
+    assert!((v.t - t).abs() < 1e-4, "at {} s", v.t);
+    assert!(
+        traj.impacts.iter().any(|i| i.t == v.t),
+        "at an impact record"
+    );
+    v
+}
+
 /// A face that lifts off leaves its support (docs/simulation.md, "Faces that open"): it opens
 /// only where its points separate under the motion of the chain without it, so it cannot land
 /// again at once. The 6 × 6 running-bond wall of `examples/wall_pulse.rs` (blocks 1.0 × 0.5 m,
@@ -474,12 +498,7 @@ fn faces_that_lift_off_do_not_land_again_at_once() {
 /// it the run goes on to its end with every face closed and no hypothesis violated.
 #[test]
 fn a_wedge_lands_on_its_whole_crack_at_once() {
-    let (model, ground, init) = wall_of_wall_pulse(5, 1.2);
-    let params = Parameters {
-        duration: 0.3,
-        ..Parameters::default()
-    };
-    let traj = common::run_to_end(&model, &ground, &init, params);
+    let (model, traj) = run_wall_to_end(5, 1.2, 0.3);
     assert!(traj.violation.is_none(), "{:?}", traj.violation);
     let samples: Vec<Sample> = traj.samples.iter().collect();
     let slot_of = |name: &str| {
@@ -644,20 +663,9 @@ fn a_corner_wedge_lifts_off_when_the_pulse_reaches_its_multiplier() {
 /// at that instant instead: a face rocking on one pivot now lifts off where it would pull).
 #[test]
 fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
-    let (model, ground, init) = wall_of_wall_pulse(4, 1.8);
-    let params = Parameters {
-        duration: 1.0,
-        ..Parameters::default()
-    };
-    let traj = common::run_to_end(&model, &ground, &init, params);
+    let (model, traj) = run_wall_to_end(4, 1.8, 1.0);
     assert_eq!(traj.end_time, 1.0);
-    let v = traj
-        .violation
-        .as_ref()
-        .expect("the impulse at 0.3896 s pulls");
-    assert_eq!(v.kind, "impulse_tension");
-    assert!((v.t - 0.3896).abs() < 1e-4, "at {} s", v.t);
-    assert!(traj.impacts.iter().any(|i| i.t == v.t), "at a landing");
+    impulse_tension_at(&traj, 0.3896);
     let scale = model.total_mass() * model.gravity * model.size;
     assert!(
         traj.energy_balance_error.abs() < 1e-9 * scale,
@@ -726,25 +734,10 @@ fn a_face_pushed_into_its_support_by_a_landing_lands_with_it() {
 /// `the_impulse_program_holds_exactly_where_compressive_impulses_exist` (unit test).
 #[test]
 fn a_landing_whose_impulse_pulls_is_recorded() {
-    let (model, ground, init) = wall_of_wall_pulse(3, 1.5);
-    let params = Parameters {
-        duration: 1.0,
-        ..Parameters::default()
-    };
-    let traj = common::run_to_end(&model, &ground, &init, params);
+    let (model, traj) = run_wall_to_end(3, 1.5, 1.0);
     assert_eq!(traj.end_time, 1.0);
-    let v = traj
-        .violation
-        .as_ref()
-        .expect("the landing's impulse pulls");
-    assert_eq!(v.kind, "impulse_tension");
+    let v = impulse_tension_at(&traj, 0.3476);
     assert_eq!(v.interface, "c1_b0_on_c0_b0");
-    let landing = traj
-        .impacts
-        .iter()
-        .find(|i| i.t == v.t)
-        .expect("recorded at a landing");
-    assert!((landing.t - 0.3476).abs() < 1e-4, "at {} s", landing.t);
     let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
     assert!(
         v.normal < -1e-3 * unit && v.normal > -1e-2 * unit,
