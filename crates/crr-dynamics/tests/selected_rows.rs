@@ -242,6 +242,29 @@ fn selected_rows_agree_with_the_svd_on_a_planar_row_of_loops() {
     }
 }
 
+/// A running-bond wall held on every seat (every slot seated, at rest): the selected rows
+/// constrain every free coordinate (r = n_f) and most rows depend on them (a hyperstatic wall:
+/// on the 4 × 3 wall B has 56 rows, the loops' and the seated slots', of rank r = n_f = 14, and
+/// 21 of the dependent rows are not zero rows), where the
+/// minimum-norm multipliers come from BᵀB instead of I + C Cᵀ over the dependent rows. Same q̈
+/// and λ as the SVD, and the selected rows reused.
+#[test]
+fn selected_rows_agree_with_the_svd_on_a_wall_held_on_every_seat() {
+    let spec = crr_kinematics::fixtures::running_bond_wall(4, 3, 0.6, 0.25, 0.3);
+    let model = Model::from_spec(&spec).unwrap();
+    let all: Vec<usize> = (0..model.slot_count).collect();
+    let (q, _, pivots) = state(&model, 0.0, 1);
+    let zero = DVector::zeros(model.dof());
+    let mut d = Dynamics::new(&model, pivots.clone());
+    let mut reused = 0;
+    for min_norm in [true, false, true] {
+        if compare(&model, &q, &zero, &pivots, &all, min_norm, Some(&mut d)) {
+            reused += 1;
+        }
+    }
+    assert!(reused > 0, "the selected rows were never reused");
+}
+
 /// The velocity projection on kept rows is the SVD's: at states whose rates are perturbed off
 /// Φ_q q̇ = 0, both give the same q̇ to round-off (the correction is the same minimum-norm one,
 /// δq̇ = −Φ_q⁺Φ_q q̇, through Φ_S Φ_Sᵀ instead of the SVD), the projected rates satisfy the

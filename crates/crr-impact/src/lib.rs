@@ -46,6 +46,7 @@
 pub mod face_forces;
 pub mod laws;
 pub mod least_distance;
+pub mod least_norm;
 pub mod monitor;
 pub mod nnls;
 pub mod simulation;

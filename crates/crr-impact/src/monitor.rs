@@ -185,6 +185,35 @@ pub fn contact_forces_into(
         return Ok(());
     }
     dynamics.accelerations(model, ground, t, q, qdot)?;
+    body_loads_into(model, dynamics, effective_gravity(model, ground, t), work);
+    interface_forces(
+        model,
+        &dynamics.kin,
+        &work.body_force,
+        &dynamics.lambda,
+        &mut work.closure_on,
+        &mut work.transmitted,
+    );
+    work.forces.clear();
+    work.forces.extend(
+        work.transmitted
+            .iter()
+            .map(|f| f.map(|(force, normal)| ContactForce::new(force, normal))),
+    );
+    seat_edges(model, dynamics, &work.forces, &mut work.edges);
+    Ok(())
+}
+
+/// The loads every body needs from its contacts at the state solved in `dynamics` (its q̈ and
+/// kinematics), under the effective gravity `g_eff`: each coordinate frame's total spatial
+/// acceleration into `work.acc` and each body's net force beyond its load, m (a_c − g_eff), into
+/// `work.body_force` (what [`crate::face_forces`] poses its programs on).
+pub fn body_loads_into(
+    model: &Model,
+    dynamics: &Dynamics,
+    g_eff: Vector3<f64>,
+    work: &mut ForceWork,
+) {
     let kin = &dynamics.kin;
     let n = model.dof();
     // Total spatial accelerations A = A_bias + Σ sⱼ q̈ⱼ along each path.
@@ -197,7 +226,6 @@ pub fn contact_forces_into(
             .map_or(Vector6::zeros(), |p| acc[p] - kin.bias_acceleration[p]);
         acc.push(kin.bias_acceleration[k] + parent + s);
     }
-    let g_eff = effective_gravity(model, ground, t);
     // Net force on each body beyond its load: m (a_c − g_eff).
     work.body_force.clear();
     work.body_force
@@ -212,22 +240,6 @@ pub fn contact_forces_into(
             let a_c = a0 + al.cross(&c) + w.cross(&(v0 + w.cross(&c)));
             (a_c - g_eff) * body.mass
         }));
-    interface_forces(
-        model,
-        kin,
-        &work.body_force,
-        &dynamics.lambda,
-        &mut work.closure_on,
-        &mut work.transmitted,
-    );
-    work.forces.clear();
-    work.forces.extend(
-        work.transmitted
-            .iter()
-            .map(|f| f.map(|(force, normal)| ContactForce::new(force, normal))),
-    );
-    seat_edges(model, dynamics, &work.forces, &mut work.edges);
-    Ok(())
 }
 
 /// World axis w, current pivot P and other pivot P′ of seated slot `slot` at the state of `kin`,

@@ -827,16 +827,12 @@ impl RestStatics {
             return Ok(None);
         }
         let d = a / magnitude;
-        let key = [d.x.to_bits(), d.y.to_bits(), d.z.to_bits()];
+        let key = direction_key(&d);
         let index = match self.by_direction.iter().position(|(k, _)| *k == key) {
             Some(i) => i,
             None => {
                 let c = collapse_multiplier(model, d, &StaticsOptions::default())?;
-                if self.by_direction.len() >= REST_DIRECTIONS {
-                    self.by_direction.remove(0);
-                }
-                self.by_direction.push((key, c));
-                self.by_direction.len() - 1
+                self.keep_direction(key, c)
             }
         };
         let collapse = &self.by_direction[index].1;
@@ -856,13 +852,38 @@ impl RestStatics {
         let mut d = Vector3::zeros();
         d[k / 2] = sign;
         let lambda = match collapse_multiplier(model, d, &StaticsOptions::default()) {
-            Ok(c) => c.lambda.unwrap_or(LAMBDA_MAX),
+            Ok(c) => {
+                let lambda = c.lambda.unwrap_or(LAMBDA_MAX);
+                // A load along the axis itself (a one-component record) asks for this
+                // collapse again, by the same direction's bits.
+                self.keep_direction(direction_key(&d), c);
+                lambda
+            }
             Err(StaticsError::DoesNotHold(_)) => 0.0,
             Err(e) => return Err(e),
         };
         self.axes[k] = Some(lambda);
         Ok(lambda)
     }
+
+    /// Keeps the collapse along the unit direction of bits `key`, dropping the oldest beyond
+    /// [`REST_DIRECTIONS`]; its index.
+    fn keep_direction(&mut self, key: [u64; 3], collapse: Collapse) -> usize {
+        if self.by_direction.len() >= REST_DIRECTIONS {
+            self.by_direction.remove(0);
+        }
+        self.by_direction.push((key, collapse));
+        self.by_direction.len() - 1
+    }
+}
+
+/// The exact bits of a unit direction, with −0 read as +0 (the key of [`RestStatics`]' answers).
+fn direction_key(d: &Vector3<f64>) -> [u64; 3] {
+    [
+        (d.x + 0.0).to_bits(),
+        (d.y + 0.0).to_bits(),
+        (d.z + 0.0).to_bits(),
+    ]
 }
 
 /// The axis multipliers of the structures one run has met, by the set of their interfaces'

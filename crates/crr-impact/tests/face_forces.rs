@@ -464,3 +464,77 @@ fn contact_program_decides_as_the_static_theorem() {
         "{held} held, {opened} opened, {undecided} near 0"
     );
 }
+
+/// The certificate the uplift test asks in motion before the contact program
+/// (`face_forces::PressingCertificate`: the last distribution carried by a least-norm change, the
+/// program solved where it fails) against the contact program itself (`simulation::opening_qp`,
+/// Gauss' principle in acceleration space) and against the faces' program solved afresh: the
+/// 4 × 3 wall of the test above, at rest and moving along the mechanisms of random free sets,
+/// under 0.05 to 2.45 g in steps of 0.02 g, asked in order with one certificate as a simulation
+/// asks it. Wherever it holds, the program opens nothing and releases nothing, and a fresh
+/// program finds every point pressing by the margin (to its tolerance, 1e-7 W); wherever it does
+/// not, the fresh program finds no distribution with that margin. Both answers occur, and most
+/// that hold are carried distributions (no program solved).
+#[test]
+fn the_pressing_certificate_holds_only_where_the_contact_program_opens_nothing() {
+    use crr_impact::face_forces::{PRESSING_MARGIN, PressingCertificate, RestFaces};
+    use crr_impact::simulation::opening_qp;
+    let model = Model::from_spec(&running_bond_wall(4, 3, 0.6, 0.25, 0.3)).unwrap();
+    let weight = model.total_mass() * model.gravity;
+    let margin = PRESSING_MARGIN * weight;
+    let slack = 1e-7 * weight;
+    let n = model.dof();
+    let zero = DVector::zeros(n);
+    let pivots = ActivePivots::uniform(&model, Side::Positive);
+    let all: Vec<usize> = (0..model.slot_count).collect();
+    let mut cases: Vec<(Vec<usize>, DVector<f64>)> = vec![(all.clone(), zero.clone())];
+    for choice in 0..40 {
+        let seated: Vec<usize> = all
+            .iter()
+            .copied()
+            .filter(|&k| wobble(13 * choice + k) < 0.8)
+            .collect();
+        let modes = mechanism(&model, &pivots, &seated);
+        if modes.ncols() > 0 {
+            let mode = modes.column(0) / modes.column(0).amax();
+            cases.push((seated, mode * 0.2));
+        }
+        if cases.len() == 5 {
+            break;
+        }
+    }
+    let (mut holds, mut fails) = (0, 0);
+    for (seated, qdot) in &cases {
+        let mut certificate = PressingCertificate::default();
+        for step in 0..=120 {
+            let ax = (0.05 + 2.4 * step as f64 / 120.0) * model.gravity;
+            let ground = constant_ground(ax, 0.0);
+            let (work, d) = solved(&model, &ground, pivots.clone(), seated, &zero, qdot);
+            let certified = certificate.holds(&model, &d, &work).expect("answers");
+            let g_eff = crr_dynamics::eom::effective_gravity(&model, &ground, 0.0);
+            let fresh = RestFaces::default()
+                .most_compressive(&model, &d, &work, &zero, qdot, g_eff, (0.0, 10.0 * margin))
+                .expect("solves")
+                .min_normal;
+            if certified {
+                let decision = opening_qp(&model, &d).expect("the contact program solves");
+                assert!(
+                    decision.releases.is_empty() && decision.lifting_off.is_empty(),
+                    "{} seated, a_x = {ax:.3}: certified, the program opens {:?}, lifts {:?}",
+                    seated.len(),
+                    decision.releases,
+                    decision.lifting_off
+                );
+                assert!(fresh >= margin - slack, "certified, fresh s* = {fresh:e} N");
+                holds += 1;
+            } else {
+                assert!(
+                    fresh < margin + slack,
+                    "not certified, fresh s* = {fresh:e} N"
+                );
+                fails += 1;
+            }
+        }
+    }
+    assert!(holds > 100 && fails > 50, "{holds} certified, {fails} not");
+}

@@ -129,7 +129,8 @@ pub(crate) struct SelectedRowsWork {
     /// The rows D with a nonzero row of C (by position in `others`): a zero row of B (a planar
     /// loop's out-of-plane closure rows) has a zero row of C and a zero multiplier.
     coupled: Vec<usize>,
-    /// I + C Cᵀ over the coupled rows, then its Cholesky factor.
+    /// I + C Cᵀ over the coupled rows (BᵀB when B has full column rank), then its Cholesky
+    /// factor.
     nn: DMatrix<f64>,
     /// Scratch of length max(r, rows D).
     e: Vec<f64>,
@@ -137,6 +138,8 @@ pub(crate) struct SelectedRowsWork {
     rest: Vec<f64>,
     /// y = −G⁻¹ e_S.
     y: Vec<f64>,
+    /// (BᵀB)⁻¹ dz, for the minimum-norm multipliers of a B of full column rank.
+    v: Vec<f64>,
 }
 
 /// Gauss' principle on the rows `selected` of B, given as the columns of `bt` = Bᵀ
@@ -335,7 +338,33 @@ pub(crate) fn solve_selected_rows(
         lambda[i] = work.y[k];
     }
     let dc = work.coupled.len();
-    if min_norm && dc > 0 {
+    if min_norm && dc > 0 && r == nf {
+        // B has full column rank (r = n_f independent rows): the minimum-norm λ with Bᵀλ = dz
+        // is B (BᵀB)⁻¹ dz, one factorisation of n_f × n_f, where the general form below needs
+        // I + C Cᵀ over the dependent rows (a structure held on every seat: d ≫ r).
+        if work.nn.nrows() != nf {
+            work.nn = DMatrix::zeros(nf, nf);
+        } else {
+            work.nn.fill(0.0);
+        }
+        for i in 0..m {
+            let row = b.row(i);
+            for (a, &(ja, va)) in row.iter().enumerate() {
+                for &(jb, vb) in &row[..=a] {
+                    work.nn[(ja, jb)] += va * vb;
+                }
+            }
+        }
+        if cholesky_in_place(&mut work.nn).is_err() {
+            return false;
+        }
+        work.v.clear();
+        work.v.extend(dz.iter());
+        cholesky_solve(&work.nn, &mut work.v);
+        for i in 0..m {
+            lambda[i] = b.dot(i, &work.v);
+        }
+    } else if min_norm && dc > 0 {
         if work.nn.nrows() != dc {
             work.nn = DMatrix::zeros(dc, dc);
         }

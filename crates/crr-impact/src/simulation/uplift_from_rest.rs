@@ -43,6 +43,10 @@ pub(super) struct RestCache {
     /// or landing (a release of another joint does not clear them), so that its answer can turn
     /// back to "holds" and the uplift event fire again for the other joints.
     pub(super) held_faces: Vec<usize>,
+    /// The certificate that a motion needs no contact to let go, carried from one step end to
+    /// the next, and the bodies' loads it is posed on.
+    pub(super) pressing: crate::face_forces::PressingCertificate,
+    pub(super) loads: crate::monitor::ForceWork,
 }
 
 #[derive(Clone, Debug)]
