@@ -38,6 +38,10 @@ impl fmt::Debug for LeastNorm {
 struct Cached {
     /// The pattern of A it was built for: (row, column) of every entry, in the caller's order.
     pattern: Vec<(usize, usize)>,
+    /// The indices into `pattern` of every column's entries.
+    by_column: Vec<Vec<usize>>,
+    /// 0, 1, … nnz − 1: every entry of AAᵀ is updated at each call.
+    indices: Vec<usize>,
     /// For every pair of entries (a, b) of one column with row(a) ≤ row(b), in the order
     /// [`products`] visits them, the index of AAᵀ's upper-triangle entry it adds to.
     map: Vec<usize>,
@@ -59,7 +63,6 @@ impl LeastNorm {
         entries: &[(usize, usize, f64)],
         r: &[f64],
     ) -> Option<Vec<f64>> {
-        let by_column = column_lists(columns, entries);
         let same = self.cached.as_ref().is_some_and(|c| {
             c.pattern.len() == entries.len()
                 && c.pattern
@@ -67,14 +70,15 @@ impl LeastNorm {
                     .zip(entries)
                     .all(|(p, e)| p.0 == e.0 && p.1 == e.1)
                 && c.diagonal.len() == rows
+                && c.by_column.len() == columns
         });
         if !same {
-            self.cached = Some(Cached::new(rows, entries, &by_column)?);
+            self.cached = Some(Cached::new(rows, columns, entries)?);
         }
         let cached = self.cached.as_mut()?;
         let mut values = vec![0.0; cached.nnz];
         let mut next = 0;
-        products(&by_column, entries, |_, _, v| {
+        products(&cached.by_column, entries, |_, _, v| {
             values[cached.map[next]] += v;
             next += 1;
         });
@@ -86,8 +90,7 @@ impl LeastNorm {
         for &d in &cached.diagonal {
             values[d] += epsilon;
         }
-        let indices: Vec<usize> = (0..cached.nnz).collect();
-        cached.factor.update_values(&indices, &values);
+        cached.factor.update_values(&cached.indices, &values);
         cached.factor.refactor().ok()?;
         // δ = Aᵀy, then once more on the residual.
         let mut delta = vec![0.0; columns];
@@ -114,9 +117,10 @@ impl Cached {
     /// AAᵀ's pattern, the map of the column products onto it, and its symbolic and first
     /// numerical factorisation (of the pattern with a unit diagonal; the caller refactors with
     /// the values).
-    fn new(rows: usize, entries: &[(usize, usize, f64)], by_column: &[Vec<usize>]) -> Option<Self> {
+    fn new(rows: usize, columns: usize, entries: &[(usize, usize, f64)]) -> Option<Self> {
+        let by_column = column_lists(columns, entries);
         let (mut ri, mut ci) = (Vec::new(), Vec::new());
-        products(by_column, entries, |i, j, _| {
+        products(&by_column, entries, |i, j, _| {
             ri.push(i);
             ci.push(j);
         });
@@ -145,6 +149,8 @@ impl Cached {
         let factor = QDLDLFactorisation::new(&aat, None).ok()?;
         Some(Self {
             pattern: entries.iter().map(|e| (e.0, e.1)).collect(),
+            by_column,
+            indices: (0..nnz).collect(),
             map,
             diagonal,
             nnz,

@@ -316,8 +316,12 @@ pub(crate) fn solve_selected_rows(
         }
     }
     let outside = outside.sqrt();
+    // With no row selected (r = 0) R_D is B itself, of round-off size against the whole
+    // Jacobian's floor (a free coordinate that no loop's row sees): the SVD keeps nothing where
+    // ‖B‖_F, which bounds σ_max(B), is below the threshold, and both solves give dz = 0, λ = 0.
+    // The test relative to ‖B‖_F is for rows dependent on selected ones.
     if outside.is_nan()
-        || outside > DEPENDENT_ROW_TOLERANCE * b_norm
+        || (r > 0 && outside > DEPENDENT_ROW_TOLERANCE * b_norm)
         || RANK_MARGIN * outside > threshold
     {
         return false;
