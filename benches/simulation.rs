@@ -576,7 +576,7 @@ fn print_growth(group: &str, points: &[(f64, f64)]) {
 /// size is run once outside criterion and its wall time per step printed, with the exponent p of
 /// cost per step ∝ DOF^p fitted over the sizes and between the two largest (the issue asks for
 /// the 10 × 10 wall in ≤ 10 s and p ≤ 1.5). n = 8 and 10 are printed, not timed by criterion
-/// (about 3 and 6.5 s a run).
+/// (about 1.6 and 3.2 s a run).
 fn wall_pulse_growth(c: &mut Criterion) {
     use crr_impact::statics::{StaticsOptions, collapse_multiplier};
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
