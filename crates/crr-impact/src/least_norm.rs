@@ -7,7 +7,11 @@
 //! of AAᵀ (`clarabel`'s QDLDL with its approximate-minimum-degree ordering). The ordering, the
 //! symbolic analysis and the map from A's column products to AAᵀ's entries are kept while A's
 //! pattern is the same, so a call costs one numerical factorisation and two solves; one step of
-//! iterative refinement follows.
+//! iterative refinement follows. QDLDL's own regularisation stays on: a pivot below 1e-12
+//! (absolute) is replaced by 1e-7, which on a rank-deficient A only damps y along AAᵀ's null
+//! space (Aᵀ maps it to nothing); on an A scaled far below 1 it would spoil the answer, so
+//! callers pose A in units of order one (the faces' rows in W and W·size) and check the residual
+//! of what they get.
 
 use std::fmt;
 
@@ -54,8 +58,8 @@ struct Cached {
 
 impl LeastNorm {
     /// The least-norm δ (`columns` long) with A δ = `r`, A the `rows` × `columns` matrix of
-    /// `entries` (row, column, value; each (row, column) once). None when the factorisation
-    /// fails.
+    /// `entries` (row, column, value; each (row, column) once). None when an entry lies outside
+    /// the matrix, `r` is not `rows` long, or the factorisation fails.
     pub fn solve(
         &mut self,
         rows: usize,
@@ -63,6 +67,9 @@ impl LeastNorm {
         entries: &[(usize, usize, f64)],
         r: &[f64],
     ) -> Option<Vec<f64>> {
+        if r.len() != rows || entries.iter().any(|e| e.0 >= rows || e.1 >= columns) {
+            return None;
+        }
         let same = self.cached.as_ref().is_some_and(|c| {
             c.pattern.len() == entries.len()
                 && c.pattern

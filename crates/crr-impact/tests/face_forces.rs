@@ -473,8 +473,9 @@ fn contact_program_decides_as_the_static_theorem() {
 /// under 0.05 to 2.45 g in steps of 0.02 g, asked in order with one certificate as a simulation
 /// asks it. Wherever it holds, the program opens nothing and releases nothing, and a fresh
 /// program finds every point pressing by the margin (to its tolerance, 1e-7 W); wherever it does
-/// not, the fresh program finds no distribution with that margin. Both answers occur, and most
-/// that hold are carried distributions (no program solved).
+/// not, the fresh program finds no distribution with that margin. Both answers occur. (The
+/// certificate's guards in the simulation, `seating.rs::openings_slide_nowhere`, are not asked
+/// here: this wall has hinges with distinct pivot lines only.)
 #[test]
 fn the_pressing_certificate_holds_only_where_the_contact_program_opens_nothing() {
     use crr_impact::face_forces::{PRESSING_MARGIN, PressingCertificate, RestFaces};
@@ -537,4 +538,49 @@ fn the_pressing_certificate_holds_only_where_the_contact_program_opens_nothing()
         }
     }
     assert!(holds > 100 && fails > 50, "{holds} certified, {fails} not");
+}
+
+/// Why the certificate is asked only where `simulation::openings_slide_nowhere` lets it: a hinge
+/// whose two pivot lines lie 1e-7 m apart is a pin for the faces (its normal forces free, so it
+/// takes any moment) while the contact program keeps its lift, whose dual bounds the moment by
+/// the pivots' offset. A trilithon beside a block of 0.4 × 2 m on such a hinge, every slot seated,
+/// at rest under 0.01 to 0.11 g along x: the certificate holds at some load where the program
+/// lifts that face off, so the guard must refuse the model; it lets the running-bond wall (hinges
+/// with distinct pivot lines) through. (Found by an independent review.)
+#[test]
+fn a_near_pin_hinge_is_left_to_the_contact_program() {
+    use crr_impact::face_forces::PressingCertificate;
+    use crr_impact::simulation::{opening_qp, openings_slide_nowhere};
+    use crr_kinematics::fixtures::{forest, hinge, single_block, trilithon};
+    let mut block = single_block(0.2, 1.0, 2000.0);
+    block.interface[0] = hinge(
+        "base",
+        "ground",
+        "block",
+        [0.0, 1.0, 0.0],
+        [5e-8, 0.0, 0.0],
+        [-5e-8, 0.0, 0.0],
+    );
+    let model =
+        Model::from_spec(&forest(&[trilithon(0.25, 1.5, 2.0, 0.5, 1.0), block], 6.0)).unwrap();
+    let all: Vec<usize> = (0..model.slot_count).collect();
+    let zero = DVector::zeros(model.dof());
+    let pivots = ActivePivots::uniform(&model, Side::Positive);
+    let mut contradicted = 0;
+    for step in 0..=10 {
+        let ground = constant_ground((0.01 + 0.01 * step as f64) * model.gravity, 0.0);
+        let (work, d) = solved(&model, &ground, pivots.clone(), &all, &zero, &zero);
+        let holds = PressingCertificate::default()
+            .holds(&model, &d, &work)
+            .expect("answers");
+        let decision = opening_qp(&model, &d).expect("the contact program solves");
+        if holds && !decision.lifting_off.is_empty() {
+            contradicted += 1;
+        }
+    }
+    assert!(contradicted > 0, "the near pin never contradicted");
+    assert!(!openings_slide_nowhere(&model, &all));
+    let wall = Model::from_spec(&running_bond_wall(4, 3, 0.6, 0.25, 0.3)).unwrap();
+    let every: Vec<usize> = (0..wall.slot_count).collect();
+    assert!(openings_slide_nowhere(&wall, &every));
 }

@@ -63,9 +63,9 @@ pub use opening_qp::{
     offers_both_pivots, opening_qp, opening_qp_holding,
 };
 pub use samples::{Iter as SampleIter, Sample, Samples};
-pub use seating::opening_mode;
 use seating::opening_mode_in;
 pub(crate) use seating::other_pivot_rest;
+pub use seating::{opening_mode, openings_slide_nowhere};
 pub use slots::check_initial_state;
 pub(crate) use slots::slot_interface;
 use slots::*;

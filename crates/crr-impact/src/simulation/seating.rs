@@ -3,8 +3,8 @@
 
 use super::open_loops::FaceRelease;
 use super::*;
-use crr_kinematics::Interface;
 use crr_kinematics::kinematics::frame_point;
+use crr_kinematics::{ContactFace, Interface};
 use nalgebra::{Matrix3, Vector3};
 
 /// Finds the interfaces that open from a seated state at (t, q, q̇): releasing a seated slot on a
@@ -240,21 +240,29 @@ pub(super) fn opening_mode_local(
 /// Whether every opening the contact program offers moves the touching points it leaves along
 /// their face's normal only, with the slots in `seated` seated: then the faces' distributions
 /// (free tangential forces at every touching point) price exactly the program's motions, and a
-/// compressive one certifies that nothing opens ([`pressing_certified`]). A hinge turns about a
+/// compressive one certifies that nothing opens (`pressing_certified`, asked by the uplift
+/// test in motion only where this holds). A hinge turns about a
 /// pivot line in its face's plane, and a rocking base with both tilts seated about an edge of
 /// its face at the seat; a lift translates along the normal. A rocking base with one tilt seated
 /// and the other turned turns about an axis out of its face's plane, so the corner it leaves
 /// slides as it lifts, which the distributions' free tangential forces would price (on the
 /// bundled 3D arch such forces of 80 W against normal forces of 0.5 W "held" a release the
-/// program opens); and a seat that may twist carries no torsion. Those decide by the program.
-fn openings_slide_nowhere(model: &Model, seated: &[usize]) -> bool {
-    model.interfaces.iter().all(|iface| match iface.kind {
-        InterfaceKind::Hinge { .. } => true,
-        InterfaceKind::RockingBase { twist, .. } => {
-            let held = iface.slots.clone().filter(|k| seated.contains(k)).count();
-            !twist && (held == 0 || held == iface.slots.len())
-        }
-    })
+/// program opens); and a rocking base that may twist carries no torsion. A hinge whose two pivot
+/// lines (nearly) coincide is a pin for the faces (free normal forces, any moment) but keeps a
+/// lift in the program, whose dual bounds its moment: such a face "held" lifts that the program
+/// makes (an independent review, with pivots 1e-7 m apart). Those decide by the program.
+pub fn openings_slide_nowhere(model: &Model, seated: &[usize]) -> bool {
+    model
+        .interfaces
+        .iter()
+        .enumerate()
+        .all(|(index, iface)| match iface.kind {
+            InterfaceKind::Hinge { .. } => !ContactFace::of_interface(model, index).pin,
+            InterfaceKind::RockingBase { twist, .. } => {
+                let held = iface.slots.clone().filter(|k| seated.contains(k)).count();
+                !twist && (held == 0 || held == iface.slots.len())
+            }
+        })
 }
 
 /// Whether the locked motion solved in `trial` (every seated slot held, every rocking face on its
