@@ -268,4 +268,51 @@ mod tests {
             assert!(worst <= 1e-13, "case {case}: residual {worst:e}");
         }
     }
+
+    /// A rank-deficient A (row 6 a copy of row 5, row 7 zero: a face's rows that depend on
+    /// others) with a consistent right-hand side r = A x₀: δ solves A δ = r to round-off and lies
+    /// in the row space of A, the two conditions that define the least-norm solution, checked
+    /// with the row space from an SVD of the dense matrix (singular values above 1e-10).
+    #[test]
+    fn a_rank_deficient_consistent_system_gets_its_least_norm_solution() {
+        let (rows, columns) = (30, 80);
+        let entries: Vec<(usize, usize, f64)> = sparse(rows, columns, 7)
+            .into_iter()
+            .filter(|e| e.0 != 6 && e.0 != 7)
+            .flat_map(|e| {
+                let copy = (e.0 == 5).then_some((6, e.1, e.2));
+                std::iter::once(e).chain(copy)
+            })
+            .collect();
+        let mut a = DMatrix::zeros(rows, columns);
+        for &(i, j, v) in &entries {
+            a[(i, j)] = v;
+        }
+        let x0 = DVector::from_fn(columns, |j, _| wobble(31 + j));
+        let r: Vec<f64> = (&a * &x0).iter().copied().collect();
+        let delta = DVector::from_column_slice(
+            &LeastNorm::default()
+                .solve(rows, columns, &entries, &r)
+                .expect("solves"),
+        );
+        let residual = (&a * &delta - DVector::from_column_slice(&r)).amax();
+        assert!(residual <= 1e-13, "residual {residual:e}");
+        let svd = a.svd(false, true);
+        let v_t = svd.v_t.expect("V");
+        let kept: Vec<usize> = (0..svd.singular_values.len())
+            .filter(|&k| svd.singular_values[k] > 1e-10)
+            .collect();
+        assert_eq!(kept.len(), rows - 2, "rank");
+        let mut in_row_space = DVector::zeros(columns);
+        for &k in &kept {
+            let v = v_t.row(k).transpose();
+            in_row_space += &v * v.dot(&delta);
+        }
+        let outside = (&delta - in_row_space).norm();
+        assert!(
+            outside <= 1e-12 * delta.norm(),
+            "{outside:e} of {:e} outside the row space",
+            delta.norm()
+        );
+    }
 }
