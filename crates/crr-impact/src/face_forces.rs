@@ -356,6 +356,22 @@ impl FaceProgram {
         )
     }
 
+    /// `last` (a distribution of this program's length, from another state) plus the least-norm
+    /// change that restores equilibrium with `loads`; None unless the result is in equilibrium to
+    /// [`CARRIED_RESIDUAL`] (or `last` has another length).
+    fn carried(&self, last: &[f64], loads: &[f64], sparse: &mut LeastNorm) -> Option<Vec<f64>> {
+        if last.len() != 1 + self.unknowns.len() {
+            return None;
+        }
+        let mut imbalance = loads.to_vec();
+        for &(row, c, v) in &self.entries {
+            imbalance[row] -= v * last[c];
+        }
+        let change = self.least_norm_change(&imbalance, sparse)?;
+        let carried: Vec<f64> = last.iter().zip(&change).map(|(x, d)| x + d).collect();
+        (self.residual(&carried, loads) <= CARRIED_RESIDUAL).then_some(carried)
+    }
+
     /// The equilibrium rows' entries as (rows, columns, values).
     fn triplets(&self) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
         let rows = self.entries.iter().map(|e| e.0).collect();
@@ -525,25 +541,15 @@ impl RestFaces {
         // In motion: the last distribution plus the least-norm change that restores the
         // equilibrium of the new state (one equality-constrained least-squares solve, cheaper
         // than the program), accepted like a carried one at rest.
-        if let Some(last) = self
+        if let Some(carried) = self
             .last
             .as_ref()
-            .filter(|x| x.len() == 1 + program.unknowns.len())
+            .and_then(|last| program.carried(last, &loads, &mut self.sparse))
+            .filter(|carried| program.smallest(carried) * program.weight >= floor)
         {
-            let mut imbalance = loads.clone();
-            for &(row, c, v) in &program.entries {
-                imbalance[row] -= v * last[c];
-            }
-            if let Some(change) = program.least_norm_change(&imbalance, &mut self.sparse) {
-                let carried: Vec<f64> = last.iter().zip(&change).map(|(x, d)| x + d).collect();
-                if program.residual(&carried, &loads) <= CARRIED_RESIDUAL
-                    && program.smallest(&carried) * program.weight >= floor
-                {
-                    let answer = program.answer(&carried, None);
-                    self.last = Some(carried);
-                    return Some(answer);
-                }
-            }
+            let answer = program.answer(&carried, None);
+            self.last = Some(carried);
+            return Some(answer);
         }
         // A positive cap can leave the interior point without convergence where the optimal
         // distributions form a wide face (the 3D arch once in its 20 s): the program with s ≤ 0
@@ -624,23 +630,16 @@ impl PressingCertificate {
     pub fn holds(&mut self, model: &Model, dynamics: &Dynamics, work: &ForceWork) -> Option<bool> {
         let program = FaceProgram::build(model, dynamics);
         let loads = program.loads(model, dynamics, work)?;
-        let columns = 1 + program.unknowns.len();
-        if let Some(last) = self.last.as_ref().filter(|x| x.len() == columns) {
-            // Any vector of the right length serves as a start: what certifies is the result's
-            // equilibrium and signs, checked here.
-            let mut imbalance = loads.clone();
-            for &(row, c, v) in &program.entries {
-                imbalance[row] -= v * last[c];
-            }
-            if let Some(change) = program.least_norm_change(&imbalance, &mut self.sparse) {
-                let carried: Vec<f64> = last.iter().zip(&change).map(|(x, d)| x + d).collect();
-                if program.residual(&carried, &loads) <= CARRIED_RESIDUAL
-                    && program.smallest(&carried) >= PRESSING_MARGIN
-                {
-                    self.last = Some(carried);
-                    return Some(true);
-                }
-            }
+        // Any vector of the right length serves as a start: what certifies is the result's
+        // equilibrium (checked in `carried`) and signs (here).
+        if let Some(carried) = self
+            .last
+            .as_ref()
+            .and_then(|last| program.carried(last, &loads, &mut self.sparse))
+            .filter(|carried| program.smallest(carried) >= PRESSING_MARGIN)
+        {
+            self.last = Some(carried);
+            return Some(true);
         }
         let (x, _) = program
             .solve(&loads, PRESSING_CAP)

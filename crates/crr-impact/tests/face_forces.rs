@@ -245,6 +245,30 @@ fn mechanism(model: &Model, pivots: &ActivePivots, seated: &[usize]) -> DMatrix<
     crr_dynamics::linalg::null_space(&b)
 }
 
+/// (seated, q̇) families of the 4 × 3 wall's contact tests: every slot seated at rest, then up to
+/// four random seated sets (each slot kept with probability 0.8) moving along the first mode of
+/// the mechanism they leave, scaled to a largest rate of 0.2 rad/s.
+fn seated_families(model: &Model, pivots: &ActivePivots) -> Vec<(Vec<usize>, DVector<f64>)> {
+    let all: Vec<usize> = (0..model.slot_count).collect();
+    let mut cases = vec![(all.clone(), DVector::zeros(model.dof()))];
+    for choice in 0..40 {
+        let seated: Vec<usize> = all
+            .iter()
+            .copied()
+            .filter(|&k| wobble(13 * choice + k) < 0.8)
+            .collect();
+        let modes = mechanism(model, pivots, &seated);
+        if modes.ncols() > 0 {
+            let mode = modes.column(0) / modes.column(0).amax();
+            cases.push((seated, mode * 0.2));
+        }
+        if cases.len() == 5 {
+            break;
+        }
+    }
+    cases
+}
+
 /// The monitor's answer through `faces` (carried where it can be; floor −tolerance/4, cap
 /// tolerance/2, tolerance 1e-3 W) and the program solved afresh at the same state, after
 /// checking that both decide alike (s* below −tolerance/2 or not).
@@ -404,24 +428,7 @@ fn contact_program_decides_as_the_static_theorem() {
     let n = model.dof();
     let zero = DVector::zeros(n);
     let pivots = ActivePivots::uniform(&model, Side::Positive);
-    let all: Vec<usize> = (0..model.slot_count).collect();
-    // (seated, q̇) families: at rest, and moving along the mechanisms of free sets.
-    let mut cases: Vec<(Vec<usize>, DVector<f64>)> = vec![(all.clone(), zero.clone())];
-    for choice in 0..40 {
-        let seated: Vec<usize> = all
-            .iter()
-            .copied()
-            .filter(|&k| wobble(13 * choice + k) < 0.8)
-            .collect();
-        let modes = mechanism(&model, &pivots, &seated);
-        if modes.ncols() > 0 {
-            let mode = modes.column(0) / modes.column(0).amax();
-            cases.push((seated, mode * 0.2));
-        }
-        if cases.len() == 5 {
-            break;
-        }
-    }
+    let cases = seated_families(&model, &pivots);
     let (mut held, mut opened, mut undecided) = (0, 0, 0);
     for (seated, qdot) in &cases {
         for step in 0..=120 {
@@ -487,23 +494,7 @@ fn the_pressing_certificate_holds_only_where_the_contact_program_opens_nothing()
     let n = model.dof();
     let zero = DVector::zeros(n);
     let pivots = ActivePivots::uniform(&model, Side::Positive);
-    let all: Vec<usize> = (0..model.slot_count).collect();
-    let mut cases: Vec<(Vec<usize>, DVector<f64>)> = vec![(all.clone(), zero.clone())];
-    for choice in 0..40 {
-        let seated: Vec<usize> = all
-            .iter()
-            .copied()
-            .filter(|&k| wobble(13 * choice + k) < 0.8)
-            .collect();
-        let modes = mechanism(&model, &pivots, &seated);
-        if modes.ncols() > 0 {
-            let mode = modes.column(0) / modes.column(0).amax();
-            cases.push((seated, mode * 0.2));
-        }
-        if cases.len() == 5 {
-            break;
-        }
-    }
+    let cases = seated_families(&model, &pivots);
     let (mut holds, mut fails) = (0, 0);
     for (seated, qdot) in &cases {
         let mut certificate = PressingCertificate::default();
