@@ -246,8 +246,9 @@ fn selected_rows_agree_with_the_svd_on_a_planar_row_of_loops() {
 /// constrain every free coordinate (r = n_f) and most rows depend on them (a hyperstatic wall:
 /// on the 4 × 3 wall B has 56 rows, the loops' and the seated slots', of rank r = n_f = 14, and
 /// 21 of the dependent rows are not zero rows), where the
-/// minimum-norm multipliers come from BᵀB instead of I + C Cᵀ over the dependent rows. Same q̈
-/// and λ as the SVD, and the selected rows reused.
+/// minimum-norm multipliers come from BᵀB instead of I + C Cᵀ over the dependent rows, and the
+/// dependent rows' part outside the selected ones' span is zero by dimension (not computed). Same
+/// q̈ and λ as the SVD, and the selected rows reused.
 #[test]
 fn selected_rows_agree_with_the_svd_on_a_wall_held_on_every_seat() {
     let spec = crr_kinematics::fixtures::running_bond_wall(4, 3, 0.6, 0.25, 0.3);
