@@ -514,22 +514,45 @@ impl Simulation<'_> {
         let (mut qdot_after, mut t_plus) =
             plastic_projection(model, &mut work, self.ground, t, &q, &qdot, &pivots, &held)?;
         // The landing slots' angles and rates: a slot brought to rest, or sent into its closed
-        // side, seats (as at an impact).
+        // side, seats (as at an impact). So does a joint rocking at φ ≈ 0 that the landing
+        // locks (a block rocking on one support whose face lands on its other: the closed loop
+        // leaves it no motion, its rate round-off). Left unseated, at an angle of round-off
+        // and no rate, it kept the structure out of the test at rest with every joint seated,
+        // and so out of the collapse multiplier's decision: the 6 × 6 wall of
+        // `examples/wall_pulse.rs` under 1.5 λ g stayed at rest from 0.346 s under 0.81 g,
+        // λ = 0.58. Seating one joint can lock others: seat, recompute the rates, until nothing
+        // changes.
         let mut angles = vec![0.0; model.slot_count];
         slot_angles(model, &mut kin, &q, &pivots, &mut angles);
         crr_kinematics::velocities(model, &mut kin, &qdot_after);
         let mut rates = vec![0.0; model.slot_count];
         slot_rates(model, &kin, &qdot_after, &mut rates);
-        let to_seat: Vec<usize> = slots
-            .iter()
-            .copied()
+        let locked_rate = LOCKED_RATE * (model.gravity / model.size).sqrt();
+        let candidates: Vec<usize> = (0..model.slot_count)
             .filter(|&s| {
-                angles[s].abs() <= self.params.simultaneity
-                    && (rates[s].abs() < self.params.seat_rate
-                        || pivots.sides[s].sign() * rates[s] < 0.0)
+                (slots.contains(&s) || !self.seated[s])
+                    && angles[s].abs() <= self.params.simultaneity
             })
             .collect();
-        if !to_seat.is_empty() {
+        let mut to_seat: Vec<usize> = Vec::new();
+        loop {
+            let pending: Vec<usize> = candidates
+                .iter()
+                .copied()
+                .filter(|&s| {
+                    !to_seat.contains(&s)
+                        && if slots.contains(&s) {
+                            rates[s].abs() < self.params.seat_rate
+                                || pivots.sides[s].sign() * rates[s] < 0.0
+                        } else {
+                            rates[s].abs() <= locked_rate
+                        }
+                })
+                .collect();
+            if pending.is_empty() {
+                break;
+            }
+            to_seat.extend(pending);
             let all: Vec<usize> = held.iter().chain(&to_seat).copied().collect();
             (qdot_after, t_plus) = plastic_projection(
                 model,
@@ -548,6 +571,28 @@ impl Simulation<'_> {
         // evaluated at the landing with the slots seated after it.
         self.check_impulse(&work, &q, (&pivots, &qdot), &qdot_after);
         self.spare.trial = Some(work);
+        // The joints the landing locked go to exactly 0, as those an impact seats do: their
+        // angles are round-off within `simultaneity`, where the outputs read a seated joint at
+        // 0. The change of T + U is a snap.
+        let locked: Vec<usize> = to_seat
+            .iter()
+            .copied()
+            .filter(|s| !slots.contains(s))
+            .collect();
+        if !locked.is_empty() {
+            let before = state_energies(model, &mut kin, &pivots, &q, &qdot_after);
+            let after = snap_to_seats(
+                model,
+                &mut kin,
+                &pivots,
+                &mut q,
+                &mut qdot_after,
+                |k| locked.contains(&k),
+                |k| held.contains(&k) || to_seat.contains(&k),
+            )
+            .map_err(|source| SimulationError::Dynamics { t, source })?;
+            self.book_snap((before.0 + before.1) - (after.0 + after.1));
+        }
         self.y[..n].copy_from_slice(q.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot_after.as_slice());
         let lost = t_minus - t_plus;
@@ -775,6 +820,12 @@ impl Simulation<'_> {
 /// velocity ω = ω_c − ω_p, in the parent's rest frame Γ_pᵀω = θ̇₁a₁ (+ θ̇₂a₂): a₁ = u for a
 /// hinge (θ̇ = uᵀΓ_pᵀω), a₁ = e₁ and a₂ = R(e₁, θ₁)e₂ for a rocking base (least squares: an open
 /// face turns freely, also about its normal). `kin` holds the chain's poses and velocities.
+/// A rate below this (in √(g/L)) is round-off: a joint rocking at φ ≈ 0 that a landing leaves
+/// with it is locked by the loops the landing closed, and seats with the landing
+/// ([`Simulation::recontact`]). Far below the seat rate of an impact (1e-4 rad/s), which would
+/// stop joints that are still turning slowly.
+const LOCKED_RATE: f64 = 1e-9;
+
 fn open_face_motion(
     model: &Model,
     kin: &Data,
