@@ -537,6 +537,56 @@ pub fn pivot_columns(a: &DMatrix<f64>, r: usize) -> Vec<usize> {
     chosen
 }
 
+/// Chooses columns of A while one is left whose part outside the span of those chosen is longer
+/// than `threshold`, the longest first (the first among equals). Returns them in the order
+/// chosen.
+///
+/// The same Gram–Schmidt with column pivoting as [`pivot_columns`], operation for operation, so
+/// that where [`pivot_columns`] is given the rank this one finds, both choose the same columns.
+/// It stops on the residual norm rather than at a given rank, and a column whose residual has
+/// fallen to the threshold is dropped for good (projections only shorten it), so that the rows
+/// of a hyperstatic structure that are dependent (most of them) cost nothing once found:
+/// O(m n r) for A of n × m and r columns chosen, against an SVD's several sweeps of O(m n²). A
+/// choice for a caller to certify, not itself a rank decision.
+pub fn pivot_columns_above(a: &DMatrix<f64>, threshold: f64) -> Vec<usize> {
+    let m = a.ncols();
+    let mut work = a.clone();
+    let mut chosen = Vec::new();
+    // Chosen or dropped: out of the search and of the projections.
+    let mut out = vec![false; m];
+    while chosen.len() < a.nrows() {
+        let mut best = (usize::MAX, -1.0);
+        for j in 0..m {
+            if out[j] {
+                continue;
+            }
+            let norm = work.column(j).norm();
+            if norm.is_nan() || norm <= threshold {
+                out[j] = true;
+            } else if norm > best.1 {
+                best = (j, norm);
+            }
+        }
+        let (best, norm) = best;
+        if best == usize::MAX {
+            break;
+        }
+        out[best] = true;
+        chosen.push(best);
+        let q = work.column(best) / norm;
+        for j in 0..m {
+            if out[j] {
+                continue;
+            }
+            let d = q.dot(&work.column(j));
+            let qd = &q * d;
+            let mut col = work.column_mut(j);
+            col -= qd;
+        }
+    }
+    chosen
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -778,5 +828,63 @@ mod tests {
         let (x, r) = pinv_solve(&a, &DVector::from_vec(vec![5.0, 1.0, 5.0]));
         assert_eq!(r, 2);
         assert!((&a * &x - DVector::from_vec(vec![5.0, 1.0, 5.0])).norm() < 1e-12);
+    }
+
+    #[test]
+    fn columns_chosen_above_a_threshold_span_the_rest_to_it() {
+        // 12 columns in R⁵ from 4 random independent ones (seeded): copies, sums, a scaled copy,
+        // a zero column and one 1e-10 off a sum. With the threshold 1e-7 (above the perturbation,
+        // far below the independent ones' residuals, which are O(1)) 4 are chosen; every column
+        // lies within the threshold of their span and the chosen ones are independent, both
+        // checked by nalgebra's own SVD and least squares (not the Gram–Schmidt under test); and
+        // they are the columns `pivot_columns` chooses given that rank.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let base = DMatrix::from_fn(5, 4, |_, _| uniform());
+        let mut a = DMatrix::zeros(5, 12);
+        let combos: [[f64; 4]; 12] = [
+            [1.0, 0.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 1.0, 1.0, 0.0],
+            [0.5, 0.0, 0.0, 3.0],
+            [0.0, 0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0, 1.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [1.0, -1.0, 0.0, 0.0],
+        ];
+        for (j, c) in combos.iter().enumerate() {
+            a.set_column(j, &(&base * DVector::from_row_slice(c)));
+        }
+        a[(2, 9)] += 1e-10;
+        let threshold = 1e-7;
+        let chosen = pivot_columns_above(&a, threshold);
+        assert_eq!(chosen.len(), 4, "{chosen:?}");
+        assert_eq!(chosen, pivot_columns(&a, 4));
+        let s = DMatrix::from_fn(5, 4, |i, k| a[(i, chosen[k])]);
+        let sv = s.clone().svd(true, true);
+        assert!(sv.singular_values.min() > 1e-3, "{}", sv.singular_values);
+        for j in 0..12 {
+            let x = sv.solve(&a.column(j).into_owned(), 1e-12).unwrap();
+            let residual = (&s * x - a.column(j)).norm();
+            assert!(residual <= threshold, "column {j}: {residual:e}");
+        }
+        // The first column chosen is the longest.
+        let longest = (0..12)
+            .max_by(|&i, &j| a.column(i).norm().total_cmp(&a.column(j).norm()))
+            .unwrap();
+        assert_eq!(chosen[0], longest);
+        // Nothing above a threshold larger than every column; all five directions below the
+        // perturbation.
+        assert!(pivot_columns_above(&a, 1e3).is_empty());
+        assert_eq!(pivot_columns_above(&a, 1e-13).len(), 5);
     }
 }

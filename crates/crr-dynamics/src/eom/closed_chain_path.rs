@@ -145,20 +145,34 @@ impl Dynamics {
             .position(|sel| sel.rows == rows && sel.free == nf && sel.seated == self.seated);
         let mut dz = DVector::zeros(nf);
         let mut lambda_scaled = DVector::zeros(rows);
-        let fast = match (cached, self.closed_chain_solve) {
-            (Some(c), ClosedChainSolve::SelectedRows) => solve_selected_rows(
-                &mut self.rows_work,
+        let mut solve_on = |rows_work: &mut SelectedRowsWork, selected: &[usize]| {
+            solve_selected_rows(
+                rows_work,
                 &self.rows_b,
                 &residual,
-                &self.selections[c].selected,
+                selected,
                 RANK_TOLERANCE.sqrt(),
                 floor,
                 self.min_norm_multipliers,
                 &mut dz,
                 &mut lambda_scaled,
-            ),
-            _ => false,
+            )
         };
+        let mut fast = false;
+        if self.closed_chain_solve == ClosedChainSolve::SelectedRows {
+            fast =
+                cached.is_some_and(|c| solve_on(&mut self.rows_work, &self.selections[c].selected));
+            if !fast && cached.is_none() {
+                // A new seated set: rows chosen by Gram–Schmidt with pivoting against the same
+                // threshold, kept if the solve certifies them; the SVD only where it does not.
+                let threshold = (RANK_TOLERANCE.sqrt() * self.rows_b.norm()).max(floor);
+                let selected = pivot_columns_above(&self.rows_b.dense_transposed(), threshold);
+                fast = solve_on(&mut self.rows_work, &selected);
+                if fast {
+                    self.remember_selection(None, rows, nf, selected);
+                }
+            }
+        }
         self.used_selected = fast;
         if !fast {
             let bt = self.rows_b.dense_transposed();
@@ -170,22 +184,7 @@ impl Dynamics {
             lambda_scaled = svd.solve_transposed_with(&dz, tol);
             if self.closed_chain_solve == ClosedChainSolve::SelectedRows {
                 let rank = svd.singular_values.iter().filter(|s| **s > tol).count();
-                let selection = RowSelection {
-                    rows,
-                    free: nf,
-                    seated: self.seated.clone(),
-                    selected: pivot_columns(&bt, rank),
-                };
-                match cached {
-                    Some(c) => self.selections[c] = selection,
-                    None if self.selections.len() < SELECTION_CACHE => {
-                        self.selections.push(selection);
-                    }
-                    None => {
-                        self.selections[self.next_evicted] = selection;
-                        self.next_evicted = (self.next_evicted + 1) % SELECTION_CACHE;
-                    }
-                }
+                self.remember_selection(cached, rows, nf, pivot_columns(&bt, rank));
             }
         }
         self.z += &dz;
@@ -223,6 +222,32 @@ impl Dynamics {
     /// of its two frames to the ground, a symmetry row on its two coordinates), then the rate
     /// rows of the seated slots held by rows (a tree coordinate's eₖ, a closure angle's on its
     /// interface's frame paths). Their right-hand sides into `bias` when `with_bias`.
+    /// Keeps the rows `selected` for the current seated set, in place of the selection at
+    /// `cached` (one that failed), or as a new entry (the oldest evicted once the cache is
+    /// full).
+    fn remember_selection(
+        &mut self,
+        cached: Option<usize>,
+        rows: usize,
+        free: usize,
+        selected: Vec<usize>,
+    ) {
+        let selection = RowSelection {
+            rows,
+            free,
+            seated: self.seated.clone(),
+            selected,
+        };
+        match cached {
+            Some(c) => self.selections[c] = selection,
+            None if self.selections.len() < SELECTION_CACHE => self.selections.push(selection),
+            None => {
+                self.selections[self.next_evicted] = selection;
+                self.next_evicted = (self.next_evicted + 1) % SELECTION_CACHE;
+            }
+        }
+    }
+
     fn gather_rows(&mut self, model: &Model, with_bias: bool, bias: &mut DVector<f64>) {
         let n = model.dof();
         self.rows_full.clear(n);

@@ -28,7 +28,10 @@ use crr_kinematics::{
 
 use crate::articulated_body::ArticulatedBody;
 use crate::ground_motion::GroundMotion;
-use crate::linalg::{JacobiSvd, RANK_TOLERANCE, cholesky_in_place, cholesky_solve, pivot_columns};
+use crate::linalg::{
+    JacobiSvd, RANK_TOLERANCE, cholesky_in_place, cholesky_solve, pivot_columns,
+    pivot_columns_above,
+};
 use crate::single_coordinate;
 use crate::sparse_cholesky::SparseCholesky;
 

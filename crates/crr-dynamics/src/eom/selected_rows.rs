@@ -1,6 +1,6 @@
-//! The solve on selected rows: independent rows S of B chosen once by the SVD, then Gauss'
-//! principle through the Cholesky factor of B_S B_Sᵀ while the SVD would make the same rank
-//! decision.
+//! The solve on selected rows: independent rows S of B chosen once per seated set (by
+//! Gram–Schmidt with pivoting, the SVD where that choice is not certified), then Gauss' principle
+//! through the Cholesky factor of B_S B_Sᵀ while the SVD would make the same rank decision.
 
 use super::*;
 
