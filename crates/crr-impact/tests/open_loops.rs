@@ -761,7 +761,8 @@ fn a_landing_whose_impulse_pulls_is_recorded() {
 /// program on the model, and the kinetic energy of the samples (from the bodies' velocities):
 /// wherever two consecutive samples are at rest, the load at the first is within the multiplier
 /// along its direction (a structure leaving rest does so from a sample at rest, so one sample
-/// alone may be at rest above λ).
+/// alone may be at rest above λ); the check meets rests after the landing, and the landing's
+/// record names a seated joint beyond its own slots.
 #[test]
 fn a_wall_at_rest_after_a_landing_leaves_rest_under_a_load_above_its_multiplier() {
     use crr_impact::statics::{StaticsOptions, collapse_multiplier};
@@ -784,9 +785,12 @@ fn a_wall_at_rest_after_a_landing_leaves_rest_under_a_load_above_its_multiplier(
             "{n} × {n}: the wedge lands at {landing} s"
         );
         let samples: Vec<Sample> = traj.samples.iter().collect();
-        let mut checked = 0;
+        let (mut checked, mut after_landing) = (0, 0);
         for pair in samples.windows(2) {
             if pair[1].t > pair[0].t && at_rest(&pair[0]) && at_rest(&pair[1]) {
+                if pair[0].t > landing {
+                    after_landing += 1;
+                }
                 let a = ground.acceleration(pair[0].t).x / model.gravity;
                 let limit = if a >= 0.0 { plus } else { minus };
                 assert!(
@@ -798,7 +802,20 @@ fn a_wall_at_rest_after_a_landing_leaves_rest_under_a_load_above_its_multiplier(
                 checked += 1;
             }
         }
-        // The wall rests before the pulse reaches λ g.
+        // The wall rests before the pulse reaches λ g, and again after the landing (where a
+        // landing that seated no joint of its own is what the check is about).
         assert!(checked > 5, "{n} × {n}: {checked} pairs of samples at rest");
+        assert!(
+            after_landing > 10,
+            "{n} × {n}: {after_landing} pairs at rest after the landing"
+        );
+        // The landing seats a joint other than its own slots: one it locked.
+        assert!(
+            traj.impacts
+                .iter()
+                .any(|i| (i.t - landing).abs() < 1e-4
+                    && i.seated.iter().any(|s| !i.slots.contains(s))),
+            "{n} × {n}: the landing seated no joint it locked"
+        );
     }
 }

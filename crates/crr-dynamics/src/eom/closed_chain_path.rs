@@ -217,11 +217,6 @@ impl Dynamics {
         self.check_finite(t)
     }
 
-    /// The constraint rows over every coordinate into `rows_full`, each on its structural
-    /// pattern (columns ascending): the row-scaled rows of Φ_q (a closure's rows on the paths
-    /// of its two frames to the ground, a symmetry row on its two coordinates), then the rate
-    /// rows of the seated slots held by rows (a tree coordinate's eₖ, a closure angle's on its
-    /// interface's frame paths). Their right-hand sides into `bias` when `with_bias`.
     /// Keeps the rows `selected` for the current seated set, in place of the selection at
     /// `cached` (one that failed), or as a new entry (the oldest evicted once the cache is
     /// full).
@@ -248,6 +243,11 @@ impl Dynamics {
         }
     }
 
+    /// The constraint rows over every coordinate into `rows_full`, each on its structural
+    /// pattern (columns ascending): the row-scaled rows of Φ_q (a closure's rows on the paths
+    /// of its two frames to the ground, a symmetry row on its two coordinates), then the rate
+    /// rows of the seated slots held by rows (a tree coordinate's eₖ, a closure angle's on its
+    /// interface's frame paths). Their right-hand sides into `bias` when `with_bias`.
     fn gather_rows(&mut self, model: &Model, with_bias: bool, bias: &mut DVector<f64>) {
         let n = model.dof();
         self.rows_full.clear(n);

@@ -183,6 +183,11 @@ pub(crate) fn solve_selected_rows(
     let (nf, m) = (b.cols, b.rows());
     let r = selected.len();
     let b_norm = b.norm();
+    // A NaN or an infinity in B: the SVD reports it (a non-finite solve); an infinite
+    // threshold would certify the empty selection, a NaN norm would fall back to the floor.
+    if !b_norm.is_finite() {
+        return false;
+    }
     let threshold = (relative * b_norm).max(floor);
     work.is_selected.clear();
     work.is_selected.resize(m, false);

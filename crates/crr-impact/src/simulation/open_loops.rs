@@ -573,7 +573,9 @@ impl Simulation<'_> {
         self.spare.trial = Some(work);
         // The joints the landing locked go to exactly 0, as those an impact seats do: their
         // angles are round-off within `simultaneity`, where the outputs read a seated joint at
-        // 0. The change of T + U is a snap.
+        // 0. The joints seated before stay at their seats (never freed, their closure angles
+        // held) and the landing slots where they land, as an impact's impacting slots. The
+        // change of T + U is a snap.
         let locked: Vec<usize> = to_seat
             .iter()
             .copied()
@@ -587,8 +589,8 @@ impl Simulation<'_> {
                 &pivots,
                 &mut q,
                 &mut qdot_after,
-                |k| locked.contains(&k),
-                |k| held.contains(&k) || to_seat.contains(&k),
+                |k| held.contains(&k) || locked.contains(&k),
+                |k| to_seat.contains(&k),
             )
             .map_err(|source| SimulationError::Dynamics { t, source })?;
             self.book_snap((before.0 + before.1) - (after.0 + after.1));
@@ -815,17 +817,17 @@ impl Simulation<'_> {
     }
 }
 
-/// The angles of the relative rotation of an open interface's child to its parent (the file's
-/// convention, [`crr_kinematics::relative_angles`]) and their rates from the relative angular
-/// velocity ω = ω_c − ω_p, in the parent's rest frame Γ_pᵀω = θ̇₁a₁ (+ θ̇₂a₂): a₁ = u for a
-/// hinge (θ̇ = uᵀΓ_pᵀω), a₁ = e₁ and a₂ = R(e₁, θ₁)e₂ for a rocking base (least squares: an open
-/// face turns freely, also about its normal). `kin` holds the chain's poses and velocities.
 /// A rate below this (in √(g/L)) is round-off: a joint rocking at φ ≈ 0 that a landing leaves
 /// with it is locked by the loops the landing closed, and seats with the landing
 /// ([`Simulation::recontact`]). Far below the seat rate of an impact (1e-4 rad/s), which would
 /// stop joints that are still turning slowly.
 const LOCKED_RATE: f64 = 1e-9;
 
+/// The angles of the relative rotation of an open interface's child to its parent (the file's
+/// convention, [`crr_kinematics::relative_angles`]) and their rates from the relative angular
+/// velocity ω = ω_c − ω_p, in the parent's rest frame Γ_pᵀω = θ̇₁a₁ (+ θ̇₂a₂): a₁ = u for a
+/// hinge (θ̇ = uᵀΓ_pᵀω), a₁ = e₁ and a₂ = R(e₁, θ₁)e₂ for a rocking base (least squares: an open
+/// face turns freely, also about its normal). `kin` holds the chain's poses and velocities.
 fn open_face_motion(
     model: &Model,
     kin: &Data,
