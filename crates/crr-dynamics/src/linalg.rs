@@ -509,52 +509,37 @@ pub fn rank(a: &DMatrix<f64>) -> usize {
 }
 
 /// Chooses `r` columns of A that are as independent as possible (Gram–Schmidt with column
-/// pivoting: each time the column with the largest remaining norm). Returns them in the order
-/// chosen.
+/// pivoting: each time the column with the largest remaining norm, the first among equals).
+/// Returns them in the order chosen.
 pub fn pivot_columns(a: &DMatrix<f64>, r: usize) -> Vec<usize> {
-    let mut work = a.clone();
-    let mut chosen = Vec::with_capacity(r);
-    for _ in 0..r {
-        let (best, norm) = (0..work.ncols())
-            .filter(|j| !chosen.contains(j))
-            .map(|j| (j, work.column(j).norm()))
-            .fold(
-                (usize::MAX, -1.0),
-                |acc, x| if x.1 > acc.1 { x } else { acc },
-            );
-        if best == usize::MAX || norm <= 0.0 {
-            break;
-        }
-        chosen.push(best);
-        let q = work.column(best) / norm;
-        for j in 0..work.ncols() {
-            let d = q.dot(&work.column(j));
-            let qd = &q * d;
-            let mut col = work.column_mut(j);
-            col -= qd;
-        }
-    }
-    chosen
+    gram_schmidt_pivoting(a, r, 0.0)
 }
 
 /// Chooses columns of A while one is left whose part outside the span of those chosen is longer
 /// than `threshold`, the longest first (the first among equals). Returns them in the order
 /// chosen.
 ///
-/// The same Gram–Schmidt with column pivoting as [`pivot_columns`], operation for operation, so
-/// that where [`pivot_columns`] is given the rank this one finds, both choose the same columns.
-/// It stops on the residual norm rather than at a given rank, and a column whose residual has
-/// fallen to the threshold is dropped for good (projections only shorten it), so that the rows
-/// of a hyperstatic structure that are dependent (most of them) cost nothing once found:
-/// O(m n r) for A of n × m and r columns chosen, against an SVD's several sweeps of O(m n²). A
-/// choice for a caller to certify, not itself a rank decision.
+/// The Gram–Schmidt of [`pivot_columns`], stopping on the residual norm rather than at a given
+/// rank: where [`pivot_columns`] is given the rank this one finds, both choose the same
+/// columns. O(m n r) for A of n × m and r columns chosen, against an SVD's several sweeps of
+/// O(m n²). A choice for a caller to certify, not itself a rank decision.
 pub fn pivot_columns_above(a: &DMatrix<f64>, threshold: f64) -> Vec<usize> {
+    gram_schmidt_pivoting(a, a.nrows(), threshold)
+}
+
+/// Gram–Schmidt with column pivoting on A: at most `most` columns, each the longest remaining
+/// (the first among equals) while it is longer than `threshold` (≥ 0). A column whose residual
+/// has fallen to the threshold is dropped for good (projections only shorten it), so that the
+/// columns that are dependent (most rows of a hyperstatic structure's B) cost nothing once
+/// found; a dropped or chosen column is left out of the projections, which changes nothing in
+/// the others'.
+fn gram_schmidt_pivoting(a: &DMatrix<f64>, most: usize, threshold: f64) -> Vec<usize> {
     let m = a.ncols();
     let mut work = a.clone();
     let mut chosen = Vec::new();
     // Chosen or dropped: out of the search and of the projections.
     let mut out = vec![false; m];
-    while chosen.len() < a.nrows() {
+    while chosen.len() < most.min(a.nrows()) {
         let mut best = (usize::MAX, -1.0);
         for j in 0..m {
             if out[j] {
