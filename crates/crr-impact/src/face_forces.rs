@@ -96,12 +96,17 @@ pub fn most_compressive(
 /// none), on the touching points of the state in `dynamics` (its kinematics, seated slots and
 /// pivots, as [`most_compressive`]). `min_normal` is then in N s: below 0 when the contacts can
 /// give that change only by pulling somewhere. None when the program does not solve.
+///
+/// The interfaces listed in `set_by_law` (those of an impact whose law sets their rates, the
+/// restitution and Dirac laws) take on their whole face whatever impulse the law needs, of
+/// either sign: the law's own hypothesis, not checked. Only the other contacts are.
 pub fn most_compressive_impulses(
     model: &Model,
     dynamics: &Dynamics,
     momentum_change: &[(Vector3<f64>, Vector3<f64>)],
+    set_by_law: &[usize],
 ) -> Option<MostCompressive> {
-    let program = FaceProgram::build(model, dynamics);
+    let program = FaceProgram::build_setting(model, dynamics, set_by_law);
     // Impulses in W·√(L/g), the structure's weight over its time unit, so that the program's
     // unknowns are of order one as its forces are (its tolerances and proximal term assume it).
     let time = (model.size / model.gravity).sqrt();
@@ -140,6 +145,12 @@ struct FaceProgram {
 
 impl FaceProgram {
     fn build(model: &Model, dynamics: &Dynamics) -> FaceProgram {
+        Self::build_setting(model, dynamics, &[])
+    }
+
+    /// [`Self::build`] with the interfaces `set_by_law` joined through the whole face: every
+    /// point of it touches (as if seated) and carries a normal force of either sign.
+    fn build_setting(model: &Model, dynamics: &Dynamics, set_by_law: &[usize]) -> FaceProgram {
         let size = model.size;
         let mut is_seated = vec![false; model.slot_count];
         for &k in &dynamics.seated {
@@ -156,9 +167,15 @@ impl FaceProgram {
                 rot * face.tangents[0],
                 rot * face.tangents[1],
             ];
+            let by_law = set_by_law.contains(&index);
+            let whole_face = vec![true; iface.slots.len()];
             let points = touching_points(
                 &iface.kind,
-                &is_seated[iface.slots.clone()],
+                if by_law {
+                    &whole_face
+                } else {
+                    &is_seated[iface.slots.clone()]
+                },
                 dynamics.pivots.of_interface(model, index),
             );
             let twist = matches!(iface.kind, InterfaceKind::RockingBase { twist: true, .. });
@@ -170,7 +187,7 @@ impl FaceProgram {
                     &axes[..]
                 };
                 for (k, &direction) in along.iter().enumerate() {
-                    if k == 0 && !face.pin {
+                    if k == 0 && !face.pin && !by_law {
                         unilateral.push(1 + unknowns.len());
                     }
                     unknowns.push(Unknown {

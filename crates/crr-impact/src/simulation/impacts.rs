@@ -372,24 +372,37 @@ impl Simulation<'_> {
         )
         .map_err(|source| SimulationError::Dynamics { t, source })?;
         // Whether the impact's whole impulse pulls at a contact (module `landing_check`), on
-        // the chain after it: its new pivots, the joints seated through it or at it. Asked of
-        // the momentum law (the law applied when any impacting interface uses it), whose
-        // impulse acts at the new pivots; the restitution and Dirac laws set the impacting
-        // rates, not an impulse at a point.
+        // the chain after it: its new pivots, the joints seated through it or at it. The
+        // momentum law (applied when any impacting interface uses it) acts at the new pivots,
+        // which are checked with the rest. The restitution and Dirac laws set the impacting
+        // rates, not an impulse at a point: the impacting interfaces then take whatever impulse
+        // the law needs on their faces (its own hypothesis), and the contacts the impact holds
+        // besides (seated joints, other pivots, loops) are checked.
         let momentum_law = impacting.iter().any(|&s| {
             matches!(
                 model.interfaces[slot_interface(model, s)].impact,
                 ImpactLaw::Momentum
             )
         });
-        if momentum_law && self.violation.is_none() {
+        if self.violation.is_none() {
+            let set_by_law: Vec<usize> = if momentum_law {
+                Vec::new()
+            } else {
+                let mut interfaces: Vec<usize> = impacting
+                    .iter()
+                    .map(|&s| slot_interface(model, s))
+                    .collect();
+                interfaces.sort_unstable();
+                interfaces.dedup();
+                interfaces
+            };
             work.pivots.clone_from(&after);
             work.seated.clear();
             work.seated.extend(held.iter().chain(&to_seat).copied());
             work.seated.sort_unstable();
             work.seated.dedup();
             work.evaluate(model, self.ground, t, &q_at, &qdot_after);
-            self.check_impulse(&work, &q_at, (&before, &qdot), &qdot_after);
+            self.check_impulse(&work, &q_at, (&before, &qdot), &qdot_after, &set_by_law);
         }
         let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;

@@ -13,6 +13,11 @@
 //! hypothesis violation (`impulse_tension`). The run goes on with the impulse as it was: the
 //! check records, it changes nothing.
 //!
+//! The restitution and Dirac laws set the impacting joints' rates, not an impulse at a point:
+//! the impulse their faces take is the law's hypothesis. Their impacting interfaces then take an
+//! impulse of either sign on their whole face (`set_by_law`), and the contacts the impact holds
+//! besides are checked.
+//!
 //! The same question, posed as Moreau's inelastic impact ([`super::impulse_qp`], the contact
 //! program one level down), answers "holds" exactly where the linear program finds a
 //! compressive distribution (the unit test below, on 400 random impacts). The motion that
@@ -33,18 +38,28 @@ impl Simulation<'_> {
     /// compressive distribution of the contact impulses over the touching points after it
     /// ([`least_tension`]) has a normal impulse below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g).
     /// The record names the contact that limits it, with that impulse (N s) as its `normal`.
+    /// The interfaces `set_by_law` (an impact's whose law sets the rates) take any impulse on
+    /// their face: only the other contacts are checked.
     pub(super) fn check_impulse(
         &mut self,
         d: &Dynamics,
         q: &DVector<f64>,
         (pivots_before, qdot_minus): (&ActivePivots, &DVector<f64>),
         qdot_after: &DVector<f64>,
+        set_by_law: &[usize],
     ) {
         if self.violation.is_some() {
             return;
         }
         let model = Arc::clone(&self.model);
-        let least = least_tension(&model, d, q, (pivots_before, qdot_minus), qdot_after);
+        let least = least_tension(
+            &model,
+            d,
+            q,
+            (pivots_before, qdot_minus),
+            qdot_after,
+            set_by_law,
+        );
         self.record_impulse_tension(&model, least);
     }
 
@@ -82,13 +97,15 @@ impl Simulation<'_> {
 
 /// The most compressive distribution of the contact impulses that take the bodies from
 /// `qdot_minus` to `qdot_after` (their momentum changes from their own velocities, ċ = J_c q̇
-/// and ω = J_ω q̇) on the touching points of the state in `d` (evaluated at q).
+/// and ω = J_ω q̇) on the touching points of the state in `d` (evaluated at q), the interfaces
+/// `set_by_law` taking any impulse on their face.
 fn least_tension(
     model: &Model,
     d: &Dynamics,
     q: &DVector<f64>,
     (pivots_before, qdot_minus): (&ActivePivots, &DVector<f64>),
     qdot_after: &DVector<f64>,
+    set_by_law: &[usize],
 ) -> Option<crate::face_forces::MostCompressive> {
     let velocities = |pivots: &ActivePivots, qdot: &DVector<f64>| {
         let mut kin = Data::new(model);
@@ -112,7 +129,7 @@ fn least_tension(
             )
         })
         .collect();
-    crate::face_forces::most_compressive_impulses(model, d, &changes)
+    crate::face_forces::most_compressive_impulses(model, d, &changes, set_by_law)
 }
 
 #[cfg(test)]
@@ -175,8 +192,8 @@ mod tests {
             let decision = impulse_qp(&model, &d, &qdot).expect("the impulse program solves");
             let momentum = &d.kin.mass_matrix * &qdot;
             let after = d.solve_impulse(&model, 0.0, &momentum).unwrap().clone();
-            let lp =
-                least_tension(&model, &d, &q, (&d.pivots, &qdot), &after).expect("the LP solves");
+            let lp = least_tension(&model, &d, &q, (&d.pivots, &qdot), &after, &[])
+                .expect("the LP solves");
             let s = lp.min_normal / unit;
             if decision.releases.is_empty() && decision.lifting_off.is_empty() {
                 holds += 1;

@@ -569,7 +569,7 @@ impl Simulation<'_> {
         }
         // Whether the landing's impulse pulls at a contact (module `landing_check`): `work` is
         // evaluated at the landing with the slots seated after it.
-        self.check_impulse(&work, &q, (&pivots, &qdot), &qdot_after);
+        self.check_impulse(&work, &q, (&pivots, &qdot), &qdot_after, &[]);
         self.spare.trial = Some(work);
         // The joints the landing locked go to exactly 0, as those an impact seats do: their
         // angles are round-off within `simultaneity`, where the outputs read a seated joint at
