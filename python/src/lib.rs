@@ -22,7 +22,7 @@ use crr::dynamics::ground_motion::{Axis, Record, RecordFormat, Units};
 use crr::impact::{SlotState, Trajectory};
 use crr::input::model_file::{ModelFile, build_model, load_model, parse_model_text};
 use crr::kinematics::Model as Structure;
-use crr::output::history::{history_csv, impacts_csv};
+use crr::output::history::{history_csv, impacts_csv, openings_csv};
 use crr::output::study::folder::header;
 use crr::output::study::{StudyOptions, case_rows_cancellable, cases_csv, run_study};
 use crr::{ModelInput, RecordFile, RecordSamples, RunOptions};
@@ -343,6 +343,12 @@ impl PyRun {
     /// The text of impacts.csv, as `crr simulate` writes it.
     fn impacts_csv(&self) -> String {
         impacts_csv(&self.trajectory)
+    }
+
+    /// The text of openings.csv, as `crr simulate` writes it: the offset of every face open at
+    /// a row of history.csv (the header alone when no face lifts off).
+    fn openings_csv(&self) -> String {
+        openings_csv(&self.structure, &self.trajectory)
     }
 }
 

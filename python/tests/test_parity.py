@@ -33,6 +33,7 @@ def assert_same_run(result: crr.Result, out: Path) -> None:
     history = (out / "history.csv").read_text()
     assert result.history_csv() == history
     assert result.impacts_csv() == (out / "impacts.csv").read_text()
+    assert result.openings_csv() == (out / "openings.csv").read_text()
     summary = json.loads((out / "summary.json").read_text())
     assert result.summary == summary
     dof = len(result.coordinates)
@@ -116,6 +117,32 @@ def test_a_record_from_arrays_equals_the_same_numbers_in_a_csv_file(cli, in_root
     got = dict(result.summary)
     assert got.pop("record") is None
     assert got == summary
+
+
+def test_the_offsets_of_open_faces_are_those_of_the_command_line(cli, in_root, tmp_path):
+    # The bundled wall under a pulse of 10 m/s²: faces lift off, and openings.csv lists them.
+    model = crr.Model.from_file("examples/models/wall.toml")
+    d = model.to_dict()
+    d["ground_motion"] = {"x": {"one_sine_pulse": {"amplitude": 10.0, "period": 0.5}}}
+    path = tmp_path / "wall_pulse.json"
+    path.write_text(json.dumps(d))
+    out = tmp_path / "cli"
+    run_cli(cli, ["simulate", str(path), "--out", str(out), "--quiet", "--duration", "1"])
+    result = crr.simulate(model, ground_motion=d["ground_motion"], duration=1.0)
+    text = result.openings_csv()
+    assert text == (out / "openings.csv").read_text()
+    assert result.history_csv() == (out / "history.csv").read_text()
+    rows = text.splitlines()
+    assert rows[0] == "row,t,interface,dx,dy,dz"
+    assert len(rows) > 10
+    # Each row names a face that history.csv reports open at that row.
+    history = (out / "history.csv").read_text().splitlines()
+    header = history[0].split(",")
+    for line in rows[1:]:
+        row, t, interface, *_ = line.split(",")
+        fields = history[int(row)].split(",")
+        assert float(fields[0]) == float(t)
+        assert fields[header.index(f"{interface}_state")] == "open"
 
 
 def test_a_model_as_text_or_dict_runs_as_its_file(in_root):

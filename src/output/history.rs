@@ -57,6 +57,32 @@ pub fn push_history_row(s: &mut String, model: &Model, x: &Sample<'_>) {
     s.push('\n');
 }
 
+/// The header line of `openings.csv`: one row per face open at a sample of `history.csv`
+/// (`row`, 1 = its first data row), with the face's offset x_c(P⁺) − x_p(P⁺) in world axes (m,
+/// [`crr_impact::simulation::FaceOpening`]).
+pub const OPENINGS_HEADER: &str = "row,t,interface,dx,dy,dz\n";
+
+/// Appends the rows of `openings.csv` for sample `x`, row `row` of `history.csv` (1 = the first
+/// data row): one per face open at it, none when no face is.
+pub fn push_openings_rows(s: &mut String, model: &Model, row: usize, x: &Sample<'_>) {
+    use std::fmt::Write;
+    for o in x.openings {
+        let name = &model.interfaces[o.interface].name;
+        let [dx, dy, dz] = o.offset;
+        // Writing to a String cannot fail.
+        let _ = writeln!(s, "{row},{:e},{name},{dx:e},{dy:e},{dz:e}", x.t);
+    }
+}
+
+/// The text of `openings.csv` for the samples a trajectory holds.
+pub fn openings_csv(model: &Model, t: &Trajectory) -> String {
+    let mut s = String::from(OPENINGS_HEADER);
+    for (i, x) in t.samples.iter().enumerate() {
+        push_openings_rows(&mut s, model, i + 1, &x);
+    }
+    s
+}
+
 /// The text of `history.csv` for the samples a trajectory holds.
 pub fn history_csv(model: &Model, t: &Trajectory) -> String {
     let mut s = history_header(model);

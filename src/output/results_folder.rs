@@ -12,10 +12,11 @@ use crate::Error;
 /// The files `crr simulate` writes, and those `--plot` and `--animate` add (the animation's
 /// index and GIF; its frames go with them): an earlier run's set is replaced whole (with
 /// `--force`), never mixed with a new one.
-pub const RESULT_FILES: [&str; 11] = [
+pub const RESULT_FILES: [&str; 12] = [
     "animation/animation.pvd",
     "animation/animation.gif",
     "history.csv",
+    "openings.csv",
     "impacts.csv",
     "summary.json",
     "coordinates.png",

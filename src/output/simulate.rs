@@ -1,6 +1,6 @@
 //! `crr simulate`'s results folder: [`crate::run`] with the history streamed to `history.csv`
-//! while it runs, then `impacts.csv` and `summary.json` (documented in `docs/outputs.md`), all
-//! renamed into place together.
+//! while it runs, then `openings.csv`, `impacts.csv` and `summary.json` (documented in
+//! `docs/outputs.md`), all renamed into place together.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use crr_impact::simulation::Samples;
 
 use super::folder_lock::FolderLock;
-use super::history::{history_header, impacts_csv, push_history_row};
+use super::history::{
+    OPENINGS_HEADER, history_header, impacts_csv, push_history_row, push_openings_rows,
+};
 use super::results_folder::{check_out_dir, default_out_dir, partial_name, write_outputs_with};
 use crate::Error;
 use crate::analysis::simulation::{Prepared, RunOptions, prepare};
@@ -71,10 +73,15 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
         .write_all(history_header(&p.model).as_bytes())
         .map_err(output_error)?;
     let mut rows = String::new();
+    // The open faces' rows are few (only while faces are open): kept, written at the end.
+    let mut openings = String::from(OPENINGS_HEADER);
+    let mut row = 0;
     let sink = |samples: &Samples| -> std::io::Result<()> {
         rows.clear();
         for x in samples {
+            row += 1;
             push_history_row(&mut rows, &p.model, &x);
+            push_openings_rows(&mut openings, &p.model, row, &x);
         }
         history.write_all(rows.as_bytes())
     };
@@ -84,6 +91,7 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
         .map_err(|e| output_error(e.into_error()))?;
     file.sync_all().map_err(output_error)?;
     let files = [
+        ("openings.csv", openings),
         ("impacts.csv", impacts_csv(&run.trajectory)),
         ("summary.json", run.summary.to_json()),
     ];

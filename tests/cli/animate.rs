@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
-use crate::common::{crr, refused, scratch};
+use crate::common::{bundled_text, crr, refused, scratch, write_model};
 use crr::kinematics::{Model, Parent, Role, Side};
 use crr::load_model;
 use crr::output::animate::render::{HEIGHT, WIDTH};
@@ -45,11 +45,13 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
-/// The rows of history.csv: time, q (by coordinate order) and the `_state` codes by interface.
+/// The rows of history.csv: time, q (by coordinate order) and the `_state` codes by interface,
+/// with the offsets of the faces open at it from openings.csv (by interface).
 struct Row {
     t: f64,
     q: Vec<f64>,
     states: Vec<String>,
+    offsets: HashMap<usize, Vector3<f64>>,
 }
 
 fn history(dir: &Path, model: &Model) -> Vec<Row> {
@@ -63,23 +65,40 @@ fn history(dir: &Path, model: &Model) -> Vec<Row> {
         .iter()
         .map(|i| col(&format!("{}_state", i.name)))
         .collect();
-    lines
+    let mut rows: Vec<Row> = lines
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
             Row {
                 t: f[0].parse().unwrap(),
                 q: qc.iter().map(|&c| f[c].parse().unwrap()).collect(),
                 states: sc.iter().map(|&c| f[c].to_string()).collect(),
+                offsets: HashMap::new(),
             }
         })
-        .collect()
+        .collect();
+    // openings.csv: row (1 = history's first data row), t, interface, dx, dy, dz.
+    let text = std::fs::read_to_string(dir.join("openings.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("row,t,interface,dx,dy,dz"));
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        let row = &mut rows[f[0].parse::<usize>().unwrap() - 1];
+        assert_eq!(row.t, f[1].parse::<f64>().unwrap(), "{l}");
+        let k = model.interface_index(f[2]).unwrap();
+        assert_eq!(row.states[k].split('/').next(), Some("open"), "{l}");
+        let d: Vec<f64> = f[3..6].iter().map(|v| v.parse().unwrap()).collect();
+        row.offsets.insert(k, Vector3::new(d[0], d[1], d[2]));
+    }
+    rows
 }
 
 /// Body poses (R, t: x = R X + t for a rest point X) computed from q and the pivots by
 /// composing nalgebra's axis-angle rotations along the tree, each body placed so that its
 /// active pivot stays where its parent holds it: R_b = R_p Π Rot(uⱼ, qⱼ),
 /// t_b = R_p P + t_p − R_b P. Independent of crr's Γ/frame code (its own Rodrigues formula,
-/// frames and translations).
+/// frames and translations). A face that is open (`open`) turns about its positive pivot P⁺ and
+/// its child is moved by the face's offset x_c(P⁺) − x_p(P⁺) from openings.csv, which the bodies
+/// below it inherit through their parents' poses.
 fn poses(model: &Model, row: &Row) -> Vec<(Matrix3<f64>, Vector3<f64>)> {
     let mut pose = vec![(Matrix3::identity(), Vector3::zeros()); model.bodies.len()];
     let mut tree: Vec<(usize, usize)> = model
@@ -103,7 +122,7 @@ fn poses(model: &Model, row: &Row) -> Vec<(Matrix3<f64>, Vector3<f64>)> {
             .iter()
             .enumerate()
             .map(|(k, c)| match *c {
-                "+" => Side::Positive,
+                "+" | "open" => Side::Positive,
                 "-" => Side::Negative,
                 _ => {
                     assert_eq!(row.q[first + k], 0.0, "a seated angle is 0");
@@ -117,7 +136,8 @@ fn poses(model: &Model, row: &Row) -> Vec<(Matrix3<f64>, Vector3<f64>)> {
             let axis = Unit::new_normalize(f.kind.axis(k));
             r *= Rotation3::from_axis_angle(&axis, row.q[first + k]).into_inner();
         }
-        let t = rp * pivot + tp - r * pivot;
+        let offset = row.offsets.get(&i).copied().unwrap_or_else(Vector3::zeros);
+        let t = rp * pivot + tp - r * pivot + offset;
         pose[f.child] = (r, t);
     }
     pose
@@ -374,6 +394,42 @@ fn chains_loops_rocking_bases_and_sectors_match_the_kinematics() {
         check_series(&results, model, every);
         assert!(!results.join("animation/animation.gif").exists());
     }
+}
+
+/// The bundled wall under a one-sine pulse of 10 m/s² (1.6 λ g): faces of its spanning tree lift
+/// off, so history.csv gives their angles as the bodies' relative rotation only, and the frames
+/// must move the bodies below them by the offsets of openings.csv to draw them where they are
+/// (checked against the poses composed here, [`poses`]). The offsets matter: a face of the tree
+/// is open with an offset above 1e-3 of the model size in a frame.
+#[test]
+fn bodies_below_an_open_face_are_drawn_where_they_are() {
+    let text = bundled_text("wall")
+        + "\n[ground_motion]\nx = { one_sine_pulse = { amplitude = 10.0, period = 0.5 } }\n";
+    let model_path = write_model("animate_wall_pulse", &text);
+    let results = scratch("animate_wall_pulse").join("r");
+    let model = model_path.to_str().unwrap();
+    ok(&[
+        "simulate",
+        model,
+        "--out",
+        s(&results),
+        "--duration",
+        "1.0",
+        "--quiet",
+    ]);
+    ok(&["animate", s(&results), "--every", "1", "--format", "vtk"]);
+    check_series_of(&results, model, "wall_pulse", 1);
+    let (_, structure) = load_model(Path::new(model)).unwrap();
+    let largest = history(&results, &structure)
+        .iter()
+        .flat_map(|r| r.offsets.iter())
+        .filter(|(k, _)| matches!(structure.interfaces[**k].role, Role::Tree { .. }))
+        .map(|(_, d)| d.norm())
+        .fold(0.0, f64::max);
+    assert!(
+        largest > 1e-3 * structure.size,
+        "largest offset of an open tree face {largest} m"
+    );
 }
 
 #[test]

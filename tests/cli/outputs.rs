@@ -78,7 +78,7 @@ fn model_names_never_lead_outside_results() {
             String::from_utf8_lossy(&o.stderr)
         );
         let written = files_below(&cwd);
-        let expected: Vec<PathBuf> = ["history.csv", "impacts.csv", "summary.json"]
+        let expected: Vec<PathBuf> = ["history.csv", "impacts.csv", "openings.csv", "summary.json"]
             .iter()
             .map(|f| Path::new("results").join(folder).join(f))
             .collect();
@@ -131,7 +131,7 @@ fn an_earlier_run_is_replaced_only_with_force_and_whole() {
     assert_eq!(summary["end_time"], 1.0);
     assert_eq!(
         files_below(&out),
-        ["history.csv", "impacts.csv", "summary.json"]
+        ["history.csv", "impacts.csv", "openings.csv", "summary.json"]
             .iter()
             .map(PathBuf::from)
             .collect::<Vec<_>>()

@@ -7,11 +7,17 @@
 //! columns), and every frame's body poses come from the engine's kinematics
 //! ([`crr_kinematics::forward_kinematics`], [`crr_kinematics::body_points`]) applied to each
 //! body's [`Surface`]. Everything is shown in the frame of the ground (the ground motion moves
-//! the whole picture, which is not drawn).
+//! the whole picture, which is not drawn). A face open at a sample gives its bodies' relative
+//! rotation in history.csv and their offset in `openings.csv`: the bodies below an open face of
+//! the model's tree are moved by it ([`crr_impact::simulation::body_offsets`]), so they are drawn
+//! where they are.
 
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
+
+use crr_impact::simulation::{FaceOpening, body_offsets};
 
 use nalgebra::{DVector, Vector3};
 use serde_json::Value;
@@ -115,6 +121,9 @@ pub struct State {
     pub peak_so_far: f64,
     /// The row of history.csv (1 = first data row).
     pub row: usize,
+    /// The faces open at this row, from `openings.csv` (empty when none is, or when the folder
+    /// has no such file: a run of an earlier version).
+    pub openings: Vec<FaceOpening>,
 }
 
 /// A results folder read back for animation: the model, and the extent of its history, whose
@@ -130,6 +139,8 @@ pub struct Run {
     pub count: usize,
     /// Time of the first and of the last state (s).
     pub span: (f64, f64),
+    /// The faces open at each row of history.csv that has any (`openings.csv`).
+    pub openings: BTreeMap<usize, Vec<FaceOpening>>,
 }
 
 impl Run {
@@ -187,13 +198,85 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
     if count == 0 {
         return Err(read_error(&history_path, "holds no data rows"));
     }
+    let openings = read_openings(&model, &dir.join("openings.csv"))?;
     Ok(Run {
         model,
         history: history_path,
         count,
         span,
+        openings,
     })
 }
+
+/// The rows of `openings.csv` by the row of history.csv they belong to; none when the file is
+/// absent (a results folder of a version that did not write it: open faces of the tree are then
+/// drawn turned about their pivot, not where they are). A row that does not fit the model (an
+/// unknown interface, a row number below 1, a field that is not a finite number) is an error
+/// naming the file and the line.
+fn read_openings(model: &Model, path: &Path) -> Result<BTreeMap<usize, Vec<FaceOpening>>, Error> {
+    let mut out: BTreeMap<usize, Vec<FaceOpening>> = BTreeMap::new();
+    if !path.is_file() {
+        return Ok(out);
+    }
+    let text = crr_dynamics::input::read_regular_text(path, crr_dynamics::input::DATA_FILE_LIMIT)
+        .map_err(|e| read_error(path, format!("cannot read the file: {e}")))?;
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, header)) if header == OPENINGS_COLUMNS => {}
+        _ => {
+            return Err(read_error(
+                path,
+                format!("line 1: the header is not `{OPENINGS_COLUMNS}`"),
+            ));
+        }
+    }
+    for (i, line) in lines {
+        let line_no = i + 1;
+        let fields: Vec<&str> = line.split(',').collect();
+        if fields.len() != 6 {
+            return Err(read_error(
+                path,
+                format!("line {line_no}: {} fields, 6 expected", fields.len()),
+            ));
+        }
+        let row = fields[0]
+            .parse::<usize>()
+            .ok()
+            .filter(|&r| r >= 1)
+            .ok_or_else(|| {
+                read_error(
+                    path,
+                    format!("line {line_no}: `row` is `{}`, not a row number", fields[0]),
+                )
+            })?;
+        let interface = model.interface_index(fields[2]).ok_or_else(|| {
+            read_error(
+                path,
+                format!("line {line_no}: no interface `{}` in the model", fields[2]),
+            )
+        })?;
+        let mut offset = [0.0; 3];
+        for (k, v) in offset.iter_mut().enumerate() {
+            *v = fields[3 + k]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    read_error(
+                        path,
+                        format!("line {line_no}: `{}` is not a finite number", fields[3 + k]),
+                    )
+                })?;
+        }
+        out.entry(row)
+            .or_default()
+            .push(FaceOpening { interface, offset });
+    }
+    Ok(out)
+}
+
+/// The header of `openings.csv`, without its line end.
+const OPENINGS_COLUMNS: &str = crate::output::history::OPENINGS_HEADER.trim_ascii_end();
 
 /// The model echoed in summary.json's `model`, validated.
 fn model_of(summary: &Value, path: &Path) -> Result<Model, Error> {
@@ -371,6 +454,7 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
             pivots,
             peak_so_far: 0.0,
             row: line_no - 1,
+            openings: Vec::new(),
         })
     }
 
@@ -450,8 +534,11 @@ pub fn frame_step(count: usize, span: (f64, f64), every: Option<usize>) -> Resul
 pub fn frame_states(run: &Run, k: usize) -> Result<Vec<State>, Error> {
     let mut frames = Vec::with_capacity(run.count.div_ceil(k.max(1)).min(DEFAULT_MAX_FRAMES));
     for (i, state) in run.states()?.enumerate() {
-        let state = state?;
+        let mut state = state?;
         if i % k.max(1) == 0 {
+            if let Some(open) = run.openings.get(&state.row) {
+                state.openings.clone_from(open);
+            }
             frames.push(state);
         }
     }
@@ -480,12 +567,16 @@ pub fn pose_vertices(
     state: &State,
 ) -> Vec<Vec<Vector3<f64>>> {
     forward_kinematics(model, data, &state.q, &state.pivots);
+    let offsets = body_offsets(model, &state.openings);
     surfaces
         .iter()
         .enumerate()
         .map(|(b, s)| {
             let mut out = Vec::with_capacity(s.vertices.len());
             body_points(model, data, b, &s.vertices, &mut out);
+            for v in &mut out {
+                *v += offsets[b];
+            }
             out
         })
         .collect()

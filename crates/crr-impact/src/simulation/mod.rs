@@ -58,11 +58,12 @@ mod uplift_from_rest;
 use events::*;
 use impacts::*;
 use open_loops::OpenLoops;
+pub use open_loops::body_offsets;
 pub use opening_qp::{
     IMPULSE_OPENING_TOLERANCE, OpeningDecision, OpeningQpError, QP_OPENING_TOLERANCE, impulse_qp,
     offers_both_pivots, opening_qp, opening_qp_holding,
 };
-pub use samples::{Iter as SampleIter, Sample, Samples};
+pub use samples::{FaceOpening, Iter as SampleIter, Sample, Samples};
 use seating::opening_mode_in;
 pub(crate) use seating::other_pivot_rest;
 pub use seating::{opening_mode, openings_slide_nowhere};
@@ -511,6 +512,8 @@ struct Workspaces {
     sample_q: DVector<f64>,
     sample_qdot: DVector<f64>,
     sample_states: Vec<SlotState>,
+    /// The open faces' offsets of the sample being taken.
+    sample_openings: Vec<FaceOpening>,
     /// The output samples a segment's steps pass, [t, y…] each, taken after the segment.
     pending: Vec<f64>,
     /// Buffers of the monitor's contact forces.
@@ -544,6 +547,7 @@ impl Workspaces {
             sample_q: DVector::zeros(model.dof()),
             sample_qdot: DVector::zeros(model.dof()),
             sample_states: Vec::with_capacity(model.slot_count),
+            sample_openings: Vec::new(),
             pending: Vec::new(),
             forces: Default::default(),
             faces: Default::default(),

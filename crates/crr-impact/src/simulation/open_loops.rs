@@ -743,6 +743,40 @@ impl Simulation<'_> {
         );
     }
 
+    /// The open faces' offsets at the current state ([`FaceOpening`]), into
+    /// `self.spare.sample_openings`.
+    pub(super) fn sample_openings(&mut self, q: &DVector<f64>) {
+        let mut out = std::mem::take(&mut self.spare.sample_openings);
+        out.clear();
+        if !self.open.faces.is_empty() {
+            forward_kinematics(&self.model, &mut self.out_kin, q, &self.dynamics.pivots);
+            face_openings(
+                self.original,
+                &self.model,
+                &self.out_kin,
+                &self.open,
+                &mut out,
+            );
+        }
+        self.spare.sample_openings = out;
+    }
+
+    /// The open faces' offsets at the current state ([`FaceOpening`]; empty when none is open).
+    pub fn face_openings(&self) -> Vec<FaceOpening> {
+        let mut out = Vec::new();
+        if !self.open.faces.is_empty() {
+            let mut kin = Data::new(&self.model);
+            forward_kinematics(
+                &self.model,
+                &mut kin,
+                &self.chain_q(),
+                &self.dynamics.pivots,
+            );
+            face_openings(self.original, &self.model, &kin, &self.open, &mut out);
+        }
+        out
+    }
+
     /// The current state in the file's coordinates.
     pub(super) fn file_state(&self) -> (DVector<f64>, DVector<f64>) {
         let (q, qdot) = (self.chain_q(), self.chain_qdot());
@@ -898,6 +932,78 @@ fn file_coordinates(
         file_q[first_coord..first_coord + count].copy_from_slice(&angles[..count]);
         file_qdot[first_coord..first_coord + count].copy_from_slice(&rates[..count]);
     }
+}
+
+/// The offset of every face of `open` ([`FaceOpening`]) in the poses of `kin`
+/// ([`forward_kinematics`] of `chain`, the chain integrated), into `out` (cleared first).
+fn face_openings(
+    original: &Model,
+    chain: &Model,
+    kin: &Data,
+    open: &OpenLoops,
+    out: &mut Vec<FaceOpening>,
+) {
+    out.clear();
+    out.extend(open.faces.iter().map(|face| {
+        let kind = &original.interfaces[face.interface].kind;
+        let reference = kind.pivot(&vec![Side::Positive; kind.angle_count()]);
+        let child = crr_kinematics::body_point(chain, kin, face.child, &reference);
+        let parent = face.parent.map_or(reference, |b| {
+            crr_kinematics::body_point(chain, kin, b, &reference)
+        });
+        let d = child - parent;
+        FaceOpening {
+            interface: face.interface,
+            offset: [d.x, d.y, d.z],
+        }
+    }));
+}
+
+/// Each body's translation from where the file's coordinates alone put it: the sum of the
+/// offsets of the open faces of the file's spanning tree on its path to the ground. The file's
+/// coordinates give an open face of the tree as its bodies' relative rotation, its child turned
+/// about P⁺ ([`FaceOpening`]); the rotations are exact, so the bodies below it are off by its
+/// offset only, and by the offsets of the open faces above it. Adding these to the poses of
+/// [`forward_kinematics`] of `model` at the sample's q (an open slot on its positive side) puts
+/// every body where it is. Faces that close loops move no body of the file's tree.
+pub fn body_offsets(model: &Model, openings: &[FaceOpening]) -> Vec<Vector3<f64>> {
+    let bodies = model.bodies.len();
+    // The interface of the file's tree that carries each body.
+    let mut carried_by: Vec<Option<usize>> = vec![None; bodies];
+    for (k, iface) in model.interfaces.iter().enumerate() {
+        if matches!(iface.role, crr_kinematics::Role::Tree { .. }) {
+            carried_by[iface.child] = Some(k);
+        }
+    }
+    let own = |k: usize| {
+        openings
+            .iter()
+            .find(|o| o.interface == k)
+            .map_or_else(Vector3::zeros, |o| Vector3::from(o.offset))
+    };
+    let mut offsets: Vec<Option<Vector3<f64>>> = vec![None; bodies];
+    for b in 0..bodies {
+        // Up to the first body whose offset is known (or the ground), then down again.
+        let mut path = Vec::new();
+        let mut at = Some(b);
+        while let Some(body) = at.filter(|&body| offsets[body].is_none()) {
+            path.push(body);
+            at = carried_by[body].and_then(|k| match model.interfaces[k].parent {
+                crr_kinematics::Parent::Body(p) => Some(p),
+                crr_kinematics::Parent::Ground => None,
+            });
+        }
+        let mut sum = at
+            .and_then(|body| offsets[body])
+            .unwrap_or_else(Vector3::zeros);
+        for &body in path.iter().rev() {
+            if let Some(k) = carried_by[body] {
+                sum += own(k);
+            }
+            offsets[body] = Some(sum);
+        }
+    }
+    offsets.into_iter().map(|o| o.unwrap_or_default()).collect()
 }
 
 /// A point's normal gap with its rate and acceleration ([`gap_motion`]).

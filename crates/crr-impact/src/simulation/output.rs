@@ -105,6 +105,7 @@ impl Simulation<'_> {
         if !self.open.files_tree {
             self.file_coordinates(&q, &qdot);
         }
+        self.sample_openings(&q);
         (self.spare.sample_q, self.spare.sample_qdot) = (q, qdot);
         let mut states = std::mem::take(&mut self.spare.sample_states);
         states.clear();
@@ -158,6 +159,7 @@ impl Simulation<'_> {
             work_in: s.work_in,
             dissipated: s.dissipated,
             states: &self.spare.sample_states,
+            openings: &self.spare.sample_openings,
         });
     }
 }

@@ -2,12 +2,29 @@
 //! `samples × DOF` row-major blocks and the slot states as `samples × slots`. A sample is read
 //! through [`Sample`], a view of one row. A run records thousands of samples: by columns they
 //! cost a few pushes each and no allocation of their own, and a caller gets each quantity as one
-//! contiguous array (a plot, a numpy array, a column of history.csv).
+//! contiguous array (a plot, a numpy array, a column of history.csv). The faces open at a sample
+//! ([`FaceOpening`], none in most samples) are kept in one list with each sample's end in it.
 
 use serde::Serialize;
 
 use super::SlotState;
 use crr_kinematics::short_copy::extend_short;
+
+/// Where an open face's bodies are relative to each other: the separation of the face's
+/// reference point P⁺ (its pivot with every angle on its positive side, world at rest) as the
+/// child carries it from where the parent carries it, x_c(P⁺) − x_p(P⁺) in world axes (m).
+///
+/// The outputs give an open face's angles as its bodies' relative rotation only (its child
+/// turned about P⁺); with this offset the child is where it is: for a face of the file's tree
+/// every body below it moves by it ([`super::open_loops::body_offsets`]). Its component along
+/// the parent's face normal is the face's opening at P⁺.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FaceOpening {
+    /// The interface (index into the file's model's interfaces).
+    pub interface: usize,
+    /// x_c(P⁺) − x_p(P⁺), world axes (m).
+    pub offset: [f64; 3],
+}
 
 /// One output sample: a view of one row of [`Samples`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -28,6 +45,8 @@ pub struct Sample<'a> {
     pub dissipated: f64,
     /// State of every angle slot.
     pub states: &'a [SlotState],
+    /// The faces open at this sample, in interface order (empty when none is).
+    pub openings: &'a [FaceOpening],
 }
 
 /// Output samples in time order, by columns (see the module documentation).
@@ -43,6 +62,9 @@ pub struct Samples {
     work_in: Vec<f64>,
     dissipated: Vec<f64>,
     states: Vec<SlotState>,
+    openings: Vec<FaceOpening>,
+    /// Each sample's end in `openings`.
+    openings_end: Vec<usize>,
 }
 
 impl Samples {
@@ -65,6 +87,8 @@ impl Samples {
             work_in: Vec::with_capacity(capacity),
             dissipated: Vec::with_capacity(capacity),
             states: Vec::with_capacity(capacity * slots),
+            openings: Vec::new(),
+            openings_end: Vec::with_capacity(capacity),
         }
     }
 
@@ -94,6 +118,7 @@ impl Samples {
             return None;
         }
         let (n, m) = (self.dof, self.slots);
+        let start = if i == 0 { 0 } else { self.openings_end[i - 1] };
         Some(Sample {
             t: self.t[i],
             q: &self.q[i * n..(i + 1) * n],
@@ -103,6 +128,7 @@ impl Samples {
             work_in: self.work_in[i],
             dissipated: self.dissipated[i],
             states: &self.states[i * m..(i + 1) * m],
+            openings: &self.openings[start..self.openings_end[i]],
         })
     }
 
@@ -165,6 +191,12 @@ impl Samples {
         &self.states
     }
 
+    /// The open faces of every sample, in sample order (sample i's are
+    /// [`Self::get`]`(i).openings`).
+    pub fn openings(&self) -> &[FaceOpening] {
+        &self.openings
+    }
+
     /// Appends a sample.
     ///
     /// # Panics
@@ -187,6 +219,8 @@ impl Samples {
         self.work_in.push(s.work_in);
         self.dissipated.push(s.dissipated);
         extend_short(&mut self.states, s.states);
+        self.openings.extend_from_slice(s.openings);
+        self.openings_end.push(self.openings.len());
     }
 
     /// Appends every sample of `other` (e.g. the batches [`super::Simulation::drain_samples`]
@@ -211,6 +245,10 @@ impl Samples {
         self.work_in.extend_from_slice(&other.work_in);
         self.dissipated.extend_from_slice(&other.dissipated);
         self.states.extend_from_slice(&other.states);
+        let base = self.openings.len();
+        self.openings.extend_from_slice(&other.openings);
+        self.openings_end
+            .extend(other.openings_end.iter().map(|&e| base + e));
     }
 
     /// Removes every sample, keeping the dimensions and the allocated capacity.
@@ -223,6 +261,8 @@ impl Samples {
         self.work_in.clear();
         self.dissipated.clear();
         self.states.clear();
+        self.openings.clear();
+        self.openings_end.clear();
     }
 }
 
@@ -293,6 +333,10 @@ mod tests {
         let mut s = Samples::new(2, 1);
         assert!(s.is_empty() && s.first().is_none() && s.last().is_none());
         let rows: Vec<_> = (0..5).map(row).collect();
+        let opened = [FaceOpening {
+            interface: 2,
+            offset: [1.0, 0.0, -1.0],
+        }];
         for (k, (t, q, qd, st)) in rows.iter().enumerate() {
             s.push(Sample {
                 t: *t,
@@ -303,6 +347,7 @@ mod tests {
                 work_in: 0.5 * k as f64,
                 dissipated: 0.25 * k as f64,
                 states: st,
+                openings: if k == 3 { &opened } else { &[] },
             });
         }
         assert_eq!(s.len(), 5);
@@ -314,7 +359,12 @@ mod tests {
             assert_eq!(x.work_in, 0.5 * k as f64);
             assert_eq!(x.dissipated, 0.25 * k as f64);
             assert_eq!(s.get(k), Some(x));
+            assert_eq!(x.openings, if k == 3 { &opened[..] } else { &[] });
         }
+        let mut twice = s.clone();
+        twice.append(&s);
+        assert_eq!(twice.get(8).unwrap().openings, &opened[..]);
+        assert!(twice.get(7).unwrap().openings.is_empty());
         let back: Vec<f64> = s.iter().rev().map(|x| x.t).collect();
         assert_eq!(back, rows.iter().rev().map(|r| r.0).collect::<Vec<_>>());
         assert_eq!(s.iter().len(), 5);
@@ -339,6 +389,7 @@ mod tests {
             work_in: 0.0,
             dissipated: 0.0,
             states: &[],
+            openings: &[],
         });
     }
 }
