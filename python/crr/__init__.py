@@ -410,6 +410,11 @@ class Result:
         """The text of ``impacts.csv``, as ``crr simulate`` writes it."""
         return self._run.impacts_csv()
 
+    def openings_csv(self) -> str:
+        """The text of ``openings.csv``, as ``crr simulate`` writes it: the offset of every face
+        open at a row of ``history.csv`` (the header alone when no face lifts off)."""
+        return self._run.openings_csv()
+
     def history_frame(self) -> "pandas.DataFrame":
         """The history as a pandas DataFrame with the columns of ``history.csv``."""
         pd = _pandas("Result.history_frame")
@@ -494,30 +499,35 @@ class Result:
         )
 
     def write(self, folder: PathLike) -> None:
-        """Writes ``history.csv``, ``impacts.csv`` and ``summary.json`` into ``folder`` (created
-        if needed), the files of ``crr simulate``."""
+        """Writes ``history.csv``, ``impacts.csv``, ``openings.csv`` and ``summary.json`` into
+        ``folder`` (created if needed), the files of ``crr simulate``."""
         d = Path(folder)
         d.mkdir(parents=True, exist_ok=True)
         for name, text in (
             ("history.csv", self.history_csv()),
             ("impacts.csv", self.impacts_csv()),
+            ("openings.csv", self.openings_csv()),
             ("summary.json", json.dumps(self.summary, indent=2, ensure_ascii=False) + "\n"),
         ):
             with open(d / name, "w", newline="", encoding="utf-8") as f:
                 f.write(text)
 
     def __getstate__(self) -> Dict[str, Any]:
-        # The native run does not pickle: its arrays do, and its two CSV texts go as strings
-        # (history_csv and impacts_csv give the same bytes after a round trip).
+        # The native run does not pickle: its arrays do, and its CSV texts go as strings
+        # (history_csv, impacts_csv and openings_csv give the same bytes after a round trip).
         _ = (self.states, self.impacts)  # built now: the native run that builds them does not pickle
         state = {k: v for k, v in self.__dict__.items() if k != "_run"}
-        state["_csv"] = (self._run.history_csv(), self._run.impacts_csv())
+        state["_csv"] = (
+            self._run.history_csv(),
+            self._run.impacts_csv(),
+            self._run.openings_csv(),
+        )
         return state
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
-        history, impacts = state.pop("_csv")
+        history, impacts, openings = state.pop("_csv")
         self.__dict__.update(state)
-        self._run = _CsvTexts(history, impacts)
+        self._run = _CsvTexts(history, impacts, openings)
 
     def __repr__(self) -> str:
         s = self.summary
@@ -528,20 +538,23 @@ class Result:
 
 
 class _CsvTexts:
-    """What an unpickled :class:`Result` keeps of its native run: the texts of its two CSV
-    files."""
+    """What an unpickled :class:`Result` keeps of its native run: the texts of its CSV files."""
 
-    __slots__ = ("_history", "_impacts")
+    __slots__ = ("_history", "_impacts", "_openings")
 
-    def __init__(self, history: str, impacts: str) -> None:
+    def __init__(self, history: str, impacts: str, openings: str) -> None:
         self._history = history
         self._impacts = impacts
+        self._openings = openings
 
     def history_csv(self) -> str:
         return self._history
 
     def impacts_csv(self) -> str:
         return self._impacts
+
+    def openings_csv(self) -> str:
+        return self._openings
 
 
 def simulate(

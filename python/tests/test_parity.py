@@ -132,6 +132,10 @@ def test_the_offsets_of_open_faces_are_those_of_the_command_line(cli, in_root, t
     text = result.openings_csv()
     assert text == (out / "openings.csv").read_text()
     assert result.history_csv() == (out / "history.csv").read_text()
+    # Result.write writes the same files as the command line.
+    result.write(tmp_path / "py")
+    for name in ("history.csv", "impacts.csv", "openings.csv"):
+        assert (tmp_path / "py" / name).read_text() == (out / name).read_text()
     rows = text.splitlines()
     assert rows[0] == "row,t,interface,dx,dy,dz"
     assert len(rows) > 10

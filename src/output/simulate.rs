@@ -1,6 +1,6 @@
 //! `crr simulate`'s results folder: [`crate::run`] with the history streamed to `history.csv`
-//! while it runs, then `openings.csv`, `impacts.csv` and `summary.json` (documented in
-//! `docs/outputs.md`), all renamed into place together.
+//! and the open faces' offsets to `openings.csv` while it runs, then `impacts.csv` and
+//! `summary.json` (documented in `docs/outputs.md`), all renamed into place together.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -72,30 +72,38 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
     history
         .write_all(history_header(&p.model).as_bytes())
         .map_err(output_error)?;
-    let mut rows = String::new();
-    // The open faces' rows are few (only while faces are open): kept, written at the end.
-    let mut openings = String::from(OPENINGS_HEADER);
+    // The open faces' offsets, streamed beside it (rows only while faces are open).
+    let openings_tmp = partial_name(out, "openings.csv");
+    let mut openings =
+        std::io::BufWriter::new(std::fs::File::create(&openings_tmp).map_err(output_error)?);
+    openings
+        .write_all(OPENINGS_HEADER.as_bytes())
+        .map_err(output_error)?;
+    let (mut rows, mut opening_rows) = (String::new(), String::new());
     let mut row = 0;
     let sink = |samples: &Samples| -> std::io::Result<()> {
         rows.clear();
+        opening_rows.clear();
         for x in samples {
             row += 1;
             push_history_row(&mut rows, &p.model, &x);
-            push_openings_rows(&mut openings, &p.model, row, &x);
+            push_openings_rows(&mut opening_rows, &p.model, row, &x);
         }
-        history.write_all(rows.as_bytes())
+        history.write_all(rows.as_bytes())?;
+        openings.write_all(opening_rows.as_bytes())
     };
     let run = p.run_streaming(sink);
-    let file = history
-        .into_inner()
-        .map_err(|e| output_error(e.into_error()))?;
-    file.sync_all().map_err(output_error)?;
+    for writer in [history, openings] {
+        let file = writer
+            .into_inner()
+            .map_err(|e| output_error(e.into_error()))?;
+        file.sync_all().map_err(output_error)?;
+    }
     let files = [
-        ("openings.csv", openings),
         ("impacts.csv", impacts_csv(&run.trajectory)),
         ("summary.json", run.summary.to_json()),
     ];
-    write_outputs_with(out, &["history.csv"], &files).map_err(output_error)?;
+    write_outputs_with(out, &["history.csv", "openings.csv"], &files).map_err(output_error)?;
     Ok(match run.summary.error.clone() {
         None => SimulateResult::Done(out.to_path_buf(), Box::new(run.summary)),
         Some(e) => SimulateResult::Failed(out.to_path_buf(), e),

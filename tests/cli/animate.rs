@@ -550,6 +550,50 @@ fn bad_inputs_are_refused_naming_the_item() {
     std::fs::copy(results.join("history.csv"), old.join("history.csv")).unwrap();
     std::fs::write(old.join("summary.json"), "{\"coordinates\": []}").unwrap();
     refused(&["animate", s(&old)], "holds no `model`");
+    // A damaged openings.csv: each refusal names the file and the line.
+    let damaged = scratch("animate_bad_openings");
+    for name in ["history.csv", "summary.json"] {
+        std::fs::copy(results.join(name), damaged.join(name)).unwrap();
+    }
+    for (rows, needle) in [
+        ("row,t,dx\n", "openings.csv: line 1: the header is not"),
+        (
+            "1,0e0,base,0e0,0e0\n",
+            "openings.csv: line 2: 5 fields, 6 expected",
+        ),
+        (
+            "0,0e0,base,0e0,0e0,0e0\n",
+            "openings.csv: line 2: `row` is `0`",
+        ),
+        (
+            "1,0e0,nowhere,0e0,0e0,0e0\n",
+            "line 2: no interface `nowhere`",
+        ),
+        (
+            "1,x,base,0e0,0e0,0e0\n",
+            "line 2: `x` is not a finite number",
+        ),
+        (
+            "1,0e0,base,0e0,NaN,0e0\n",
+            "line 2: `NaN` is not a finite number",
+        ),
+        (
+            "1,0e0,base,0e0,0e0,0e0\n1,0e0,base,1e0,0e0,0e0\n",
+            "line 3: `base` listed twice at row 1",
+        ),
+        (
+            "100000,0e0,base,0e0,0e0,0e0\n",
+            "openings.csv: row 100000 is beyond the",
+        ),
+    ] {
+        let text = if rows.starts_with("row,") {
+            rows.to_string()
+        } else {
+            format!("row,t,interface,dx,dy,dz\n{rows}")
+        };
+        std::fs::write(damaged.join("openings.csv"), text).unwrap();
+        refused(&["animate", s(&damaged)], needle);
+    }
     // An earlier animation is kept without --force, replaced with it.
     ok(&["animate", r, "--format", "vtk"]);
     let before = std::fs::read_dir(results.join("animation"))

@@ -97,9 +97,10 @@ pub fn most_compressive(
 /// pivots, as [`most_compressive`]). `min_normal` is then in N s: below 0 when the contacts can
 /// give that change only by pulling somewhere. None when the program does not solve.
 ///
-/// The interfaces listed in `set_by_law` (those of an impact whose law sets their rates, the
-/// restitution and Dirac laws) take on their whole face whatever impulse the law needs, of
-/// either sign: the law's own hypothesis, not checked. Only the other contacts are.
+/// The slots listed in `set_by_law` (those of an impact whose law sets their rates, the
+/// restitution and Dirac laws) touch on both of their pivots, and their interfaces take on the
+/// points that touch whatever impulse the law needs, of either sign: the law's own hypothesis,
+/// not checked. Only the other contacts are.
 pub fn most_compressive_impulses(
     model: &Model,
     dynamics: &Dynamics,
@@ -148,12 +149,12 @@ impl FaceProgram {
         Self::build_setting(model, dynamics, &[])
     }
 
-    /// [`Self::build`] with the interfaces `set_by_law` joined through the whole face: every
-    /// point of it touches (as if seated) and carries a normal force of either sign.
+    /// [`Self::build`] with the slots `set_by_law` touching on both pivots (as if seated), and
+    /// every touching point of their interfaces carrying a normal force of either sign.
     fn build_setting(model: &Model, dynamics: &Dynamics, set_by_law: &[usize]) -> FaceProgram {
         let size = model.size;
         let mut is_seated = vec![false; model.slot_count];
-        for &k in &dynamics.seated {
+        for &k in dynamics.seated.iter().chain(set_by_law) {
             is_seated[k] = true;
         }
         let mut unknowns = Vec::new();
@@ -167,15 +168,10 @@ impl FaceProgram {
                 rot * face.tangents[0],
                 rot * face.tangents[1],
             ];
-            let by_law = set_by_law.contains(&index);
-            let whole_face = vec![true; iface.slots.len()];
+            let by_law = iface.slots.clone().any(|k| set_by_law.contains(&k));
             let points = touching_points(
                 &iface.kind,
-                if by_law {
-                    &whole_face
-                } else {
-                    &is_seated[iface.slots.clone()]
-                },
+                &is_seated[iface.slots.clone()],
                 dynamics.pivots.of_interface(model, index),
             );
             let twist = matches!(iface.kind, InterfaceKind::RockingBase { twist: true, .. });

@@ -19,7 +19,7 @@
 //!
 //! Where min(N_L, N_R) is below −1e-3 W·√(L/g) (the monitor's impulse tolerance), the run records
 //! an `impulse_tension` at the impact's instant on `base` with that impulse as its `normal` (to
-//! 1e-8 of the unit, 91 N s: the distribution is unique, so the program's proximal term moves
+//! 1e-8 of the unit W·√(L/g) = 9 113 N s, i.e. 9.1e-5 N s: the distribution is unique, so the program's proximal term moves
 //! nothing and what is left is its interior point's accuracy; measured 3e-10 of the unit); where
 //! both push, the impact records nothing. The laws chosen give both answers (r = 0.3, 0.6 and
 //! the Dirac law with r^C = 0.35 pull at the right corner by 618, 330 and 567 N s; r = 1 pushes

@@ -187,6 +187,7 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
     let model = model_of(&summary, &summary_path)?;
     let mut count = 0;
     let mut span = (0.0, 0.0);
+    let mut rows = 0;
     for state in HistoryStates::open(&model, &history_path)? {
         let state = state?;
         if count == 0 {
@@ -194,11 +195,19 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
         }
         span.1 = state.t;
         count += 1;
+        rows = state.row;
     }
     if count == 0 {
         return Err(read_error(&history_path, "holds no data rows"));
     }
-    let openings = read_openings(&model, &dir.join("openings.csv"))?;
+    let openings_path = dir.join("openings.csv");
+    let openings = read_openings(&model, &openings_path)?;
+    if let Some((&last, _)) = openings.last_key_value().filter(|(r, _)| **r > rows) {
+        return Err(read_error(
+            &openings_path,
+            format!("row {last} is beyond the {rows} data rows of history.csv"),
+        ));
+    }
     Ok(Run {
         model,
         history: history_path,
@@ -211,8 +220,8 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
 /// The rows of `openings.csv` by the row of history.csv they belong to; none when the file is
 /// absent (a results folder of a version that did not write it: open faces of the tree are then
 /// drawn turned about their pivot, not where they are). A row that does not fit the model (an
-/// unknown interface, a row number below 1, a field that is not a finite number) is an error
-/// naming the file and the line.
+/// unknown interface, a row number below 1, a field that is not a finite number, an interface
+/// listed twice at one row) is an error naming the file and the line.
 fn read_openings(model: &Model, path: &Path) -> Result<BTreeMap<usize, Vec<FaceOpening>>, Error> {
     let mut out: BTreeMap<usize, Vec<FaceOpening>> = BTreeMap::new();
     if !path.is_file() {
@@ -255,22 +264,31 @@ fn read_openings(model: &Model, path: &Path) -> Result<BTreeMap<usize, Vec<FaceO
                 format!("line {line_no}: no interface `{}` in the model", fields[2]),
             )
         })?;
-        let mut offset = [0.0; 3];
-        for (k, v) in offset.iter_mut().enumerate() {
-            *v = fields[3 + k]
+        let mut numbers = [0.0; 4];
+        for (k, v) in numbers.iter_mut().enumerate() {
+            let field = if k == 0 { 1 } else { 2 + k };
+            *v = fields[field]
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
                     read_error(
                         path,
-                        format!("line {line_no}: `{}` is not a finite number", fields[3 + k]),
+                        format!("line {line_no}: `{}` is not a finite number", fields[field]),
                     )
                 })?;
         }
-        out.entry(row)
-            .or_default()
-            .push(FaceOpening { interface, offset });
+        let at_row = out.entry(row).or_default();
+        if at_row.iter().any(|o| o.interface == interface) {
+            return Err(read_error(
+                path,
+                format!("line {line_no}: `{}` listed twice at row {row}", fields[2]),
+            ));
+        }
+        at_row.push(FaceOpening {
+            interface,
+            offset: [numbers[1], numbers[2], numbers[3]],
+        });
     }
     Ok(out)
 }
@@ -428,8 +446,8 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
                     "+" => Side::Positive,
                     "-" => Side::Negative,
                     // A face that lifted off has no pivot. A loop-closing one places no body; on a
-                    // tree interface of the file q is its bodies' relative rotation, drawn about
-                    // P⁺ (docs/simulation.md, "Faces that open": not where they are).
+                    // tree interface of the file q is its bodies' relative rotation about P⁺, and
+                    // openings.csv moves the bodies below it to where they are (`pose_vertices`).
                     "open" => Side::Positive,
                     "seated" => {
                         // A seated tree angle is 0: either side gives the same pose.

@@ -375,34 +375,31 @@ impl Simulation<'_> {
         // the chain after it: its new pivots, the joints seated through it or at it. The
         // momentum law (applied when any impacting interface uses it) acts at the new pivots,
         // which are checked with the rest. The restitution and Dirac laws set the impacting
-        // rates, not an impulse at a point: the impacting interfaces then take whatever impulse
-        // the law needs on their faces (its own hypothesis), and the contacts the impact holds
-        // besides (seated joints, other pivots, loops) are checked.
+        // rates, not an impulse at a point: the impacting slots then touch on both pivots and
+        // their interfaces take whatever impulse the law needs there (its own hypothesis), and
+        // the contacts the impact holds besides (seated joints, other pivots, loops) are
+        // checked; where every interface is the impact's, nothing is left to check.
         let momentum_law = impacting.iter().any(|&s| {
             matches!(
                 model.interfaces[slot_interface(model, s)].impact,
                 ImpactLaw::Momentum
             )
         });
-        if self.violation.is_none() {
-            let set_by_law: Vec<usize> = if momentum_law {
-                Vec::new()
-            } else {
-                let mut interfaces: Vec<usize> = impacting
-                    .iter()
-                    .map(|&s| slot_interface(model, s))
-                    .collect();
-                interfaces.sort_unstable();
-                interfaces.dedup();
-                interfaces
-            };
+        let set_by_law: &[usize] = if momentum_law { &[] } else { &impacting };
+        let left_to_check = (0..model.interfaces.len()).any(|i| {
+            !model.interfaces[i]
+                .slots
+                .clone()
+                .any(|s| set_by_law.contains(&s))
+        });
+        if self.violation.is_none() && left_to_check {
             work.pivots.clone_from(&after);
             work.seated.clear();
             work.seated.extend(held.iter().chain(&to_seat).copied());
             work.seated.sort_unstable();
             work.seated.dedup();
             work.evaluate(model, self.ground, t, &q_at, &qdot_after);
-            self.check_impulse(&work, &q_at, (&before, &qdot), &qdot_after, &set_by_law);
+            self.check_impulse(&work, &q_at, (&before, &qdot), &qdot_after, set_by_law);
         }
         let before_rates: Vec<f64> = impacting.iter().map(|&s| rates_before[s]).collect();
         let lost = result.kinetic_before - kinetic_after;

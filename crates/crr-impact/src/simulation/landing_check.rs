@@ -14,9 +14,9 @@
 //! check records, it changes nothing.
 //!
 //! The restitution and Dirac laws set the impacting joints' rates, not an impulse at a point:
-//! the impulse their faces take is the law's hypothesis. Their impacting interfaces then take an
-//! impulse of either sign on their whole face (`set_by_law`), and the contacts the impact holds
-//! besides are checked.
+//! the impulse their faces take is the law's hypothesis. Their impacting slots then touch on both
+//! pivots, their interfaces take an impulse of either sign there (`set_by_law`), and the contacts
+//! the impact holds besides are checked.
 //!
 //! The same question, posed as Moreau's inelastic impact ([`super::impulse_qp`], the contact
 //! program one level down), answers "holds" exactly where the linear program finds a
@@ -38,8 +38,8 @@ impl Simulation<'_> {
     /// compressive distribution of the contact impulses over the touching points after it
     /// ([`least_tension`]) has a normal impulse below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g).
     /// The record names the contact that limits it, with that impulse (N s) as its `normal`.
-    /// The interfaces `set_by_law` (an impact's whose law sets the rates) take any impulse on
-    /// their face: only the other contacts are checked.
+    /// The slots `set_by_law` (an impact's whose law sets the rates) touch on both pivots and
+    /// their interfaces take any impulse there: only the other contacts are checked.
     pub(super) fn check_impulse(
         &mut self,
         d: &Dynamics,
@@ -97,8 +97,8 @@ impl Simulation<'_> {
 
 /// The most compressive distribution of the contact impulses that take the bodies from
 /// `qdot_minus` to `qdot_after` (their momentum changes from their own velocities, ċ = J_c q̇
-/// and ω = J_ω q̇) on the touching points of the state in `d` (evaluated at q), the interfaces
-/// `set_by_law` taking any impulse on their face.
+/// and ω = J_ω q̇) on the touching points of the state in `d` (evaluated at q), the slots
+/// `set_by_law` touching on both pivots and their interfaces taking any impulse.
 fn least_tension(
     model: &Model,
     d: &Dynamics,
