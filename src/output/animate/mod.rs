@@ -264,10 +264,8 @@ fn read_openings(model: &Model, path: &Path) -> Result<BTreeMap<usize, Vec<FaceO
                 format!("line {line_no}: no interface `{}` in the model", fields[2]),
             )
         })?;
-        let mut numbers = [0.0; 4];
-        for (k, v) in numbers.iter_mut().enumerate() {
-            let field = if k == 0 { 1 } else { 2 + k };
-            *v = fields[field]
+        let number = |field: usize| {
+            fields[field]
                 .parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
@@ -276,8 +274,10 @@ fn read_openings(model: &Model, path: &Path) -> Result<BTreeMap<usize, Vec<FaceO
                         path,
                         format!("line {line_no}: `{}` is not a finite number", fields[field]),
                     )
-                })?;
-        }
+                })
+        };
+        number(1)?;
+        let offset = [number(3)?, number(4)?, number(5)?];
         let at_row = out.entry(row).or_default();
         if at_row.iter().any(|o| o.interface == interface) {
             return Err(read_error(
@@ -285,10 +285,7 @@ fn read_openings(model: &Model, path: &Path) -> Result<BTreeMap<usize, Vec<FaceO
                 format!("line {line_no}: `{}` listed twice at row {row}", fields[2]),
             ));
         }
-        at_row.push(FaceOpening {
-            interface,
-            offset: [numbers[1], numbers[2], numbers[3]],
-        });
+        at_row.push(FaceOpening { interface, offset });
     }
     Ok(out)
 }

@@ -967,43 +967,21 @@ fn face_openings(
 /// [`forward_kinematics`] of `model` at the sample's q (an open slot on its positive side) puts
 /// every body where it is. Faces that close loops move no body of the file's tree.
 pub fn body_offsets(model: &Model, openings: &[FaceOpening]) -> Vec<Vector3<f64>> {
-    let bodies = model.bodies.len();
-    // The interface of the file's tree that carries each body.
-    let mut carried_by: Vec<Option<usize>> = vec![None; bodies];
-    for (k, iface) in model.interfaces.iter().enumerate() {
-        if matches!(iface.role, crr_kinematics::Role::Tree { .. }) {
-            carried_by[iface.child] = Some(k);
+    // Frame by frame in the order of [`forward_kinematics`] (a parent's frame before its
+    // children's): a frame carries its parent frame's offset, and the first frame of an open
+    // face of the tree adds the face's own.
+    let mut frames: Vec<Vector3<f64>> = Vec::with_capacity(model.dof());
+    for (k, c) in model.coords.iter().enumerate() {
+        let mut offset = c.parent.map_or_else(Vector3::zeros, |p| frames[p]);
+        if matches!(model.interfaces[c.interface].role,
+            crr_kinematics::Role::Tree { first_coord } if first_coord == k)
+            && let Some(o) = openings.iter().find(|o| o.interface == c.interface)
+        {
+            offset += Vector3::from(o.offset);
         }
+        frames.push(offset);
     }
-    let own = |k: usize| {
-        openings
-            .iter()
-            .find(|o| o.interface == k)
-            .map_or_else(Vector3::zeros, |o| Vector3::from(o.offset))
-    };
-    let mut offsets: Vec<Option<Vector3<f64>>> = vec![None; bodies];
-    for b in 0..bodies {
-        // Up to the first body whose offset is known (or the ground), then down again.
-        let mut path = Vec::new();
-        let mut at = Some(b);
-        while let Some(body) = at.filter(|&body| offsets[body].is_none()) {
-            path.push(body);
-            at = carried_by[body].and_then(|k| match model.interfaces[k].parent {
-                crr_kinematics::Parent::Body(p) => Some(p),
-                crr_kinematics::Parent::Ground => None,
-            });
-        }
-        let mut sum = at
-            .and_then(|body| offsets[body])
-            .unwrap_or_else(Vector3::zeros);
-        for &body in path.iter().rev() {
-            if let Some(k) = carried_by[body] {
-                sum += own(k);
-            }
-            offsets[body] = Some(sum);
-        }
-    }
-    offsets.into_iter().map(|o| o.unwrap_or_default()).collect()
+    model.body_coord.iter().map(|&k| frames[k]).collect()
 }
 
 /// A point's normal gap with its rate and acceleration ([`gap_motion`]).
