@@ -430,6 +430,30 @@ fn bodies_below_an_open_face_are_drawn_where_they_are() {
         largest > 1e-3 * structure.size,
         "largest offset of an open tree face {largest} m"
     );
+    // The same history with an openings.csv that lists none of its open faces (of another run)
+    // is refused at the first row with a face open, naming that face, not drawn without offsets.
+    let (row, open) = history(&results, &structure)
+        .iter()
+        .enumerate()
+        .find_map(|(i, r)| {
+            // In model order, from history.csv's own `_state` codes.
+            let open: Vec<&str> = (r.states.iter().enumerate())
+                .filter(|(_, code)| code.split('/').any(|c| c == "open"))
+                .map(|(k, _)| structure.interfaces[k].name.as_str())
+                .collect();
+            (!open.is_empty()).then_some((i + 1, open))
+        })
+        .expect("a face opens");
+    std::fs::write(results.join("openings.csv"), "row,t,interface,dx,dy,dz\n").unwrap();
+    let open: Vec<String> = open.iter().map(|name| format!("`{name}`")).collect();
+    refused(
+        &["animate", s(&results), "--force"],
+        &format!(
+            "history.csv: line {}: the faces open there ({}) are not those",
+            row + 1,
+            open.join(", ")
+        ),
+    );
 }
 
 #[test]
@@ -584,6 +608,12 @@ fn bad_inputs_are_refused_naming_the_item() {
         (
             "100000,0e0,base,0e0,0e0,0e0\n",
             "openings.csv: row 100000 is beyond the",
+        ),
+        // A face listed open at a row whose `base_state` is a pivot side: the files are not of
+        // one run.
+        (
+            "1,0e0,base,0e0,0e0,0e0\n",
+            "history.csv: line 2: the faces open there (none) are not those",
         ),
     ] {
         let text = if rows.starts_with("row,") {

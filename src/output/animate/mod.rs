@@ -124,6 +124,8 @@ pub struct State {
     /// The faces open at this row, from `openings.csv` (empty when none is, or when the folder
     /// has no such file: a run of an earlier version).
     pub openings: Vec<FaceOpening>,
+    /// The interfaces whose `_state` column is `open` at this row, in model order.
+    pub open: Vec<usize>,
 }
 
 /// A results folder read back for animation: the model, and the extent of its history, whose
@@ -185,10 +187,16 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
     let summary: Value = serde_json::from_str(&summary_text)
         .map_err(|e| read_error(&summary_path, format!("not valid JSON: {e}")))?;
     let model = model_of(&summary, &summary_path)?;
+    let openings_path = dir.join("openings.csv");
+    let openings = read_openings(&model, &openings_path)?;
     let mut count = 0;
     let mut span = (0.0, 0.0);
     let mut rows = 0;
-    for state in HistoryStates::open(&model, &history_path)? {
+    let mut history = HistoryStates::open(&model, &history_path)?;
+    if openings_path.is_file() {
+        history = history.checked_against(&openings, &openings_path);
+    }
+    for state in history {
         let state = state?;
         if count == 0 {
             span.0 = state.t;
@@ -200,8 +208,6 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
     if count == 0 {
         return Err(read_error(&history_path, "holds no data rows"));
     }
-    let openings_path = dir.join("openings.csv");
-    let openings = read_openings(&model, &openings_path)?;
     if let Some((&last, _)) = openings.last_key_value().filter(|(r, _)| **r > rows) {
         return Err(read_error(
             &openings_path,
@@ -325,6 +331,9 @@ pub struct HistoryStates<'m, R> {
     peak: f64,
     pending: Option<State>,
     done: bool,
+    /// The faces `openings.csv` lists at each row, and its path, when every row's `open`
+    /// states are to be checked against it ([`HistoryStates::checked_against`]).
+    expected_open: Option<(BTreeMap<usize, Vec<usize>>, PathBuf)>,
 }
 
 impl<'m> HistoryStates<'m, BufReader<File>> {
@@ -350,6 +359,7 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
             peak: 0.0,
             pending: None,
             done: false,
+            expected_open: None,
         };
         let header = states
             .next_line()?
@@ -378,6 +388,57 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
 
     fn error(&self, message: impl std::fmt::Display) -> Error {
         read_error(&self.path, message)
+    }
+
+    /// Checks every row's `open` states against the faces `openings.csv` (at `path`) lists at
+    /// that row: the offsets drawn are those of the faces open there, or the two files are not
+    /// of one run (an error naming both and the row).
+    pub fn checked_against(
+        mut self,
+        openings: &BTreeMap<usize, Vec<FaceOpening>>,
+        path: &Path,
+    ) -> Self {
+        let listed = openings
+            .iter()
+            .map(|(&row, faces)| {
+                let mut interfaces: Vec<usize> = faces.iter().map(|o| o.interface).collect();
+                interfaces.sort_unstable();
+                (row, interfaces)
+            })
+            .collect();
+        self.expected_open = Some((listed, path.to_path_buf()));
+        self
+    }
+
+    /// An error where the faces open at `state`'s row are not those `openings.csv` lists there.
+    fn check_open(&self, state: &State) -> Result<(), Error> {
+        let Some((listed, openings_path)) = &self.expected_open else {
+            return Ok(());
+        };
+        let expected = listed.get(&state.row).map_or(&[][..], Vec::as_slice);
+        if expected == state.open.as_slice() {
+            return Ok(());
+        }
+        let names = |faces: &[usize]| {
+            if faces.is_empty() {
+                "none".to_string()
+            } else {
+                faces
+                    .iter()
+                    .map(|&i| format!("`{}`", self.model.interfaces[i].name))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            }
+        };
+        Err(self.error(format!(
+            "line {}: the faces open there ({}) are not those {} lists at row {} ({}): the two \
+             files are not of one run",
+            self.lines.number(),
+            names(&state.open),
+            openings_path.display(),
+            state.row,
+            names(expected)
+        )))
     }
 
     /// The next line without its line end; None at the end of the file. A last line without
@@ -428,7 +489,8 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
         );
         let model = self.model;
         let mut pivots = ActivePivots::uniform(model, Side::Positive);
-        for (iface, &c) in model.interfaces.iter().zip(&self.state_cols) {
+        let mut open = Vec::new();
+        for (index, (iface, &c)) in model.interfaces.iter().zip(&self.state_cols).enumerate() {
             let codes: Vec<&str> = fields[c].split('/').collect();
             if codes.len() != iface.slots.len() {
                 return Err(self.error(format!(
@@ -445,7 +507,12 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
                     // A face that lifted off has no pivot. A loop-closing one places no body; on a
                     // tree interface of the file q is its bodies' relative rotation about P⁺, and
                     // openings.csv moves the bodies below it to where they are (`pose_vertices`).
-                    "open" => Side::Positive,
+                    "open" => {
+                        if open.last() != Some(&index) {
+                            open.push(index);
+                        }
+                        Side::Positive
+                    }
                     "seated" => {
                         // A seated tree angle is 0: either side gives the same pose.
                         let angle = match iface.role {
@@ -470,6 +537,7 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
             peak_so_far: 0.0,
             row: line_no - 1,
             openings: Vec::new(),
+            open,
         })
     }
 
@@ -481,6 +549,7 @@ impl<'m, R: BufRead> HistoryStates<'m, R> {
             };
             let line = line.to_string();
             let mut state = self.parse_row(&line)?;
+            self.check_open(&state)?;
             self.peak = state.q.iter().fold(self.peak, |m, v| m.max(v.abs()));
             state.peak_so_far = self.peak;
             match self.pending.take() {
