@@ -396,15 +396,16 @@ fn chains_loops_rocking_bases_and_sectors_match_the_kinematics() {
     }
 }
 
-/// The bundled wall under a one-sine pulse of 10 m/s² (1.6 λ g): faces of its spanning tree lift
-/// off, so history.csv gives their angles as the bodies' relative rotation only, and the frames
-/// must move the bodies below them by the offsets of openings.csv to draw them where they are
-/// (checked against the poses composed here, [`poses`]). The offsets matter: a face of the tree
-/// is open with an offset above 1e-3 of the model size in a frame.
+/// The bundled wall under a one-sine pulse of −10 m/s² (1.6 λ g, along −x first): faces of its
+/// spanning tree lift off, so history.csv gives their angles as the bodies' relative rotation
+/// only, and the frames must move the bodies below them by the offsets of openings.csv to draw
+/// them where they are (checked against the poses composed here, [`poses`]). The offsets
+/// matter: a face of the tree is open with an offset above 1e-3 of the model size in a frame
+/// (0.039 m of `c3_b2_on_c2_b1`). Along +x the wedge lifts off faces that close loops instead.
 #[test]
 fn bodies_below_an_open_face_are_drawn_where_they_are() {
     let text = bundled_text("wall")
-        + "\n[ground_motion]\nx = { one_sine_pulse = { amplitude = 10.0, period = 0.5 } }\n";
+        + "\n[ground_motion]\nx = { one_sine_pulse = { amplitude = -10.0, period = 0.5 } }\n";
     let model_path = write_model("animate_wall_pulse", &text);
     let results = scratch("animate_wall_pulse").join("r");
     let model = model_path.to_str().unwrap();

@@ -35,10 +35,28 @@ pub(super) enum FaceRelease {
     Released,
     /// The chain without them drives one into its support: they stay closed.
     Contradicted,
+    /// In motion, none of them moves relative to its support in the chain without them: the
+    /// gap of every point that touches keeps exactly its value (its rate and acceleration are
+    /// 0), its two bodies at rest relative to each other. They stay closed, carrying no force:
+    /// the lift-off is one of the program's equal answers, which a mirrored file's program
+    /// need not return, and an open face that does not move would only land again later.
+    Ties,
     /// The chain without them could not be solved at this state: they stay closed, undecided.
     Unsolved,
     /// No chain of the CRR model is left without them (why).
     Impossible(String),
+}
+
+/// How a face that the contact program lifts off moves relative to its support in the chain
+/// without it ([`Simulation::faces_separate`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Separation {
+    /// A point that touches approaches its support: the face would be driven into it.
+    Approaches,
+    /// Points touch and none moves: every gap rate and acceleration is exactly 0.
+    Still,
+    /// Otherwise: it leaves (or is not driven into its support).
+    Leaves,
 }
 
 /// One open face: an interface of the file's model whose loop is released.
@@ -224,7 +242,9 @@ impl Simulation<'_> {
     /// ([`FaceRelease::Released`]) — when the chain without them confirms it
     /// ([`Self::faces_separate`]). Otherwise the faces stay closed
     /// ([`FaceRelease::Contradicted`]), or no spanning tree is left (a twisting seat would have
-    /// to enter it: [`FaceRelease::Impossible`] with why).
+    /// to enter it: [`FaceRelease::Impossible`] with why). In motion, faces that do not move
+    /// ([`FaceRelease::Ties`]) stay closed, and the others are released without them (checked
+    /// again on the chain that keeps them).
     pub(super) fn release_faces(&mut self, lifting: &[String]) -> FaceRelease {
         let mut open = self.open.interfaces();
         let opening: Vec<usize> = lifting
@@ -236,22 +256,42 @@ impl Simulation<'_> {
             Ok(built) => built,
             Err(e) => return FaceRelease::Impossible(e.to_string()),
         };
-        match self.faces_separate(&built, &opening) {
-            Ok(true) => match self.switch_chain(built, &[]) {
-                Ok(()) => FaceRelease::Released,
-                Err(e) => FaceRelease::Impossible(e.to_string()),
-            },
-            Ok(false) => FaceRelease::Contradicted,
-            Err(_) => FaceRelease::Unsolved,
+        let verdicts = match self.faces_separate(&built, &opening) {
+            Ok(verdicts) => verdicts,
+            Err(_) => return FaceRelease::Unsolved,
+        };
+        if verdicts.contains(&Separation::Approaches) {
+            return FaceRelease::Contradicted;
+        }
+        // At rest every acceleration vanishes at the load's threshold, where lift-offs are
+        // decided: only in motion does a face that does not move tie.
+        let ties = |v: &Separation| *v == Separation::Still && !self.at_rest();
+        if verdicts.iter().any(ties) {
+            let moving: Vec<String> = lifting
+                .iter()
+                .zip(&verdicts)
+                .filter(|(_, v)| !ties(v))
+                .map(|(name, _)| name.clone())
+                .collect();
+            return if moving.is_empty() {
+                FaceRelease::Ties
+            } else {
+                self.release_faces(&moving)
+            };
+        }
+        match self.switch_chain(built, &[]) {
+            Ok(()) => FaceRelease::Released,
+            Err(e) => FaceRelease::Impossible(e.to_string()),
         }
     }
 
-    /// Whether the faces `opening` (interfaces of the file) leave their supports in the motion
-    /// of the chain without them (`built`), by its own equations at the current state, with the
-    /// other slots as that chain's own uplift test sets them (its releases, outside faces it
-    /// would lift off too, where its exact solve opens them; seated slots it does not release
-    /// held): every point of those faces that touches (gap within 1e-9 of the model size) has a
-    /// gap rate above −1e-9 √(g L) and a gap acceleration above −1e-6 g. The gap's rate and
+    /// Whether each of the faces `opening` (interfaces of the file, in that order) leaves its
+    /// support in the motion of the chain without them (`built`), by its own equations at the
+    /// current state, with the other slots as that chain's own uplift test sets them (its
+    /// releases, outside faces it would lift off too, where its exact solve opens them; seated
+    /// slots it does not release held) ([`Separation`]): it does not approach where every point
+    /// that touches (gap within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a
+    /// gap acceleration above −1e-6 g, and it is still where they are all exactly 0. The gap's rate and
     /// acceleration are its central differences over the states q ± h q̇ + ½h² q̈
     /// (h = 1e-4 √(L/g), q̈ of the chain without the faces).
     ///
@@ -265,7 +305,7 @@ impl Simulation<'_> {
         &mut self,
         (loops, chain): &(OpenLoops, Model),
         opening: &[usize],
-    ) -> Result<bool, SimulationError> {
+    ) -> Result<Vec<Separation>, SimulationError> {
         let (q, qdot) = self.state_on(chain, loops);
         let (mut d, _, _) = self.dynamics_on(chain, loops, &[]);
         // The chain's own decision at this state: the releases of its uplift test, those of
@@ -316,17 +356,35 @@ impl Simulation<'_> {
         d.accelerations(chain, self.ground, self.t, &q, &qdot)
             .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
         let (g, size) = (chain.gravity, chain.size);
-        let faces: Vec<&OpenFace> = loops
-            .faces
+        let faces: Vec<&OpenFace> = opening
             .iter()
-            .filter(|f| opening.contains(&f.interface))
+            .map(|&k| {
+                loops
+                    .faces
+                    .iter()
+                    .find(|f| f.interface == k)
+                    .expect("a face lifting off is open in the chain built without it")
+            })
             .collect();
         let mut kin = Data::new(chain);
         let motion = gap_motion(chain, &mut kin, &d.pivots, &faces, (&q, &qdot, &d.qddot));
-        Ok(motion.iter().flatten().all(|p| {
-            p.gap > 1e-9 * size
-                || (p.rate > -1e-9 * (g * size).sqrt() && p.acceleration > -1e-6 * g)
-        }))
+        Ok(motion
+            .iter()
+            .map(|points| {
+                let touching = || points.iter().filter(|p| p.gap <= 1e-9 * size);
+                if touching()
+                    .any(|p| p.rate <= -1e-9 * (g * size).sqrt() || p.acceleration <= -1e-6 * g)
+                {
+                    Separation::Approaches
+                } else if touching().all(|p| p.rate == 0.0 && p.acceleration == 0.0)
+                    && touching().next().is_some()
+                {
+                    Separation::Still
+                } else {
+                    Separation::Leaves
+                }
+            })
+            .collect())
     }
 
     /// The dynamics of `chain` (its maps `loops`) at the current state: every slot keeps its

@@ -1046,8 +1046,10 @@ impl Simulation<'_> {
                         "every body keeps a support through other contacts, but no chain of \
                          the CRR model is left without them ({why})"
                     )),
-                    FaceRelease::Contradicted => {
-                        contradicted = true;
+                    release @ (FaceRelease::Contradicted | FaceRelease::Ties) => {
+                        // Faces that do not move stay closed without a record: no point would
+                        // leave or be driven in, no hypothesis is at stake.
+                        contradicted = matches!(release, FaceRelease::Contradicted);
                         // A face rocking on one pivot stays on it: the program leaves its
                         // lift out until the next impact or landing.
                         for name in &interfaces {
