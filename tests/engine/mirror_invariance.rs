@@ -183,7 +183,8 @@ fn mirrored_files_under_the_mirrored_record_move_as_mirror_images() {
 /// order of the file decides); such a face stayed open without moving and landed later with no
 /// energy, one more impact record along −x; under 11 m/s² the two runs parted, one reaching the
 /// chatter stop at 0.3848 s with 206 impacts and the other with 207. Faces that do not move
-/// now stay closed (docs/simulation.md, "Faces that open").
+/// now stay closed, their lift left out of the program until the next impact or landing
+/// (docs/simulation.md, "Faces that open"). A stop on a flight is compared to 1e-6 s (below).
 #[test]
 fn the_wall_under_a_pulse_and_under_the_mirrored_pulse_moves_as_its_mirror_image() {
     let (file, _) = load_model(&common::bundled_path("wall")).unwrap();
@@ -250,9 +251,11 @@ fn the_wall_under_a_pulse_and_under_the_mirrored_pulse_moves_as_its_mirror_image
             a.summary.error,
             b.summary.error
         );
-        // A stop (a flight) falls at the same instant to the event location's round-off.
+        // A stop on a flight falls where the program's answer turns, a threshold crossed
+        // nearly tangentially, which magnifies round-off: 6e-8 s apart at 18 m/s² (up to 6e-7 s
+        // at 12, 16 and 20 m/s²; 2e-7 s at 12 m/s² before this change too).
         assert!(
-            (ta.end_time - tb.end_time).abs() <= 1e-9,
+            (ta.end_time - tb.end_time).abs() <= 1e-6,
             "{name}: end {} against {}",
             ta.end_time,
             tb.end_time
@@ -301,7 +304,7 @@ fn the_wall_under_a_pulse_and_under_the_mirrored_pulse_moves_as_its_mirror_image
             .fold(1.0f64, |m, v| m.max(v.abs()));
         for (x, y) in sa.iter().zip(sb.iter()) {
             assert!(
-                (x.t - y.t).abs() <= 1e-8,
+                (x.t - y.t).abs() <= 1e-6,
                 "{name}: sample at {} against {}",
                 x.t,
                 y.t

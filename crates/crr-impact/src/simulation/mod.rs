@@ -1108,15 +1108,23 @@ impl<'a> Simulation<'a> {
                 self.params.options.rtol
             ),
         };
-        match self.impacts.last().filter(|i| i.t == self.t) {
-            Some(impact) => format!(
-                "{integration}; the state at this instant was set by the impact or landing of {} \
-                 and its snap, which a tolerance does not change: if the failure comes back at \
-                 the same instant, the contacts rattle beyond what the event-driven model resolves",
-                impact.interfaces.join(", ")
-            ),
-            None => integration,
+        // Every record of this instant (landings that push other faces in come in a cascade).
+        let names: Vec<&str> = self
+            .impacts
+            .iter()
+            .rev()
+            .take_while(|i| i.t == self.t)
+            .flat_map(|i| i.interfaces.iter().map(String::as_str))
+            .collect();
+        if names.is_empty() {
+            return integration;
         }
+        format!(
+            "{integration}; the state at this instant was set by the impact or landing of {} and \
+             its snap, which a tolerance does not change: if the failure comes back at the same \
+             instant, the contacts rattle beyond what the event-driven model resolves",
+            names.join(", ")
+        )
     }
 
     fn step_unchecked(&mut self) -> Result<StopReason, SimulationError> {

@@ -35,11 +35,12 @@ pub(super) enum FaceRelease {
     Released,
     /// The chain without them drives one into its support: they stay closed.
     Contradicted,
-    /// In motion, none of them moves relative to its support in the chain without them: the
-    /// gap of every point that touches keeps exactly its value (its rate and acceleration are
-    /// 0), its two bodies at rest relative to each other. They stay closed, carrying no force:
-    /// the lift-off is one of the program's equal answers, which a mirrored file's program
-    /// need not return, and an open face that does not move would only land again later.
+    /// In motion, none of them moves in the chain without them: the gap of every point that
+    /// touches keeps exactly its value (its rate and acceleration are 0.0, as where every
+    /// coordinate on both bodies' paths to the ground is still). They stay closed, carrying no
+    /// force, and the program leaves their lift out until the next impact or landing: the
+    /// lift-off is one of its equal answers, which a mirrored file's program need not return,
+    /// and an open face that does not move would only land again later.
     Ties,
     /// The chain without them could not be solved at this state: they stay closed, undecided.
     Unsolved,

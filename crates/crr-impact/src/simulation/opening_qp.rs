@@ -259,7 +259,7 @@ fn program(
         d.seated.len() + lifts.len(),
         &scale,
     )?;
-    let mut decision = decide(model, d, &lifts, &rate_rows, &solution, &scale);
+    let mut decision = decide(model, d, &lifts, &rate_rows, &solution, &scale, held);
     decision.complete = complete;
     Ok(decision)
 }
@@ -582,7 +582,10 @@ fn dense_to_csc(m: &DMatrix<f64>, upper: bool) -> CscMatrix<f64> {
 /// and lifts off when both are; a rocking base with both tilts seated is read from the normal
 /// accelerations of its four pivot corners (its two lifts are parallel translations, so their
 /// split is not unique): the corners that stay down name the pivot (two: an edge, the tilt
-/// across it turns; one: both tilts; none: the base lifts off).
+/// across it turns; one: both tilts; none: the base lifts off). A seated face in `held` (one
+/// whose lift-off tied: its blocks did not move without it, docs/simulation.md, "Faces that
+/// open") does not lift off: it holds (`held_faces`), so that the answer can turn back to "holds" and the
+/// uplift event fire again for the other joints.
 fn decide(
     model: &Model,
     d: &Dynamics,
@@ -590,6 +593,7 @@ fn decide(
     rate_rows: &[(DVector<f64>, f64)],
     solution: &Solution,
     scale: &Scale,
+    held_faces: &[usize],
 ) -> OpeningDecision {
     let n = model.dof();
     let x = &solution.x;
@@ -655,6 +659,7 @@ fn decide(
                 let side = d.pivots.sides[k];
                 let (plus, minus) = opening(i);
                 match (plus > tol, minus > tol) {
+                    (true, true) if held_faces.contains(&index) => {}
                     (true, true) => decision.lifting_off.push(index),
                     (true, false) => decision.releases.push((k, side)),
                     (false, true) => decision.releases.push((k, side.flipped())),
@@ -662,7 +667,10 @@ fn decide(
                 }
             }
             // A base whose every row is held has every corner down: it holds.
-            _ => base_decision(model, d, index, &seated, opening, tol).apply(index, &mut decision),
+            _ => match base_decision(model, d, index, &seated, opening, tol) {
+                BaseMotion::LiftsOff if held_faces.contains(&index) => {}
+                motion => motion.apply(index, &mut decision),
+            },
         }
     }
     decision.lifting_off.sort_unstable();

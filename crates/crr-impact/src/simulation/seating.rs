@@ -1050,14 +1050,17 @@ impl Simulation<'_> {
                         // Faces that do not move stay closed without a record: no point would
                         // leave or be driven in, no hypothesis is at stake.
                         contradicted = matches!(release, FaceRelease::Contradicted);
-                        // A face rocking on one pivot stays on it: the program leaves its
-                        // lift out until the next impact or landing.
+                        // A face rocking on one pivot stays on it, and a face that ties stays
+                        // seated: the program leaves its lift out until the next impact or
+                        // landing (else its answer would stay "opens" and the uplift event
+                        // could not fire again for the other joints).
                         for name in &interfaces {
                             if let Some(k) = self.model.interface_index(name)
-                                && !self.model.interfaces[k]
-                                    .slots
-                                    .clone()
-                                    .any(|s| self.seated[s])
+                                && (!contradicted
+                                    || !self.model.interfaces[k]
+                                        .slots
+                                        .clone()
+                                        .any(|s| self.seated[s]))
                                 && !self.spare.rest.held_faces.contains(&k)
                             {
                                 self.spare.rest.held_faces.push(k);
