@@ -912,3 +912,29 @@ fn a_wall_at_rest_after_a_landing_leaves_rest_under_a_load_above_its_multiplier(
         );
     }
 }
+
+/// A face whose lift-off ties (its blocks do not move without it) stays closed and is left out
+/// of the contact program until the next impact or landing, so that the uplift event can fire
+/// again for the other joints (docs/simulation.md, "Faces that open"). The 3 × 3 wall of
+/// `examples/wall_pulse.rs` under 2 λ g: at 0.0796 s the program lifts off `c2_b1_on_c1_b2`,
+/// whose blocks do not move, and then `c2_b2_on_c1_b3`, which the chain without it drives back
+/// into its support: the run records that `lift_off` at its instant. With the tied face kept
+/// closed but still offered to the program (28f35b8), the program's answer stayed "opens", the
+/// uplift event never fired again, and the run's first record was an `outside_face` of the
+/// monitor at 0.0900 s, the lift-off unseen.
+#[test]
+fn a_tied_face_does_not_hide_the_lift_offs_that_follow() {
+    let (_, traj) = run_wall_to_end(3, 2.0, 1.0);
+    assert_eq!(traj.end_time, 1.0);
+    let v = traj
+        .violation
+        .as_ref()
+        .expect("a lift-off the chain contradicts");
+    assert_eq!(
+        (v.kind.as_str(), v.interface.as_str()),
+        ("lift_off", "c2_b2_on_c1_b3"),
+        "at {} s",
+        v.t
+    );
+    assert!((v.t - 0.0796).abs() < 1e-4, "at {} s", v.t);
+}
