@@ -12,6 +12,34 @@ use crr::{ModelInput, RecordSamples, RunOptions};
 
 use crate::common;
 
+/// The two runs' impacts: as many, at the same instants (1e-8 s), on the same interfaces, `a`'s
+/// named by `rename` as `b` names them.
+fn assert_same_impacts(
+    name: &str,
+    a: &crr::impact::Trajectory,
+    b: &crr::impact::Trajectory,
+    rename: impl Fn(&str) -> String,
+) {
+    assert_eq!(
+        a.impacts.len(),
+        b.impacts.len(),
+        "{name}: impact counts differ"
+    );
+    for (i, j) in a.impacts.iter().zip(&b.impacts) {
+        assert!(
+            (i.t - j.t).abs() <= 1e-8,
+            "{name}: impact at {} against {}",
+            i.t,
+            j.t
+        );
+        let mut x: Vec<String> = i.interfaces.iter().map(|n| rename(n)).collect();
+        let mut y = j.interfaces.clone();
+        x.sort();
+        y.sort();
+        assert_eq!(x, y, "{name}: impact at {}", i.t);
+    }
+}
+
 /// The bundled model `name` and its mirror (x → −x), as model inputs without their own ground
 /// motion.
 fn original_and_mirror(name: &str) -> (ModelInput, ModelInput) {
@@ -116,23 +144,7 @@ fn mirrored_files_under_the_mirrored_record_move_as_mirror_images() {
             // comparison covers the collapse decision as well).
             assert!(ta.collapse.is_some(), "{name}: it overturns");
         }
-        assert_eq!(
-            ta.impacts.len(),
-            tb.impacts.len(),
-            "{name}: impact counts differ"
-        );
-        for (i, j) in ta.impacts.iter().zip(&tb.impacts) {
-            assert!(
-                (i.t - j.t).abs() <= 1e-8,
-                "{name}: impact at {} against {}",
-                i.t,
-                j.t
-            );
-            let (mut x, mut y) = (i.interfaces.clone(), j.interfaces.clone());
-            x.sort();
-            y.sort();
-            assert_eq!(x, y, "{name}: impact at {}", i.t);
-        }
+        assert_same_impacts(name, ta, tb, str::to_string);
         match (ta.uplift_time, tb.uplift_time) {
             (Some(x), Some(y)) => assert!((x - y).abs() <= 1e-9, "{name}: uplift {x} against {y}"),
             (x, y) => assert_eq!(x, y, "{name}: uplift"),
@@ -260,23 +272,8 @@ fn the_wall_under_a_pulse_and_under_the_mirrored_pulse_moves_as_its_mirror_image
             ta.end_time,
             tb.end_time
         );
-        assert_eq!(
-            ta.impacts.len(),
-            tb.impacts.len(),
-            "{name}: impact counts differ"
-        );
+        assert_same_impacts(&name, ta, tb, mirror_interface);
         for (i, j) in ta.impacts.iter().zip(&tb.impacts) {
-            assert!(
-                (i.t - j.t).abs() <= 1e-8,
-                "{name}: impact at {} against {}",
-                i.t,
-                j.t
-            );
-            let mut x: Vec<String> = i.interfaces.iter().map(|n| mirror_interface(n)).collect();
-            let mut y = j.interfaces.clone();
-            x.sort();
-            y.sort();
-            assert_eq!(x, y, "{name}: impact at {}", i.t);
             let scale = i.energy_lost.abs().max(j.energy_lost.abs()).max(1.0);
             assert!(
                 (i.energy_lost - j.energy_lost).abs() <= 1e-8 * scale,

@@ -292,8 +292,8 @@ impl Simulation<'_> {
     /// releases, outside faces it would lift off too, where its exact solve opens them; seated
     /// slots it does not release held) ([`Separation`]): it does not approach where every point
     /// that touches (gap within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a
-    /// gap acceleration above −1e-6 g, and it is still where they are all exactly 0. The gap's rate and
-    /// acceleration are its central differences over the states q ± h q̇ + ½h² q̈
+    /// gap acceleration above −1e-6 g, and it is still where they are all exactly 0. The gap's
+    /// rate and acceleration are its central differences over the states q ± h q̇ + ½h² q̈
     /// (h = 1e-4 √(L/g), q̈ of the chain without the faces).
     ///
     /// The program's own motion cannot be trusted for this: a face it lifts off keeps its slip

@@ -582,10 +582,10 @@ fn dense_to_csc(m: &DMatrix<f64>, upper: bool) -> CscMatrix<f64> {
 /// and lifts off when both are; a rocking base with both tilts seated is read from the normal
 /// accelerations of its four pivot corners (its two lifts are parallel translations, so their
 /// split is not unique): the corners that stay down name the pivot (two: an edge, the tilt
-/// across it turns; one: both tilts; none: the base lifts off). A seated face in `held` (one
-/// whose lift-off tied: its blocks did not move without it, docs/simulation.md, "Faces that
-/// open") does not lift off: it holds (`held_faces`), so that the answer can turn back to "holds" and the
-/// uplift event fire again for the other joints.
+/// across it turns; one: both tilts; none: the base lifts off). A seated face in `held_faces`
+/// (one whose lift-off tied: its blocks did not move without it, docs/simulation.md, "Faces
+/// that open") does not lift off: it holds, so that the answer can turn back to "holds" and
+/// the uplift event fire again for the other joints.
 fn decide(
     model: &Model,
     d: &Dynamics,
