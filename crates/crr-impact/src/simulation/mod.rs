@@ -1098,8 +1098,9 @@ impl<'a> Simulation<'a> {
     /// What to change when the invariant fails: the step of RK4, the tolerance otherwise. Where
     /// an impact or a landing set the state at this very instant, its snap (the least change
     /// that closes the loops on the new pivots) may be what moved it, which no tolerance
-    /// changes: the message says so (on the bundled wall under a pulse of 12 m/s² a landing's
-    /// snap put a rocking angle 7.9e-5 rad past its pivot, the same with rtol 1e-10 and 1e-12).
+    /// changes: the message says so (on the bundled wall under a pulse of 12 m/s², as of commit
+    /// 6ac4261, a landing's snap put a rocking angle 7.9e-5 rad past its pivot, the same with
+    /// rtol 1e-10 and 1e-12).
     fn remedy(&self) -> String {
         let integration = match self.params.method {
             Method::Rk4 { step } => format!("shorten analysis.rk4_step (now {step:e} s)"),

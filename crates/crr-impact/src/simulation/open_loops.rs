@@ -35,9 +35,9 @@ pub(super) enum FaceRelease {
     Released,
     /// The chain without them drives one into its support: they stay closed.
     Contradicted,
-    /// In motion, none of them moves in the chain without them: the gap of every point that
-    /// touches keeps exactly its value (its rate and acceleration are 0.0, as where every
-    /// coordinate on both bodies' paths to the ground is still). They stay closed, carrying no
+    /// In motion, none of them moves in the chain without them: each child is still relative to
+    /// its parent (every coordinate on the tree path between the two at q̇ = q̈ = 0.0), so its
+    /// gaps keep their values whatever the two bodies' common motion. They stay closed, carrying no
     /// force, and the program leaves their lift out until the next impact or landing: the
     /// lift-off is one of its equal answers, which a mirrored file's program need not return,
     /// and an open face that does not move would only land again later.
@@ -48,13 +48,37 @@ pub(super) enum FaceRelease {
     Impossible(String),
 }
 
+/// Whether body `child` does not move relative to `parent` (a body, or None: the ground) in
+/// `model`'s tree at rates `qdot` and accelerations `qddot`: every coordinate on the path
+/// between their frames (the coordinates carrying exactly one of the two) has q̇ and q̈ exactly
+/// 0.0 (a seated coordinate, or one its chain holds). Exact, whatever the bodies' common
+/// motion: the path from their common ancestor to the ground is not looked at, so a block at
+/// rest on a block that moves is still on it (its gap's central differences there are
+/// round-off, not 0.0).
+fn child_still_on_parent(
+    model: &Model,
+    parent: Option<usize>,
+    child: usize,
+    qdot: &DVector<f64>,
+    qddot: &DVector<f64>,
+) -> bool {
+    let (child_frame, parent_frame) = (
+        Some(model.body_coord[child]),
+        parent.map(|b| model.body_coord[b]),
+    );
+    (0..model.dof())
+        .filter(|&k| model.carries(k, child_frame) != model.carries(k, parent_frame))
+        .all(|k| qdot[k] == 0.0 && qddot[k] == 0.0)
+}
+
 /// How a face that the contact program lifts off moves relative to its support in the chain
 /// without it ([`Simulation::faces_separate`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Separation {
     /// A point that touches approaches its support: the face would be driven into it.
     Approaches,
-    /// Points touch and none moves: every gap rate and acceleration is exactly 0.
+    /// Points touch and the child does not move relative to its parent: every coordinate on
+    /// the tree path between the two bodies has q̇ and q̈ exactly 0.0.
     Still,
     /// Otherwise: it leaves (or is not driven into its support).
     Leaves,
@@ -292,9 +316,11 @@ impl Simulation<'_> {
     /// releases, outside faces it would lift off too, where its exact solve opens them; seated
     /// slots it does not release held) ([`Separation`]): it does not approach where every point
     /// that touches (gap within 1e-9 of the model size) has a gap rate above −1e-9 √(g L) and a
-    /// gap acceleration above −1e-6 g, and it is still where they are all exactly 0. The gap's
-    /// rate and acceleration are its central differences over the states q ± h q̇ + ½h² q̈
-    /// (h = 1e-4 √(L/g), q̈ of the chain without the faces).
+    /// gap acceleration above −1e-6 g, and it is still where a point touches and its child does
+    /// not move relative to its parent ([`child_still_on_parent`]: exact, where the gaps' rates
+    /// on blocks carried by a moving one are round-off). The gap's rate and acceleration are its
+    /// central differences over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g), q̈ of the chain
+    /// without the faces).
     ///
     /// The program's own motion cannot be trusted for this: a face it lifts off keeps its slip
     /// rows there (no tangential acceleration relative to its support, module `opening_qp`), a
@@ -371,16 +397,17 @@ impl Simulation<'_> {
         let motion = gap_motion(chain, &mut kin, &d.pivots, &faces, (&q, &qdot, &d.qddot));
         Ok(motion
             .iter()
-            .map(|points| {
+            .zip(&faces)
+            .map(|(points, face)| {
                 let touching = || points.iter().filter(|p| p.gap <= 1e-9 * size);
-                if touching()
+                if touching().next().is_some()
+                    && child_still_on_parent(chain, face.parent, face.child, &qdot, &d.qddot)
+                {
+                    Separation::Still
+                } else if touching()
                     .any(|p| p.rate <= -1e-9 * (g * size).sqrt() || p.acceleration <= -1e-6 * g)
                 {
                     Separation::Approaches
-                } else if touching().all(|p| p.rate == 0.0 && p.acceleration == 0.0)
-                    && touching().next().is_some()
-                {
-                    Separation::Still
                 } else {
                     Separation::Leaves
                 }
@@ -1084,4 +1111,54 @@ fn gap_motion(
                 .collect()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A hanging chain ground → link0 → link1 → link2, one coordinate each: whether link2 moves
+    /// relative to a body depends on the coordinates between the two alone, however the bodies
+    /// below them move.
+    #[test]
+    fn a_child_is_still_on_its_parent_when_the_coordinates_between_them_are() {
+        let model = Model::from_spec(&crr_kinematics::fixtures::serial_chain(3)).unwrap();
+        let v = |a: [f64; 3]| DVector::from_row_slice(&a);
+        let (link0, link1, link2) = (Some(0), Some(1), 2);
+        // link0 and link1 turn and accelerate; link2 keeps its angle to link1.
+        let (qdot, qddot) = (v([0.3, -0.1, 0.0]), v([1.0, 2.0, 0.0]));
+        assert!(child_still_on_parent(&model, link1, link2, &qdot, &qddot));
+        // Relative to link0, to the ground: link1's turn lies between them.
+        assert!(!child_still_on_parent(&model, link0, link2, &qdot, &qddot));
+        assert!(!child_still_on_parent(&model, None, link2, &qdot, &qddot));
+        // Its own coordinate moving, by a rate or an acceleration however small: not still.
+        let tiny = f64::MIN_POSITIVE;
+        assert!(!child_still_on_parent(
+            &model,
+            link1,
+            link2,
+            &v([0.3, -0.1, tiny]),
+            &qddot
+        ));
+        assert!(!child_still_on_parent(
+            &model,
+            link1,
+            link2,
+            &qdot,
+            &v([1.0, 2.0, -tiny])
+        ));
+        // Everything still: still relative to the ground too.
+        let zero = v([0.0; 3]);
+        assert!(child_still_on_parent(&model, None, link2, &zero, &zero));
+        // The path read from the other end (the upper body as the parent): link1 turns between
+        // link0 and link2; link1 on link2 is still when only link0 turns.
+        assert!(!child_still_on_parent(&model, Some(2), 0, &qdot, &qddot));
+        assert!(child_still_on_parent(
+            &model,
+            Some(2),
+            1,
+            &v([0.3, 0.0, 0.0]),
+            &v([1.0, 0.0, 0.0])
+        ));
+    }
 }
