@@ -50,6 +50,15 @@ pub(super) struct SegmentEvents<'b> {
     /// another landing or an impact left that point a hair inside its support), as
     /// [`rocking_seats`] does for angles: the event then fires when the point moves further in.
     pub(super) gap_seats: Vec<f64>,
+    /// Open chains ([`pressing_faces`]): the faces rocking on one pivot whose pivot's normal
+    /// force is watched, by the tree slot of each (the first of its interface). Each event is
+    /// that force over W L, positive while the pivot presses, falling through 0 where it would
+    /// pull: the face lifts off and every body it carries loses its only support (a flight).
+    pub(super) pressing: Vec<usize>,
+    /// The dynamics the pivots' forces are computed with (the current pivots and seats, solved
+    /// by M: the subtree forces need the bias accelerations); present when `pressing` is not
+    /// empty.
+    pub(super) pressing_trial: Option<Box<Dynamics>>,
 }
 
 impl SegmentEvents<'_> {
@@ -77,6 +86,25 @@ impl SegmentEvents<'_> {
     }
     fn gap_count(&self) -> usize {
         self.open_faces.iter().map(|f| f.len()).sum()
+    }
+    pub(super) fn first_pressing_index(&self) -> usize {
+        self.first_gap_index() + self.gap_count()
+    }
+    /// The pivots' normal forces of [`Self::pressing`] at time t into `out` (needs
+    /// [`Self::load_state`]): [`pressing_forces`].
+    pub(super) fn pressing_values(&mut self, t: f64, out: &mut [f64]) {
+        if let Some(trial) = self.pressing_trial.as_mut() {
+            let state = (t, &self.q, &self.qdot);
+            pressing_forces(
+                self.model,
+                self.ground,
+                trial,
+                &self.pivots,
+                &self.pressing,
+                state,
+                out,
+            );
+        }
     }
     /// Gap event `j` (needs [`Self::load_state`]).
     fn gap_value(&self, j: usize) -> f64 {
@@ -163,7 +191,7 @@ impl SegmentEvents<'_> {
 
 impl EventFunctions for SegmentEvents<'_> {
     fn count(&self) -> usize {
-        self.first_gap_index() + self.gap_count()
+        self.first_pressing_index() + self.pressing.len()
     }
 
     fn eval(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
@@ -171,6 +199,8 @@ impl EventFunctions for SegmentEvents<'_> {
         if self.uplift.is_some() {
             g[self.uplift_index()] = self.uplift_value(t);
         }
+        let p0 = self.first_pressing_index();
+        self.pressing_values(t, &mut g[p0..]);
     }
 
     /// After the projection of an accepted step: the angles, the collapse function, the zones
@@ -180,8 +210,10 @@ impl EventFunctions for SegmentEvents<'_> {
     /// loops' drift over one step, which cannot change that sign except at a threshold, and
     /// there the next step's end, on the projected trajectory, decides the crossing. Evaluating
     /// it twice per step doubled the contact program's cost (55 % of the 10 × 10 wall's run).
-    fn eval_after_projection(&mut self, _t: f64, y: &[f64], g: &mut [f64]) {
+    fn eval_after_projection(&mut self, t: f64, y: &[f64], g: &mut [f64]) {
         self.eval_distances(y, g);
+        let p0 = self.first_pressing_index();
+        self.pressing_values(t, &mut g[p0..]);
     }
 
     /// One function alone: root location on an impact does not solve the uplift problem.
@@ -203,13 +235,18 @@ impl EventFunctions for SegmentEvents<'_> {
             self.uplift_value(t)
         } else if i < self.first_gap_index() {
             self.zone_value(i - self.first_zone_index())
-        } else {
+        } else if i < self.first_pressing_index() {
             self.gap_value(i - self.first_gap_index())
+        } else {
+            let mut values = vec![0.0; self.pressing.len()];
+            self.pressing_values(t, &mut values);
+            values[i - self.first_pressing_index()]
         }
     }
 
     fn direction(&self, i: usize) -> Direction {
-        // Impacts (sign(side)·φ + margin) and collapse (U past its threshold) fall through 0.
+        // Impacts (sign(side)·φ + margin), collapse (U past its threshold), the open faces'
+        // gaps and the pivots' normal forces fall through 0.
         if i < self.rocking.len() || i == self.collapse_index() || i >= self.first_gap_index() {
             Direction::Falling
         } else if self.uplift.is_some() && i == self.uplift_index() {
@@ -249,4 +286,56 @@ pub(super) fn rocking_seats(
             0.0
         }
     }));
+}
+
+/// The faces of an open chain that rock on one pivot and can lift off it (two distinct pivot
+/// lines, or a rocking base): the first tree slot of each interface with no slot seated. On an
+/// open chain every body has one support, so a pivot that would pull means the bodies it
+/// carries fly. None on a structure with loops (there the contact program of module
+/// `opening_qp` watches the rocking faces, while some joint is seated) or with a regularised
+/// impact law (its δ zone's force is not in the solve of [`SegmentEvents::pressing_values`]).
+pub(super) fn pressing_faces(model: &Model, seated: &[bool], regularised: bool) -> Vec<usize> {
+    if !model.closures.is_empty() || regularised {
+        return Vec::new();
+    }
+    model
+        .interfaces
+        .iter()
+        .filter(|iface| !iface.slots.is_empty() && iface.slots.clone().all(|s| !seated[s]))
+        .filter(|iface| {
+            let count = iface.kind.angle_count();
+            let current = vec![Side::Positive; count];
+            let mut other = current.clone();
+            other[0] = Side::Negative;
+            (iface.kind.pivot(&current) - iface.kind.pivot(&other)).norm() > 1e-9 * model.size
+        })
+        .map(|iface| iface.slots.start)
+        .collect()
+}
+
+/// The normal force of each pivot of `pressing` (tree slots of faces rocking on one pivot,
+/// [`pressing_faces`]) at the state (t, q, q̇), over W L, into `out`: σ′r′, r′ the joint's
+/// reaction about its other pivot P′ of side σ′ while it carries no moment about its pivot P
+/// (`seating::SubtreeLoads`, from a solve by M in `trial`, the current pivots and seats), as
+/// the contact program reads a rocking face's lift (module `opening_qp`). Positive while the
+/// pivot presses. Where the solve fails, +1 (no event).
+pub(super) fn pressing_forces(
+    model: &Model,
+    ground: &GroundMotion,
+    trial: &mut Dynamics,
+    pivots: &ActivePivots,
+    pressing: &[usize],
+    (t, q, qdot): (f64, &DVector<f64>, &DVector<f64>),
+    out: &mut [f64],
+) {
+    if trial.accelerations(model, ground, t, q, qdot).is_err() {
+        out.fill(1.0);
+        return;
+    }
+    let loads = super::seating::SubtreeLoads::new(model, trial);
+    let scale = model.total_mass() * model.gravity * model.size;
+    for (value, &k) in out.iter_mut().zip(pressing) {
+        let (r_other, _) = loads.other_side_reaction(model, trial, pivots, k, 0.0);
+        *value = pivots.sides[k].flipped().sign() * r_other / scale;
+    }
 }
