@@ -288,14 +288,23 @@ pub(super) fn rocking_seats(
     }));
 }
 
-/// The faces of an open chain that rock on one pivot and can lift off it (two distinct pivot
-/// lines, or a rocking base): the first tree slot of each interface with no slot seated. On an
-/// open chain every body has one support, so a pivot that would pull means the bodies it
-/// carries fly. None on a structure with loops (there the contact program of module
-/// `opening_qp` watches the rocking faces, while some joint is seated) or with a regularised
-/// impact law (its δ zone's force is not in the solve of [`SegmentEvents::pressing_values`]).
-pub(super) fn pressing_faces(model: &Model, seated: &[bool], regularised: bool) -> Vec<usize> {
-    if !model.closures.is_empty() || regularised {
+/// The faces of an open chain that rock on one pivot and can lift off it (two distinct pivots
+/// for the current sides: a hinge's two pivot lines, a rocking base's corners): the first tree
+/// slot of each interface with no slot seated. On an open chain every body has one support, so
+/// a pivot that would pull means the bodies it carries fly. None unless `watched`: the file is
+/// an open chain without symmetry rows (a symmetry row puts a torque on its coordinates, so the
+/// joint's reaction about its other pivot is no longer its normal force alone; on a file with
+/// loops the contact program of module `opening_qp` watches the rocking faces while some joint
+/// is seated, and a chain left by faces that opened has supports that can land again) and has
+/// no regularised impact law (its δ zone's force is not in the solve of
+/// [`SegmentEvents::pressing_values`]).
+pub(super) fn pressing_faces(
+    model: &Model,
+    pivots: &ActivePivots,
+    seated: &[bool],
+    watched: bool,
+) -> Vec<usize> {
+    if !watched || model.constraint_rows > 0 {
         return Vec::new();
     }
     model
@@ -303,11 +312,10 @@ pub(super) fn pressing_faces(model: &Model, seated: &[bool], regularised: bool) 
         .iter()
         .filter(|iface| !iface.slots.is_empty() && iface.slots.clone().all(|s| !seated[s]))
         .filter(|iface| {
-            let count = iface.kind.angle_count();
-            let current = vec![Side::Positive; count];
-            let mut other = current.clone();
-            other[0] = Side::Negative;
-            (iface.kind.pivot(&current) - iface.kind.pivot(&other)).norm() > 1e-9 * model.size
+            let current = &pivots.sides[iface.slots.clone()];
+            let mut other = current.to_vec();
+            other[0] = other[0].flipped();
+            (iface.kind.pivot(current) - iface.kind.pivot(&other)).norm() > 1e-9 * model.size
         })
         .map(|iface| iface.slots.start)
         .collect()

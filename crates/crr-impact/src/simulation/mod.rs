@@ -1193,7 +1193,8 @@ impl<'a> Simulation<'a> {
         // seats can start on sides their next instant changes (the bundled drum column at
         // 0.42250 s: a pivot "pulling" by 9e-4 W L in a state whose motion the samples around it
         // show pressing with 0.96 of the weight it carries).
-        let pressing = pressing_faces(model, &self.seated, self.regularised.is_some());
+        let watched = self.original.constraint_rows == 0 && self.regularised.is_none();
+        let pressing = pressing_faces(model, &self.dynamics.pivots, &self.seated, watched);
         let pressing_trial = (!pressing.is_empty()).then(|| {
             let mut d = Box::new(self.dynamics.clone());
             d.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
@@ -1384,7 +1385,7 @@ impl<'a> Simulation<'a> {
     /// now ([`pressing_faces`]): its face lifts off its only support.
     fn flight_of(&mut self, k: usize) -> SimulationError {
         let model = Arc::clone(&self.model);
-        self.record_current_sample(self.t);
+        self.record_final_sample();
         let iface = &model.interfaces[model.coords[k].interface];
         let in_flight: Vec<String> = (0..model.bodies.len())
             .filter(|&b| model.carries(k, Some(model.body_coord[b])))

@@ -36,7 +36,7 @@ pub(super) enum FaceRelease {
     /// The chain without them drives one into its support: they stay closed.
     Contradicted,
     /// In motion, none of them moves in the chain without them: each child is still relative to
-    /// its parent (every coordinate on the tree path between the two at q̇ = q̈ = 0.0), so its
+    /// its parent (every coordinate on the tree path between the two seated or at q̇ = q̈ = 0.0), so its
     /// gaps keep their values whatever the two bodies' common motion. They stay closed, carrying no
     /// force, and the program leaves their lift out until the next impact or landing: the
     /// lift-off is one of its equal answers, which a mirrored file's program need not return,
@@ -49,18 +49,16 @@ pub(super) enum FaceRelease {
 }
 
 /// Whether body `child` does not move relative to `parent` (a body, or None: the ground) in
-/// `model`'s tree at rates `qdot` and accelerations `qddot`: every coordinate on the path
-/// between their frames (the coordinates carrying exactly one of the two) has q̇ and q̈ exactly
-/// 0.0 (a seated coordinate, or one its chain holds). Exact, whatever the bodies' common
-/// motion: the path from their common ancestor to the ground is not looked at, so a block at
-/// rest on a block that moves is still on it (its gap's central differences there are
-/// round-off, not 0.0).
+/// `model`'s tree, `still[k]` telling whether coordinate k is still (seated, or q̇ and q̈
+/// exactly 0.0): every coordinate on the path between their frames (the coordinates carrying
+/// exactly one of the two) is. Exact, whatever the bodies' common motion: the path from their
+/// common ancestor to the ground is not looked at, so a block at rest on a block that moves is
+/// still on it (its gap's central differences there are round-off, not 0.0).
 fn child_still_on_parent(
     model: &Model,
     parent: Option<usize>,
     child: usize,
-    qdot: &DVector<f64>,
-    qddot: &DVector<f64>,
+    still: &[bool],
 ) -> bool {
     let (child_frame, parent_frame) = (
         Some(model.body_coord[child]),
@@ -68,7 +66,7 @@ fn child_still_on_parent(
     );
     (0..model.dof())
         .filter(|&k| model.carries(k, child_frame) != model.carries(k, parent_frame))
-        .all(|k| qdot[k] == 0.0 && qddot[k] == 0.0)
+        .all(|k| still[k])
 }
 
 /// How a face that the contact program lifts off moves relative to its support in the chain
@@ -78,7 +76,7 @@ pub(super) enum Separation {
     /// A point that touches approaches its support: the face would be driven into it.
     Approaches,
     /// Points touch and the child does not move relative to its parent: every coordinate on
-    /// the tree path between the two bodies has q̇ and q̈ exactly 0.0.
+    /// the tree path between the two bodies is seated or has q̇ and q̈ exactly 0.0.
     Still,
     /// Otherwise: it leaves (or is not driven into its support).
     Leaves,
@@ -395,13 +393,18 @@ impl Simulation<'_> {
             .collect();
         let mut kin = Data::new(chain);
         let motion = gap_motion(chain, &mut kin, &d.pivots, &faces, (&q, &qdot, &d.qddot));
+        // Still: seated (held at its seat: a coordinate that closed a loop in the chain before
+        // maps its rate from the poses, round-off rather than 0.0), or q̇ and q̈ exactly 0.0.
+        let still: Vec<bool> = (0..chain.dof())
+            .map(|k| d.seated.contains(&k) || (qdot[k] == 0.0 && d.qddot[k] == 0.0))
+            .collect();
         Ok(motion
             .iter()
             .zip(&faces)
             .map(|(points, face)| {
                 let touching = || points.iter().filter(|p| p.gap <= 1e-9 * size);
                 if touching().next().is_some()
-                    && child_still_on_parent(chain, face.parent, face.child, &qdot, &d.qddot)
+                    && child_still_on_parent(chain, face.parent, face.child, &still)
                 {
                     Separation::Still
                 } else if touching()
@@ -1123,42 +1126,30 @@ mod tests {
     #[test]
     fn a_child_is_still_on_its_parent_when_the_coordinates_between_them_are() {
         let model = Model::from_spec(&crr_kinematics::fixtures::serial_chain(3)).unwrap();
-        let v = |a: [f64; 3]| DVector::from_row_slice(&a);
         let (link0, link1, link2) = (Some(0), Some(1), 2);
-        // link0 and link1 turn and accelerate; link2 keeps its angle to link1.
-        let (qdot, qddot) = (v([0.3, -0.1, 0.0]), v([1.0, 2.0, 0.0]));
-        assert!(child_still_on_parent(&model, link1, link2, &qdot, &qddot));
+        // link0 and link1 move; link2 keeps its angle to link1.
+        let still = [false, false, true];
+        assert!(child_still_on_parent(&model, link1, link2, &still));
         // Relative to link0, to the ground: link1's turn lies between them.
-        assert!(!child_still_on_parent(&model, link0, link2, &qdot, &qddot));
-        assert!(!child_still_on_parent(&model, None, link2, &qdot, &qddot));
-        // Its own coordinate moving, by a rate or an acceleration however small: not still.
-        let tiny = f64::MIN_POSITIVE;
+        assert!(!child_still_on_parent(&model, link0, link2, &still));
+        assert!(!child_still_on_parent(&model, None, link2, &still));
+        // Its own coordinate moving: not still.
         assert!(!child_still_on_parent(
             &model,
             link1,
             link2,
-            &v([0.3, -0.1, tiny]),
-            &qddot
-        ));
-        assert!(!child_still_on_parent(
-            &model,
-            link1,
-            link2,
-            &qdot,
-            &v([1.0, 2.0, -tiny])
+            &[true, true, false]
         ));
         // Everything still: still relative to the ground too.
-        let zero = v([0.0; 3]);
-        assert!(child_still_on_parent(&model, None, link2, &zero, &zero));
+        assert!(child_still_on_parent(&model, None, link2, &[true; 3]));
         // The path read from the other end (the upper body as the parent): link1 turns between
         // link0 and link2; link1 on link2 is still when only link0 turns.
-        assert!(!child_still_on_parent(&model, Some(2), 0, &qdot, &qddot));
+        assert!(!child_still_on_parent(&model, Some(2), 0, &still));
         assert!(child_still_on_parent(
             &model,
             Some(2),
             1,
-            &v([0.3, 0.0, 0.0]),
-            &v([1.0, 0.0, 0.0])
+            &[false, true, true]
         ));
     }
 }
