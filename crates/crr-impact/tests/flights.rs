@@ -13,14 +13,65 @@ use std::path::Path;
 use crr_dynamics::ground_motion::{Axis, ComponentSpec, GroundMotion, PulseSpec, SignalSpec};
 use crr_dynamics::{InitialSpec, solve_initial};
 use crr_impact::simulation::body_offsets;
-use crr_impact::{Parameters, Simulation, SimulationError, SlotState};
+use crr_impact::{Parameters, Simulation, SimulationError, SlotState, Trajectory};
 use crr_kinematics::fixtures::running_bond_wall;
 use crr_kinematics::{ActivePivots, Data, Model, Side, forward_kinematics};
 use nalgebra::{DVector, Vector3};
 
+/// A run that ended on a flight: its ground motion, the stop and its trajectory until then.
+struct Flight {
+    ground: GroundMotion,
+    /// The flight's instant (s), the interfaces lifting off and the bodies in flight.
+    t: f64,
+    interfaces: Vec<String>,
+    in_flight: Vec<String>,
+    traj: Trajectory,
+}
+
+/// Runs `model` from rest under a one-sine pulse along x (`amplitude` m/s², `period` s),
+/// sampled every `output_interval` s, to the flight it must end on.
+fn run_to_flight(model: &Model, amplitude: f64, period: f64, output_interval: f64) -> Flight {
+    let pulse = SignalSpec::OneSinePulse(PulseSpec {
+        amplitude,
+        period,
+        start: 0.0,
+    });
+    let ground = GroundMotion::none()
+        .with_component(Axis::X, &ComponentSpec::new(pulse), Path::new("."))
+        .unwrap();
+    let init = solve_initial(model, &InitialSpec::default()).unwrap();
+    let params = Parameters {
+        duration: 1.0,
+        output_interval,
+        ..Parameters::default()
+    };
+    let failure = Simulation::new(model, &ground, &init, params)
+        .unwrap()
+        .run()
+        .unwrap_err();
+    let SimulationError::LiftOff {
+        t,
+        interfaces,
+        in_flight,
+        ..
+    } = failure.error
+    else {
+        panic!("a flight, not {}", failure.error)
+    };
+    Flight {
+        ground,
+        t,
+        interfaces,
+        in_flight,
+        traj: failure.partial,
+    }
+}
+
 /// One sample's pose of the flying block and of its support.
 struct Pose {
     t: f64,
+    /// Every slot's state at the sample.
+    states: Vec<SlotState>,
     /// The block's centre of mass (m).
     com: Vector3<f64>,
     /// Its rotation about y (rad).
@@ -31,13 +82,113 @@ struct Pose {
     normal: Vector3<f64>,
 }
 
+/// The poses of `block` resting on `support` at the samples from `from` (s) on, from the bodies'
+/// poses the samples' coordinates give (open faces of the file's tree move the bodies below them
+/// by their offsets); `pivot_at_rest` is where the block rests, at rest, for the slots' sides.
+fn poses_from(
+    model: &Model,
+    traj: &Trajectory,
+    from: f64,
+    (block, support): (usize, usize),
+    pivot_at_rest: impl Fn(&ActivePivots) -> Vector3<f64>,
+) -> Vec<Pose> {
+    let mut data = Data::new(model);
+    let mut poses = Vec::new();
+    for s in traj.samples.iter().filter(|s| s.t >= from) {
+        let mut pivots = ActivePivots::uniform(model, Side::Positive);
+        for (k, state) in s.states.iter().enumerate() {
+            if *state == SlotState::Negative {
+                pivots.sides[k] = Side::Negative;
+            }
+        }
+        forward_kinematics(model, &mut data, &DVector::from_column_slice(s.q), &pivots);
+        let offsets = body_offsets(model, s.openings);
+        let place = |b: usize, x: &Vector3<f64>| {
+            let f = model.body_coord[b];
+            data.rot_ops[f] * x + data.frame_translation[f] + offsets[b]
+        };
+        let rotation = data.rot_ops[model.body_coord[block]];
+        poses.push(Pose {
+            t: s.t,
+            states: s.states.to_vec(),
+            com: place(block, &model.bodies[block].com),
+            theta: rotation[(0, 2)].atan2(rotation[(0, 0)]),
+            pivot: place(block, &pivot_at_rest(&pivots)),
+            normal: data.rot_ops[model.body_coord[support]] * Vector3::z(),
+        });
+    }
+    poses
+}
+
+/// Newton on `block` at every pose whose neighbours share its states, evenly spaced (an
+/// event's own sample is off the grid), with no impact between: the force its support exerts,
+/// F = m (a + a_g + g ẑ), a from the centre of mass's second differences, has the moment about
+/// the centre of mass that turns the block, I θ̈, to 1e-6 m g L (asserted), and `at` checks the
+/// pose. Returns (t, F·n / (m g)) of each, n the support's face normal, and the largest moment
+/// residual over m g L.
+fn newton_normal_forces(
+    model: &Model,
+    flight: &Flight,
+    poses: &[Pose],
+    block: usize,
+    at: impl Fn(&Pose),
+) -> (Vec<(f64, f64)>, f64) {
+    let (m, g) = (model.bodies[block].mass, model.gravity);
+    let inertia = model.bodies[block].inertia[(1, 1)];
+    let mut normal_forces = Vec::new();
+    let mut worst = 0.0f64;
+    for w in poses.windows(3) {
+        let [before, now, after] = w else {
+            unreachable!()
+        };
+        let h = after.t - now.t;
+        let impact_between = flight
+            .traj
+            .impacts
+            .iter()
+            .any(|i| i.t > before.t && i.t < after.t);
+        if before.states != now.states
+            || now.states != after.states
+            || impact_between
+            || (now.t - before.t - h).abs() > 1e-12
+        {
+            continue;
+        }
+        at(now);
+        let a = (after.com - now.com * 2.0 + before.com) / (h * h);
+        let alpha = (after.theta - 2.0 * now.theta + before.theta) / (h * h);
+        let force = m * (a + flight.ground.acceleration(now.t) + Vector3::new(0.0, 0.0, g));
+        let moment = (now.pivot - now.com).cross(&force).y;
+        assert!(
+            (moment - inertia * alpha).abs() <= 1e-6 * m * g * model.size,
+            "at {} s: the force's moment {moment} N m against I θ̈ = {} N m",
+            now.t,
+            inertia * alpha
+        );
+        worst = worst.max((moment - inertia * alpha).abs() / (m * g * model.size));
+        normal_forces.push((now.t, force.dot(&now.normal) / (m * g)));
+    }
+    for &(t, f) in &normal_forces {
+        assert!(f > 0.0, "at {t} s the support pulls: {f} m g");
+    }
+    (normal_forces, worst)
+}
+
+/// The normal force (m g) at the flight's instant, extrapolated from the last two samples.
+fn at_the_stop(normal_forces: &[(f64, f64)], t_stop: f64) -> f64 {
+    let [.., (t1, f1), (t2, f2)] = normal_forces[..] else {
+        panic!("two samples at least")
+    };
+    f2 + (f2 - f1) / (t2 - t1) * (t_stop - t2)
+}
+
 /// The bundled wall (`examples/models/wall.toml`: 4 courses of 3 blocks of 1.0 × 0.5 × 0.5 m in
 /// running bond, λ = 7/11) under a one-sine pulse of 12 m/s² (0.5 s), sampled every 0.1 ms. Its
 /// top block `c3_b1` lifts off `c2_b1` early in the pulse and rocks on one pivot of `c2_b0`, its
 /// own left corner (x = −1 m at rest) on `c2_b0`'s top face; the engine stops at 0.40421 s: the
 /// program lifts it off that face too, a flight. By Newton, on the samples of the last 50 ms
 /// (those whose neighbours, 0.1 ms away, share their states, no impact between): the support's normal force
-/// is compressive at every one, up to 0.20 m g, and falls to 5.6e-5 m g at the stop
+/// is compressive at every one, up to 0.21 m g, and falls to 5.6e-5 m g at the stop
 /// (extrapolated from the last two samples), crossing zero 65 µs after it. The engine decides
 /// early by that much: its interior point reads which contacts hold from their forces and
 /// accelerations, whose product it resolves to 1e-11 in its units (weight and g / size), so a
@@ -50,36 +201,9 @@ struct Pose {
 #[test]
 fn a_block_the_engine_reports_in_flight_has_lost_its_support_force_by_newton() {
     let model = Model::from_spec(&running_bond_wall(4, 3, 1.0, 0.5, 0.5)).unwrap();
-    let pulse = SignalSpec::OneSinePulse(PulseSpec {
-        amplitude: 12.0,
-        period: 0.5,
-        start: 0.0,
-    });
-    let ground = GroundMotion::none()
-        .with_component(Axis::X, &ComponentSpec::new(pulse), Path::new("."))
-        .unwrap();
-    let init = solve_initial(&model, &InitialSpec::default()).unwrap();
-    let params = Parameters {
-        duration: 1.0,
-        output_interval: 1e-4,
-        ..Parameters::default()
-    };
-    let failure = Simulation::new(&model, &ground, &init, params)
-        .unwrap()
-        .run()
-        .unwrap_err();
-    let SimulationError::LiftOff {
-        t: t_stop,
-        in_flight,
-        interfaces,
-        ..
-    } = &failure.error
-    else {
-        panic!("a flight, not {}", failure.error)
-    };
-    assert_eq!(in_flight, &["c3_b1"]);
-    assert_eq!(interfaces, &["c3_b1_on_c2_b0"]);
-    let traj = &failure.partial;
+    let flight = run_to_flight(&model, 12.0, 0.5, 1e-4);
+    assert_eq!(flight.in_flight, ["c3_b1"]);
+    assert_eq!(flight.interfaces, ["c3_b1_on_c2_b0"]);
     let block = model.body_index("c3_b1").unwrap();
     let support = model.body_index("c2_b0").unwrap();
     let resting = model.interface_index("c3_b1_on_c2_b0").unwrap();
@@ -89,78 +213,27 @@ fn a_block_the_engine_reports_in_flight_has_lost_its_support_force_by_newton() {
         model.interfaces[other].slots.start,
     );
     // The block's corner at x = −1 m is the interface's negative pivot.
-    let corner = Vector3::new(-1.0, 0.0, 1.5);
-    let mut data = Data::new(&model);
-    let mut poses: Vec<(Pose, Vec<SlotState>)> = Vec::new();
-    for s in traj.samples.iter().filter(|s| s.t >= t_stop - 0.05) {
-        let mut pivots = ActivePivots::uniform(&model, Side::Positive);
-        for (k, state) in s.states.iter().enumerate() {
-            if *state == SlotState::Negative {
-                pivots.sides[k] = Side::Negative;
-            }
-        }
-        forward_kinematics(&model, &mut data, &DVector::from_column_slice(s.q), &pivots);
-        // Open faces of the file's tree move the bodies below them by their offsets.
-        let offsets = body_offsets(&model, s.openings);
-        let place = |b: usize, x: &Vector3<f64>| {
-            let f = model.body_coord[b];
-            data.rot_ops[f] * x + data.frame_translation[f] + offsets[b]
-        };
-        let rotation = data.rot_ops[model.body_coord[block]];
-        poses.push((
-            Pose {
-                t: s.t,
-                com: place(block, &model.bodies[block].com),
-                theta: rotation[(0, 2)].atan2(rotation[(0, 0)]),
-                pivot: place(block, &corner),
-                normal: data.rot_ops[model.body_coord[support]] * Vector3::z(),
-            },
-            s.states.to_vec(),
-        ));
-    }
-    let (m, g) = (model.bodies[block].mass, model.gravity);
-    let inertia = model.bodies[block].inertia[(1, 1)];
-    let mut normal_forces: Vec<(f64, f64)> = Vec::new();
-    let mut worst = 0.0f64;
-    for w in poses.windows(3) {
-        let [(before, s0), (now, s1), (after, s2)] = w else {
-            unreachable!()
-        };
-        let impact_between = traj.impacts.iter().any(|i| i.t > before.t && i.t < after.t);
-        // Evenly spaced (an event's own sample is not on the grid).
-        let h = after.t - now.t;
-        if s0 != s1 || s1 != s2 || impact_between || (now.t - before.t - h).abs() > 1e-12 {
-            continue;
-        }
+    let corner = |_: &ActivePivots| Vector3::new(-1.0, 0.0, 1.5);
+    let poses = poses_from(
+        &model,
+        &flight.traj,
+        flight.t - 0.05,
+        (block, support),
+        corner,
+    );
+    let (normal_forces, worst) = newton_normal_forces(&model, &flight, &poses, block, |now| {
         // The block rests on its corner on c2_b0 alone.
-        assert_eq!(s1[slot], SlotState::Negative, "at {} s", now.t);
-        assert_eq!(s1[other_slot], SlotState::Open, "at {} s", now.t);
-        let a = (after.com - now.com * 2.0 + before.com) / (h * h);
-        let alpha = (after.theta - 2.0 * now.theta + before.theta) / (h * h);
-        let force = m * (a + ground.acceleration(now.t) + Vector3::new(0.0, 0.0, g));
-        let moment = (now.pivot - now.com).cross(&force).y;
-        assert!(
-            (moment - inertia * alpha).abs() <= 1e-6 * m * g * model.size,
-            "at {} s: the force's moment {moment} N m against I θ̈ = {} N m",
-            now.t,
-            inertia * alpha
-        );
-        worst = worst.max((moment - inertia * alpha).abs() / (m * g * model.size));
-        normal_forces.push((now.t, force.dot(&now.normal) / (m * g)));
-    }
+        assert_eq!(now.states[slot], SlotState::Negative, "at {} s", now.t);
+        assert_eq!(now.states[other_slot], SlotState::Open, "at {} s", now.t);
+    });
     assert!(normal_forces.len() > 400, "{} samples", normal_forces.len());
-    for &(t, f) in &normal_forces {
-        assert!(f > 0.0, "at {t} s the support pulls: {f} m g");
-    }
     let largest = normal_forces.iter().fold(0.0f64, |m, x| m.max(x.1));
     assert!(largest > 0.15, "largest normal force {largest} m g");
-    let [.., (t1, f1), (t2, f2)] = normal_forces[..] else {
-        unreachable!()
-    };
-    let at_stop = f2 + (f2 - f1) / (t2 - t1) * (t_stop - t2);
+    let at_stop = at_the_stop(&normal_forces, flight.t);
     println!("moment residual {worst:.2e} m g L");
     println!(
-        "normal force: largest {largest:.4} m g, at the stop {at_stop:.3e} m g (t = {t_stop} s)"
+        "normal force: largest {largest:.4} m g, at the stop {at_stop:.3e} m g (t = {} s)",
+        flight.t
     );
     assert!(
         at_stop.abs() <= 1e-4,
@@ -211,109 +284,32 @@ fn an_open_chain_s_block_flies_where_newton_s_normal_force_reaches_zero() {
         symmetry: Vec::new(),
     };
     let model = Model::from_spec(&spec).unwrap();
-    let pulse = SignalSpec::OneSinePulse(PulseSpec {
-        amplitude: 30.0,
-        period: 0.15,
-        start: 0.0,
-    });
-    let ground = GroundMotion::none()
-        .with_component(Axis::X, &ComponentSpec::new(pulse), Path::new("."))
-        .unwrap();
-    let init = solve_initial(&model, &InitialSpec::default()).unwrap();
-    let params = Parameters {
-        duration: 1.0,
-        output_interval: 1e-5,
-        ..Parameters::default()
-    };
-    let failure = Simulation::new(&model, &ground, &init, params)
-        .unwrap()
-        .run()
-        .unwrap_err();
-    let SimulationError::LiftOff {
-        t: t_stop,
-        in_flight,
-        interfaces,
-        ..
-    } = &failure.error
-    else {
-        panic!("a flight, not {}", failure.error)
-    };
+    let flight = run_to_flight(&model, 30.0, 0.15, 1e-5);
     assert_eq!(
-        (in_flight, interfaces),
+        (&flight.in_flight, &flight.interfaces),
         (&vec!["upper".to_string()], &vec!["joint".to_string()])
     );
-    let traj = &failure.partial;
     let (lower, upper) = (0, 1);
-    let joint = model.interface_index("joint").unwrap();
-    let slot = model.interfaces[joint].slots.start;
-    let mut data = Data::new(&model);
-    // (t, states, centre of mass, rotation about y, pivot, the lower block's face normal)
-    let mut poses = Vec::new();
-    for s in traj.samples.iter().filter(|s| s.t >= t_stop - 0.02) {
-        let mut pivots = ActivePivots::uniform(&model, Side::Positive);
-        for (k, state) in s.states.iter().enumerate() {
-            if *state == SlotState::Negative {
-                pivots.sides[k] = Side::Negative;
-            }
-        }
-        forward_kinematics(&model, &mut data, &DVector::from_column_slice(s.q), &pivots);
-        let frame = model.body_coord[upper];
-        let (r, x) = (data.rot_ops[frame], data.frame_translation[frame]);
-        let pivot_rest = Vector3::new(0.2 * pivots.sides[slot].sign(), 0.0, 1.5);
-        poses.push((
-            s.t,
-            s.states.to_vec(),
-            r * model.bodies[upper].com + x,
-            r[(0, 2)].atan2(r[(0, 0)]),
-            r * pivot_rest + x,
-            data.rot_ops[model.body_coord[lower]] * Vector3::z(),
-        ));
-    }
-    let (m, g) = (model.bodies[upper].mass, model.gravity);
-    let inertia = model.bodies[upper].inertia[(1, 1)];
-    let mut normal_forces: Vec<(f64, f64)> = Vec::new();
-    for w in poses.windows(3) {
-        let [before, now, after] = w else {
-            unreachable!()
-        };
-        let h = after.0 - now.0;
-        let impact_between = traj.impacts.iter().any(|i| i.t > before.0 && i.t < after.0);
-        if before.1 != now.1
-            || now.1 != after.1
-            || impact_between
-            || (now.0 - before.0 - h).abs() > 1e-12
-        {
-            continue;
-        }
+    let slot = model.interfaces[model.interface_index("joint").unwrap()]
+        .slots
+        .start;
+    // The upper block rests on the lower one's edge on the side it rocks on.
+    let edge = |pivots: &ActivePivots| Vector3::new(0.2 * pivots.sides[slot].sign(), 0.0, 1.5);
+    let poses = poses_from(&model, &flight.traj, flight.t - 0.02, (upper, lower), edge);
+    let (normal_forces, _) = newton_normal_forces(&model, &flight, &poses, upper, |now| {
         assert_ne!(
-            now.1[slot],
+            now.states[slot],
             SlotState::Seated,
             "the upper block rocks at {} s",
-            now.0
+            now.t
         );
-        let a = (after.2 - now.2 * 2.0 + before.2) / (h * h);
-        let alpha = (after.3 - 2.0 * now.3 + before.3) / (h * h);
-        let force = m * (a + ground.acceleration(now.0) + Vector3::new(0.0, 0.0, g));
-        let moment = (now.4 - now.2).cross(&force).y;
-        assert!(
-            (moment - inertia * alpha).abs() <= 1e-6 * m * g * model.size,
-            "at {} s: the force's moment {moment} N m against I θ̈ = {} N m",
-            now.0,
-            inertia * alpha
-        );
-        normal_forces.push((now.0, force.dot(&now.5) / (m * g)));
-    }
+    });
     assert!(normal_forces.len() > 100, "{} samples", normal_forces.len());
-    for &(t, f) in &normal_forces {
-        assert!(f > 0.0, "at {t} s the lower block pulls: {f} m g");
-    }
-    let [.., (t1, f1), (t2, f2)] = normal_forces[..] else {
-        unreachable!()
-    };
-    let at_stop = f2 + (f2 - f1) / (t2 - t1) * (t_stop - t2);
+    let at_stop = at_the_stop(&normal_forces, flight.t);
     let largest = normal_forces.iter().fold(0.0f64, |m, x| m.max(x.1));
     println!(
-        "normal force: largest {largest:.3} m g, at the stop {at_stop:.2e} m g (t = {t_stop} s)"
+        "normal force: largest {largest:.3} m g, at the stop {at_stop:.2e} m g (t = {} s)",
+        flight.t
     );
     assert!(at_stop.abs() <= 1e-5, "{at_stop} m g at the flight");
 }

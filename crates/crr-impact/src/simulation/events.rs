@@ -238,9 +238,16 @@ impl EventFunctions for SegmentEvents<'_> {
         } else if i < self.first_pressing_index() {
             self.gap_value(i - self.first_gap_index())
         } else {
-            let mut values = vec![0.0; self.pressing.len()];
-            self.pressing_values(t, &mut values);
-            values[i - self.first_pressing_index()]
+            // That pivot's force alone (root location evaluates it a dozen times).
+            let j = i - self.first_pressing_index();
+            let mut value = [1.0];
+            if let Some(trial) = self.pressing_trial.as_mut() {
+                let state = (t, &self.q, &self.qdot);
+                let pivot = &self.pressing[j..=j];
+                let (model, ground) = (self.model, self.ground);
+                pressing_forces(model, ground, trial, &self.pivots, pivot, state, &mut value);
+            }
+            value[0]
         }
     }
 
