@@ -50,8 +50,9 @@ pub(super) struct SegmentEvents<'b> {
     /// another landing or an impact left that point a hair inside its support), as
     /// [`rocking_seats`] does for angles: the event then fires when the point moves further in.
     pub(super) gap_seats: Vec<f64>,
-    /// Open chains ([`pressing_faces`]): the faces rocking on one pivot whose pivot's normal
-    /// force is watched, by the tree slot of each (the first of its interface). Each event is
+    /// Open chains ([`pressing_faces`]): the faces rocking on a pivot (a corner, an edge or a
+    /// hinge's line) whose normal force is watched, by the tree slot of each (the first rocking
+    /// slot of its interface). Each event is
     /// that force over W L, positive while the pivot presses, falling through 0 where it would
     /// pull: the face lifts off and every body it carries loses its only support (a flight).
     pub(super) pressing: Vec<usize>,
@@ -295,16 +296,19 @@ pub(super) fn rocking_seats(
     }));
 }
 
-/// The faces of an open chain that rock on one pivot and can lift off it (two distinct pivots
-/// for the current sides: a hinge's two pivot lines, a rocking base's corners): the first tree
-/// slot of each interface with no slot seated. On an open chain every body has one support, so
-/// a pivot that would pull means the bodies it carries fly. None unless `watched`: the file is
-/// an open chain without symmetry rows (a symmetry row puts a torque on its coordinates, so the
-/// joint's reaction about its other pivot is no longer its normal force alone; on a file with
-/// loops the contact program of module `opening_qp` watches the rocking faces while some joint
-/// is seated, and a chain left by faces that opened has supports that can land again) and has
-/// no regularised impact law (its δ zone's force is not in the solve of
-/// [`SegmentEvents::pressing_values`]).
+/// The faces of an open chain that rock on their pivot and can lift off it (two distinct pivots
+/// for the current sides: a hinge's two pivot lines, a rocking base's corners or edges): the
+/// first rocking tree slot of each interface with one. A rocking base with a tilt seated turns
+/// on an edge, and its rocking tilt's reaction about its other pivot is the edge's whole normal
+/// force times the base's width (the seated tilt's reaction is about an axis across that lever,
+/// and the face's tangential forces have no moment about a line in its plane). On an open chain
+/// every body has one support, so a pivot that would pull means the bodies it carries fly.
+/// None unless `watched`: the file is an open chain without symmetry rows (a symmetry row puts
+/// a torque on its coordinates, so the joint's reaction about its other pivot is no longer its
+/// normal force alone; on a file with loops the contact program of module `opening_qp` watches
+/// the rocking faces while some joint is seated, and a chain left by faces that opened has
+/// supports that can land again) and has no regularised impact law (its δ zone's force is not
+/// in the solve of [`SegmentEvents::pressing_values`]).
 pub(super) fn pressing_faces(
     model: &Model,
     pivots: &ActivePivots,
@@ -317,18 +321,19 @@ pub(super) fn pressing_faces(
     model
         .interfaces
         .iter()
-        .filter(|iface| !iface.slots.is_empty() && iface.slots.clone().all(|s| !seated[s]))
-        .filter(|iface| {
+        .filter_map(|iface| {
+            let k = iface.slots.clone().find(|&s| !seated[s])?;
             let current = &pivots.sides[iface.slots.clone()];
             let mut other = current.to_vec();
-            other[0] = other[0].flipped();
-            (iface.kind.pivot(current) - iface.kind.pivot(&other)).norm() > 1e-9 * model.size
+            other[k - iface.slots.start] = other[k - iface.slots.start].flipped();
+            let distinct =
+                (iface.kind.pivot(current) - iface.kind.pivot(&other)).norm() > 1e-9 * model.size;
+            distinct.then_some(k)
         })
-        .map(|iface| iface.slots.start)
         .collect()
 }
 
-/// The normal force of each pivot of `pressing` (tree slots of faces rocking on one pivot,
+/// The normal force of each pivot of `pressing` (tree slots of faces rocking on a pivot,
 /// [`pressing_faces`]) at the state (t, q, q̇), over W L, into `out`: σ′r′, r′ the joint's
 /// reaction about its other pivot P′ of side σ′ while it carries no moment about its pivot P
 /// (`seating::SubtreeLoads`, from a solve by M in `trial`, the current pivots and seats), as
