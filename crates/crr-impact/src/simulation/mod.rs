@@ -504,6 +504,9 @@ struct Workspaces {
     /// (a `memcpy` of its size otherwise, at every step or segment).
     events_kin: Option<Box<Data>>,
     trial: Option<Box<Dynamics>>,
+    /// The dynamics of the open chains' pivot events ([`SegmentEvents::pressing_trial`]),
+    /// loaded with the current pivots and seats by each segment that watches a pivot.
+    pressing: Option<Box<Dynamics>>,
     /// The buffers of a segment's events and output, taken by each segment and given back.
     segment: Option<Box<SegmentBuffers>>,
     /// The buffers of the test for joints coming to rest ([`Simulation::step`]'s first task).
@@ -542,6 +545,7 @@ impl Workspaces {
         Self {
             events_kin: Some(Box::new(Data::new(model))),
             trial: Some(Box::new(trial)),
+            pressing: None,
             segment: None,
             settle: None,
             monitor: Dynamics::new(model, pivots.clone()),
@@ -1196,7 +1200,14 @@ impl<'a> Simulation<'a> {
         let watched = self.original.constraint_rows == 0 && self.regularised.is_none();
         let pressing = pressing_faces(model, &self.dynamics.pivots, &self.seated, watched);
         let pressing_trial = (!pressing.is_empty()).then(|| {
-            let mut d = Box::new(self.dynamics.clone());
+            let mut d = match self.spare.pressing.take() {
+                Some(mut d) => {
+                    d.pivots.clone_from(&self.dynamics.pivots);
+                    d.seated.clone_from(&self.dynamics.seated);
+                    d
+                }
+                None => Box::new(self.dynamics.clone()),
+            };
             d.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
             d
         });
@@ -1312,6 +1323,7 @@ impl<'a> Simulation<'a> {
         let SegmentEvents {
             kin: events_kin,
             trial,
+            pressing_trial,
             rest,
             rocking,
             seats,
@@ -1324,6 +1336,9 @@ impl<'a> Simulation<'a> {
         seg.seats = seats;
         self.spare.events_kin = Some(events_kin);
         self.spare.trial = Some(trial);
+        if pressing_trial.is_some() {
+            self.spare.pressing = pressing_trial;
+        }
         self.spare.rest = rest;
         self.next_sample = next_sample;
         // In the file's coordinates (a coordinate of a re-rooted chain that closes a loop of
