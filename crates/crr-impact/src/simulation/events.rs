@@ -3,6 +3,7 @@
 //! δ zones.
 
 use super::*;
+use crr_kinematics::{Parent, Role};
 
 /// The impact event of a rocking slot is g = sign(side)·φ + this margin (rad), falling through 0.
 /// A slot that starts a segment at φ = 0 exactly (just released, or just impacted) then starts
@@ -296,31 +297,31 @@ pub(super) fn rocking_seats(
     }));
 }
 
-/// The faces of an open chain that rock on their pivot and can lift off it (two distinct pivots
-/// for the current sides: a hinge's two pivot lines, a rocking base's corners or edges): the
-/// first rocking tree slot of each interface with one. A rocking base with a tilt seated turns
-/// on an edge, and its rocking tilt's reaction about its other pivot is the edge's whole normal
-/// force times the base's width (the seated tilt's reaction is about an axis across that lever,
-/// and the face's tangential forces have no moment about a line in its plane). On an open chain
-/// every body has one support, so a pivot that would pull means the bodies it carries fly.
-/// None unless `watched`: the file is an open chain without symmetry rows (a symmetry row puts
-/// a torque on its coordinates, so the joint's reaction about its other pivot is no longer its
-/// normal force alone; on a file with loops the contact program of module `opening_qp` watches
-/// the rocking faces while some joint is seated, and a chain left by faces that opened has
-/// supports that can land again) and has no regularised impact law (its δ zone's force is not
-/// in the solve of [`SegmentEvents::pressing_values`]).
+/// The faces that rock on their pivot, can lift off it (two distinct pivots for the current
+/// sides: a hinge's two pivot lines, a rocking base's corners or edges) and are the only
+/// contact between the bodies they carry and the rest ([`only_support`]: every face of an open
+/// chain; on loops a block hanging on one face, its others open): the first rocking tree slot
+/// of each interface with one. A rocking base with a tilt seated turns on an edge, and its
+/// rocking tilt's reaction about its other pivot is the edge's whole normal force times the
+/// base's width (the seated tilt's reaction is about an axis across that lever, and the face's
+/// tangential forces have no moment about a line in its plane). A pivot of such a face that
+/// would pull means the bodies it carries fly. None unless `watched`: the file has no symmetry
+/// rows (a symmetry row puts a torque on its coordinates, so the joint's reaction about its
+/// other pivot is no longer its normal force alone) and no regularised impact law (its δ
+/// zone's force is not in the solve of [`SegmentEvents::pressing_values`]).
 pub(super) fn pressing_faces(
     model: &Model,
     pivots: &ActivePivots,
     seated: &[bool],
     watched: bool,
 ) -> Vec<usize> {
-    if !watched || model.constraint_rows > 0 {
+    if !watched || !model.symmetries.is_empty() {
         return Vec::new();
     }
     model
         .interfaces
         .iter()
+        .filter(|iface| matches!(iface.role, Role::Tree { .. }))
         .filter_map(|iface| {
             let k = iface.slots.clone().find(|&s| !seated[s])?;
             let current = &pivots.sides[iface.slots.clone()];
@@ -328,9 +329,25 @@ pub(super) fn pressing_faces(
             other[k - iface.slots.start] = other[k - iface.slots.start].flipped();
             let distinct =
                 (iface.kind.pivot(current) - iface.kind.pivot(&other)).norm() > 1e-9 * model.size;
-            distinct.then_some(k)
+            (distinct && only_support(model, k)).then_some(k)
         })
         .collect()
+}
+
+/// Whether tree coordinate k's interface is the only contact between the bodies it carries
+/// and the rest of the chain: no loop closure joins a body it carries to one it does not (or
+/// to the ground). Then its subtree's load fₖ holds no closure force (those of loops within
+/// the subtree enter it twice, with opposite signs), and its pivot's normal force is that of
+/// the carried bodies' motion alone.
+pub(super) fn only_support(model: &Model, k: usize) -> bool {
+    let carried = |p: Parent| match p {
+        Parent::Ground => false,
+        Parent::Body(b) => model.carries(k, Some(model.body_coord[b])),
+    };
+    model.closures.iter().all(|cl| {
+        let closing = &model.interfaces[cl.interface];
+        carried(closing.parent) == carried(Parent::Body(closing.child))
+    })
 }
 
 /// The normal force of each pivot of `pressing` (tree slots of faces rocking on a pivot,
@@ -338,7 +355,7 @@ pub(super) fn pressing_faces(
 /// reaction about its other pivot P′ of side σ′ while it carries no moment about its pivot P
 /// (`seating::SubtreeLoads`, from a solve by M in `trial`, the current pivots and seats), as
 /// the contact program reads a rocking face's lift (module `opening_qp`). Positive while the
-/// pivot presses. Where the solve fails, +1 (no event).
+/// pivot presses. Where the solve fails, +1 (no event) and false.
 pub(super) fn pressing_forces(
     model: &Model,
     ground: &GroundMotion,
@@ -347,15 +364,39 @@ pub(super) fn pressing_forces(
     pressing: &[usize],
     (t, q, qdot): (f64, &DVector<f64>, &DVector<f64>),
     out: &mut [f64],
-) {
+) -> bool {
     if trial.accelerations(model, ground, t, q, qdot).is_err() {
         out.fill(1.0);
-        return;
+        return false;
     }
     let loads = super::seating::SubtreeLoads::new(model, trial);
     let scale = model.total_mass() * model.gravity * model.size;
     for (value, &k) in out.iter_mut().zip(pressing) {
         let (r_other, _) = loads.other_side_reaction(model, trial, pivots, k, 0.0);
         *value = pivots.sides[k].flipped().sign() * r_other / scale;
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crr_kinematics::fixtures::{serial_chain, trilithon};
+
+    /// A face is the only support of what it carries on an open chain (every tree coordinate of
+    /// a hanging chain), and never in a loop: the trilithon's lintel closes its loop on the
+    /// second post, so neither post's foot nor the first head carries alone; without that
+    /// closure the first head carries the lintel alone, and each foot its post and what is on
+    /// it.
+    #[test]
+    fn a_face_is_the_only_support_of_what_it_carries_outside_loops() {
+        let chain = Model::from_spec(&serial_chain(4)).unwrap();
+        assert!((0..chain.dof()).all(|k| only_support(&chain, k)));
+        let frame = Model::from_spec(&trilithon(0.2, 1.0, 1.5, 0.3, 1.0)).unwrap();
+        assert!(!frame.closures.is_empty());
+        assert!((0..frame.dof()).all(|k| !only_support(&frame, k)));
+        let closing: Vec<usize> = frame.closures.iter().map(|c| c.interface).collect();
+        let open = frame.without_loop_closures(&closing).unwrap();
+        assert!((0..open.dof()).all(|k| only_support(&open, k)));
     }
 }

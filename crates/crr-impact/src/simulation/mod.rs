@@ -1191,13 +1191,14 @@ impl<'a> Simulation<'a> {
         };
         rocking_seats(&seg.rocking, &seg.angles, regularised, &mut seats);
         let gap_seats = self.gap_seats();
-        // Open chains: the pivots of the faces rocking on one pivot, each watched for the instant
-        // its normal force falls through 0 (a flight). One that pulls already where the segment
-        // starts is left to the monitor (`tension`): at an impact's instant the joints at their
-        // seats can start on sides their next instant changes (the bundled drum column at
-        // 0.42250 s: a pivot "pulling" by 9e-4 W L in a state whose motion the samples around it
-        // show pressing with 0.96 of the weight it carries).
-        let watched = self.original.constraint_rows == 0 && self.regularised.is_none();
+        // The pivots of the faces rocking on a pivot that alone carry the bodies above them,
+        // each watched for the instant its normal force falls through 0 (a flight). One that
+        // pulls already where the segment starts is left to the monitor (`tension`): at an
+        // impact's instant the joints at their seats can start on sides their next instant
+        // changes (the bundled drum column at 0.42250 s: a pivot "pulling" by 9e-4 W L in a
+        // state whose motion the samples around it show pressing with 0.96 of the weight it
+        // carries).
+        let watched = self.original.symmetries.is_empty() && self.regularised.is_none();
         let pressing = pressing_faces(model, &self.dynamics.pivots, &self.seated, watched);
         let pressing_trial = (!pressing.is_empty()).then(|| {
             let mut d = match self.spare.pressing.take() {

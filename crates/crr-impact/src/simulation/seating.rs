@@ -1000,6 +1000,66 @@ impl Simulation<'_> {
         Ok(released)
     }
 
+    /// Whether the flight the contact program finds, the faces `lifting` (names of the chain's
+    /// interfaces) opening, comes early: every one of them is a face whose pivot's normal force
+    /// is watched by an event ([`pressing_faces`]) and that force, from the chain's solve at the
+    /// current state, still presses. The program reads which contacts hold from its interior
+    /// point's forces and accelerations, and a force below about √(its tolerance) of the
+    /// structure's weight is zero to it: a block on one pivot was found flying 65 µs early on
+    /// the bundled wall, with 5.6e-5 of its weight still pressing by Newton's second law.
+    pub(super) fn flight_not_yet(&mut self, lifting: &[String]) -> bool {
+        let model = Arc::clone(&self.model);
+        let watched = self.original.symmetries.is_empty() && self.regularised.is_none();
+        let pressing = pressing_faces(&model, &self.dynamics.pivots, &self.seated, watched);
+        let mut slots = Vec::with_capacity(lifting.len());
+        for name in lifting {
+            let Some(k) = pressing
+                .iter()
+                .copied()
+                .find(|&k| model.interfaces[model.coords[k].interface].name == *name)
+            else {
+                return false;
+            };
+            slots.push(k);
+        }
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        let mut trial = match self.spare.pressing.take() {
+            Some(mut d) => {
+                d.pivots.clone_from(&self.dynamics.pivots);
+                d.seated.clone_from(&self.dynamics.seated);
+                d
+            }
+            None => Box::new(self.dynamics.clone()),
+        };
+        trial.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
+        let mut forces = vec![0.0; slots.len()];
+        let state = (self.t, &q, &qdot);
+        let pivots = &self.dynamics.pivots;
+        let solved = pressing_forces(
+            &model,
+            self.ground,
+            &mut trial,
+            pivots,
+            &slots,
+            state,
+            &mut forces,
+        );
+        self.spare.pressing = Some(trial);
+        solved && !slots.is_empty() && forces.iter().all(|&f| f > 0.0)
+    }
+
+    /// Keeps the faces `names` (the chain's interfaces) on their pivots in the contact program
+    /// until the next impact or landing.
+    fn hold_faces(&mut self, names: &[String]) {
+        for name in names {
+            if let Some(k) = self.model.interface_index(name)
+                && !self.spare.rest.held_faces.contains(&k)
+            {
+                self.spare.rest.held_faces.push(k);
+            }
+        }
+    }
+
     /// One round of [`Self::release_if_opening`].
     fn release_once(&mut self) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
         if self.dynamics.seated.is_empty() {
@@ -1070,6 +1130,11 @@ impl Simulation<'_> {
                     }
                     FaceRelease::Unsolved => None,
                 }
+            } else if self.flight_not_yet(&interfaces) {
+                // Faces whose pivots' normal forces the chain's exact solve still finds
+                // pressing: their events locate the flight where those forces reach zero.
+                self.hold_faces(&interfaces);
+                None
             } else {
                 Some(super::flight_words(&in_flight))
             };
