@@ -37,9 +37,10 @@ const AMPLITUDE: f64 = 100.0;
 const B: f64 = 0.002;
 const H: f64 = 0.01;
 
-/// The run of the tiny block on `support` under A sin(2πft) along x.
-fn sine_run(support: &str, f: f64) -> crr::Run {
-    let tag = format!("tiny_sine_{f}_{}", support.len());
+/// The run of the tiny block on `support` under A sin(2πft) along x, its model file named by
+/// `test` (tests run in parallel: each writes its own files).
+fn sine_run(test: &str, support: &str, f: f64) -> crr::Run {
+    let tag = format!("tiny_sine_{test}_{f}_{}", support.len());
     let text = tiny_block_on(
         support,
         &format!("sine = {{ amplitude = {AMPLITUDE}, frequency = {f} }}"),
@@ -103,7 +104,7 @@ fn assert_flight_by_closed_form(run: &crr::Run, f: f64, rocking: usize) -> f64 {
 #[test]
 fn a_fast_sine_uplifts_at_its_first_crossing_of_the_threshold() {
     for f in [499.0, 500.0, 501.0, 1000.0] {
-        assert_flight_by_closed_form(&sine_run(HINGE, f), f, 0);
+        assert_flight_by_closed_form(&sine_run("hinge", HINGE, f), f, 0);
     }
 }
 
@@ -117,7 +118,7 @@ fn a_fast_sine_uplifts_at_its_first_crossing_of_the_threshold() {
 #[test]
 fn a_block_on_a_square_base_flies_off_its_edge_where_the_planar_block_flies() {
     for f in [499.0, 500.0, 1000.0] {
-        let run = sine_run(SQUARE_BASE, f);
+        let run = sine_run("base", SQUARE_BASE, f);
         let flight = assert_flight_by_closed_form(&run, f, 1);
         let tilt_x_seated = run
             .trajectory
@@ -125,7 +126,7 @@ fn a_block_on_a_square_base_flies_off_its_edge_where_the_planar_block_flies() {
             .iter()
             .all(|s| s.states[0] == crr::impact::SlotState::Seated && s.q[0] == 0.0);
         assert!(tilt_x_seated, "{f} Hz: the tilt about x stays seated");
-        let planar = assert_flight_by_closed_form(&sine_run(HINGE, f), f, 0);
+        let planar = assert_flight_by_closed_form(&sine_run("base", HINGE, f), f, 0);
         assert!(
             (flight - planar).abs() <= 1e-12,
             "{f} Hz: flight at {flight} s on the base, {planar} s on the hinge"

@@ -51,8 +51,8 @@ pub(super) struct SegmentEvents<'b> {
     /// another landing or an impact left that point a hair inside its support), as
     /// [`rocking_seats`] does for angles: the event then fires when the point moves further in.
     pub(super) gap_seats: Vec<f64>,
-    /// Open chains ([`pressing_faces`]): the faces rocking on a pivot (a corner, an edge or a
-    /// hinge's line) whose normal force is watched, by the tree slot of each (the first rocking
+    /// The faces rocking on a pivot (a corner, an edge or a hinge's line) that alone carry the
+    /// bodies above them ([`pressing_faces`]), whose normal force is watched, by the tree slot of each (the first rocking
     /// slot of its interface). Each event is
     /// that force over W L, positive while the pivot presses, falling through 0 where it would
     /// pull: the face lifts off and every body it carries loses its only support (a flight).
@@ -105,6 +105,7 @@ impl SegmentEvents<'_> {
                 &self.pressing,
                 state,
                 out,
+                None,
             );
         }
     }
@@ -247,7 +248,8 @@ impl EventFunctions for SegmentEvents<'_> {
                 let state = (t, &self.q, &self.qdot);
                 let pivot = &self.pressing[j..=j];
                 let (model, ground) = (self.model, self.ground);
-                pressing_forces(model, ground, trial, &self.pivots, pivot, state, &mut value);
+                let pivots = &self.pivots;
+                pressing_forces(model, ground, trial, pivots, pivot, state, &mut value, None);
             }
             value[0]
         }
@@ -305,7 +307,10 @@ pub(super) fn rocking_seats(
 /// rocking tilt's reaction about its other pivot is the edge's whole normal force times the
 /// base's width (the seated tilt's reaction is about an axis across that lever, and the face's
 /// tangential forces have no moment about a line in its plane). A pivot of such a face that
-/// would pull means the bodies it carries fly. None unless `watched`: the file has no symmetry
+/// would pull means the bodies it carries fly. Not the faces a re-rooted chain turned round
+/// (`turned`, per interface): their other pivot P′ moves with the file's child, whose face is
+/// tilted from the supporting one by the angle, so the reaction about it would mix the
+/// tangential force into the normal one. None unless `watched`: the file has no symmetry
 /// rows (a symmetry row puts a torque on its coordinates, so the joint's reaction about its
 /// other pivot is no longer its normal force alone) and no regularised impact law (its δ
 /// zone's force is not in the solve of [`SegmentEvents::pressing_values`]).
@@ -313,6 +318,7 @@ pub(super) fn pressing_faces(
     model: &Model,
     pivots: &ActivePivots,
     seated: &[bool],
+    turned: &[bool],
     watched: bool,
 ) -> Vec<usize> {
     if !watched || !model.symmetries.is_empty() {
@@ -321,8 +327,9 @@ pub(super) fn pressing_faces(
     model
         .interfaces
         .iter()
-        .filter(|iface| matches!(iface.role, Role::Tree { .. }))
-        .filter_map(|iface| {
+        .zip(turned)
+        .filter(|(iface, turned)| matches!(iface.role, Role::Tree { .. }) && !**turned)
+        .filter_map(|(iface, _)| {
             let k = iface.slots.clone().find(|&s| !seated[s])?;
             let current = &pivots.sides[iface.slots.clone()];
             let mut other = current.to_vec();
@@ -355,7 +362,8 @@ pub(super) fn only_support(model: &Model, k: usize) -> bool {
 /// reaction about its other pivot P′ of side σ′ while it carries no moment about its pivot P
 /// (`seating::SubtreeLoads`, from a solve by M in `trial`, the current pivots and seats), as
 /// the contact program reads a rocking face's lift (module `opening_qp`). Positive while the
-/// pivot presses. Where the solve fails, +1 (no event) and false.
+/// pivot presses. Where the solve fails, +1 (no event) and false. `roundoff`, when given,
+/// receives each value's round-off (that of the reaction's transfer to P′, over W L).
 pub(super) fn pressing_forces(
     model: &Model,
     ground: &GroundMotion,
@@ -364,6 +372,7 @@ pub(super) fn pressing_forces(
     pressing: &[usize],
     (t, q, qdot): (f64, &DVector<f64>, &DVector<f64>),
     out: &mut [f64],
+    mut roundoff: Option<&mut [f64]>,
 ) -> bool {
     if trial.accelerations(model, ground, t, q, qdot).is_err() {
         out.fill(1.0);
@@ -371,9 +380,12 @@ pub(super) fn pressing_forces(
     }
     let loads = super::seating::SubtreeLoads::new(model, trial);
     let scale = model.total_mass() * model.gravity * model.size;
-    for (value, &k) in out.iter_mut().zip(pressing) {
-        let (r_other, _) = loads.other_side_reaction(model, trial, pivots, k, 0.0);
-        *value = pivots.sides[k].flipped().sign() * r_other / scale;
+    for (j, &k) in pressing.iter().enumerate() {
+        let (r_other, error) = loads.other_side_reaction(model, trial, pivots, k, 0.0);
+        out[j] = pivots.sides[k].flipped().sign() * r_other / scale;
+        if let Some(r) = roundoff.as_deref_mut() {
+            r[j] = error / scale;
+        }
     }
     true
 }

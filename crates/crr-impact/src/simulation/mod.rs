@@ -504,7 +504,7 @@ struct Workspaces {
     /// (a `memcpy` of its size otherwise, at every step or segment).
     events_kin: Option<Box<Data>>,
     trial: Option<Box<Dynamics>>,
-    /// The dynamics of the open chains' pivot events ([`SegmentEvents::pressing_trial`]),
+    /// The dynamics of the pivot events ([`SegmentEvents::pressing_trial`]),
     /// loaded with the current pivots and seats by each segment that watches a pivot.
     pressing: Option<Box<Dynamics>>,
     /// The buffers of a segment's events and output, taken by each segment and given back.
@@ -1197,9 +1197,12 @@ impl<'a> Simulation<'a> {
         // impact's instant the joints at their seats can start on sides their next instant
         // changes (the bundled drum column at 0.42250 s: a pivot "pulling" by 9e-4 W L in a
         // state whose motion the samples around it show pressing with 0.96 of the weight it
-        // carries).
-        let watched = self.original.symmetries.is_empty() && self.regularised.is_none();
-        let pressing = pressing_faces(model, &self.dynamics.pivots, &self.seated, watched);
+        // carries). Except a face held on its pivot for this event after the contact program
+        // found it lifting (a flight): there the flight is now.
+        let pressing = self.pressing_faces_now();
+        if let Some(k) = self.held_face_pulling(&pressing) {
+            return Err(self.flight_of(k));
+        }
         let pressing_trial = (!pressing.is_empty()).then(|| {
             let mut d = match self.spare.pressing.take() {
                 Some(mut d) => {
@@ -1397,8 +1400,8 @@ impl<'a> Simulation<'a> {
         )
     }
 
-    /// The flight of the bodies carried by tree slot k of an open chain, whose pivot would pull
-    /// now ([`pressing_faces`]): its face lifts off its only support.
+    /// The flight of the bodies carried by tree slot k, whose pivot would pull now
+    /// ([`pressing_faces`]): its face lifts off their only support.
     fn flight_of(&mut self, k: usize) -> SimulationError {
         let model = Arc::clone(&self.model);
         self.record_final_sample();

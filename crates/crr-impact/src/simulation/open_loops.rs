@@ -179,6 +179,8 @@ pub(super) struct OpenLoops {
     to_original: Vec<usize>,
     /// Slot of the file's model → slot of the chain (None: its interface is open).
     to_active: Vec<Option<usize>>,
+    /// Per interface of the chain, whether it was turned round (its child is the file's parent).
+    pub(super) turned: Vec<bool>,
 }
 
 impl OpenLoops {
@@ -189,6 +191,7 @@ impl OpenLoops {
             files_tree: true,
             to_original: (0..model.slot_count).collect(),
             to_active: (0..model.slot_count).map(Some).collect(),
+            turned: vec![false; model.interfaces.len()],
         }
     }
 
@@ -228,6 +231,7 @@ impl OpenLoops {
                 files_tree,
                 to_original,
                 to_active,
+                turned,
             },
             chain,
         ))

@@ -1003,14 +1003,14 @@ impl Simulation<'_> {
     /// Whether the flight the contact program finds, the faces `lifting` (names of the chain's
     /// interfaces) opening, comes early: every one of them is a face whose pivot's normal force
     /// is watched by an event ([`pressing_faces`]) and that force, from the chain's solve at the
-    /// current state, still presses. The program reads which contacts hold from its interior
-    /// point's forces and accelerations, and a force below about √(its tolerance) of the
-    /// structure's weight is zero to it: a block on one pivot was found flying 65 µs early on
-    /// the bundled wall, with 5.6e-5 of its weight still pressing by Newton's second law.
+    /// current state, still presses beyond the event's zero and its own round-off. The program
+    /// reads which contacts hold from its interior point's forces and accelerations, and a force
+    /// below about √(its tolerance) of the structure's weight is zero to it: a block on one
+    /// pivot was found flying 65 µs early on the bundled wall, with 5.6e-5 of its weight still
+    /// pressing by Newton's second law.
     pub(super) fn flight_not_yet(&mut self, lifting: &[String]) -> bool {
         let model = Arc::clone(&self.model);
-        let watched = self.original.symmetries.is_empty() && self.regularised.is_none();
-        let pressing = pressing_faces(&model, &self.dynamics.pivots, &self.seated, watched);
+        let pressing = self.pressing_faces_now();
         let mut slots = Vec::with_capacity(lifting.len());
         for name in lifting {
             let Some(k) = pressing
@@ -1022,6 +1022,24 @@ impl Simulation<'_> {
             };
             slots.push(k);
         }
+        !slots.is_empty()
+            && self
+                .pressing_now(&slots)
+                .is_some_and(|pressed| pressed.iter().all(|&p| p))
+    }
+
+    /// The faces whose pivots' normal forces are watched now ([`pressing_faces`]).
+    pub(super) fn pressing_faces_now(&self) -> Vec<usize> {
+        let watched = self.original.symmetries.is_empty() && self.regularised.is_none();
+        let (pivots, seated) = (&self.dynamics.pivots, &self.seated);
+        pressing_faces(&self.model, pivots, seated, &self.open.turned, watched)
+    }
+
+    /// Whether the pivot of each face of `slots` ([`pressing_faces`]) presses at the current
+    /// state, beyond the event's zero ([`crr_dynamics::integrator::EVENT_ZERO_TOL`]) and the
+    /// round-off of its normal force; None where the chain's solve fails.
+    pub(super) fn pressing_now(&mut self, slots: &[usize]) -> Option<Vec<bool>> {
+        let model = Arc::clone(&self.model);
         let (q, qdot) = (self.chain_q(), self.chain_qdot());
         let mut trial = match self.spare.pressing.take() {
             Some(mut d) => {
@@ -1032,7 +1050,7 @@ impl Simulation<'_> {
             None => Box::new(self.dynamics.clone()),
         };
         trial.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
-        let mut forces = vec![0.0; slots.len()];
+        let (mut forces, mut roundoff) = (vec![0.0; slots.len()], vec![0.0; slots.len()]);
         let state = (self.t, &q, &qdot);
         let pivots = &self.dynamics.pivots;
         let solved = pressing_forces(
@@ -1040,12 +1058,42 @@ impl Simulation<'_> {
             self.ground,
             &mut trial,
             pivots,
-            &slots,
+            slots,
             state,
             &mut forces,
+            Some(&mut roundoff),
         );
         self.spare.pressing = Some(trial);
-        solved && !slots.is_empty() && forces.iter().all(|&f| f > 0.0)
+        let zero = crr_dynamics::integrator::EVENT_ZERO_TOL;
+        solved.then(|| {
+            forces
+                .iter()
+                .zip(&roundoff)
+                .map(|(&f, &e)| f > zero + e)
+                .collect()
+        })
+    }
+
+    /// A face held on its pivot for its flight event ([`Self::flight_not_yet`]) whose pivot
+    /// no longer presses where a segment starts (the program's other releases, made with the
+    /// face held, changed its load): its flight is now (its event, starting at or below its
+    /// zero, would never fire). Among `pressing`, the faces watched in that segment.
+    pub(super) fn held_face_pulling(&mut self, pressing: &[usize]) -> Option<usize> {
+        let held: Vec<usize> = pressing
+            .iter()
+            .copied()
+            .filter(|&k| {
+                self.spare
+                    .rest
+                    .held_faces
+                    .contains(&self.model.coords[k].interface)
+            })
+            .collect();
+        if held.is_empty() {
+            return None;
+        }
+        let pressed = self.pressing_now(&held)?;
+        held.iter().zip(pressed).find(|(_, p)| !p).map(|(&k, _)| k)
     }
 
     /// Keeps the faces `names` (the chain's interfaces) on their pivots in the contact program
