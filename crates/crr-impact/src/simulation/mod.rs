@@ -1193,12 +1193,13 @@ impl<'a> Simulation<'a> {
         let gap_seats = self.gap_seats();
         // The pivots of the faces rocking on a pivot that alone carry the bodies above them,
         // each watched for the instant its normal force falls through 0 (a flight). One that
-        // pulls already where the segment starts is left to the monitor (`tension`): at an
-        // impact's instant the joints at their seats can start on sides their next instant
-        // changes (the bundled drum column at 0.42250 s: a pivot "pulling" by 9e-4 W L in a
-        // state whose motion the samples around it show pressing with 0.96 of the weight it
-        // carries). Except a face held on its pivot for this event after the contact program
-        // found it lifting (a flight): there the flight is now.
+        // pulls already where the segment starts has no event (it would start below its zero)
+        // and is left to the monitor (`tension`): such pulls start at an impact and end at the
+        // next (the bundled drum column after `bed_2`'s impact at 0.42250 s: the bodies above
+        // `bed_3` pull with 0.8 % of their weight for 0.11 ms, by Newton's second law on the
+        // samples, `crates/crr-impact/tests/flights.rs`), and a flight there would end runs in
+        // the chatter that follows impacts. Except a face held on its pivot for this event
+        // after the contact program found it lifting (a flight): there the flight is now.
         let pressing = self.pressing_faces_now();
         if let Some(k) = self.held_face_pulling(&pressing) {
             return Err(self.flight_of(k));
