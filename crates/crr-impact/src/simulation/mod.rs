@@ -301,8 +301,9 @@ pub enum SimulationError {
     #[error("{0}")]
     Invariant(String),
     /// The contact program finds that blocks lift off a support (at rest: the mechanism the load
-    /// opens; in motion: the motion of least Gauss function), or on an open chain a face
-    /// rocking on one pivot would pull on it, and the chain cannot go on without those
+    /// opens; in motion: the motion of least Gauss function), or a face rocking on a pivot that
+    /// alone carries the bodies above it (on an open chain, or a block hanging on one face of a
+    /// structure with loops) would pull on it, and the chain cannot go on without those
     /// interfaces: a body left with no support (a flight), or no spanning tree left that the CRR
     /// model can integrate (docs/simulation.md, "Faces that open").
     #[error(
@@ -1155,6 +1156,19 @@ impl<'a> Simulation<'a> {
             return Ok(stop);
         }
         let h_max = self.step_cap();
+        // The pivots of the faces rocking on a pivot that alone carry the bodies above them,
+        // each watched for the instant its normal force falls through 0 (a flight). One that
+        // pulls already where the segment starts has no event (it would start below its zero)
+        // and is left to the monitor (`tension`): such pulls start at an impact and end at the
+        // next (the bundled drum column after `bed_2`'s impact at 0.42250 s: the bodies above
+        // `bed_3` pull with 0.8 % of their weight for 0.11 ms, by Newton's second law on the
+        // samples, `crates/crr-impact/tests/flights.rs`), and a flight there would end runs in
+        // the chatter that follows impacts. Except a face held on its pivot for this event
+        // after the contact program found it lifting (a flight): there the flight is now.
+        let pressing = self.pressing_faces_now();
+        if let Some(k) = self.held_face_pulling(&pressing) {
+            return Err(self.flight_of(k));
+        }
         let mut seg = self.spare.segment.take().unwrap_or_default();
         seg.rocking.clear();
         seg.rocking.extend(
@@ -1191,19 +1205,6 @@ impl<'a> Simulation<'a> {
         };
         rocking_seats(&seg.rocking, &seg.angles, regularised, &mut seats);
         let gap_seats = self.gap_seats();
-        // The pivots of the faces rocking on a pivot that alone carry the bodies above them,
-        // each watched for the instant its normal force falls through 0 (a flight). One that
-        // pulls already where the segment starts has no event (it would start below its zero)
-        // and is left to the monitor (`tension`): such pulls start at an impact and end at the
-        // next (the bundled drum column after `bed_2`'s impact at 0.42250 s: the bodies above
-        // `bed_3` pull with 0.8 % of their weight for 0.11 ms, by Newton's second law on the
-        // samples, `crates/crr-impact/tests/flights.rs`), and a flight there would end runs in
-        // the chatter that follows impacts. Except a face held on its pivot for this event
-        // after the contact program found it lifting (a flight): there the flight is now.
-        let pressing = self.pressing_faces_now();
-        if let Some(k) = self.held_face_pulling(&pressing) {
-            return Err(self.flight_of(k));
-        }
         let pressing_trial = (!pressing.is_empty()).then(|| {
             let mut d = match self.spare.pressing.take() {
                 Some(mut d) => {

@@ -125,9 +125,10 @@ pub fn opening_qp(model: &Model, d: &Dynamics) -> Result<OpeningDecision, Openin
     opening_qp_holding(model, d, &[])
 }
 
-/// [`opening_qp`] with the faces rocking on one pivot listed in `held` (interfaces) kept on it:
-/// their lifts are left out (a lift-off the chain without the face contradicted, which the
-/// simulation keeps closed until the chain next changes).
+/// [`opening_qp`] with the faces listed in `held` (interfaces) kept on their pivots: their lifts
+/// are left out (a lift-off the chain without the face contradicted, a face that ties, or a
+/// flight the chain's exact solve finds early, which the simulation keeps closed until the next
+/// impact, landing or change of chain).
 pub fn opening_qp_holding(
     model: &Model,
     d: &Dynamics,

@@ -38,10 +38,14 @@ pub(super) struct RestCache {
     /// Set by the uplift test when the load exceeds the collapse multiplier in a mechanism where
     /// blocks lift off a support (outside the CRR chain): those interfaces' names.
     pub(super) lift_off: Option<Vec<String>>,
-    /// Faces rocking on one pivot (interfaces of the chain) whose lift-off the chain without
-    /// them contradicted: the contact program keeps them on their pivots until the next impact
-    /// or landing (a release of another joint does not clear them), so that its answer can turn
-    /// back to "holds" and the uplift event fire again for the other joints.
+    /// Faces (interfaces of the chain) the contact program keeps on their pivots, their lifts
+    /// left out, until the next impact, landing or change of chain (a release of another joint
+    /// does not clear them): faces rocking on one pivot whose lift-off the chain without them
+    /// contradicted, faces that tie (still on the block under them), so that the program's
+    /// answer can turn back to "holds" and the uplift event fire again for the other joints;
+    /// and faces whose flight the chain's exact solve finds early (their pivots still press:
+    /// `Simulation::flight_not_yet`, a rocking base on an edge among them), whose pivot events
+    /// then locate the flight.
     pub(super) held_faces: Vec<usize>,
     /// The certificate that a motion needs no contact to let go, carried from one step end to
     /// the next, and the bodies' loads it is posed on.
