@@ -536,3 +536,68 @@ fn a_drum_column_s_pivot_that_pulls_after_an_impact_pulls_by_newton() {
         range(&outside)
     );
 }
+
+/// A running-bond wall of 4 × 4 blocks (`running_bond_wall(4, 4, 1.0, 0.5, 0.5)`, λ = 7/11)
+/// under a one-sine pulse of 2 λ g (0.5 s), sampled every 10 µs. At 0.40913 s the contact
+/// program finds seven faces lifting at once, `c3_b1` losing every support. The chain's exact
+/// solve, every face held, still finds `c3_b1` pressing on its one pivot on `c2_b0` (with
+/// 0.176 of its weight, by Newton), so that face is held and the decision is taken again: the
+/// other faces open (five in the run), the block's force falls to 4e-5 m g, and the run stops
+/// 56 µs later, at 0.409184 s, where the face's pivot event finds it at zero (before
+/// 2026-11-29 the program's word stopped the run at 0.409128 s, with the others still
+/// closed). By Newton on the block's samples, as for the bundled wall above: compressive at
+/// every sample of the last 50 ms, the samples after the decision included (4.0e-5 to
+/// 1.3e-5 m g), at the pivot (I θ̈ to 1e-6 m g L; measured 2.5e-7), and zero at the stop within
+/// 1e-5 m g (measured −5e-7, extrapolated from the last two samples).
+#[test]
+fn a_block_flying_with_other_faces_lifting_has_lost_its_support_force_by_newton() {
+    let model = Model::from_spec(&running_bond_wall(4, 4, 1.0, 0.5, 0.5)).unwrap();
+    let lambda = crr_impact::statics::collapse_multiplier(
+        &model,
+        Vector3::x(),
+        &crr_impact::statics::StaticsOptions::default(),
+    )
+    .unwrap()
+    .lambda
+    .unwrap();
+    assert!((lambda - 7.0 / 11.0).abs() < 1e-9, "λ = {lambda}");
+    let flight = run_to_flight(&model, 2.0 * lambda * model.gravity, 0.5, 1e-5);
+    assert_eq!(flight.in_flight, ["c3_b1"]);
+    assert_eq!(flight.interfaces, ["c3_b1_on_c2_b0"]);
+    let block = model.body_index("c3_b1").unwrap();
+    let support = model.body_index("c2_b0").unwrap();
+    let resting = model.interface_index("c3_b1_on_c2_b0").unwrap();
+    let slot = model.interfaces[resting].slots.start;
+    let kind = model.interfaces[resting].kind.clone();
+    let pivot = move |pivots: &ActivePivots| kind.pivot(&pivots.sides[slot..=slot]);
+    let poses = poses_from(
+        &model,
+        &flight.traj,
+        flight.t - 0.05,
+        (block, support),
+        pivot,
+    );
+    let (normal_forces, worst) = newton_normal_forces(&model, &flight, &poses, block, |now| {
+        assert_ne!(now.states[slot], SlotState::Seated, "at {} s", now.t);
+    });
+    assert!(normal_forces.len() > 100, "{} samples", normal_forces.len());
+    // Between the program's decision and the stop (56 µs) the block still presses, by a
+    // little: samples there, and all compressive (asserted by `newton_normal_forces`).
+    let after: Vec<f64> = normal_forces
+        .iter()
+        .filter(|(t, _)| *t > flight.t - 6e-5)
+        .map(|x| x.1)
+        .collect();
+    assert!(
+        after.len() >= 3,
+        "{} samples after the decision",
+        after.len()
+    );
+    println!("after the decision: {after:?} m g");
+    let at_stop = at_the_stop(&normal_forces, flight.t);
+    println!(
+        "moment residual {worst:.2e} m g L; normal force at the stop {at_stop:.3e} m g (t = {} s)",
+        flight.t
+    );
+    assert!(at_stop.abs() <= 1e-5, "{at_stop} m g at the flight");
+}

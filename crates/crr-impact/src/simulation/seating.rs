@@ -1000,32 +1000,50 @@ impl Simulation<'_> {
         Ok(released)
     }
 
-    /// Whether the flight the contact program finds, the faces `lifting` (names of the chain's
-    /// interfaces) opening, comes early: every one of them is a face whose pivot's normal force
-    /// is watched by an event ([`pressing_faces`]) and that force, from the chain's solve at the
-    /// current state, still presses beyond the event's zero and its own round-off. The program
-    /// reads which contacts hold from its interior point's forces and accelerations, and a force
-    /// below about √(its tolerance) of the structure's weight is zero to it: a block on one
-    /// pivot was found flying 65 µs early on the bundled wall, with 5.6e-5 of its weight still
-    /// pressing by Newton's second law.
-    pub(super) fn flight_not_yet(&mut self, lifting: &[String]) -> bool {
+    /// The faces among `lifting` (names of the chain's interfaces) that carry the bodies
+    /// `in_flight`, when the flight the contact program finds comes early: each body in flight
+    /// is carried by one of them, each of them is a face whose pivot's normal force is watched
+    /// by an event ([`pressing_faces`]), and that force, from the chain's solve at the current
+    /// state, still presses beyond the event's zero and its own round-off. In motion only (at
+    /// rest the program's mechanism stands). The program reads which contacts hold from its
+    /// interior point's forces and accelerations, and a force below about √(its tolerance) of
+    /// the structure's weight is zero to it: a block on one pivot was found flying 65 µs early
+    /// on the bundled wall, with 5.6e-5 of its weight still pressing by Newton's second law.
+    pub(super) fn early_flight(
+        &mut self,
+        lifting: &[String],
+        in_flight: &[String],
+    ) -> Option<Vec<String>> {
+        if self.at_rest() {
+            return None;
+        }
         let model = Arc::clone(&self.model);
         let pressing = self.pressing_faces_now();
-        let mut slots = Vec::with_capacity(lifting.len());
-        for name in lifting {
-            let Some(k) = pressing
+        let watched: Vec<usize> = pressing
+            .iter()
+            .copied()
+            .filter(|&k| lifting.contains(&model.interfaces[model.coords[k].interface].name))
+            .collect();
+        let mut slots = Vec::new();
+        for name in in_flight {
+            let b = model.body_index(name)?;
+            let k = watched
                 .iter()
                 .copied()
-                .find(|&k| model.interfaces[model.coords[k].interface].name == *name)
-            else {
-                return false;
-            };
-            slots.push(k);
+                .find(|&k| model.carries(k, Some(model.body_coord[b])))?;
+            if !slots.contains(&k) {
+                slots.push(k);
+            }
         }
-        !slots.is_empty()
-            && self
-                .pressing_now(&slots)
-                .is_some_and(|pressed| pressed.iter().all(|&p| p))
+        if slots.is_empty() || !self.pressing_now(&slots)?.iter().all(|&p| p) {
+            return None;
+        }
+        Some(
+            slots
+                .iter()
+                .map(|&k| model.interfaces[model.coords[k].interface].name.clone())
+                .collect(),
+        )
     }
 
     /// The faces whose pivots' normal forces are watched now ([`pressing_faces`]).
@@ -1178,10 +1196,15 @@ impl Simulation<'_> {
                     }
                     FaceRelease::Unsolved => None,
                 }
-            } else if self.flight_not_yet(&interfaces) {
-                // Faces whose pivots' normal forces the chain's exact solve still finds
-                // pressing: their events locate the flight where those forces reach zero.
-                self.hold_faces(&interfaces);
+            } else if let Some(carrying) = self.early_flight(&interfaces, &in_flight) {
+                // The faces carrying the bodies in flight, whose pivots' normal forces the
+                // chain's exact solve still finds pressing, stay on their pivots: their events
+                // locate the flight where those forces reach zero. With other faces lifting
+                // too, the decision is taken again with those held (in motion).
+                self.hold_faces(&carrying);
+                if carrying.len() < interfaces.len() {
+                    return self.release_once();
+                }
                 None
             } else {
                 Some(super::flight_words(&in_flight))
