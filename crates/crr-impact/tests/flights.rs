@@ -12,7 +12,7 @@ use std::path::Path;
 
 use crr_dynamics::ground_motion::{Axis, ComponentSpec, GroundMotion, PulseSpec, SignalSpec};
 use crr_dynamics::{InitialSpec, solve_initial};
-use crr_impact::simulation::body_offsets;
+use crr_impact::simulation::{ImpactRecord, body_offsets};
 use crr_impact::{Parameters, Simulation, SimulationError, SlotState, Trajectory};
 use crr_kinematics::fixtures::running_bond_wall;
 use crr_kinematics::{ActivePivots, Data, Model, Side, forward_kinematics};
@@ -28,17 +28,43 @@ struct Flight {
     traj: Trajectory,
 }
 
-/// Runs `model` from rest under a one-sine pulse along x (`amplitude` m/s², `period` s),
-/// sampled every `output_interval` s, to the flight it must end on.
-fn run_to_flight(model: &Model, amplitude: f64, period: f64, output_interval: f64) -> Flight {
+/// A one-sine pulse along x (`amplitude` m/s², `period` s) from t = 0.
+fn pulse_along_x(amplitude: f64, period: f64) -> GroundMotion {
     let pulse = SignalSpec::OneSinePulse(PulseSpec {
         amplitude,
         period,
         start: 0.0,
     });
-    let ground = GroundMotion::none()
+    GroundMotion::none()
         .with_component(Axis::X, &ComponentSpec::new(pulse), Path::new("."))
-        .unwrap();
+        .unwrap()
+}
+
+/// The pivots a sample's slot states give (a seated or open slot on its positive side).
+fn pivots_of(model: &Model, states: &[SlotState]) -> ActivePivots {
+    let mut pivots = ActivePivots::uniform(model, Side::Positive);
+    for (k, state) in states.iter().enumerate() {
+        if *state == SlotState::Negative {
+            pivots.sides[k] = Side::Negative;
+        }
+    }
+    pivots
+}
+
+/// Whether second differences over three samples (times `t`, slot states `states`) are those
+/// of one smooth motion: the same states, evenly spaced (an event's own sample is off the
+/// grid), no impact between.
+fn differentiable(impacts: &[ImpactRecord], t: [f64; 3], states: [&[SlotState]; 3]) -> bool {
+    states[0] == states[1]
+        && states[1] == states[2]
+        && !impacts.iter().any(|i| i.t > t[0] && i.t < t[2])
+        && ((t[1] - t[0]) - (t[2] - t[1])).abs() <= 1e-12
+}
+
+/// Runs `model` from rest under a one-sine pulse along x (`amplitude` m/s², `period` s),
+/// sampled every `output_interval` s, to the flight it must end on.
+fn run_to_flight(model: &Model, amplitude: f64, period: f64, output_interval: f64) -> Flight {
+    let ground = pulse_along_x(amplitude, period);
     let init = solve_initial(model, &InitialSpec::default()).unwrap();
     let params = Parameters {
         duration: 1.0,
@@ -95,12 +121,7 @@ fn poses_from(
     let mut data = Data::new(model);
     let mut poses = Vec::new();
     for s in traj.samples.iter().filter(|s| s.t >= from) {
-        let mut pivots = ActivePivots::uniform(model, Side::Positive);
-        for (k, state) in s.states.iter().enumerate() {
-            if *state == SlotState::Negative {
-                pivots.sides[k] = Side::Negative;
-            }
-        }
+        let pivots = pivots_of(model, s.states);
         forward_kinematics(model, &mut data, &DVector::from_column_slice(s.q), &pivots);
         let offsets = body_offsets(model, s.openings);
         let place = |b: usize, x: &Vector3<f64>| {
@@ -120,8 +141,7 @@ fn poses_from(
     poses
 }
 
-/// Newton on `block` at every pose whose neighbours share its states, evenly spaced (an
-/// event's own sample is off the grid), with no impact between: the force its support exerts,
+/// Newton on `block` at every pose [`differentiable`] with its neighbours: the force its support exerts,
 /// F = m (a + a_g + g ẑ), a from the centre of mass's second differences, has the moment about
 /// the centre of mass that turns the block, I θ̈, to 1e-6 m g L (asserted), and `at` checks the
 /// pose. Returns (t, F·n / (m g)) of each, n the support's face normal, and the largest moment
@@ -142,16 +162,9 @@ fn newton_normal_forces(
             unreachable!()
         };
         let h = after.t - now.t;
-        let impact_between = flight
-            .traj
-            .impacts
-            .iter()
-            .any(|i| i.t > before.t && i.t < after.t);
-        if before.states != now.states
-            || now.states != after.states
-            || impact_between
-            || (now.t - before.t - h).abs() > 1e-12
-        {
+        let times = [before.t, now.t, after.t];
+        let states = [&before.states[..], &now.states, &after.states];
+        if !differentiable(&flight.traj.impacts, times, states) {
             continue;
         }
         at(now);
@@ -419,14 +432,7 @@ fn a_drum_column_s_pivot_that_pulls_after_an_impact_pulls_by_newton() {
         symmetry: Vec::new(),
     };
     let model = Model::from_spec(&spec).unwrap();
-    let pulse = SignalSpec::OneSinePulse(PulseSpec {
-        amplitude: 2.5,
-        period: 0.5,
-        start: 0.0,
-    });
-    let ground = GroundMotion::none()
-        .with_component(Axis::X, &ComponentSpec::new(pulse), Path::new("."))
-        .unwrap();
+    let ground = pulse_along_x(2.5, 0.5);
     let init = solve_initial(&model, &InitialSpec::default()).unwrap();
     let params = Parameters {
         duration: 0.425,
@@ -466,12 +472,7 @@ fn a_drum_column_s_pivot_that_pulls_after_an_impact_pulls_by_newton() {
         .iter()
         .filter(|s| s.t >= impact - 1e-3 && s.t <= next + 1e-3)
     {
-        let mut pivots = ActivePivots::uniform(&model, Side::Positive);
-        for (j, state) in s.states.iter().enumerate() {
-            if *state == SlotState::Negative {
-                pivots.sides[j] = Side::Negative;
-            }
-        }
+        let pivots = pivots_of(&model, s.states);
         forward_kinematics(&model, &mut data, &DVector::from_column_slice(s.q), &pivots);
         let coms: Vec<Vector3<f64>> = carried
             .iter()
@@ -489,8 +490,7 @@ fn a_drum_column_s_pivot_that_pulls_after_an_impact_pulls_by_newton() {
             unreachable!()
         };
         let h = t2 - t1;
-        let impact_between = traj.impacts.iter().any(|i| i.t > *t0 && i.t < *t2);
-        if s0 != s1 || s1 != s2 || impact_between || (t1 - t0 - h).abs() > 1e-12 {
+        if !differentiable(&traj.impacts, [*t0, *t1, *t2], [s0, s1, s2]) {
             continue;
         }
         let mut force = Vector3::zeros();

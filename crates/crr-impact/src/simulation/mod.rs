@@ -1205,18 +1205,7 @@ impl<'a> Simulation<'a> {
         };
         rocking_seats(&seg.rocking, &seg.angles, regularised, &mut seats);
         let gap_seats = self.gap_seats();
-        let pressing_trial = (!pressing.is_empty()).then(|| {
-            let mut d = match self.spare.pressing.take() {
-                Some(mut d) => {
-                    d.pivots.clone_from(&self.dynamics.pivots);
-                    d.seated.clone_from(&self.dynamics.seated);
-                    d
-                }
-                None => Box::new(self.dynamics.clone()),
-            };
-            d.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
-            d
-        });
+        let pressing_trial = (!pressing.is_empty()).then(|| self.take_pressing_trial());
         let mut events = SegmentEvents {
             model,
             ground: self.ground,

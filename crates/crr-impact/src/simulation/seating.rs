@@ -1024,16 +1024,21 @@ impl Simulation<'_> {
             .copied()
             .filter(|&k| lifting.contains(&model.interfaces[model.coords[k].interface].name))
             .collect();
-        let mut slots = Vec::new();
-        for name in in_flight {
-            let b = model.body_index(name)?;
-            let k = watched
-                .iter()
-                .copied()
-                .find(|&k| model.carries(k, Some(model.body_coord[b])))?;
-            if !slots.contains(&k) {
-                slots.push(k);
-            }
+        // Every watched lifting face that carries a body in flight (all of them, so that the
+        // answer does not depend on the order the faces are listed in), and each body carried
+        // by one.
+        let flying: Vec<usize> = in_flight
+            .iter()
+            .map(|name| model.body_index(name))
+            .collect::<Option<_>>()?;
+        let carries = |k: usize, b: usize| model.carries(k, Some(model.body_coord[b]));
+        let slots: Vec<usize> = watched
+            .iter()
+            .copied()
+            .filter(|&k| flying.iter().any(|&b| carries(k, b)))
+            .collect();
+        if !flying.iter().all(|&b| slots.iter().any(|&k| carries(k, b))) {
+            return None;
         }
         if slots.is_empty() || !self.pressing_now(&slots)?.iter().all(|&p| p) {
             return None;
@@ -1044,6 +1049,22 @@ impl Simulation<'_> {
                 .map(|&k| model.interfaces[model.coords[k].interface].name.clone())
                 .collect(),
         )
+    }
+
+    /// The dynamics the pivots' normal forces are solved with ([`pressing_forces`]): the spare
+    /// one kept between uses, loaded with the current pivots and seats, solved by M (give it
+    /// back to `spare.pressing` after use).
+    pub(super) fn take_pressing_trial(&mut self) -> Box<Dynamics> {
+        let mut d = match self.spare.pressing.take() {
+            Some(mut d) => {
+                d.pivots.clone_from(&self.dynamics.pivots);
+                d.seated.clone_from(&self.dynamics.seated);
+                d
+            }
+            None => Box::new(self.dynamics.clone()),
+        };
+        d.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
+        d
     }
 
     /// The faces whose pivots' normal forces are watched now ([`pressing_faces`]).
@@ -1059,15 +1080,7 @@ impl Simulation<'_> {
     pub(super) fn pressing_now(&mut self, slots: &[usize]) -> Option<Vec<bool>> {
         let model = Arc::clone(&self.model);
         let (q, qdot) = (self.chain_q(), self.chain_qdot());
-        let mut trial = match self.spare.pressing.take() {
-            Some(mut d) => {
-                d.pivots.clone_from(&self.dynamics.pivots);
-                d.seated.clone_from(&self.dynamics.seated);
-                d
-            }
-            None => Box::new(self.dynamics.clone()),
-        };
-        trial.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
+        let mut trial = self.take_pressing_trial();
         let (mut forces, mut roundoff) = (vec![0.0; slots.len()], vec![0.0; slots.len()]);
         let state = (self.t, &q, &qdot);
         let pivots = &self.dynamics.pivots;
@@ -1092,7 +1105,7 @@ impl Simulation<'_> {
         })
     }
 
-    /// A face held on its pivot for its flight event ([`Self::flight_not_yet`]) whose pivot
+    /// A face held on its pivot for its flight event ([`Self::early_flight`]) whose pivot
     /// no longer presses where a segment starts (the program's other releases, made with the
     /// face held, changed its load): its flight is now (its event, starting at or below its
     /// zero, would never fire). Among `pressing`, the faces watched in that segment.
@@ -1111,7 +1124,13 @@ impl Simulation<'_> {
             return None;
         }
         let pressed = self.pressing_now(&held)?;
-        held.iter().zip(pressed).find(|(_, p)| !p).map(|(&k, _)| k)
+        // The first by name among those pulling: the same face whatever the file's order.
+        let name = |k: usize| &self.model.interfaces[self.model.coords[k].interface].name;
+        held.iter()
+            .zip(pressed)
+            .filter(|(_, p)| !p)
+            .map(|(&k, _)| k)
+            .min_by(|&a, &b| name(a).cmp(name(b)))
     }
 
     /// Keeps the faces `names` (the chain's interfaces) on their pivots in the contact program

@@ -44,7 +44,7 @@ pub(super) struct RestCache {
     /// contradicted, faces that tie (still on the block under them), so that the program's
     /// answer can turn back to "holds" and the uplift event fire again for the other joints;
     /// and faces whose flight the chain's exact solve finds early (their pivots still press:
-    /// `Simulation::flight_not_yet`, a rocking base on an edge among them), whose pivot events
+    /// `Simulation::early_flight`, a rocking base on an edge among them), whose pivot events
     /// then locate the flight.
     pub(super) held_faces: Vec<usize>,
     /// The certificate that a motion needs no contact to let go, carried from one step end to
