@@ -8,4 +8,5 @@ mod common;
 mod duality;
 mod independent;
 mod invariance;
+mod rest_loads;
 mod static_multiplier;

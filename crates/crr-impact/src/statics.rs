@@ -774,6 +774,13 @@ impl Program {
 /// both) has no λ ≥ 0. A structure under a one-component pulse costs two programs, not six.
 /// Each chain a run switches to (a face that opens or lands) starts its own, from the axes
 /// [`AxisMemory`] kept for the same interfaces.
+///
+/// Every program's answer is also a point λ(d)·d of the set's boundary (in units of g), and the
+/// set contains the convex hull of 0 and of the points found: a load in the triangle of 0 and
+/// two of them (the axes' included) holds without a program. A record in two components (a
+/// plane of loads) so needs a program only where its direction and magnitude leave the polygon
+/// of the answers so far; before, every new direction outside the octahedron cost one (the
+/// bundled temple under 0.8 times its record: 1 080 programs, 28 % of its run).
 #[derive(Clone, Debug, Default)]
 pub struct RestStatics {
     /// λ along +x, −x, +y, −y, +z, −z (capped at [`LAMBDA_MAX`]; 0 for a structure that cannot
@@ -781,6 +788,10 @@ pub struct RestStatics {
     axes: [Option<f64>; 6],
     /// Answers along directions asked before (exact bits of the unit direction).
     by_direction: Vec<([u64; 3], Collapse)>,
+    /// Points λ(d)·d of the boundary found along directions off the axes (units of g).
+    boundary: Vec<Vector3<f64>>,
+    /// Programs solved (the axes' and the directions').
+    programs: usize,
 }
 
 /// Most directions a [`RestStatics`] keeps.
@@ -831,7 +842,12 @@ impl RestStatics {
         let index = match self.by_direction.iter().position(|(k, _)| *k == key) {
             Some(i) => i,
             None => {
+                if self.within_known_loads(&(a / g)) {
+                    return Ok(None);
+                }
+                self.programs += 1;
                 let c = collapse_multiplier(model, d, &StaticsOptions::default())?;
+                self.keep_boundary(c.lambda.unwrap_or(LAMBDA_MAX) * d);
                 self.keep_direction(key, c)
             }
         };
@@ -851,6 +867,7 @@ impl RestStatics {
         let sign = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
         let mut d = Vector3::zeros();
         d[k / 2] = sign;
+        self.programs += 1;
         let lambda = match collapse_multiplier(model, d, &StaticsOptions::default()) {
             Ok(c) => {
                 let lambda = c.lambda.unwrap_or(LAMBDA_MAX);
@@ -864,6 +881,57 @@ impl RestStatics {
         };
         self.axes[k] = Some(lambda);
         Ok(lambda)
+    }
+
+    /// Programs this statics has solved (along the axes and along other directions).
+    pub fn programs_solved(&self) -> usize {
+        self.programs
+    }
+
+    /// Whether the load `x` (units of g) lies in a triangle of 0 and two known boundary points
+    /// (the axes' and [`Self::boundary`]), the loads the structure holds by convexity: x =
+    /// αp + βp′ with α, β ≥ 0, α + β ≤ 1, to 1e-12 of |x| out of the pair's plane (a load in the
+    /// plane of the points, as a record in two components is, has no residual beyond round-off;
+    /// a load outside every such plane is left to the program). The program itself calls a
+    /// load exceeded only beyond λ(1 + 1e-9), so a load inside the hull is never one it calls
+    /// exceeded, to its own tolerance.
+    fn within_known_loads(&self, x: &Vector3<f64>) -> bool {
+        let axes = self.axes.iter().enumerate().filter_map(|(k, lambda)| {
+            let lambda = (*lambda)?;
+            let mut p = Vector3::zeros();
+            p[k / 2] = if k.is_multiple_of(2) { lambda } else { -lambda };
+            (lambda > 0.0).then_some(p)
+        });
+        let points: Vec<Vector3<f64>> = axes.chain(self.boundary.iter().copied()).collect();
+        let size = x.norm();
+        for (i, p) in points.iter().enumerate() {
+            for r in &points[i + 1..] {
+                let (pp, pr, rr) = (p.dot(p), p.dot(r), r.dot(r));
+                let det = pp * rr - pr * pr;
+                if det <= 1e-12 * pp * rr {
+                    continue;
+                }
+                let (px, rx) = (p.dot(x), r.dot(x));
+                let alpha = (px * rr - rx * pr) / det;
+                let beta = (rx * pp - px * pr) / det;
+                if alpha >= 0.0
+                    && beta >= 0.0
+                    && alpha + beta <= 1.0
+                    && (x - alpha * p - beta * r).norm() <= 1e-12 * size
+                {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// Keeps a boundary point found, dropping the oldest beyond [`REST_DIRECTIONS`].
+    fn keep_boundary(&mut self, point: Vector3<f64>) {
+        if self.boundary.len() >= REST_DIRECTIONS {
+            self.boundary.remove(0);
+        }
+        self.boundary.push(point);
     }
 
     /// Keeps the collapse along the unit direction of bits `key`, dropping the oldest beyond
@@ -894,11 +962,16 @@ fn direction_key(d: &Vector3<f64>) -> [u64; 3] {
 /// faces of the structure at its reference pose (every joint seated, so every block where the
 /// file puts it), and two chains over the same interfaces differ only in their tree and loops
 /// (which interfaces close loops, which sense a re-rooted interface is written in), not in the
-/// faces or the bodies. The mechanisms (slots of one chain) are not kept.
+/// faces or the bodies. The boundary points found along other directions are kept with them;
+/// the mechanisms (slots of one chain) are not.
 #[derive(Clone, Debug, Default)]
 pub struct AxisMemory {
-    entries: Vec<(Vec<String>, [Option<f64>; 6])>,
+    entries: Vec<MemoryEntry>,
 }
+
+/// What [`AxisMemory`] keeps for one set of interfaces: its sorted names, the axis multipliers
+/// and the boundary points.
+type MemoryEntry = (Vec<String>, [Option<f64>; 6], Vec<Vector3<f64>>);
 
 /// Most structures an [`AxisMemory`] keeps (the oldest is dropped beyond).
 const AXIS_MEMORY: usize = 64;
@@ -914,34 +987,48 @@ impl AxisMemory {
     /// Rest statics for `model` that start from the axes known for its interfaces.
     pub fn statics_for(&self, model: &Model) -> RestStatics {
         let key = Self::key(model);
-        let axes = self
+        let (axes, boundary) = self
             .entries
             .iter()
-            .find(|(k, _)| *k == key)
-            .map_or([None; 6], |(_, axes)| *axes);
+            .find(|(k, ..)| *k == key)
+            .map_or(([None; 6], Vec::new()), |(_, axes, boundary)| {
+                (*axes, boundary.clone())
+            });
         RestStatics {
             axes,
             by_direction: Vec::new(),
+            boundary,
+            programs: 0,
         }
     }
 
-    /// Keeps the axes `statics` has computed for `model` (none computed: nothing to keep).
+    /// Keeps the axes and boundary points `statics` has computed for `model` (none computed:
+    /// nothing to keep).
     pub fn remember(&mut self, model: &Model, statics: &RestStatics) {
         if statics.axes.iter().all(Option::is_none) {
             return;
         }
         let key = Self::key(model);
-        match self.entries.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, axes)) => {
+        match self.entries.iter_mut().find(|(k, ..)| *k == key) {
+            Some((_, axes, boundary)) => {
                 for (kept, new) in axes.iter_mut().zip(statics.axes) {
                     *kept = kept.or(new);
+                }
+                for point in &statics.boundary {
+                    if !boundary.contains(point) {
+                        if boundary.len() >= REST_DIRECTIONS {
+                            boundary.remove(0);
+                        }
+                        boundary.push(*point);
+                    }
                 }
             }
             None => {
                 if self.entries.len() >= AXIS_MEMORY {
                     self.entries.remove(0);
                 }
-                self.entries.push((key, statics.axes));
+                self.entries
+                    .push((key, statics.axes, statics.boundary.clone()));
             }
         }
     }
