@@ -89,6 +89,12 @@ fn a_load_inside_the_answers_found_holds_as_the_program_finds() {
             Vector3::y(),
         ),
         (
+            "running-bond wall, x and z",
+            bundled_model("wall"),
+            Vector3::x(),
+            Vector3::z(),
+        ),
+        (
             "trilithon, x and z",
             bundled_model("trilithon"),
             Vector3::x(),
