@@ -1,10 +1,11 @@
 //! The simulation's test of a structure at rest (`crr::impact::statics::RestStatics`: does it
 //! hold under the ground acceleration a?) answers inside the convex hull of 0 and the boundary
-//! points λ(d)·d it has found without solving a program. The loads a structure at rest holds
-//! form a convex set (static theorem), so that inference is exact; checked here against the
-//! contact faces' program solved afresh along each load's own direction, on loads that sweep
-//! the plane of a record in two components and straddle the boundary (0.7 to 1.3 times the
-//! multiplier along their direction), and on a plane with a vertical component.
+//! points λ(d)·d it has found, within the cuts of the mechanisms found, without solving a
+//! program. The loads the convex program holds form a convex set (static theorem), so that
+//! inference is exact for it, and the cuts keep the sliding lift-offs found. Checked here
+//! against the contact faces' program solved afresh along each load's own direction, on loads
+//! that sweep the plane of a record in two components and straddle the boundary (0.7 to 1.3
+//! times the multiplier along their direction), and on planes with a vertical component.
 //!
 //! Loads within 1e-7 of λ(d)·g are not compared: there the two decide by their solver's
 //! tolerance (duality gap 1e-12 of the weight), not by the statics.
@@ -25,8 +26,8 @@ fn fresh_lambda(model: &Model, d: &Vector3<f64>) -> f64 {
 }
 
 /// Sweeps `count` loads a = f·λ(d)·g·d along d = cos φ u + sin φ v (golden-angle φ, f uniform
-/// in [0.7, 1.3]; g·d where the structure holds along d up to the programs' cap) through one `RestStatics`, each decision against the fresh program's; returns
-/// the loads that hold and the programs the statics solved for them (every load beyond the
+/// in [0.7, 1.3]; g·d where the structure holds along d up to the programs' cap) through one
+/// `RestStatics`, each decision against the fresh program's; returns the loads that hold and the programs the statics solved for them (every load beyond the
 /// multiplier costs one: the hull never says "exceeded", and each direction is new; the four
 /// axes' programs are counted with them).
 fn sweep(

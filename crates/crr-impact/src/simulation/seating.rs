@@ -85,7 +85,18 @@ pub(super) fn opening_mode_in(
     // compressive equilibrium exists, so no mechanism of the CRR model, each one admissible on
     // the contact faces, has positive power), and then no local search is needed; most instants
     // at rest cost no solve at all (the load inside the cached octahedron of the six axis
-    // multipliers). A failed program leaves the decision to the local test.
+    // multipliers). A failed program leaves the decision to the local test. A load beyond a
+    // mechanism found before is exceeded (kinematic theorem), and the local test's opening,
+    // when it finds one, is the answer with or without the program along a's direction (below):
+    // the program runs only if the local test finds none (in the bisection of an uplift
+    // instant, most probes beyond the multiplier).
+    if rest.global.beyond_a_known_mechanism(model, &a)
+        && let Some(local) = opening_mode_local(
+            model, ground, template, trial, rest, slot_part, t, q, qdot, true,
+        )
+    {
+        return Some(local);
+    }
     let collapse = match rest.global.exceeded(model, &a) {
         Ok(None) => return None,
         Ok(Some(collapse)) => collapse.clone(),
