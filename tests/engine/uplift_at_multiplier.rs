@@ -198,3 +198,75 @@ fn models_of_rigid_domains_leave_rest_at_their_multiplier() {
         }
     }
 }
+
+/// Under a load that turns as it grows, a(t) = A(t)(cos θ(t), sin θ(t), 0), a structure leaves
+/// rest at the first instant where |a| passes λ(a/|a|)·g: the load's direction is new at every
+/// instant, so the run's rest statics decide most instants from the answers they have found
+/// (the polygon of boundary points and the mechanisms' cuts, docs/simulation.md, Uplift, item
+/// 4). The reference instant is found here from the contact faces' program solved afresh along
+/// the load's direction at each instant: a scan every 2 ms brackets the first crossing, and a
+/// bisection narrows it to 1e-10 s. The run's uplift test at rest locates its instant by its
+/// own bisection on the time grid (to 1e-9 s and better); asserted to 1e-7 s.
+#[test]
+fn a_structure_under_a_turning_load_leaves_rest_where_it_first_passes_its_multiplier() {
+    use crr::dynamics::ground_motion::Record;
+    let model = bundled("baldachin");
+    let g = model.gravity;
+    let lambda_x = collapse_multiplier(&model, Vector3::x(), &StaticsOptions::default())
+        .unwrap()
+        .lambda
+        .unwrap();
+    let dt = 1e-3;
+    let samples = 801;
+    let load = |t: f64| {
+        let (magnitude, angle) = (lambda_x * g * (0.8 + 0.5 * t), 0.3 + 2.5 * t);
+        Vector3::new(magnitude * angle.cos(), magnitude * angle.sin(), 0.0)
+    };
+    let component =
+        |k: usize| -> Vec<f64> { (0..samples).map(|i| load(i as f64 * dt)[k]).collect() };
+    let ground = GroundMotion::none()
+        .with_record(Axis::X, Record::uniform(dt, component(0)).unwrap(), 1.0)
+        .unwrap()
+        .with_record(Axis::Y, Record::uniform(dt, component(1)).unwrap(), 1.0)
+        .unwrap();
+    // The reference: does the load the run sees at t exceed the program's λ along it?
+    let exceeds = |t: f64| {
+        let a = ground.acceleration(t);
+        let lambda = collapse_multiplier(&model, a.normalize(), &StaticsOptions::default())
+            .unwrap()
+            .lambda
+            .unwrap_or(f64::INFINITY);
+        a.norm() > lambda * g
+    };
+    let step = 2e-3;
+    let mut upper = step;
+    while !exceeds(upper) {
+        upper += step;
+        assert!(upper < 0.8, "the load never passes the multiplier");
+    }
+    let mut lower = upper - step;
+    assert!(lower > 0.0 && !exceeds(lower));
+    while upper - lower > 1e-10 {
+        let mid = 0.5 * (lower + upper);
+        if exceeds(mid) {
+            upper = mid;
+        } else {
+            lower = mid;
+        }
+    }
+    let initial = solve_initial(&model, &InitialSpec::default()).unwrap();
+    let params = Parameters {
+        duration: upper + 0.02,
+        ..Default::default()
+    };
+    let run = Simulation::new(&model, &ground, &initial, params)
+        .unwrap()
+        .run()
+        .unwrap_or_else(|f| panic!("{}", f.error));
+    let uplift = run.uplift_time.expect("the baldachin leaves rest");
+    eprintln!(
+        "turning load: uplift at {uplift} s, the programs' crossing at {upper} s ({:e} s apart)",
+        uplift - upper
+    );
+    assert!((uplift - upper).abs() <= 1e-7, "{uplift} against {upper}");
+}
