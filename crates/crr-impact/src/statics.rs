@@ -781,15 +781,16 @@ impl Program {
 /// components (a plane of loads) so needs a program only where its direction and magnitude
 /// leave the polygon of the answers so far; before, every new direction outside the octahedron
 /// cost one (the bundled temple under 0.8 times its record: 216 programs, 28 % of its run, now
-/// 79 with [`Self::beyond_a_known_mechanism`]).
+/// 110; 79 with its caller's local test first where [`Self::beyond_a_known_mechanism`]).
 ///
 /// The search for sliding lift-offs ([`collapse_multiplier`]) lowers λ(d) below the convex
 /// program's where it finds such a mechanism along d, so the programs' answers need not form a
 /// convex set. A mechanism bounds λ along every direction it is driven by (kinematic theorem),
 /// so each answer's mechanism is kept as a cut, x·V ≤ λ(d)(d·V) with V = Σ mᵢvᵢ its bodies'
-/// momentum: every kept point is pulled in radially onto the cuts found (the hull then lies
-/// within each, even after the cut's answer is dropped), and a load beyond any cut kept goes to
-/// the program, the octahedron's included. The inference is exact for the convex program;
+/// momentum: every point kept when a cut is found is pulled in radially onto it (those points
+/// then stay within it after the cut's answer is dropped), and a load beyond any cut kept goes
+/// to the program, the octahedron's included. An answer kept along the load's exact direction
+/// answers for that direction alone, as its program would again. The inference is exact for the convex program;
 /// with sliding lift-offs it is as good as the mechanisms found so far (a program along a new
 /// direction may find one that none of the answers kept has).
 #[derive(Clone, Debug, Default)]
@@ -829,7 +830,7 @@ impl KnownAnswer {
             .map(|(b, m)| b.mass * Vector3::from(m.velocity))
             .sum();
         let along = d.dot(&momentum);
-        let cut = lambda.and_then(|l| {
+        let cut = lambda.filter(|&l| l > 0.0).and_then(|l| {
             (along.abs() > 1e-12 * momentum.norm())
                 .then(|| (along.signum() * momentum, l * along.abs()))
         });
@@ -877,7 +878,7 @@ impl RestStatics {
         if magnitude == 0.0 || !magnitude.is_finite() {
             return Ok(None);
         }
-        if hull < 1.0 && !self.beyond_a_known_mechanism(model, a) {
+        if hull < 1.0 && !self.beyond_a_cut(&(a / g), 0.0) {
             return Ok(None);
         }
         let d = a / magnitude;
@@ -914,7 +915,11 @@ impl RestStatics {
         let lambda = match collapse_multiplier(model, d, &StaticsOptions::default()) {
             Ok(c) => {
                 let lambda = c.lambda.unwrap_or(LAMBDA_MAX);
-                self.keep_answer(KnownAnswer::of(model, &d, &c));
+                // A structure that cannot stand along this axis (λ ≤ 0) has no boundary point
+                // or cut to keep: the standing check stops every test first.
+                if lambda > 0.0 {
+                    self.keep_answer(KnownAnswer::of(model, &d, &c));
+                }
                 // A load along the axis itself (a one-component record) asks for this
                 // collapse again, by the same direction's bits.
                 self.keep_direction(direction_key(&d), c);
@@ -933,11 +938,15 @@ impl RestStatics {
     /// mechanism; it lets a caller that needs the collapse only when its own test finds no
     /// opening ask for it then.
     pub fn beyond_a_known_mechanism(&self, model: &Model, a: &Vector3<f64>) -> bool {
-        let x = a / model.gravity;
+        self.beyond_a_cut(&(a / model.gravity), 1e-6)
+    }
+
+    /// Whether the load `x` (units of g) lies beyond a kept cut by more than `margin` of it.
+    fn beyond_a_cut(&self, x: &Vector3<f64>, margin: f64) -> bool {
         self.known
             .iter()
             .filter_map(|k| k.cut)
-            .any(|(momentum, c)| x.dot(&momentum) > c * (1.0 + 1e-6))
+            .any(|(momentum, c)| x.dot(&momentum) > c * (1.0 + margin))
     }
 
     /// Programs this statics has solved (along the axes and along other directions).
@@ -953,12 +962,7 @@ impl RestStatics {
     /// λ(1 + 1e-9), so a load inside the hull of the convex program's answers is never one it
     /// calls exceeded, to its own tolerance.
     fn within_known_loads(&self, x: &Vector3<f64>) -> bool {
-        if self
-            .known
-            .iter()
-            .filter_map(|k| k.cut)
-            .any(|(momentum, c)| x.dot(&momentum) > c)
-        {
+        if self.beyond_a_cut(x, 0.0) {
             return false;
         }
         let points: Vec<Vector3<f64>> = self.known.iter().map(|k| k.point).collect();

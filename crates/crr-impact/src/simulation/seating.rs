@@ -90,16 +90,19 @@ pub(super) fn opening_mode_in(
     // when it finds one, is the answer with or without the program along a's direction (below):
     // the program runs only if the local test finds none (in the bisection of an uplift
     // instant, most probes beyond the multiplier).
-    if rest.global.beyond_a_known_mechanism(model, &a)
+    let local_first = rest.global.beyond_a_known_mechanism(model, &a);
+    if local_first
         && let Some(local) = opening_mode_local(
             model, ground, template, trial, rest, slot_part, t, q, qdot, true,
         )
     {
         return Some(local);
     }
+    // (A local test already run found no opening; it would find none again.)
     let collapse = match rest.global.exceeded(model, &a) {
         Ok(None) => return None,
         Ok(Some(collapse)) => collapse.clone(),
+        Err(_) if local_first => return None,
         Err(_) => {
             return opening_mode_local(
                 model, ground, template, trial, rest, slot_part, t, q, qdot, true,
@@ -108,9 +111,11 @@ pub(super) fn opening_mode_in(
     };
     // Beyond the multiplier the local test gives the opening accelerations' own mode when it
     // finds one; the mechanism's sides open otherwise.
-    if let Some(local) = opening_mode_local(
-        model, ground, template, trial, rest, slot_part, t, q, qdot, true,
-    ) {
+    if !local_first
+        && let Some(local) = opening_mode_local(
+            model, ground, template, trial, rest, slot_part, t, q, qdot, true,
+        )
+    {
         return Some(local);
     }
     let lifting: Vec<String> = collapse.lifting_off().map(|i| i.name.clone()).collect();
