@@ -27,9 +27,10 @@ fn fresh_lambda(model: &Model, d: &Vector3<f64>) -> f64 {
 
 /// Sweeps `count` loads a = f·λ(d)·g·d along d = cos φ u + sin φ v (golden-angle φ, f uniform
 /// in [0.7, 1.3]; g·d where the structure holds along d up to the programs' cap) through one
-/// `RestStatics`, each decision against the fresh program's; returns the loads that hold and the programs the statics solved for them (every load beyond the
-/// multiplier costs one: the hull never says "exceeded", and each direction is new; the four
-/// axes' programs are counted with them).
+/// `RestStatics`, each decision against the fresh program's; returns the loads that hold and
+/// the programs the statics solved for them (every load beyond the multiplier costs one: the
+/// hull never says "exceeded", and each direction is new; the four axes' programs are counted
+/// with them).
 fn sweep(
     name: &str,
     model: &Model,

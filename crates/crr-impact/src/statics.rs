@@ -790,9 +790,9 @@ impl Program {
 /// momentum: every point kept when a cut is found is pulled in radially onto it (those points
 /// then stay within it after the cut's answer is dropped), and a load beyond any cut kept goes
 /// to the program, the octahedron's included. An answer kept along the load's exact direction
-/// answers for that direction alone, as its program would again. The inference is exact for the convex program;
-/// with sliding lift-offs it is as good as the mechanisms found so far (a program along a new
-/// direction may find one that none of the answers kept has).
+/// answers for that direction alone, as its program would again. The inference is exact for
+/// the convex program; with sliding lift-offs it is as good as the mechanisms found so far (a
+/// program along a new direction may find one that none of the answers kept has).
 #[derive(Clone, Debug, Default)]
 pub struct RestStatics {
     /// λ along +x, −x, +y, −y, +z, −z (capped at [`LAMBDA_MAX`]; 0 for a structure that cannot
@@ -965,10 +965,10 @@ impl RestStatics {
         if self.beyond_a_cut(x, 0.0) {
             return false;
         }
-        let points: Vec<Vector3<f64>> = self.known.iter().map(|k| k.point).collect();
         let size = x.norm();
-        for (i, p) in points.iter().enumerate() {
-            for r in &points[i + 1..] {
+        for (i, first) in self.known.iter().enumerate() {
+            let p = &first.point;
+            for r in self.known[i + 1..].iter().map(|k| &k.point) {
                 let (pp, pr, rr) = (p.dot(p), p.dot(r), r.dot(r));
                 // |p × r|² = pp·rr − pr², without the cancellation.
                 let det = p.cross(r).norm_squared();
