@@ -430,3 +430,148 @@ fn the_program_is_the_least_gauss_function_on_seats_that_twist() {
     );
     assert!(opened > 0, "no load opened anything");
 }
+
+/// The certificate the uplift test asks in motion before the contact program
+/// (`face_forces::PressingCertificate`: a distribution of the locked motion's contact forces on
+/// the faces pressing everywhere by a margin) on rocking bases, against the exhaustive search
+/// above and the program. The states hold every kind of rocking face the simulation lets it
+/// decide (`simulation::openings_slide_nowhere`): bases on an edge with their first tilt turned
+/// and their second seated (whose touching corners leave along the child's face normal, on
+/// which the faces then pose their forces), with their first seated and their second turned,
+/// on one corner, with both seated, and seats that may twist. One certificate is asked state
+/// after state and load after load, as a simulation asks it (its distribution carried over the
+/// columns two states share, the faces' program solved where none carries). Wherever it holds,
+/// holding every seated slot is the exhaustive search's least Gauss function and the program
+/// opens and lifts nothing. Both answers occur, and states with the two kinds of edge.
+#[test]
+fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
+    use crr::impact::face_forces::PressingCertificate;
+    use crr::impact::monitor::{ForceWork, body_loads_into};
+    use crr::impact::simulation::{offers_both_pivots, openings_slide_nowhere};
+    let t = G * 0.2 / 1.5;
+    let pulse = |axis: Axis| {
+        GroundMotion::none()
+            .with_component(
+                axis,
+                &ComponentSpec::new(SignalSpec::OneSinePulse(PulseSpec {
+                    amplitude: 3.0 * t,
+                    period: 0.8,
+                    start: 0.0,
+                })),
+                Path::new("."),
+            )
+            .unwrap()
+    };
+    let colonnade_model = Model::from_spec(&colonnade(0.2, 1.5, 1.2, 0.4)).unwrap();
+    let twisting = crr::load_model(&crate::common::write_model(
+        "baldachin_twist_certificate",
+        &crate::twist_closure::twisting_text(),
+    ))
+    .unwrap()
+    .1;
+    let arch = {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let opts = crr::RunOptions {
+            duration: Some(3.0),
+            ..Default::default()
+        };
+        let input = crr::ModelInput::read(root.join("examples/models/arch_3d.toml")).unwrap();
+        crr::analysis::simulation::prepare(&input, &opts).unwrap()
+    };
+    let cases: Vec<(&Model, Vec<State>)> = vec![
+        (
+            &colonnade_model,
+            moving_states(&colonnade_model, &pulse(Axis::X), 0.6, 8, 7),
+        ),
+        (
+            &colonnade_model,
+            moving_states(&colonnade_model, &pulse(Axis::Y), 0.6, 8, 7),
+        ),
+        (
+            &twisting,
+            moving_states(&twisting, &pulse(Axis::X), 0.8, 8, 9),
+        ),
+        (
+            &twisting,
+            moving_states(&twisting, &pulse(Axis::Y), 0.8, 8, 9),
+        ),
+        (
+            &arch.model,
+            moving_states(&arch.model, &arch.ground, 3.0, 6, 8),
+        ),
+    ];
+    let loads = [
+        (0.0, 0.0),
+        (0.5 * t, 0.2 * t),
+        (-0.3 * t, 0.6 * t),
+        (1.5 * t, -t),
+        (-2.0 * t, -0.5 * t),
+    ];
+    // Certified states with an edge turned on the first tilt (second seated) and on the second
+    // (first seated); certified (state, load) pairs; pairs where the exhaustive search opens.
+    let (mut first_turned, mut second_turned, mut certified, mut opened) = (0, 0, 0, 0);
+    for (model, states) in &cases {
+        assert!(states.len() >= 3, "{}: {} states", model.name, states.len());
+        assert!(openings_slide_nowhere(model), "{}", model.name);
+        let mut certificate = PressingCertificate::default();
+        let mut work = ForceWork::default();
+        for (q, qdot, pivots, seated) in states {
+            for &(ax, ay) in &loads {
+                let ground = constant(ax, ay);
+                let mut d = Dynamics::new(model, pivots.clone());
+                d.seated = seated.clone();
+                if !offers_both_pivots(model, &{
+                    let mut e = d.clone();
+                    e.evaluate(model, &ground, 0.0, q, qdot);
+                    e
+                }) {
+                    continue;
+                }
+                d.accelerations(model, &ground, 0.0, q, qdot).unwrap();
+                body_loads_into(model, &d, d.effective_gravity(), &mut work);
+                let holds = certificate.holds(model, &d, &work).expect("answers");
+                let (best, _) = exhaustive(model, &ground, &d, q, qdot);
+                let tag = format!("{} a = ({ax}, {ay}), seated {seated:?}", model.name);
+                if holds {
+                    assert!(
+                        best.is_empty(),
+                        "{tag}: certified, the search opens {best:?}"
+                    );
+                    let mut e = Dynamics::new(model, pivots.clone());
+                    e.seated = seated.clone();
+                    e.evaluate(model, &ground, 0.0, q, qdot);
+                    let decision = opening_qp(model, &e).expect("the program solves");
+                    assert!(
+                        decision.releases.is_empty() && decision.lifting_off.is_empty(),
+                        "{tag}: certified, the program opens {:?}, lifts {:?}",
+                        decision.releases,
+                        decision.lifting_off
+                    );
+                    certified += 1;
+                    let edges = |pattern: [bool; 2]| {
+                        model.interfaces.iter().any(|f| {
+                            matches!(f.kind, crr::kinematics::InterfaceKind::RockingBase { .. })
+                                && f.slots.clone().map(|k| seated.contains(&k)).eq(pattern)
+                        })
+                    };
+                    first_turned += usize::from(edges([false, true]));
+                    second_turned += usize::from(edges([true, false]));
+                } else if !best.is_empty() {
+                    opened += 1;
+                }
+            }
+        }
+    }
+    eprintln!(
+        "certificate on rocking bases: {certified} certified ({first_turned} with an edge on \
+         the first tilt, {second_turned} on the second), {opened} opened"
+    );
+    assert!(
+        certified >= 20 && opened >= 5,
+        "{certified} certified, {opened} opened"
+    );
+    assert!(
+        first_turned >= 3 && second_turned >= 3,
+        "{first_turned} / {second_turned} certified states with each kind of edge"
+    );
+}

@@ -73,6 +73,18 @@ struct Unknown {
     point: Option<Vector3<f64>>,
     /// Direction (world, current).
     direction: Vector3<f64>,
+    /// What the column is, whatever the state: its interface, its point at rest (None for a
+    /// couple) and the place of its direction among the point's or the couples.
+    key: UnknownKey,
+}
+
+/// A column's identity across states ([`Unknown::key`]): a distribution found at one state is
+/// carried to another with other touching points by the columns they share.
+#[derive(Clone, Debug, PartialEq)]
+struct UnknownKey {
+    interface: usize,
+    rest: Option<[u64; 3]>,
+    along: usize,
 }
 
 /// The most compressive distribution of the contact forces at the state solved in `dynamics`
@@ -107,7 +119,7 @@ pub fn most_compressive_impulses(
     momentum_change: &[(Vector3<f64>, Vector3<f64>)],
     set_by_law: &[usize],
 ) -> Option<MostCompressive> {
-    let program = FaceProgram::build_setting(model, dynamics, set_by_law);
+    let program = FaceProgram::build_setting(model, dynamics, set_by_law, FaceAxes::Parent);
     // Impulses in W·√(L/g), the structure's weight over its time unit, so that the program's
     // unknowns are of order one as its forces are (its tolerances and proximal term assume it).
     let time = (model.size / model.gravity).sqrt();
@@ -144,14 +156,32 @@ struct FaceProgram {
     interfaces: usize,
 }
 
+/// The axes a face's point forces are posed on.
+#[derive(Clone, Copy, PartialEq)]
+enum FaceAxes {
+    /// The parent's face axes, turned with the parent: the normal force is the one across the
+    /// parent's face (the monitor's question, as the subtree recursion of `monitor` asks it).
+    Parent,
+    /// The axes of the normal along which the touching points leave under the contact program's
+    /// openings ([`leaves_along_child_normal`]): the certificate's, which must price exactly
+    /// the program's motions.
+    Leaving,
+}
+
 impl FaceProgram {
     fn build(model: &Model, dynamics: &Dynamics) -> FaceProgram {
-        Self::build_setting(model, dynamics, &[])
+        Self::build_setting(model, dynamics, &[], FaceAxes::Parent)
     }
 
     /// [`Self::build`] with the slots `set_by_law` touching on both pivots (as if seated), and
-    /// every touching point of their interfaces carrying a normal force of either sign.
-    fn build_setting(model: &Model, dynamics: &Dynamics, set_by_law: &[usize]) -> FaceProgram {
+    /// every touching point of their interfaces carrying a normal force of either sign, posed on
+    /// the axes `posed_on`.
+    fn build_setting(
+        model: &Model,
+        dynamics: &Dynamics,
+        set_by_law: &[usize],
+        posed_on: FaceAxes,
+    ) -> FaceProgram {
         let size = model.size;
         let mut is_seated = vec![false; model.slot_count];
         for &k in dynamics.seated.iter().chain(set_by_law) {
@@ -162,7 +192,13 @@ impl FaceProgram {
         for (index, iface) in model.interfaces.iter().enumerate() {
             let face = ContactFace::of_interface(model, index);
             let frame = model.frame_of(iface.parent);
-            let rot = frame.map_or_else(Matrix3::identity, |k| dynamics.kin.rot_ops[k]);
+            let rot = if posed_on == FaceAxes::Leaving
+                && leaves_along_child_normal(&iface.kind, &is_seated[iface.slots.clone()])
+            {
+                dynamics.kin.rot_ops[model.body_coord[iface.child]]
+            } else {
+                frame.map_or_else(Matrix3::identity, |k| dynamics.kin.rot_ops[k])
+            };
             let axes = [
                 rot * face.normal,
                 rot * face.tangents[0],
@@ -190,6 +226,11 @@ impl FaceProgram {
                         interface: index,
                         point: Some(point),
                         direction,
+                        key: UnknownKey {
+                            interface: index,
+                            rest: Some([rest.x.to_bits(), rest.y.to_bits(), rest.z.to_bits()]),
+                            along: k,
+                        },
                     });
                 }
             }
@@ -201,11 +242,21 @@ impl FaceProgram {
             {
                 couples.push(torsion_axis(model, &dynamics.kin, index));
             }
-            unknowns.extend(couples.into_iter().map(|direction| Unknown {
-                interface: index,
-                point: None,
-                direction,
-            }));
+            unknowns.extend(
+                couples
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, direction)| Unknown {
+                        interface: index,
+                        point: None,
+                        direction,
+                        key: UnknownKey {
+                            interface: index,
+                            rest: None,
+                            along: k,
+                        },
+                    }),
+            );
         }
         // Six rows per body: force / W, moment about the centre / (W·size); every entry kept
         // (zeros too), so that the pattern depends on the touching points only.
@@ -385,6 +436,29 @@ impl FaceProgram {
         (self.residual(&carried, loads) <= CARRIED_RESIDUAL).then_some(carried)
     }
 
+    /// The columns' keys, in order.
+    fn keys(&self) -> Vec<UnknownKey> {
+        self.unknowns.iter().map(|u| u.key.clone()).collect()
+    }
+
+    /// A distribution `x` over the columns `keys` (another state's) on this program's columns:
+    /// the value of each column found there, 0 for the others (column 0, s, left 0).
+    fn on_columns(&self, x: &[f64], keys: &[UnknownKey]) -> Vec<f64> {
+        let mut out = vec![0.0; 1 + self.unknowns.len()];
+        // Both lists run interface by interface: a cursor moving on finds most columns at once.
+        let mut from = 0;
+        for (j, u) in self.unknowns.iter().enumerate() {
+            let found = (from..keys.len())
+                .chain(0..from)
+                .find(|&i| keys[i] == u.key);
+            if let Some(i) = found {
+                out[1 + j] = x[1 + i];
+                from = i + 1;
+            }
+        }
+        out
+    }
+
     /// The equilibrium rows' entries as (rows, columns, values).
     fn triplets(&self) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
         let rows = self.entries.iter().map(|e| e.0).collect();
@@ -482,7 +556,7 @@ pub struct RestFaces {
     entry: Option<RestEntry>,
     /// The last distribution found (W), whatever the state: in motion it is carried by the
     /// least-norm correction that restores equilibrium at the new state.
-    last: Option<Vec<f64>>,
+    last: Option<(Vec<f64>, Vec<UnknownKey>)>,
     /// The factorisation of the carried distributions' least-norm changes.
     sparse: LeastNorm,
 }
@@ -540,7 +614,7 @@ impl RestFaces {
                 && program.smallest(&carried) * program.weight >= floor
             {
                 let answer = program.answer(&carried, None);
-                self.last = Some(carried.clone());
+                self.last = Some((carried.clone(), program.keys()));
                 entry.x = carried;
                 entry.g_eff = g_eff;
                 return Some(answer);
@@ -557,11 +631,12 @@ impl RestFaces {
         if let Some(carried) = self
             .last
             .as_ref()
-            .and_then(|last| program.carried(last, &loads, &mut self.sparse))
+            .map(|(x, keys)| program.on_columns(x, keys))
+            .and_then(|start| program.carried(&start, &loads, &mut self.sparse))
             .filter(|carried| program.smallest(carried) * program.weight >= floor)
         {
             let answer = program.answer(&carried, None);
-            self.last = Some(carried);
+            self.last = Some((carried, program.keys()));
             return Some(answer);
         }
         // A positive cap can leave the interior point without convergence where the optimal
@@ -571,7 +646,7 @@ impl RestFaces {
             .solve(&loads, cap / program.weight)
             .or_else(|| program.solve(&loads, 0.0))?;
         let answer = program.answer(&x, Some(&z));
-        self.last = Some(x.clone());
+        self.last = Some((x.clone(), program.keys()));
         if at_rest {
             // A unit effective gravity along each axis at rest: −mᵦ eₖ on every body.
             let total = model.total_mass();
@@ -612,14 +687,31 @@ impl RestFaces {
 /// are one split among many and certify almost nothing there.
 ///
 /// The last distribution found is carried to the next state by the least-norm change that
-/// restores equilibrium ([`RestFaces`]), and answers when its points all keep the margin; the
-/// linear program is solved otherwise (s ≤ [`PRESSING_CAP`], so that the distribution it keeps
-/// has room to be carried).
+/// restores equilibrium ([`RestFaces`]), over the columns the two states share (a face that
+/// changed its pivot keeps its other points' forces), and answers when its points all keep the
+/// margin ([`Self::carries`]). The linear program, s ≤ [`PRESSING_CAP`] so that the distribution
+/// it keeps has room to be carried, is solved where the caller asks ([`Self::refresh`]): the
+/// simulation asks it only where the contact program has found that nothing opens, since it
+/// costs about twice that program and finds no certificate where something opens.
 #[derive(Clone, Debug, Default)]
 pub struct PressingCertificate {
-    last: Option<Vec<f64>>,
+    /// The last distribution found (W, column 0 unused) and its columns' keys.
+    last: Option<(Vec<f64>, Vec<UnknownKey>)>,
+    /// The program and loads of the last state [`Self::carries`] did not certify, for
+    /// [`Self::refresh`].
+    pending: Option<(FaceProgram, Vec<f64>)>,
+    /// Whether the distribution of the last program solved by [`Self::refresh_paced`] has
+    /// certified a state since.
+    used: bool,
+    /// Refreshes [`Self::refresh_paced`] skips before it solves again, and the length of the
+    /// last such pause.
+    skip: u32,
+    pause: u32,
     sparse: LeastNorm,
 }
+
+/// The longest pause of [`PressingCertificate::refresh_paced`] (refreshes skipped).
+const LONGEST_PAUSE: u32 = 32;
 
 /// The margin (in units of the structure's weight W) by which every unilateral point of a
 /// certifying distribution presses: far above the equilibrium residual accepted (1e-9 W) and the
@@ -638,30 +730,99 @@ pub const PRESSING_CAP: f64 = 1e-2;
 impl PressingCertificate {
     /// Whether the motion solved in `dynamics` (its kinematics, seated slots and pivots), with
     /// the bodies' loads in `work` ([`crate::monitor::body_loads_into`] at that state), has a
-    /// distribution whose unilateral points all press by at least [`PRESSING_MARGIN`] W. None
-    /// when the loads are not known or the program does not solve.
+    /// distribution whose unilateral points all press by at least [`PRESSING_MARGIN`] W: the
+    /// last one carried ([`Self::carries`]), or the program's ([`Self::refresh`]). None when the
+    /// loads are not known or the program does not solve.
     pub fn holds(&mut self, model: &Model, dynamics: &Dynamics, work: &ForceWork) -> Option<bool> {
-        let program = FaceProgram::build(model, dynamics);
-        let loads = program.loads(model, dynamics, work)?;
-        // Any vector of the right length serves as a start: what certifies is the result's
-        // equilibrium (checked in `carried`) and signs (here).
-        if let Some(carried) = self
-            .last
-            .as_ref()
-            .and_then(|last| program.carried(last, &loads, &mut self.sparse))
-            .filter(|carried| program.smallest(carried) >= PRESSING_MARGIN)
-        {
-            self.last = Some(carried);
+        if self.carries(model, dynamics, work)? {
             return Some(true);
         }
+        self.refresh()
+    }
+
+    /// Whether the last distribution found, carried to this state by the least-norm change that
+    /// restores equilibrium, presses by the margin at every unilateral point (then it is kept).
+    /// No linear program: false where nothing is kept yet or the carried one does not press.
+    /// None when the loads are not known.
+    pub fn carries(
+        &mut self,
+        model: &Model,
+        dynamics: &Dynamics,
+        work: &ForceWork,
+    ) -> Option<bool> {
+        let program = FaceProgram::build_setting(model, dynamics, &[], FaceAxes::Leaving);
+        let loads = program.loads(model, dynamics, work)?;
+        // The last distribution on this state's columns (those it shares with the last state's,
+        // the others 0): any start serves, what certifies is the result's equilibrium (checked
+        // in `carried`) and signs (here).
+        let carried = self
+            .last
+            .as_ref()
+            .map(|(x, keys)| program.on_columns(x, keys))
+            .and_then(|start| program.carried(&start, &loads, &mut self.sparse))
+            .filter(|carried| program.smallest(carried) >= PRESSING_MARGIN);
+        let holds = carried.is_some();
+        match carried {
+            Some(carried) => {
+                self.last = Some((carried, program.keys()));
+                self.pending = None;
+                self.used = true;
+            }
+            None => self.pending = Some((program, loads)),
+        }
+        Some(holds)
+    }
+
+    /// The program's distribution at the state [`Self::carries`] last did not certify (s ≤
+    /// [`PRESSING_CAP`], so that it has room to be carried), kept for the next states, and
+    /// whether it presses by the margin everywhere. None when there is no such state or the
+    /// program does not solve.
+    pub fn refresh(&mut self) -> Option<bool> {
+        let (program, loads) = self.pending.take()?;
         let (x, _) = program
             .solve(&loads, PRESSING_CAP)
             .or_else(|| program.solve(&loads, 0.0))?;
         let holds = program.residual(&x, &loads) <= CARRIED_RESIDUAL
             && program.smallest(&x) >= PRESSING_MARGIN;
-        self.last = Some(x);
+        self.last = Some((x, program.keys()));
         Some(holds)
     }
+
+    /// [`Self::refresh`] paced by what the distributions it finds are worth: where the last one
+    /// certified no state before this refresh was asked (the motion changes faster than a
+    /// distribution carries, as on the bundled temple's rattling bay), the next 1, 2, 4 …
+    /// [`LONGEST_PAUSE`] refreshes are skipped, and the pause ends at the first that pays. A
+    /// skipped refresh leaves the decision to the contact program, as a failed one does, so the
+    /// pace changes the cost, never an answer.
+    pub fn refresh_paced(&mut self) {
+        if self.skip > 0 {
+            self.skip -= 1;
+            self.pending = None;
+            return;
+        }
+        self.pause = if self.used {
+            0
+        } else {
+            (2 * self.pause).clamp(1, LONGEST_PAUSE)
+        };
+        self.skip = self.pause;
+        self.used = false;
+        self.refresh();
+    }
+}
+
+/// Whether the touching points of interface `kind`, with its slots seated as `seated`, leave
+/// along the child's face normal rather than the parent's: a rocking base turned on its first
+/// tilt (about the parent's e₁, through the edge it rocks on) with its second seated. Opening
+/// the second tilt turns the child about an end of that edge, about R(e₁, θ₁)e₂, which lies in
+/// the child's face plane: the other end leaves along the child's normal, tilted by θ₁ from the
+/// parent's, and so does the lift (the contact program's τ = σ w × (P′ − P)). Posed on the
+/// child's axes, the points' tangential forces do no work on any opening the program offers
+/// (on the parent's they would, θ₁ times their size). Every other face leaves along the
+/// parent's normal: a hinge and a base with its first tilt seated turn about axes in the
+/// parent's face plane, and a base on one corner lifts along the parent's normal.
+fn leaves_along_child_normal(kind: &InterfaceKind, seated: &[bool]) -> bool {
+    matches!(kind, InterfaceKind::RockingBase { .. }) && seated == [false, true]
 }
 
 /// The axis of the couple a rocking base on one corner transmits: the one its two tilts leave no

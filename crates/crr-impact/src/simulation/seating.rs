@@ -214,20 +214,25 @@ pub(super) fn opening_mode_local(
     // releases and the active set below remain for open chains (where single releases are
     // exact) and for a program that fails. At rest it has run above, on the same state.
     if with_program && model.constraint_rows > 0 && !at_rest {
+        // A compressive distribution of the locked motion's forces: the program's minimum is
+        // that motion (most step ends in motion: the locked solve's own reactions are one split
+        // among many on hyperstatic loops and seldom certify). Only where the program would be
+        // the whole problem: a restricted one leaves the decision to the local test below, and
+        // so does the certificate.
+        let certificate =
+            may_open.is_some() && openings_slide_nowhere(model) && offers_both_pivots(model, trial);
         if may_open.is_none() {
             trial.evaluate(model, ground, t, q, qdot);
-        } else if openings_slide_nowhere(model, &seated)
-            && offers_both_pivots(model, trial)
-            && pressing_certified(model, trial, rest)
-        {
-            // A compressive distribution of the locked motion's forces: the program's minimum
-            // is that motion (most step ends in motion: the locked solve's own reactions are one
-            // split among many on hyperstatic loops and seldom certify). Only where the program
-            // would be the whole problem: a restricted one leaves the decision to the local
-            // test below, and so does the certificate.
+        } else if certificate && pressing_carried(model, trial, rest) {
             return None;
         }
         if let Some(mode) = loop_opening(model, ground, template, trial, rest, t, q, qdot, tol) {
+            if certificate && mode.is_none() {
+                // Nothing opens: the faces' program finds a distribution to carry to the next
+                // states (where something opens it finds none, at twice the contact program's
+                // cost).
+                rest.pressing.refresh_paced();
+            }
             return mode;
         }
     }
@@ -253,42 +258,42 @@ pub(super) fn opening_mode_local(
     active_set_opening(model, ground, template, trial, &seated, t, q, qdot, tol)
 }
 
-/// Whether every opening the contact program offers moves the touching points it leaves along
-/// their face's normal only, with the slots in `seated` seated: then the faces' distributions
-/// (free tangential forces at every touching point) price exactly the program's motions, and a
-/// compressive one certifies that nothing opens (`pressing_certified`, asked by the uplift
-/// test in motion only where this holds). A hinge turns about a
-/// pivot line in its face's plane, and a rocking base with both tilts seated about an edge of
-/// its face at the seat; a lift translates along the normal. A rocking base with one tilt seated
-/// and the other turned turns about an axis out of its face's plane, so the corner it leaves
-/// slides as it lifts, which the distributions' free tangential forces would price (on the
-/// bundled 3D arch such forces of 80 W against normal forces of 0.5 W "held" a release the
-/// program opens); and a rocking base that may twist carries no torsion. A hinge whose two pivot
-/// lines (nearly) coincide is a pin for the faces (free normal forces, any moment) but keeps a
-/// lift in the program, whose dual bounds its moment: such a face "held" lifts that the program
-/// makes (an independent review, with pivots 1e-7 m apart). Those decide by the program.
-pub fn openings_slide_nowhere(model: &Model, seated: &[usize]) -> bool {
+/// Whether, in any state of `model`, every opening the contact program offers moves the touching
+/// points it leaves along the normal their face's forces are posed on (`face_forces`), so that
+/// the faces' distributions (free tangential forces at every touching point) price exactly the
+/// program's motions, and a compressive one certifies that nothing opens (`pressing_carried`,
+/// asked by the uplift test in motion only where this holds). A hinge turns about a pivot line
+/// in its face's plane. A rocking base with both tilts seated turns about an edge of the seat,
+/// and one with its first tilt seated and its second turned about the parent's e₁, both in the
+/// parent's face plane; one with its first tilt turned and its second seated turns about
+/// R(e₁, θ₁)e₂, in the child's face plane, whose normal the faces then use (the corner it
+/// leaves moves along it; posed on the parent's axes its tangential forces held releases the
+/// program opens: `tests/engine/opening_program.rs`); a lift translates along that normal; a
+/// seat that may twist carries tangential forces at its current pivot only, where the twist
+/// does no work. A hinge whose two pivot lines (nearly) coincide is a pin for the faces (free
+/// normal forces, any moment) but keeps a lift in the program, whose dual bounds its moment:
+/// such a face "held" lifts that the program makes (an independent review, with pivots 1e-7 m
+/// apart). A model with one decides by the program.
+pub fn openings_slide_nowhere(model: &Model) -> bool {
     model
         .interfaces
         .iter()
         .enumerate()
         .all(|(index, iface)| match iface.kind {
             InterfaceKind::Hinge { .. } => !ContactFace::of_interface(model, index).pin,
-            InterfaceKind::RockingBase { twist, .. } => {
-                let held = iface.slots.clone().filter(|k| seated.contains(k)).count();
-                !twist && (held == 0 || held == iface.slots.len())
-            }
+            InterfaceKind::RockingBase { .. } => true,
         })
 }
 
 /// Whether the locked motion solved in `trial` (every seated slot held, every rocking face on its
-/// pivot) is certified by a compressive distribution of its contact forces on the faces
-/// ([`crate::face_forces::PressingCertificate`]): then it is the contact program's minimum, and
-/// nothing opens. False where the certificate fails or cannot be computed (the program decides).
-fn pressing_certified(model: &Model, trial: &Dynamics, rest: &mut RestCache) -> bool {
+/// pivot) is certified by a compressive distribution of its contact forces on the faces, the last
+/// one found carried to this state ([`crate::face_forces::PressingCertificate::carries`]): then
+/// it is the contact program's minimum, and nothing opens. False where the carried distribution
+/// does not press everywhere or cannot be computed (the program decides).
+fn pressing_carried(model: &Model, trial: &Dynamics, rest: &mut RestCache) -> bool {
     crate::monitor::body_loads_into(model, trial, trial.effective_gravity(), &mut rest.loads);
     rest.pressing
-        .holds(model, trial, &rest.loads)
+        .carries(model, trial, &rest.loads)
         .unwrap_or(false)
 }
 
