@@ -6,6 +6,7 @@
 mod common;
 
 mod duality;
+mod friction;
 mod independent;
 mod invariance;
 mod rest_loads;

@@ -711,7 +711,7 @@ pub struct PressingCertificate {
 }
 
 /// The longest pause of [`PressingCertificate::refresh_paced`] (refreshes skipped).
-const LONGEST_PAUSE: u32 = 32;
+pub const LONGEST_PAUSE: u32 = 32;
 
 /// The margin (in units of the structure's weight W) by which every unilateral point of a
 /// certifying distribution presses: far above the equilibrium residual accepted (1e-9 W) and the

@@ -267,18 +267,41 @@ fn sliding_lift_offs(
         return Ok(convex);
     };
     let mut best = convex;
+    let probe_options = |mu: f64| StaticsOptions {
+        friction: Friction::Pyramid(mu),
+        sliding_lift_off: false,
+        ..*options
+    };
+    let lowers = |probe: &Collapse, best_lambda: f64| {
+        probe.lambda.is_some_and(|l| l < best_lambda * (1.0 - 1e-6))
+    };
     for _ in 0..LIFT_OFF_ROUNDS {
         let mut improved = false;
+        // λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a smaller
+        // one, with the same freed interfaces. So where the smallest probe does not lower λ,
+        // no probe does, and one program answers for the four.
+        let smallest_mu = PROBE_FRICTION[PROBE_FRICTION.len() - 1];
+        let mut smallest = Some(solve_program(
+            model,
+            faces,
+            d,
+            &probe_options(smallest_mu),
+            free,
+        ));
+        if let Some(Ok(probe)) = &smallest
+            && !lowers(probe, best_lambda)
+        {
+            break;
+        }
         for mu in PROBE_FRICTION {
-            let probe_options = StaticsOptions {
-                friction: Friction::Pyramid(mu),
-                sliding_lift_off: false,
-                ..*options
+            let probe = match smallest.take_if(|_| mu == smallest_mu) {
+                Some(probe) => probe,
+                None => solve_program(model, faces, d, &probe_options(mu), free),
             };
-            let Ok(probe) = solve_program(model, faces, d, &probe_options, free) else {
+            let Ok(probe) = probe else {
                 continue;
             };
-            if probe.lambda.is_none_or(|l| l >= best_lambda * (1.0 - 1e-6)) {
+            if !lowers(&probe, best_lambda) {
                 continue;
             }
             let mut trial = free.clone();
