@@ -13,8 +13,10 @@ use crr::kinematics::fixtures::{running_bond_wall, running_bond_wall_3d};
 
 /// The bundled temple, wall and trilithon and two walls in running bond (planar and 3D), along
 /// ±x and ±y: λ(0.25) ≤ λ(0.5) ≤ λ(1) ≤ λ(2) ≤ λ(no sliding), each to 1e-7 of the larger (the
-/// interior point's tolerance is 1e-8; "holds up to the bound" counts as the bound). Some pair
-/// grows strictly, so that the order is not met by equal values alone.
+/// statics' interior point solves to 1e-12, and an answer only almost solved is accepted with
+/// clarabel's reduced tolerances, 5e-5 on the gap; the largest fall here was 1.6e-12 of λ;
+/// "holds up to the bound" counts as the bound). Some pair grows strictly,
+/// so that the order is not met by equal values alone.
 #[test]
 fn the_multiplier_grows_with_the_friction_coefficient() {
     let models = [
@@ -31,7 +33,7 @@ fn the_multiplier_grows_with_the_friction_coefficient() {
         Friction::Pyramid(2.0),
         Friction::NoSliding,
     ];
-    let mut strictly = 0;
+    let (mut strictly, mut worst_fall) = (0, 0.0f64);
     for model in &models {
         for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
             let lambdas: Vec<f64> = frictions
@@ -49,6 +51,7 @@ fn the_multiplier_grows_with_the_friction_coefficient() {
                 })
                 .collect();
             for (pair, w) in lambdas.windows(2).enumerate() {
+                worst_fall = worst_fall.max((w[0] - w[1]) / w[1].abs().max(1e-3));
                 assert!(
                     w[0] <= w[1] + 1e-7 * w[1].abs().max(1e-3),
                     "{} along {d:?}: λ falls from {} to {} between {:?} and {:?}",
@@ -64,5 +67,6 @@ fn the_multiplier_grows_with_the_friction_coefficient() {
             }
         }
     }
+    eprintln!("{strictly} pairs grow strictly; the largest relative fall {worst_fall:.1e}");
     assert!(strictly >= 5, "{strictly} pairs grow strictly");
 }

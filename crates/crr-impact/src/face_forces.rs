@@ -14,7 +14,8 @@
 //! current pivot. So a seated hinge touches on its two pivot lines, a rocking hinge on one; a
 //! rocking base on one corner (both tilts free), on an edge (one tilt seated) or on its four
 //! corners. Each touching point carries f = fₙn + f₁t₁ + f₂t₂ from the parent on the child (the
-//! face's axes turned with the parent), unilateral: fₙ ≥ s. A hinge also carries its bilateral
+//! face's axes turned with the parent; the pressing certificate turns them with the child on a
+//! base rocking on an edge of its first tilt, [`PressingCertificate`]), unilateral: fₙ ≥ s. A hinge also carries its bilateral
 //! couples about n and t₁ (it is a line); a rocking base on one corner the couple about n that its
 //! two tilts leave no freedom for (the CRR base does not twist); a seat that may twist carries no
 //! torsion, so only its current pivot takes tangential forces. A plain hinge (one pivot line) is
@@ -80,7 +81,7 @@ struct Unknown {
 
 /// A column's identity across states ([`Unknown::key`]): a distribution found at one state is
 /// carried to another with other touching points by the columns they share.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct UnknownKey {
     interface: usize,
     rest: Option<[u64; 3]>,
@@ -444,16 +445,12 @@ impl FaceProgram {
     /// A distribution `x` over the columns `keys` (another state's) on this program's columns:
     /// the value of each column found there, 0 for the others (column 0, s, left 0).
     fn on_columns(&self, x: &[f64], keys: &[UnknownKey]) -> Vec<f64> {
+        let column: std::collections::HashMap<&UnknownKey, usize> =
+            keys.iter().enumerate().map(|(i, k)| (k, i)).collect();
         let mut out = vec![0.0; 1 + self.unknowns.len()];
-        // Both lists run interface by interface: a cursor moving on finds most columns at once.
-        let mut from = 0;
         for (j, u) in self.unknowns.iter().enumerate() {
-            let found = (from..keys.len())
-                .chain(0..from)
-                .find(|&i| keys[i] == u.key);
-            if let Some(i) = found {
+            if let Some(&i) = column.get(&u.key) {
                 out[1 + j] = x[1 + i];
-                from = i + 1;
             }
         }
         out
@@ -700,9 +697,9 @@ pub struct PressingCertificate {
     /// The program and loads of the last state [`Self::carries`] did not certify, for
     /// [`Self::refresh`].
     pending: Option<(FaceProgram, Vec<f64>)>,
-    /// Whether the distribution of the last program solved by [`Self::refresh_paced`] has
-    /// certified a state since.
-    used: bool,
+    /// The distribution of the last program solved by [`Self::refresh_paced`] has certified no
+    /// state yet.
+    unpaid: bool,
     /// Refreshes [`Self::refresh_paced`] skips before it solves again, and the length of the
     /// last such pause.
     skip: u32,
@@ -750,6 +747,7 @@ impl PressingCertificate {
         dynamics: &Dynamics,
         work: &ForceWork,
     ) -> Option<bool> {
+        self.pending = None;
         let program = FaceProgram::build_setting(model, dynamics, &[], FaceAxes::Leaving);
         let loads = program.loads(model, dynamics, work)?;
         // The last distribution on this state's columns (those it shares with the last state's,
@@ -765,8 +763,10 @@ impl PressingCertificate {
         match carried {
             Some(carried) => {
                 self.last = Some((carried, program.keys()));
-                self.pending = None;
-                self.used = true;
+                // A distribution that pays ends the pause of `refresh_paced`.
+                self.unpaid = false;
+                self.pause = 0;
+                self.skip = 0;
             }
             None => self.pending = Some((program, loads)),
         }
@@ -789,25 +789,27 @@ impl PressingCertificate {
     }
 
     /// [`Self::refresh`] paced by what the distributions it finds are worth: where the last one
-    /// certified no state before this refresh was asked (the motion changes faster than a
-    /// distribution carries, as on the bundled temple's rattling bay), the next 1, 2, 4 …
-    /// [`LONGEST_PAUSE`] refreshes are skipped, and the pause ends at the first that pays. A
-    /// skipped refresh leaves the decision to the contact program, as a failed one does, so the
-    /// pace changes the cost, never an answer.
+    /// it solved certified no state before the next refresh is asked (the motion changes faster
+    /// than a distribution carries, as on the bundled temple's rattling bay), the next 1, 2, 4 …
+    /// [`LONGEST_PAUSE`] refreshes are skipped, and a distribution that certifies a state ends
+    /// the pause. A skipped refresh leaves the decisions to the contact program until a
+    /// distribution is found again; the certificate stays sound whatever it carries (each state
+    /// checks its own equilibrium and margins), but which distribution it carries decides where
+    /// it answers instead of the program, and near a threshold the two part by the margin.
     pub fn refresh_paced(&mut self) {
+        if self.unpaid {
+            self.pause = (2 * self.pause).clamp(1, LONGEST_PAUSE);
+            self.skip = self.pause;
+            self.unpaid = false;
+        }
         if self.skip > 0 {
             self.skip -= 1;
             self.pending = None;
             return;
         }
-        self.pause = if self.used {
-            0
-        } else {
-            (2 * self.pause).clamp(1, LONGEST_PAUSE)
-        };
-        self.skip = self.pause;
-        self.used = false;
-        self.refresh();
+        if self.refresh().is_some() {
+            self.unpaid = true;
+        }
     }
 }
 

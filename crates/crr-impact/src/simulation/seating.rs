@@ -269,8 +269,9 @@ pub(super) fn opening_mode_local(
 /// R(e₁, θ₁)e₂, in the child's face plane, whose normal the faces then use (the corner it
 /// leaves moves along it; posed on the parent's axes its tangential forces held releases the
 /// program opens: `tests/engine/opening_program.rs`); a lift translates along that normal; a
-/// seat that may twist carries tangential forces at its current pivot only, where the twist
-/// does no work. A hinge whose two pivot lines (nearly) coincide is a pin for the faces (free
+/// seat that may twist carries tangential forces at its current pivot only (its twist is a
+/// free motion of the locked chain, on which a distribution in equilibrium with the locked
+/// motion's loads does no net work). A hinge whose two pivot lines (nearly) coincide is a pin for the faces (free
 /// normal forces, any moment) but keeps a lift in the program, whose dual bounds its moment:
 /// such a face "held" lifts that the program makes (an independent review, with pivots 1e-7 m
 /// apart). A model with one decides by the program.
