@@ -396,13 +396,17 @@ impl FaceProgram {
         )
     }
 
-    /// `last` (a distribution of this program's length, from another state) plus the least-norm
-    /// change that restores equilibrium with `loads`; None unless the result is in equilibrium to
-    /// [`CARRIED_RESIDUAL`] (or `last` has another length).
-    fn carried(&self, last: &[f64], loads: &[f64], sparse: &mut LeastNorm) -> Option<Vec<f64>> {
-        if last.len() != 1 + self.unknowns.len() {
-            return None;
-        }
+    /// The distribution `x` found at another state over the columns `keys`, put on this
+    /// program's columns ([`Self::on_columns`]), plus the least-norm change that restores
+    /// equilibrium with `loads`; None unless the result is in equilibrium to
+    /// [`CARRIED_RESIDUAL`].
+    fn carried(
+        &self,
+        (x, keys): &(Vec<f64>, Vec<UnknownKey>),
+        loads: &[f64],
+        sparse: &mut LeastNorm,
+    ) -> Option<Vec<f64>> {
+        let last = self.on_columns(x, keys);
         let mut imbalance = loads.to_vec();
         for &(row, c, v) in &self.entries {
             imbalance[row] -= v * last[c];
@@ -603,8 +607,7 @@ impl RestFaces {
         if let Some(carried) = self
             .last
             .as_ref()
-            .map(|(x, keys)| program.on_columns(x, keys))
-            .and_then(|start| program.carried(&start, &loads, &mut self.sparse))
+            .and_then(|last| program.carried(last, &loads, &mut self.sparse))
             .filter(|carried| program.smallest(carried) * program.weight >= floor)
         {
             let answer = program.answer(&carried, None);
@@ -731,8 +734,7 @@ impl PressingCertificate {
         let carried = self
             .last
             .as_ref()
-            .map(|(x, keys)| program.on_columns(x, keys))
-            .and_then(|start| program.carried(&start, &loads, &mut self.sparse))
+            .and_then(|last| program.carried(last, &loads, &mut self.sparse))
             .filter(|carried| program.smallest(carried) >= PRESSING_MARGIN);
         let holds = carried.is_some();
         match carried {

@@ -277,12 +277,12 @@ fn sliding_lift_offs(
     let lowers = |probe: &Collapse, best_lambda: f64| {
         !probe.lambda.is_none_or(|l| l >= best_lambda * (1.0 - 1e-6))
     };
+    let smallest_mu = PROBE_FRICTION.iter().copied().fold(f64::INFINITY, f64::min);
     for _ in 0..LIFT_OFF_ROUNDS {
         let mut improved = false;
         // λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a smaller
         // one, with the same freed interfaces. So where the smallest probe does not lower λ,
         // no probe does, and one program answers for the four.
-        let smallest_mu = PROBE_FRICTION.iter().copied().fold(f64::INFINITY, f64::min);
         let mut smallest = Some(solve_program(
             model,
             faces,
