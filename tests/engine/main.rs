@@ -6,6 +6,7 @@
 mod common;
 
 mod arch_3d;
+mod certificate_audit;
 mod collapse;
 mod impact_laws_on_chains;
 mod impulse_tension;

@@ -44,6 +44,7 @@ use crate::laws::{
     momentum_law_projected, restitution_law_holding,
 };
 
+mod certificate_audit;
 mod events;
 mod impacts;
 mod landing_check;
@@ -55,6 +56,7 @@ mod seating;
 mod slots;
 mod uplift_from_rest;
 
+pub use certificate_audit::{CertificateAudit, CertificateDisagreement};
 use events::*;
 use impacts::*;
 use open_loops::OpenLoops;
@@ -983,6 +985,18 @@ impl<'a> Simulation<'a> {
         self.solver.reset(self.t, &self.y);
         // Every segment rebuilds its event list: an index from the last one means nothing now.
         self.solver.forget_last_event();
+    }
+
+    /// Audits the faces' certificate from now on: wherever it decides that nothing opens, the
+    /// contact program is solved too and its answer recorded ([`CertificateAudit`]; the run's
+    /// motion is unchanged, each certified step end costs one program more).
+    pub fn audit_certificate(&mut self) {
+        self.spare.rest.audit.get_or_insert_with(Default::default);
+    }
+
+    /// What the audit found so far (None: not audited).
+    pub fn certificate_audit(&self) -> Option<&CertificateAudit> {
+        self.spare.rest.audit.as_ref()
     }
 
     /// Integrates to the next event, breakpoint or the end.

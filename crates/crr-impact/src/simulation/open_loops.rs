@@ -469,8 +469,10 @@ impl Simulation<'_> {
         let trial = dynamics.clone();
         self.axis_memory
             .remember(&self.model, &self.spare.rest.global);
+        let audit = self.spare.rest.audit.take();
         self.spare = Workspaces::new(&chain, trial, &dynamics.pivots);
         self.spare.rest.global = self.axis_memory.statics_for(&chain);
+        self.spare.rest.audit = audit;
         self.dynamics = dynamics;
         self.regularised = Regularised::of(&chain);
         self.parts = chain.parts();

@@ -225,6 +225,7 @@ pub(super) fn opening_mode_local(
         if may_open.is_none() {
             trial.evaluate(model, ground, t, q, qdot);
         } else if certificate && pressing_carried(model, trial, rest) {
+            audit_certified(model, ground, template, trial, rest, t, q, qdot, tol);
             return None;
         }
         if let Some(mode) = loop_opening(model, ground, template, trial, rest, t, q, qdot, tol) {
@@ -301,6 +302,49 @@ fn pressing_carried(model: &Model, trial: &Dynamics, rest: &mut RestCache) -> bo
     rest.pressing
         .carries(model, trial, &rest.loads)
         .unwrap_or(false)
+}
+
+/// With the run audited ([`super::Simulation::audit_certificate`]), the contact program's answer
+/// at a state the certificate decided, confirmed by the chain's exact solve as the run would
+/// confirm it, recorded; solved on a copy of `trial`, so that the run goes on as unaudited.
+#[allow(clippy::too_many_arguments)]
+fn audit_certified(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &Dynamics,
+    rest: &mut RestCache,
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+    tol: f64,
+) {
+    let Some(audit) = rest.audit.as_mut() else {
+        return;
+    };
+    let mut scratch = trial.clone();
+    match opening_qp_holding(model, &scratch, &rest.held_faces) {
+        Ok(decision) if !decision.lifting_off.is_empty() => {
+            audit.record(model, t, &decision.releases, &decision.lifting_off);
+        }
+        Ok(decision) => {
+            match confirmed_releases(
+                model,
+                ground,
+                template,
+                &mut scratch,
+                decision.releases,
+                t,
+                q,
+                qdot,
+                tol,
+            ) {
+                Some(confirmed) => audit.record(model, t, &confirmed.unwrap_or_default(), &[]),
+                None => audit.unsolved += 1,
+            }
+        }
+        Err(_) => audit.unsolved += 1,
+    }
 }
 
 /// The contact program's decision on a structure with loops (`trial` evaluated at the state

@@ -51,6 +51,9 @@ pub(super) struct RestCache {
     /// the next, and the bodies' loads it is posed on.
     pub(super) pressing: crate::face_forces::PressingCertificate,
     pub(super) loads: crate::monitor::ForceWork,
+    /// The certificate's audit, when the run is audited
+    /// ([`super::Simulation::audit_certificate`]).
+    pub(super) audit: Option<super::CertificateAudit>,
 }
 
 #[derive(Clone, Debug)]
