@@ -17,6 +17,21 @@
 //! out), it found 66 disagreements on the arch (the first at 6.334 s, four second tilts released)
 //! and 7 081 of 9 114 certified step ends on the temple (the first at 2.4136 s, `c13_neck.2`
 //! released on its negative pivot), 2026-11-30.
+//!
+//! Why those two part on the temple: at 2.4136 s every neck and entablature seat sits a few
+//! 1e-8 to 3e-7 rad from its seat, where the loops through the entablature are dependent to
+//! about that angle. The closed-chain solve takes rows dependent below √1e-9 of its largest
+//! singular value as dependent, so its locked motion leaves the front capitals' closures open
+//! by 1.49e-7 m/s² along their edges (Φ_q q̈ + Φ̇_q q̇, the audit's `closure_residual`), with
+//! coordinate accelerations up to 8.1 rad/s² while the bodies barely move. The certificate's
+//! distribution (in equilibrium with the locked motion's loads to 7e-11 W) does positive power
+//! on the change to the released motion (2.508e-3 W·m/s², equal to the loads' own power summed
+//! body by body), so Gauss' function rises on that release; yet the chain's released solve opens
+//! the neck, at 4.9e-8 rad/s², below the locked solve's error: the two solves keep different
+//! rows (the released one closes `entablature_on_c13`, which the locked one leaves open), so at
+//! that level they do not compare. Over the rigid temple's certified
+//! states that residual reaches 8.2e-4 m/s²; on the 3D arch and the walls it stays at
+//! round-off (1.5e-14 or less), which `assert_closed` asserts.
 
 use std::path::Path;
 
@@ -82,10 +97,12 @@ fn audited_file(tag: &str, path: &Path, duration: f64) -> (CertificateAudit, f64
 
 fn assert_sound(tag: &str, (audit, t, error): &(CertificateAudit, f64, Option<String>)) {
     eprintln!(
-        "{tag}: to {t:.4} s ({error:?}): {} certified, {} disagreements, {} unsolved",
+        "{tag}: to {t:.4} s ({error:?}): {} certified, {} disagreements, {} unsolved, \
+         closure residual up to {:.3e}",
         audit.certified,
         audit.disagreements.len(),
-        audit.unsolved
+        audit.unsolved,
+        audit.largest_closure_residual
     );
     assert!(
         audit.disagreements.is_empty(),
@@ -98,12 +115,25 @@ fn assert_sound(tag: &str, (audit, t, error): &(CertificateAudit, f64, Option<St
     );
 }
 
+/// The locked solves at the certified states keep the loops closed at acceleration level:
+/// Φ_q q̈ + Φ̇_q q̇ of every closure row (from the kinematics' rows, not the solve) within
+/// 1e-10 m/s² (1e-11 g; measured at most 1.5e-14, round-off). The bundled temple's loops are not
+/// (see the module's doc), which is why it is not asked this.
+fn assert_closed(tag: &str, audit: &CertificateAudit) {
+    assert!(
+        audit.largest_closure_residual <= 1e-10,
+        "{tag}: the locked solve leaves a loop open by {:.3e} m/s²",
+        audit.largest_closure_residual
+    );
+}
+
 #[test]
 fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_3d_arch() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let run = audited_file("arch_3d", &root.join("examples/models/arch_3d.toml"), 20.0);
     assert_sound("arch_3d", &run);
     assert!(run.0.certified > 1000, "{} certified", run.0.certified);
+    assert_closed("arch_3d", &run.0);
 }
 
 #[test]
@@ -143,6 +173,7 @@ fn the_certificate_holds_only_where_the_program_opens_nothing_on_walls() {
         };
         let tag = format!("{n} x {n} wall, {factor} λ g");
         let (report, t, error, instants) = run(&model, &ground, &init, params.clone(), true);
+        assert_closed(&tag, &report);
         assert_sound(&tag, &(report, t, error));
         // The audit solves on a copy: the run it watches is the run unaudited, impact for
         // impact, to the last bit.

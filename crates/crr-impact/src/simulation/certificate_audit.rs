@@ -21,6 +21,12 @@ pub struct CertificateDisagreement {
     pub releases: Vec<(String, Side)>,
     /// The interfaces the program lifts off.
     pub lifting_off: Vec<String>,
+    /// The locked solve's own error on the loops at that state: the largest closure row of
+    /// Φ_q q̈ + Φ̇_q q̇ (m/s² for a corner row; an orientation row's 1/s² times the model size).
+    /// Near a hyperstatic seat the closed-chain solve takes nearly dependent rows as dependent
+    /// and leaves them open by this much; an opening rate below it times the model size is
+    /// within the solve's error.
+    pub closure_residual: f64,
 }
 
 /// What the audit found over a run.
@@ -32,6 +38,9 @@ pub struct CertificateAudit {
     pub disagreements: Vec<CertificateDisagreement>,
     /// Those at which the contact program failed (no answer to compare).
     pub unsolved: usize,
+    /// The largest locked solve's error on the loops over the certified states
+    /// ([`CertificateDisagreement::closure_residual`]).
+    pub largest_closure_residual: f64,
 }
 
 impl CertificateAudit {
@@ -43,8 +52,10 @@ impl CertificateAudit {
         t: f64,
         releases: &[(usize, Side)],
         lifting_off: &[usize],
+        closure_residual: f64,
     ) {
         self.certified += 1;
+        self.largest_closure_residual = self.largest_closure_residual.max(closure_residual);
         if releases.is_empty() && lifting_off.is_empty() {
             return;
         }
@@ -58,6 +69,7 @@ impl CertificateAudit {
                 .iter()
                 .map(|&i| model.interfaces[i].name.clone())
                 .collect(),
+            closure_residual,
         });
     }
 }
