@@ -12,6 +12,7 @@ mod impact_laws_on_chains;
 mod impulse_tension;
 mod initial_state_paths;
 mod invariant;
+mod loop_residual;
 mod mirror_invariance;
 mod opening_program;
 mod order_invariance;

@@ -507,4 +507,31 @@ impl Dynamics {
     pub fn row_scale(&self) -> &DVector<f64> {
         &self.row_scale
     }
+
+    /// How far the last solve leaves the loops open at acceleration level: the largest closure
+    /// row of Φ_q q̈ + Φ̇_q q̇ (a corner row's m/s², an orientation row's 1/s² times the model
+    /// size, so m/s² too), from the kinematics' rows of the state solved. Round-off where the
+    /// closure rows are independent or exactly dependent; near a hyperstatic seat, rows
+    /// dependent to less than the rank rule are taken as dependent and left open by this much.
+    /// 0 without loops.
+    pub fn loop_residual(&self, model: &Model) -> f64 {
+        let mut worst: f64 = 0.0;
+        for closure in &model.closures {
+            for r in 0..closure.rows {
+                let i = closure.first_row + r;
+                let rate = self
+                    .kin
+                    .phi_q
+                    .row(i)
+                    .iter()
+                    .zip(self.qddot.iter())
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>()
+                    + self.kin.phi_bias[i];
+                let rate = if r < 3 { rate } else { rate * model.size };
+                worst = worst.max(rate.abs());
+            }
+        }
+        worst
+    }
 }

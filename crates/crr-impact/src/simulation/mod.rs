@@ -469,6 +469,22 @@ pub struct Simulation<'a> {
     /// First failure of the no-flight (compressive contact) or no-slip hypothesis, checked at
     /// every output sample and impact instant.
     pub violation: Option<crate::monitor::Violation>,
+    /// The largest opening of the loops at acceleration level left by the monitor's solves.
+    loop_residual: LoopResidual,
+}
+
+/// The largest opening of the loops at acceleration level (Φ_q q̈ + Φ̇_q q̇ of a closure row,
+/// [`Dynamics::loop_residual`]) left by the closed-chain solves at the output samples, until the
+/// monitor's first violation. Round-off (about 1e-14 m/s²) on structures whose loops are
+/// independent or exactly dependent; near a hyperstatic seat the solve takes rows dependent to
+/// less than its rank rule as dependent and leaves them open by this much, and decisions whose
+/// rates lie below it are within the solve's error (docs/simulation.md, Limitations).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LoopResidual {
+    /// The largest residual (m/s²).
+    pub largest: f64,
+    /// The sample's time (s).
+    pub t: f64,
 }
 
 /// The buffers of one integration segment ([`Simulation::step`]): the events' state and pivots,
@@ -854,6 +870,7 @@ impl<'a> Simulation<'a> {
             uplift_time: None,
             collapse: None,
             violation: None,
+            loop_residual: LoopResidual::default(),
         };
         let y = std::mem::take(&mut sim.y);
         let first = sim.sample_at(0.0, &y);
@@ -1629,6 +1646,7 @@ impl<'a> Simulation<'a> {
             snaps_and_losses,
             end_time: self.t,
             solver_stats: self.solver.stats(),
+            loop_residual: self.loop_residual,
         }
     }
 }
@@ -1665,6 +1683,8 @@ pub struct Trajectory {
     pub end_time: f64,
     /// Integrator work over the whole run: steps, rejections, right-hand side evaluations.
     pub solver_stats: crr_dynamics::integrator::Stats,
+    /// How far the closed-chain solves left the loops open at acceleration level.
+    pub loop_residual: LoopResidual,
 }
 
 impl Trajectory {
@@ -1684,6 +1704,7 @@ impl Trajectory {
             snaps_and_losses: SnapsAndLosses::default(),
             end_time: 0.0,
             solver_stats: Default::default(),
+            loop_residual: LoopResidual::default(),
         }
     }
 }

@@ -48,6 +48,13 @@ impl Simulation<'_> {
             {
                 let (forces, edges) = (&work.forces, &work.edges);
                 monitor_kin = true;
+                let residual = d.loop_residual(&self.model);
+                if residual > self.loop_residual.largest {
+                    self.loop_residual = super::LoopResidual {
+                        largest: residual,
+                        t,
+                    };
+                }
                 let tol = crate::monitor::TENSION_TOLERANCE
                     * self.model.total_mass()
                     * self.model.gravity;

@@ -323,7 +323,7 @@ fn audit_certified(
         return;
     };
     let mut scratch = trial.clone();
-    let residual = closure_residual(model, trial);
+    let residual = trial.loop_residual(model);
     match opening_qp_holding(model, &scratch, &rest.held_faces) {
         Ok(decision) if !decision.lifting_off.is_empty() => {
             audit.record(
@@ -354,29 +354,6 @@ fn audit_certified(
         }
         Err(_) => audit.unsolved += 1,
     }
-}
-
-/// The largest closure row of Φ_q q̈ + Φ̇_q q̇ after the solve in `trial` (a corner row's m/s², an
-/// orientation row's 1/s² times the model size): the solve's own error on the loops
-/// ([`super::CertificateDisagreement::closure_residual`]).
-fn closure_residual(model: &Model, trial: &Dynamics) -> f64 {
-    let kin = &trial.kin;
-    let mut worst: f64 = 0.0;
-    for closure in &model.closures {
-        for r in 0..closure.rows {
-            let i = closure.first_row + r;
-            let rate = kin
-                .phi_q
-                .row(i)
-                .iter()
-                .zip(trial.qddot.iter())
-                .map(|(a, b)| a * b)
-                .sum::<f64>()
-                + kin.phi_bias[i];
-            worst = worst.max(if r < 3 { rate } else { rate * model.size }.abs());
-        }
-    }
-    worst
 }
 
 /// The contact program's decision on a structure with loops (`trial` evaluated at the state
