@@ -24,8 +24,8 @@ pub struct CertificateDisagreement {
     /// The locked solve's own error on the loops at that state: the largest closure row of
     /// Φ_q q̈ + Φ̇_q q̇ (m/s² for a corner row; an orientation row's 1/s² times the model size).
     /// Near a hyperstatic seat the closed-chain solve takes nearly dependent rows as dependent
-    /// and leaves them open by this much; an opening rate below it times the model size is
-    /// within the solve's error.
+    /// and leaves them open by this much; an opening rate (rad/s²) below it divided by the model
+    /// size is within the solve's error.
     pub closure_residual: f64,
 }
 
