@@ -25,7 +25,7 @@
 //! by 1.49e-7 m/s² along their edges (Φ_q q̈ + Φ̇_q q̇, the audit's `closure_residual`), with
 //! coordinate accelerations up to 8.1 rad/s² while the bodies barely move. The certificate's
 //! distribution (in equilibrium with the locked motion's loads to 7e-11 W) does positive power
-//! on the change to the released motion (2.508e-3 W·m/s², equal to the loads' own power summed
+//! on the change to the released motion (2.508e-3 N·m/s², equal to the loads' own power summed
 //! body by body), so Gauss' function rises on that release; yet the chain's released solve opens
 //! the neck, at 4.9e-8 rad/s², below the locked solve's error: the two solves keep different
 //! rows (the released one closes `entablature_on_c13`, which the locked one leaves open), so at
