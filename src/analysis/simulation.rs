@@ -432,7 +432,7 @@ pub const ENERGY_BALANCE_WARNING: f64 = 1e-3;
 /// ([`crr_impact::simulation::LoopResidual`]), in units of g, above which a run warns: the level
 /// at which the contact program reads a contact's opening rate and force as a tie
 /// (docs/simulation.md, Limitations, "Contacts at a threshold"). The bundled models' loops stay
-/// at round-off (1.9e-14 m/s² or less; the temple 1.4e-11 m/s² until its monitor's first
+/// at round-off (4.7e-14 m/s² or less; the temple 1.4e-11 m/s² until its monitor's first
 /// violation); the temple with rigid seats under 0.8 of its record reaches 1.9e-5 m/s².
 pub const LOOP_RESIDUAL_WARNING: f64 = 1e-6;
 

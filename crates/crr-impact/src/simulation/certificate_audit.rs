@@ -45,13 +45,13 @@ pub struct CertificateAudit {
 
 impl CertificateAudit {
     /// Records the program's answer at a certified state: `releases` as confirmed by the chain,
-    /// `lifting_off` the interfaces it lifts off (indices of `model`'s).
+    /// `lifting_off` the interfaces it lifts off (their names).
     pub(super) fn record(
         &mut self,
         model: &Model,
         t: f64,
         releases: &[(usize, Side)],
-        lifting_off: &[usize],
+        lifting_off: Vec<String>,
         closure_residual: f64,
     ) {
         self.certified += 1;
@@ -65,10 +65,7 @@ impl CertificateAudit {
                 .iter()
                 .map(|&(k, side)| (model.slot_name(k), side))
                 .collect(),
-            lifting_off: lifting_off
-                .iter()
-                .map(|&i| model.interfaces[i].name.clone())
-                .collect(),
+            lifting_off,
             closure_residual,
         });
     }

@@ -475,7 +475,7 @@ pub struct Simulation<'a> {
 
 /// The largest opening of the loops at acceleration level (Φ_q q̈ + Φ̇_q q̇ of a closure row,
 /// [`Dynamics::loop_residual`]) left by the closed-chain solves at the output samples, until the
-/// monitor's first violation. Round-off (1e-14 to 1e-11 m/s² on the bundled models) where the
+/// monitor's first violation. Round-off (7e-15 to 1.4e-11 m/s² on the bundled models) where the
 /// loops are independent or exactly dependent; near a hyperstatic seat the solve takes rows dependent to
 /// less than its rank rule as dependent and leaves them open by this much, and decisions whose
 /// rates lie below it are within the solve's error (docs/simulation.md, Limitations).

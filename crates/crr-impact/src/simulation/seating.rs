@@ -305,8 +305,9 @@ fn pressing_carried(model: &Model, trial: &Dynamics, rest: &mut RestCache) -> bo
 }
 
 /// With the run audited ([`super::Simulation::audit_certificate`]), the contact program's answer
-/// at a state the certificate decided, confirmed by the chain's exact solve as the run would
-/// confirm it, recorded; solved on a copy of `trial`, so that the run goes on as unaudited.
+/// at a state the certificate decided, recorded: the uplift test's own [`loop_opening`] (the
+/// program, its releases confirmed by the chain's exact solve) on a copy of `trial`, with the
+/// lift-off it may name taken back, so that the run goes on as unaudited.
 #[allow(clippy::too_many_arguments)]
 fn audit_certified(
     model: &Model,
@@ -319,41 +320,25 @@ fn audit_certified(
     qdot: &DVector<f64>,
     tol: f64,
 ) {
-    let Some(audit) = rest.audit.as_mut() else {
+    let Some(mut audit) = rest.audit.take() else {
         return;
     };
-    let mut scratch = trial.clone();
     let residual = trial.loop_residual(model);
-    match opening_qp_holding(model, &scratch, &rest.held_faces) {
-        Ok(decision) if !decision.lifting_off.is_empty() => {
-            audit.record(
-                model,
-                t,
-                &decision.releases,
-                &decision.lifting_off,
-                residual,
-            );
-        }
-        Ok(decision) => {
-            match confirmed_releases(
-                model,
-                ground,
-                template,
-                &mut scratch,
-                decision.releases,
-                t,
-                q,
-                qdot,
-                tol,
-            ) {
-                Some(confirmed) => {
-                    audit.record(model, t, &confirmed.unwrap_or_default(), &[], residual);
-                }
-                None => audit.unsolved += 1,
-            }
-        }
-        Err(_) => audit.unsolved += 1,
+    let mut scratch = trial.clone();
+    let kept = rest.lift_off.take();
+    let answer = loop_opening(model, ground, template, &mut scratch, rest, t, q, qdot, tol);
+    let lifting_off = std::mem::replace(&mut rest.lift_off, kept).unwrap_or_default();
+    match answer {
+        Some(releases) => audit.record(
+            model,
+            t,
+            &releases.unwrap_or_default(),
+            lifting_off,
+            residual,
+        ),
+        None => audit.unsolved += 1,
     }
+    rest.audit = Some(audit);
 }
 
 /// The contact program's decision on a structure with loops (`trial` evaluated at the state
