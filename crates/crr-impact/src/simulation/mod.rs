@@ -68,7 +68,7 @@ pub use opening_qp::{
 pub use samples::{FaceOpening, Iter as SampleIter, Sample, Samples};
 use seating::opening_mode_in;
 pub(crate) use seating::other_pivot_rest;
-pub use seating::{opening_mode, openings_slide_nowhere};
+pub use seating::{CERTIFIED_CLOSURE_RESIDUAL, opening_mode, openings_slide_nowhere};
 pub use slots::check_initial_state;
 pub(crate) use slots::slot_interface;
 use slots::*;
