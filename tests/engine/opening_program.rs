@@ -434,14 +434,16 @@ fn the_program_is_the_least_gauss_function_on_seats_that_twist() {
 /// The certificate the uplift test asks in motion before the contact program
 /// (`face_forces::PressingCertificate`: a distribution of the locked motion's contact forces on
 /// the faces pressing everywhere by a margin) on rocking bases, against the exhaustive search
-/// above and the program, at the states the simulation lets it decide
-/// (`simulation::openings_slide_nowhere`): bases on an edge with their first tilt seated and
-/// their second turned, on one corner, with both seated. One certificate is asked state after
-/// state and load after load, as a simulation asks it (its distribution carried over the
+/// above and the program. The states hold every kind of rocking face the simulation lets it
+/// decide (`simulation::openings_slide_nowhere`): bases on an edge with their first tilt turned
+/// and their second seated (whose touching corners leave along the child's face normal, on
+/// which the faces then pose their forces), with their first seated and their second turned,
+/// on one corner, with both seated, and seats that may twist. One certificate is asked state
+/// after state and load after load, as a simulation asks it (its distribution carried over the
 /// columns two states share, the faces' program solved where none carries). Wherever it holds,
 /// holding every seated slot is the exhaustive search's least Gauss function and the program
-/// opens and lifts nothing, at states with bases on such an edge (the states the simulation
-/// leaves to the certificate here hold under every load tried: the certificate holds at all).
+/// opens and lifts nothing. Both answers occur, and states with the two kinds of edge, on tree and
+/// loop-closing bases.
 #[test]
 fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
     use crr::impact::face_forces::PressingCertificate;
@@ -462,6 +464,12 @@ fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
             .unwrap()
     };
     let colonnade_model = Model::from_spec(&colonnade(0.2, 1.5, 1.2, 0.4)).unwrap();
+    let twisting = crr::load_model(&crate::common::write_model(
+        "baldachin_twist_certificate",
+        &crate::twist_closure::twisting_text(),
+    ))
+    .unwrap()
+    .1;
     let arch = {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
         let opts = crr::RunOptions {
@@ -481,6 +489,14 @@ fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
             moving_states(&colonnade_model, &pulse(Axis::Y), 0.6, 8, 7),
         ),
         (
+            &twisting,
+            moving_states(&twisting, &pulse(Axis::X), 0.8, 8, 9),
+        ),
+        (
+            &twisting,
+            moving_states(&twisting, &pulse(Axis::Y), 0.8, 8, 9),
+        ),
+        (
             &arch.model,
             moving_states(&arch.model, &arch.ground, 3.0, 6, 8),
         ),
@@ -496,15 +512,15 @@ fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
     ];
     // Certified states with an edge turned on the first tilt (second seated) and on the second
     // (first seated); certified (state, load) pairs; pairs where the exhaustive search opens.
-    let (mut second_turned, mut certified, mut opened) = (0, 0, 0);
+    let (mut first_turned, mut second_turned, mut certified, mut opened) = (0, 0, 0, 0);
+    // Certified states where a loop-closing base rocks on an edge of its first tilt.
+    let mut closing_first_turned = 0;
     for (model, states) in &cases {
         assert!(states.len() >= 3, "{}: {} states", model.name, states.len());
+        assert!(openings_slide_nowhere(model), "{}", model.name);
         let mut certificate = PressingCertificate::default();
         let mut work = ForceWork::default();
         for (q, qdot, pivots, seated) in states {
-            if !openings_slide_nowhere(model, seated) {
-                continue;
-            }
             for &(ax, ay) in &loads {
                 let ground = constant(ax, ay);
                 let mut d = Dynamics::new(model, pivots.clone());
@@ -543,7 +559,16 @@ fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
                                 && f.slots.clone().map(|k| seated.contains(&k)).eq(pattern)
                         })
                     };
+                    first_turned += usize::from(edges([false, true]));
                     second_turned += usize::from(edges([true, false]));
+                    closing_first_turned += usize::from(model.interfaces.iter().any(|f| {
+                        matches!(f.kind, crr::kinematics::InterfaceKind::RockingBase { .. })
+                            && matches!(f.role, crr::kinematics::Role::Closure { .. })
+                            && f.slots
+                                .clone()
+                                .map(|k| seated.contains(&k))
+                                .eq([false, true])
+                    }));
                 } else {
                     let mut e = Dynamics::new(model, pivots.clone());
                     e.seated = seated.clone();
@@ -560,12 +585,17 @@ fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
         }
     }
     eprintln!(
-        "certificate on rocking bases: {certified} certified ({second_turned} with a base on an \
-         edge of its second tilt), {opened} opened"
+        "certificate on rocking bases: {certified} certified ({first_turned} with an edge on \
+         the first tilt, {closing_first_turned} of them on a loop-closing base, {second_turned} \
+         on the second), {opened} opened"
     );
-    assert!(certified >= 20, "{certified} certified, {opened} opened");
     assert!(
-        second_turned >= 3,
-        "{second_turned} certified states with a base on an edge of its second tilt"
+        certified >= 20 && opened >= 5,
+        "{certified} certified, {opened} opened"
+    );
+    assert!(
+        first_turned >= 3 && second_turned >= 3 && closing_first_turned >= 3,
+        "{first_turned} / {second_turned} certified states with each kind of edge, \
+         {closing_first_turned} on a loop-closing base's first tilt"
     );
 }

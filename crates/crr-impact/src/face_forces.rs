@@ -14,8 +14,9 @@
 //! current pivot. So a seated hinge touches on its two pivot lines, a rocking hinge on one; a
 //! rocking base on one corner (both tilts free), on an edge (one tilt seated) or on its four
 //! corners. Each touching point carries f = fₙn + f₁t₁ + f₂t₂ from the parent on the child (the
-//! face's axes turned with the parent), unilateral: fₙ ≥ s. A hinge also carries its bilateral
-//! couples about n and t₁ (it is a line); a rocking base on one corner the couple about n that its
+//! face's axes turned with the parent; the pressing certificate turns them with the child on a
+//! base rocking on an edge of its first tilt, [`PressingCertificate`]), unilateral: fₙ ≥ s. A
+//! hinge also carries its bilateral couples about n and t₁ (it is a line); a rocking base on one corner the couple about n that its
 //! two tilts leave no freedom for (the CRR base does not twist); a seat that may twist carries no
 //! torsion, so only its current pivot takes tangential forces. A plain hinge (one pivot line) is
 //! a pin: its force is free.
@@ -119,7 +120,7 @@ pub fn most_compressive_impulses(
     momentum_change: &[(Vector3<f64>, Vector3<f64>)],
     set_by_law: &[usize],
 ) -> Option<MostCompressive> {
-    let program = FaceProgram::build_setting(model, dynamics, set_by_law);
+    let program = FaceProgram::build_setting(model, dynamics, set_by_law, FaceAxes::Parent);
     // Impulses in W·√(L/g), the structure's weight over its time unit, so that the program's
     // unknowns are of order one as its forces are (its tolerances and proximal term assume it).
     let time = (model.size / model.gravity).sqrt();
@@ -156,14 +157,32 @@ struct FaceProgram {
     interfaces: usize,
 }
 
+/// The axes a face's point forces are posed on.
+#[derive(Clone, Copy, PartialEq)]
+enum FaceAxes {
+    /// The parent's face axes, turned with the parent: the normal force is the one across the
+    /// parent's face (the monitor's question, as the subtree recursion of `monitor` asks it).
+    Parent,
+    /// The axes of the normal along which the touching points leave under the contact program's
+    /// openings ([`leaves_along_child_normal`]): the certificate's, which must price exactly
+    /// the program's motions.
+    Leaving,
+}
+
 impl FaceProgram {
     fn build(model: &Model, dynamics: &Dynamics) -> FaceProgram {
-        Self::build_setting(model, dynamics, &[])
+        Self::build_setting(model, dynamics, &[], FaceAxes::Parent)
     }
 
     /// [`Self::build`] with the slots `set_by_law` touching on both pivots (as if seated), and
-    /// every touching point of their interfaces carrying a normal force of either sign.
-    fn build_setting(model: &Model, dynamics: &Dynamics, set_by_law: &[usize]) -> FaceProgram {
+    /// every touching point of their interfaces carrying a normal force of either sign, posed on
+    /// the axes `posed_on`.
+    fn build_setting(
+        model: &Model,
+        dynamics: &Dynamics,
+        set_by_law: &[usize],
+        posed_on: FaceAxes,
+    ) -> FaceProgram {
         let size = model.size;
         let mut is_seated = vec![false; model.slot_count];
         for &k in dynamics.seated.iter().chain(set_by_law) {
@@ -174,7 +193,13 @@ impl FaceProgram {
         for (index, iface) in model.interfaces.iter().enumerate() {
             let face = ContactFace::of_interface(model, index);
             let frame = model.frame_of(iface.parent);
-            let rot = frame.map_or_else(Matrix3::identity, |k| dynamics.kin.rot_ops[k]);
+            let rot = if posed_on == FaceAxes::Leaving
+                && leaves_along_child_normal(&iface.kind, &is_seated[iface.slots.clone()])
+            {
+                dynamics.kin.rot_ops[model.body_coord[iface.child]]
+            } else {
+                frame.map_or_else(Matrix3::identity, |k| dynamics.kin.rot_ops[k])
+            };
             let axes = [
                 rot * face.normal,
                 rot * face.tangents[0],
@@ -726,7 +751,7 @@ impl PressingCertificate {
         work: &ForceWork,
     ) -> Option<bool> {
         self.pending = None;
-        let program = FaceProgram::build(model, dynamics);
+        let program = FaceProgram::build_setting(model, dynamics, &[], FaceAxes::Leaving);
         let loads = program.loads(model, dynamics, work)?;
         // The last distribution on this state's columns (those it shares with the last state's,
         // the others 0): any start serves, what certifies is the result's equilibrium (checked
@@ -788,6 +813,20 @@ impl PressingCertificate {
             self.unpaid = true;
         }
     }
+}
+
+/// Whether the touching points of interface `kind`, with its slots seated as `seated`, leave
+/// along the child's face normal rather than the parent's: a rocking base turned on its first
+/// tilt (about the parent's e₁, through the edge it rocks on) with its second seated. Opening
+/// the second tilt turns the child about an end of that edge, about R(e₁, θ₁)e₂, which lies in
+/// the child's face plane: the other end leaves along the child's normal, tilted by θ₁ from the
+/// parent's, and so does the lift (the contact program's τ = σ w × (P′ − P)). Posed on the
+/// child's axes, the points' tangential forces do no work on any opening the program offers
+/// (on the parent's they would, θ₁ times their size). Every other face leaves along the
+/// parent's normal: a hinge and a base with its first tilt seated turn about axes in the
+/// parent's face plane, and a base on one corner lifts along the parent's normal.
+fn leaves_along_child_normal(kind: &InterfaceKind, seated: &[bool]) -> bool {
+    matches!(kind, InterfaceKind::RockingBase { .. }) && seated == [false, true]
 }
 
 /// The axis of the couple a rocking base on one corner transmits: the one its two tilts leave no

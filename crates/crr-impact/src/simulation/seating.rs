@@ -219,9 +219,8 @@ pub(super) fn opening_mode_local(
         // among many on hyperstatic loops and seldom certify). Only where the program would be
         // the whole problem: a restricted one leaves the decision to the local test below, and
         // so does the certificate.
-        let certificate = may_open.is_some()
-            && openings_slide_nowhere(model, &seated)
-            && offers_both_pivots(model, trial);
+        let certificate =
+            may_open.is_some() && openings_slide_nowhere(model) && offers_both_pivots(model, trial);
         if may_open.is_none() {
             trial.evaluate(model, ground, t, q, qdot);
         } else if certificate
@@ -264,39 +263,31 @@ pub(super) fn opening_mode_local(
 }
 
 /// Whether every opening the contact program offers moves the touching points it leaves along
-/// their face's normal, with the slots in `seated` seated, so that the faces' distributions
-/// (free tangential forces at every touching point) price exactly the program's motions, and a
-/// compressive one certifies that nothing opens (`pressing_carried`, asked by the uplift test in
-/// motion only where this holds). A hinge turns about a pivot line in its face's plane; a
-/// rocking base with both tilts seated about an edge of the seat, and one with its first tilt
-/// seated and its second turned about the parent's e₁, both in the parent's face plane; a lift
-/// translates along that normal. A rocking base with its first tilt turned and its second
-/// seated turns about R(e₁, θ₁)e₂, out of the parent's face plane: on the parent's axes the
-/// faces' tangential forces held releases the program opens, and on the child's axes too (the
-/// temple with its seats made rigid, 2026-11-30: 5 346 step ends certified where the program,
-/// confirmed by the chain's own solve, released a neck; that was before the bound of
-/// [`CERTIFIED_CLOSURE_RESIDUAL`], with which the temple has none, but the 3D arch on the
-/// parent's axes still has 66, at round-off residuals), so the program decides there. A seat
-/// that may twist is a rocking base for this rule: its twist turns the child's axes about the
-/// face's normal, within the face's plane, and the faces' points are the parent's corners. (Its
-/// exclusion until 2026-11-30, after a distribution held `c21_neck` of the temple at 0.8 of its
-/// record where the program released it, was the closed-chain solve's residual near the
-/// temple's seats: [`CERTIFIED_CLOSURE_RESIDUAL`].) A hinge whose two pivot lines (nearly)
+/// the normal the faces pose their forces on, so that the faces' distributions (free tangential
+/// forces at every touching point) price exactly the program's motions, and a compressive one
+/// certifies that nothing opens (`pressing_carried`, asked by the uplift test in motion only
+/// where this holds). A hinge turns about a pivot line in its face's plane; a rocking base with
+/// both tilts seated about an edge of the seat, and one with its first tilt seated and its
+/// second turned about the parent's e₁, both in the parent's face plane; a lift translates
+/// along that normal. A rocking base with its first tilt turned and its second seated turns
+/// about R(e₁, θ₁)e₂, in the child's face plane: the certificate poses that face's forces on
+/// the child's axes (`face_forces`, `leaves_along_child_normal`; on the parent's, the 3D arch
+/// had 66 step ends certified where the program, confirmed by the chain's own solve, released a
+/// joint). A seat that may twist is a rocking base for this rule: its twist turns the child's
+/// axes about the face's normal, within the face's plane. (Both were kept out from 2026-11-30
+/// until the cause of the temple's disagreements was found: the closed-chain solve's residual
+/// near its seats, [`CERTIFIED_CLOSURE_RESIDUAL`].) A hinge whose two pivot lines (nearly)
 /// coincide is a pin for the faces (free normal forces, any moment) but keeps a lift in the
 /// program, whose dual bounds its moment: such a face "held" lifts that the program makes (an
 /// independent review, with pivots 1e-7 m apart). Those decide by the program.
-pub fn openings_slide_nowhere(model: &Model, seated: &[usize]) -> bool {
+pub fn openings_slide_nowhere(model: &Model) -> bool {
     model
         .interfaces
         .iter()
         .enumerate()
         .all(|(index, iface)| match iface.kind {
             InterfaceKind::Hinge { .. } => !ContactFace::of_interface(model, index).pin,
-            InterfaceKind::RockingBase { .. } => {
-                let first_seated = seated.contains(&iface.slots.start);
-                let second_seated = seated.contains(&(iface.slots.start + 1));
-                first_seated || !second_seated
-            }
+            InterfaceKind::RockingBase { .. } => true,
         })
 }
 
@@ -306,10 +297,11 @@ pub fn openings_slide_nowhere(model: &Model, seated: &[usize]) -> bool {
 /// seat the closed-chain solve takes rows dependent below its rank rule as dependent and leaves
 /// them open (docs/simulation.md, Limitations), and what it certifies there is another motion.
 /// Round-off is 1.5e-14 m/s² or less on the bundled 3D arch and on walls, and up to 2e-11 m/s²
-/// on the bundled temple's certified states; the temple near its seats reaches 8.2e-4 m/s²
-/// (with rigid seats) and 7e-7 m/s² (as bundled, at 0.8 of its record), where the certificate
-/// let through on its twisting seats held 140 step ends at which the program, confirmed by the
-/// chain's own solve, released a joint (`tests/engine/certificate_audit.rs`, 2026-11-30).
+/// on the bundled temple's certified states; the temple near its seats reaches 1.3e-3 m/s²
+/// (with rigid seats) and 7e-7 m/s² (as bundled, at 0.8 of its record). Without this bound the
+/// audit found 7 749 and 140 step ends there at which the certificate held and the program,
+/// confirmed by the chain's own solve, released a joint; with it, none
+/// (`tests/engine/certificate_audit.rs`, 2026-11-30).
 pub const CERTIFIED_CLOSURE_RESIDUAL: f64 = 1e-11;
 
 /// Whether the locked solve in `trial` keeps every loop closed at acceleration level to
