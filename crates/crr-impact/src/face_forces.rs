@@ -16,10 +16,10 @@
 //! corners. Each touching point carries f = fₙn + f₁t₁ + f₂t₂ from the parent on the child (the
 //! face's axes turned with the parent; the pressing certificate turns them with the child on a
 //! base rocking on an edge of its first tilt, [`PressingCertificate`]), unilateral: fₙ ≥ s. A
-//! hinge also carries its bilateral couples about n and t₁ (it is a line); a rocking base on one corner the couple about n that its
-//! two tilts leave no freedom for (the CRR base does not twist); a seat that may twist carries no
-//! torsion, so only its current pivot takes tangential forces. A plain hinge (one pivot line) is
-//! a pin: its force is free.
+//! hinge also carries its bilateral couples about n and t₁ (it is a line); a rocking base on one
+//! corner the couple about n that its two tilts leave no freedom for (the CRR base does not
+//! twist); a seat that may twist carries no torsion, so only its current pivot takes tangential
+//! forces. A plain hinge (one pivot line) is a pin: its force is free.
 //!
 //! **Program.** max s subject to every body's equilibrium Σ f = Fᵦ, Σ (p − c_b) × f + couples = Mᵦ,
 //! fₙ ≥ s at every unilateral point, s ≤ 0 (with a small proximal term on the forces,
