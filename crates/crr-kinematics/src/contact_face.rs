@@ -43,6 +43,23 @@ pub struct ContactFace {
 }
 
 impl ContactFace {
+    /// Whether interface `index` is a pin ([`Self::pin`]): a hinge whose two pivot lines
+    /// coincide within the geometry's tolerance, |u × (P⁻ − P⁺)| ≤ tolerance × model size. Asked
+    /// without building the face.
+    pub fn is_pin(model: &Model, index: usize) -> bool {
+        match &model.interfaces[index].kind {
+            InterfaceKind::Hinge {
+                axis,
+                pivot_positive,
+                pivot_negative,
+            } => {
+                axis.cross(&(pivot_negative - pivot_positive)).norm()
+                    <= GEOMETRY_TOLERANCE * model.size
+            }
+            InterfaceKind::RockingBase { .. } => false,
+        }
+    }
+
     /// The contact face of interface `index` of `model`.
     pub fn of_interface(model: &Model, index: usize) -> ContactFace {
         match &model.interfaces[index].kind {
@@ -51,9 +68,8 @@ impl ContactFace {
                 pivot_positive,
                 pivot_negative,
             } => {
-                let offset = pivot_negative - pivot_positive;
-                let lift = axis.cross(&offset);
-                let pin = lift.norm() <= GEOMETRY_TOLERANCE * model.size;
+                let lift = axis.cross(&(pivot_negative - pivot_positive));
+                let pin = Self::is_pin(model, index);
                 let normal = if pin {
                     any_perpendicular(axis)
                 } else {

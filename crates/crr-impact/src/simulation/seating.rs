@@ -281,14 +281,7 @@ pub(super) fn opening_mode_local(
 /// program, whose dual bounds its moment: such a face "held" lifts that the program makes (an
 /// independent review, with pivots 1e-7 m apart). Those decide by the program.
 pub fn openings_slide_nowhere(model: &Model) -> bool {
-    model
-        .interfaces
-        .iter()
-        .enumerate()
-        .all(|(index, iface)| match iface.kind {
-            InterfaceKind::Hinge { .. } => !ContactFace::of_interface(model, index).pin,
-            InterfaceKind::RockingBase { .. } => true,
-        })
+    (0..model.interfaces.len()).all(|index| !ContactFace::is_pin(model, index))
 }
 
 /// The largest closure residual Φ_q q̈ + Φ̇_q q̇ of the locked solve (in g) at which the faces'
