@@ -7,7 +7,6 @@
 //! and in-plane hinging with 32 impacts. (Later the two runs part where an impact leaves a joint's
 //! rate within round-off of the seating threshold: a discontinuous decision, not an order.) The
 //! bundled temple with its bodies in reverse order moves the same over its 85 impacts.
-
 //!
 //! The corners of a rocking base may be listed from any corner: listed from the third (corners 2,
 //! 3, 0, 1, the same winding) the first edge runs the other way, so e₁ and e₂ = n × e₁ both turn
@@ -16,6 +15,7 @@
 //! certificate and the contact program decide on the corners) are run both ways: every angle is
 //! the negative of the other run's to round-off, every rate too (to 1e-8 rad/s, the round-off of
 //! an impact's rates), and every impact comes at the same time on the same interfaces.
+
 use crate::common;
 
 /// `text` with its `[[body]]` blocks in reverse order, and its `[[interface]]` blocks too when
