@@ -11,7 +11,7 @@
 //! The corners of a rocking base may be listed from any corner: listed from the third (corners 2,
 //! 3, 0, 1, the same winding) the first edge runs the other way, so e₁ and e₂ = n × e₁ both turn
 //! round and both tilts change sign, and the motion is the same. The bundled baldachin, the 3D arch
-//! and the temple (30 rocking bases, six of them seats that may twist, where the faces'
+//! and the temple (30 rocking bases, five of them seats that may twist, where the faces'
 //! certificate and the contact program decide on the corners) are run both ways: every angle is
 //! the negative of the other run's to round-off, every rate too (to 1e-8 rad/s, the round-off of
 //! an impact's rates), and every impact comes at the same time on the same interfaces.
