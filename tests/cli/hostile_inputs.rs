@@ -155,8 +155,9 @@ fn a_fifo_in_place_of_an_output_file_is_replaced() {
     let mkfifo = |p: &std::path::Path| {
         assert!(Command::new("mkfifo").arg(p).status().unwrap().success());
     };
-    // Generous for a debug build on a loaded machine; a hang would last for ever.
-    let guard = Duration::from_secs(300);
+    // The suite's hang guard, generous for a debug build on a loaded machine; a hang would last
+    // for ever.
+    let guard = Duration::from_secs(common::HANG_GUARD_S);
     let run = |args: &[&str]| {
         let mut child = Command::new(env!("CARGO_BIN_EXE_crr"))
             .args(args)

@@ -241,7 +241,8 @@ fn a_wall_whose_moving_wedge_carries_blocks_at_rest_on_each_other_moves_as_its_m
 /// `amplitude` m/s² (period 0.5 s, 1 s) along +x and along −x: the two runs are mirror images.
 /// The same impacts and landings at the same instants (1e-8 s) on mirrored interfaces, with the
 /// same energy lost (1e-8 relative), the same faces open at every sample and the same energies
-/// (1e-7 of the largest); a stop on a flight compared to 1e-6 s (below).
+/// (1e-7 of the largest); a stop on a flight compared to 1e-9 s (below), every sample's time to
+/// 1e-8 s like the impacts'.
 fn assert_mirror_runs(file: &ModelFile, amplitude: f64) {
     let with_pulse = |amplitude: f64| {
         let mut json = serde_json::to_value(ModelFile {
@@ -345,7 +346,7 @@ fn assert_mirror_runs(file: &ModelFile, amplitude: f64) {
         .fold(1.0f64, |m, v| m.max(v.abs()));
     for (x, y) in sa.iter().zip(sb.iter()) {
         assert!(
-            (x.t - y.t).abs() <= 1e-6,
+            (x.t - y.t).abs() <= 1e-8,
             "{name}: sample at {} against {}",
             x.t,
             y.t

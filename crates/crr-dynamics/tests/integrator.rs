@@ -637,7 +637,9 @@ fn earliest_of_several_events_wins() {
         panic!()
     };
     assert_eq!(index, 1);
-    // RK4 with h = 0.5: interpolation error ~1e-3.
+    // RK4 with h = 0.5: the dense output's error is of order h⁴/24 of the solution's fourth
+    // derivative, 0.0026 here (measured: 3.5e-4 on this root, 1.0e-3 on the next); 1e-2 bounds
+    // it with room.
     assert!((t - PI / 3.0).abs() < 1e-2, "{t}");
     let stop = s
         .advance(&mut Oscillator, 10.0, &mut Two, &mut ignore)

@@ -89,21 +89,59 @@ fn box_axis_aligned_closed_form() {
 
 #[test]
 fn box_rotated_is_rotated_inertia() {
-    let base = box_shape([0.5, 0.2, 1.0], [0.4, 1.3, 2.2], None);
-    let rot = [0.3, -0.7, 1.1];
-    let rotated = BoxShape {
-        rotation: Some(rot),
+    let (a, b, c) = (0.4, 1.3, 2.2);
+    let base = box_shape([0.5, 0.2, 1.0], [a, b, c], None);
+    let rho = 2000.0;
+    let m = rho * a * b * c;
+    // A quarter turn about z lays the box's a edge along y and its b edge along x: the moments
+    // about x and y trade places (closed form of the box, m (sides²)/12).
+    let quarter = BoxShape {
+        rotation: Some([0.0, 0.0, std::f64::consts::FRAC_PI_2]),
         ..base.clone()
-    };
+    }
+    .mass_properties()
+    .unwrap();
+    let i = quarter.inertia(rho);
+    assert!(rel_err(i[(0, 0)], m * (a * a + c * c) / 12.0) < 1e-14);
+    assert!(rel_err(i[(1, 1)], m * (b * b + c * c) / 12.0) < 1e-14);
+    assert!(rel_err(i[(2, 2)], m * (a * a + b * b) / 12.0) < 1e-14);
+    assert!(i[(0, 1)].abs().max(i[(0, 2)].abs()).max(i[(1, 2)].abs()) < 1e-14 * m);
+    // Any turn (here 1.36 rad about (0.3, −0.7, 1.1)/|·|): the same principal moments, and the
+    // least of them, m (a² + b²)/12, about the box's c edge turned by Rodrigues' formula
+    // v cos θ + (k × v) sin θ + k (k·v)(1 − cos θ), written out here.
+    let rot = Vector3::new(0.3, -0.7, 1.1);
+    let turned = BoxShape {
+        rotation: Some([rot.x, rot.y, rot.z]),
+        ..base.clone()
+    }
+    .mass_properties()
+    .unwrap();
     let m0 = base.mass_properties().unwrap();
-    let m1 = rotated.mass_properties().unwrap();
-    let r = *Rotation3::new(Vector3::from(rot)).matrix();
-    assert_eq!(m1.volume, m0.volume);
-    assert_eq!(m1.centroid, m0.centroid);
-    let expected = r * m0.inertia(2000.0) * r.transpose();
-    assert!((m1.inertia(2000.0) - expected).norm() <= 1e-13 * expected.norm());
+    assert_eq!(turned.volume, m0.volume);
+    assert_eq!(turned.centroid, m0.centroid);
+    let eigen = turned.inertia(rho).symmetric_eigen();
+    let mut moments: Vec<f64> = eigen.eigenvalues.iter().copied().collect();
+    moments.sort_by(f64::total_cmp);
+    let mut expected = [
+        m * (b * b + c * c) / 12.0,
+        m * (a * a + c * c) / 12.0,
+        m * (a * a + b * b) / 12.0,
+    ];
+    expected.sort_by(f64::total_cmp);
+    for (got, want) in moments.iter().zip(expected) {
+        assert!(rel_err(*got, want) < 1e-13, "{got} against {want}");
+    }
+    let (theta, k) = (rot.norm(), rot.normalize());
+    let v = Vector3::z();
+    let axis = v * theta.cos() + k.cross(&v) * theta.sin() + k * k.dot(&v) * (1.0 - theta.cos());
+    let least = eigen.eigenvalues.imin();
+    let found = eigen.eigenvectors.column(least).into_owned();
+    assert!(
+        found.dot(&axis).abs() > 1.0 - 1e-12,
+        "{found} against {axis}"
+    );
     // Rotation preserves the trace (polar moment about the centroid).
-    assert!(rel_err(m1.second_moment.trace(), m0.second_moment.trace()) < 1e-14);
+    assert!(rel_err(turned.second_moment.trace(), m0.second_moment.trace()) < 1e-14);
 }
 
 #[test]
