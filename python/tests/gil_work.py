@@ -1,4 +1,4 @@
-"""The work of the GIL tests: importable by the processes of their control."""
+"""The work of the GIL tests."""
 
 from __future__ import annotations
 
@@ -12,8 +12,3 @@ RECORD = crr.Record.from_file(ROOT / "examples/records/synthetic.AT2", format="p
 def one_run(_: object = None) -> crr.Result:
     """The arch under the 20 s synthetic record: a fraction of a second to a second of work."""
     return crr.simulate(MODEL, ground_motion=RECORD, duration=25.0)
-
-
-def one_run_samples(_: object = None) -> int:
-    """`one_run` in a worker process, returning what pickles: its number of samples."""
-    return len(one_run().t)
