@@ -418,9 +418,9 @@ fn the_drum_column_under_its_pulse_keeps_momenta_and_never_gains_energy() {
             crr::analysis::simulation::prepare(&crr::ModelInput::read(&path).unwrap(), &opts)
                 .unwrap();
         let outcome = prepared.run();
-        // The whole 4 s: until 2026-11 a joint crossed its pivot near 0.5 s between two impacts
-        // of its neighbours without an impact of its own, and the run's invariant stopped it
-        // there; nothing may stop it now.
+        // The whole 4 s. An earlier engine missed an impact near 0.5 s (a joint crossed its
+        // pivot between two impacts of its neighbours) and the run's invariant stopped it
+        // there; the run now completes, and every impact of it is checked.
         assert!(
             outcome.summary.error.is_none(),
             "{law}: {:?}",
