@@ -4,9 +4,10 @@
 //! The model files also go through `crr simulate`, where an input is refused with an error that
 //! names its file, or runs.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-fn replay(target: &str, run: fn(&[u8])) {
+/// The inputs of the corpus of fuzz target `target`, in name order (never empty).
+fn corpus(target: &str) -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fuzz/corpus")
         .join(target);
@@ -16,6 +17,11 @@ fn replay(target: &str, run: fn(&[u8])) {
         .collect();
     files.sort();
     assert!(!files.is_empty(), "{}: empty corpus", dir.display());
+    files
+}
+
+fn replay(target: &str, run: fn(&[u8])) {
+    let files = corpus(target);
     for f in &files {
         let data = std::fs::read(f).unwrap();
         let outcome = std::panic::catch_unwind(|| run(&data));
@@ -45,14 +51,8 @@ fn results_corpus() {
 /// starts with the file's path, never a panic (exit 101) or a signal.
 #[test]
 fn model_file_corpus_through_the_command_line() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/model_file");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    files.sort();
     let (mut ran, mut refused) = (0, 0);
-    for (k, file) in files.iter().enumerate() {
+    for (k, file) in corpus("model_file").iter().enumerate() {
         let out = crate::common::scratch(&format!("fuzz_cli_{k}"));
         let o = crate::common::crr(&[
             "simulate",

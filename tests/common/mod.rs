@@ -55,6 +55,13 @@ pub fn bundled_text(name: &str) -> String {
     std::fs::read_to_string(root.join(format!("examples/models/{name}.toml"))).unwrap()
 }
 
+/// [`bundled_text`] with its record paths (`../records/`, relative to the bundled model) made
+/// absolute, so that the text runs from any folder it is written to.
+pub fn bundled_text_with_records(name: &str) -> String {
+    let records = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/records");
+    bundled_text(name).replace("../records/", &format!("{}/", records.display()))
+}
+
 /// `crr args` exits with status 2 and one `crr: error:` message containing `needle`, no panic.
 pub fn refused(args: &[&str], needle: &str) {
     let o = crr(args);

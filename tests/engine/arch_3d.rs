@@ -225,9 +225,7 @@ fn in_plane_motion_reproduces_the_planar_arch() {
 /// energy D dissipated at its impacts.
 #[test]
 fn the_record_at_45_degrees_rocks_in_and_out_of_plane() {
-    let text = common::bundled_text("arch_3d");
-    let records = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/records/");
-    let text = text.replace("../records/", &format!("{}/", records.display()));
+    let text = common::bundled_text_with_records("arch_3d");
     let (model, traj) = common::run_model_text("arch_3d_record", &text, None);
     assert!(traj.collapse.is_none());
     assert!(traj.impacts.len() > 10, "{} impacts", traj.impacts.len());

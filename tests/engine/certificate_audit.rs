@@ -140,11 +140,7 @@ fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_3d_arch() {
 
 #[test]
 fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_rigid_seated_temple() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let records = root.join("examples/records");
-    let text = common::bundled_text("temple")
-        .replace("twist = true", "twist = false")
-        .replace("../records/", &format!("{}/", records.display()));
+    let text = common::bundled_text_with_records("temple").replace("twist = true", "twist = false");
     let path = common::write_model("temple_rigid_seats_audit", &text);
     let run = audited_file("temple, rigid seats", &path, 6.0);
     assert_sound("temple, rigid seats", &run);
@@ -193,14 +189,10 @@ fn the_certificate_holds_only_where_the_program_opens_nothing_on_walls() {
 fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_temple_with_twisting_seats() {
     // The bundled temple (its entablature on seats that may twist) at 0.8 of its record, which
     // it rocks through for the whole 6 s (at 1.0 it stops at 2.054 s).
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let records = root.join("examples/records");
-    let text = common::bundled_text("temple")
-        .replace(
-            "format = \"peer-at2\" }",
-            "format = \"peer-at2\" }, scale = 0.8",
-        )
-        .replace("../records/", &format!("{}/", records.display()));
+    let text = common::bundled_text_with_records("temple").replace(
+        "format = \"peer-at2\" }",
+        "format = \"peer-at2\" }, scale = 0.8",
+    );
     assert_eq!(
         text.matches("scale = 0.8").count(),
         2,

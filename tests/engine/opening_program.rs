@@ -553,22 +553,19 @@ fn the_pressing_certificate_on_rocking_bases_holds_only_where_nothing_opens() {
                         decision.lifting_off
                     );
                     certified += 1;
-                    let edges = |pattern: [bool; 2]| {
+                    // Some rocking base (loop-closing only, when `closing`) with its slots
+                    // seated as `pattern`.
+                    let edges = |pattern: [bool; 2], closing: bool| {
                         model.interfaces.iter().any(|f| {
                             matches!(f.kind, crr::kinematics::InterfaceKind::RockingBase { .. })
+                                && (!closing
+                                    || matches!(f.role, crr::kinematics::Role::Closure { .. }))
                                 && f.slots.clone().map(|k| seated.contains(&k)).eq(pattern)
                         })
                     };
-                    first_turned += usize::from(edges([false, true]));
-                    second_turned += usize::from(edges([true, false]));
-                    closing_first_turned += usize::from(model.interfaces.iter().any(|f| {
-                        matches!(f.kind, crr::kinematics::InterfaceKind::RockingBase { .. })
-                            && matches!(f.role, crr::kinematics::Role::Closure { .. })
-                            && f.slots
-                                .clone()
-                                .map(|k| seated.contains(&k))
-                                .eq([false, true])
-                    }));
+                    first_turned += usize::from(edges([false, true], false));
+                    second_turned += usize::from(edges([true, false], false));
+                    closing_first_turned += usize::from(edges([false, true], true));
                 } else {
                     let mut e = Dynamics::new(model, pivots.clone());
                     e.seated = seated.clone();

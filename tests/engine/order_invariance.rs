@@ -17,6 +17,7 @@
 //! an impact's rates), and every impact comes at the same time on the same interfaces.
 
 use crate::common;
+use crr::impact::Trajectory;
 
 /// `text` with its `[[body]]` blocks in reverse order, and its `[[interface]]` blocks too when
 /// `interfaces` (a block runs from its header to the next header; other tables keep their place
@@ -58,11 +59,24 @@ fn reversed(text: &str, interfaces: bool) -> String {
     )
 }
 
+/// Checks that `a` and `b` have the same impacts on the same interfaces (in any order within an
+/// impact), and returns the largest difference of their times (s).
+fn same_impacts(tag: &str, a: &Trajectory, b: &Trajectory) -> f64 {
+    assert_eq!(a.impacts.len(), b.impacts.len(), "{tag}: impact counts");
+    let mut worst = 0.0_f64;
+    for (x, y) in a.impacts.iter().zip(&b.impacts) {
+        worst = worst.max((x.t - y.t).abs());
+        let (mut p, mut q) = (x.interfaces.clone(), y.interfaces.clone());
+        p.sort();
+        q.sort();
+        assert_eq!(p, q, "{tag}: impact at {} against {}", x.t, y.t);
+    }
+    worst
+}
+
 #[test]
 fn the_3d_arch_written_in_reverse_order_moves_the_same() {
-    let records = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/records");
-    let text = common::bundled_text("arch_3d")
-        .replace("\"../records/", &format!("\"{}/", records.display()));
+    let text = common::bundled_text_with_records("arch_3d");
     let other = reversed(&text, true);
     assert_ne!(text, other);
     let duration = Some(2.6);
@@ -73,20 +87,9 @@ fn the_3d_arch_written_in_reverse_order_moves_the_same() {
         "the bodies are listed in another order"
     );
     assert_eq!(a.uplift_time, b.uplift_time);
-    assert_eq!(a.impacts.len(), b.impacts.len());
     assert!(a.impacts.len() > 20, "{} impacts", a.impacts.len());
-    for (x, y) in a.impacts.iter().zip(&b.impacts) {
-        assert!(
-            (x.t - y.t).abs() < 1e-9,
-            "impact at {} against {}",
-            x.t,
-            y.t
-        );
-        let (mut p, mut q) = (x.interfaces.clone(), y.interfaces.clone());
-        p.sort();
-        q.sort();
-        assert_eq!(p, q, "at {}", x.t);
-    }
+    let parted = same_impacts("arch_3d", &a, &b);
+    assert!(parted < 1e-9, "impact times part by {parted} s");
     assert_eq!(a.samples.len(), b.samples.len());
     for (k, coord) in model_a.coords.iter().enumerate() {
         let j = model_b
@@ -112,25 +115,15 @@ fn the_temple_with_its_bodies_in_reverse_order_moves_the_same() {
     // Its interfaces keep their order: it says which seats close the loops (the five that may
     // twist must). To 2.05 s, 4 ms before its run stops (`entablature_on_c11` lifting off):
     // the uplift, the rocking of the six columns and the entablature, 85 impacts.
-    let records = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/records");
-    let text = common::bundled_text("temple")
-        .replace("\"../records/", &format!("\"{}/", records.display()));
+    let text = common::bundled_text_with_records("temple");
     let other = reversed(&text, false);
     assert_ne!(text, other);
     let (model_a, a) = common::run_model_text("temple_order_a", &text, Some(2.05));
     let (model_b, b) = common::run_model_text("temple_order_b", &other, Some(2.05));
     assert_ne!(model_a.bodies[0].name, model_b.bodies[0].name);
     assert_eq!(a.uplift_time, b.uplift_time);
-    assert_eq!(a.impacts.len(), b.impacts.len());
     assert!(a.impacts.len() >= 80, "{} impacts", a.impacts.len());
-    let mut worst = (0.0_f64, 0.0_f64, 0.0_f64);
-    for (x, y) in a.impacts.iter().zip(&b.impacts) {
-        worst.0 = worst.0.max((x.t - y.t).abs());
-        let (mut p, mut q) = (x.interfaces.clone(), y.interfaces.clone());
-        p.sort();
-        q.sort();
-        assert_eq!(p, q, "at {}", x.t);
-    }
+    let mut worst = (same_impacts("temple", &a, &b), 0.0_f64, 0.0_f64);
     assert_eq!(a.samples.len(), b.samples.len());
     for (s, r) in a.samples.iter().zip(b.samples.iter()) {
         for k in 0..s.q.len() {
@@ -174,9 +167,7 @@ fn corners_from_the_third(text: &str) -> String {
 /// Runs `name` as bundled and with its corners listed from the third, for `duration` seconds, and
 /// checks the second motion is the first with every tilt's sign turned.
 fn moves_the_same_with_corners_from_the_third(name: &str, duration: f64, min_impacts: usize) {
-    let records = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/records");
-    let text =
-        common::bundled_text(name).replace("\"../records/", &format!("\"{}/", records.display()));
+    let text = common::bundled_text_with_records(name);
     let other = corners_from_the_third(&text);
     assert_ne!(text, other);
     let (model_a, a) = common::run_model_text(&format!("{name}_corners_a"), &text, Some(duration));
@@ -201,19 +192,8 @@ fn moves_the_same_with_corners_from_the_third(name: &str, duration: f64, min_imp
         "{name}: {} impacts",
         a.impacts.len()
     );
-    assert_eq!(a.impacts.len(), b.impacts.len(), "{name}");
-    for (x, y) in a.impacts.iter().zip(&b.impacts) {
-        assert!(
-            (x.t - y.t).abs() < 1e-9,
-            "{name}: impact at {} against {}",
-            x.t,
-            y.t
-        );
-        let (mut p, mut q) = (x.interfaces.clone(), y.interfaces.clone());
-        p.sort();
-        q.sort();
-        assert_eq!(p, q, "{name}: at {}", x.t);
-    }
+    let parted = same_impacts(name, &a, &b);
+    assert!(parted < 1e-9, "{name}: impact times part by {parted} s");
     assert_eq!(a.samples.len(), b.samples.len(), "{name}");
     let mut moved = 0.0_f64;
     for (s, r) in a.samples.iter().zip(b.samples.iter()) {

@@ -36,8 +36,7 @@ fn frame_rule() -> f64 {
 }
 
 fn temple_text() -> String {
-    let records = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/records/");
-    common::bundled_text("temple").replace("../records/", &format!("{}/", records.display()))
+    common::bundled_text_with_records("temple")
 }
 
 #[test]

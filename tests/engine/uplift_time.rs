@@ -15,9 +15,7 @@ fn free_rocking_has_no_uplift_and_a_run_from_rest_keeps_its_own() {
     );
     assert!(traj.impacts.len() > 10);
     assert_eq!(traj.uplift_time, None);
-    let records = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/records/");
-    let text = common::bundled_text("block_record")
-        .replace("../records/", &format!("{}/", records.display()));
+    let text = common::bundled_text_with_records("block_record");
     let (_, traj) = common::run_model_text("block_record_uplift", &text, Some(3.0));
     let uplift = traj.uplift_time.expect("it uplifts");
     assert!((2.42..2.43).contains(&uplift), "{uplift}");

@@ -161,27 +161,27 @@ fn the_temple_along_y_is_below_the_frame_rule() {
     let model = bundled("temple");
     let body = |name: &str| {
         model
-            .bodies
-            .iter()
-            .position(|b| b.name == name)
+            .body_index(name)
             .unwrap_or_else(|| panic!("no body {name}"))
     };
     let corners = |name: &str| match &model.interfaces[model.interface_index(name).unwrap()].kind {
         InterfaceKind::RockingBase { corners, .. } => *corners,
         _ => panic!("{name} is not a rocking base"),
     };
+    // The corner of least (or greatest) y.
+    let extreme = |points: &[Vector3<f64>], least: bool| {
+        let by_y = points.iter().copied();
+        match least {
+            true => by_y.min_by(|a, b| a.y.total_cmp(&b.y)).unwrap(),
+            false => by_y.max_by(|a, b| a.y.total_cmp(&b.y)).unwrap(),
+        }
+    };
     let columns = ["c11", "c21", "c12", "c22", "c13", "c23"];
     for sway in [1.0, -1.0] {
-        // ω about x: a column sways towards −y (sway 1) about its bed's least-y edge, towards +y
-        // about its greatest-y edge; the entablature turns about the capitals' other top edge.
+        // ω about x: a column's drums sway towards −y (sway 1) about their bed's least-y edge,
+        // towards +y about its greatest-y edge; the capitals and the entablature translate,
+        // hinged on the necks' other edge.
         let omega = Vector3::new(sway, 0.0, 0.0);
-        let extreme = |points: &[Vector3<f64>], least: bool| {
-            let by_y = points.iter().copied();
-            match least {
-                true => by_y.min_by(|a, b| a.y.total_cmp(&b.y)).unwrap(),
-                false => by_y.max_by(|a, b| a.y.total_cmp(&b.y)).unwrap(),
-            }
-        };
         let mut bodies = vec![(Vector3::zeros(), Vector3::zeros()); model.bodies.len()];
         let mut translation: Option<Vector3<f64>> = None;
         for c in columns {

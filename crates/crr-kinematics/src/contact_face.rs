@@ -52,10 +52,7 @@ impl ContactFace {
                 axis,
                 pivot_positive,
                 pivot_negative,
-            } => {
-                axis.cross(&(pivot_negative - pivot_positive)).norm()
-                    <= GEOMETRY_TOLERANCE * model.size
-            }
+            } => hinge_lift(model, axis, pivot_positive, pivot_negative).is_none(),
             InterfaceKind::RockingBase { .. } => false,
         }
     }
@@ -68,13 +65,9 @@ impl ContactFace {
                 pivot_positive,
                 pivot_negative,
             } => {
-                let lift = axis.cross(&(pivot_negative - pivot_positive));
-                let pin = Self::is_pin(model, index);
-                let normal = if pin {
-                    any_perpendicular(axis)
-                } else {
-                    lift.normalize()
-                };
+                let lift = hinge_lift(model, axis, pivot_positive, pivot_negative);
+                let pin = lift.is_none();
+                let normal = lift.map_or_else(|| any_perpendicular(axis), |l| l.normalize());
                 let t1 = axis.cross(&normal);
                 ContactFace {
                     interface: index,
@@ -113,6 +106,19 @@ pub fn contact_faces(model: &Model) -> Vec<ContactFace> {
     (0..model.interfaces.len())
         .map(|i| ContactFace::of_interface(model, i))
         .collect()
+}
+
+/// u × (P⁻ − P⁺) of a hinge with axis u and pivots P⁺, P⁻: the direction P⁻ lifts in when the
+/// child turns about P⁺; None for a pin, where it is within the geometry's tolerance (× the model
+/// size) of zero.
+fn hinge_lift(
+    model: &Model,
+    axis: &Vector3<f64>,
+    pivot_positive: &Vector3<f64>,
+    pivot_negative: &Vector3<f64>,
+) -> Option<Vector3<f64>> {
+    let lift = axis.cross(&(pivot_negative - pivot_positive));
+    (lift.norm() > GEOMETRY_TOLERANCE * model.size).then_some(lift)
 }
 
 /// A unit vector perpendicular to the unit vector `u`.
