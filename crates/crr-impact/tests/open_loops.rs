@@ -938,3 +938,69 @@ fn a_tied_face_does_not_hide_the_lift_offs_that_follow() {
     );
     assert!((v.t - 0.0796).abs() < 1e-4, "at {} s", v.t);
 }
+
+/// A state the engine cannot decide stops the run instead of stalling it (docs/simulation.md,
+/// "Limitations"). The 5 × 5 wall of `examples/wall_pulse.rs` under 1.8 λ g (λ = 0.6) is back at
+/// rest after a landing at 0.4032 s, under a ground acceleration of about 1.7 λ g: it must move.
+/// The contact program lifts 14 faces off, the chain without them drives some into their
+/// supports, and the chain with them confirms none of the program's other releases; the uplift
+/// test fired again one round-off step (6e-14 s) later, for ever (the run did not end in 5
+/// minutes). It now stops with `SimulationError::Undecided` after 100 such events: checked
+/// here against the load (the structure cannot be at rest at that instant: |a_g| > λ g along
+/// the load's direction, λ from the static theorem), with the results up to that instant kept
+/// and the lifting faces named.
+#[test]
+fn a_state_the_engine_cannot_decide_stops_the_run() {
+    use crr_impact::SimulationError;
+    use crr_impact::statics::{StaticsOptions, collapse_multiplier};
+    let (model, ground, init) = wall_of_wall_pulse(5, 1.8);
+    let params = Parameters {
+        duration: 0.45,
+        ..Parameters::default()
+    };
+    let failure = Simulation::new(&model, &ground, &init, params)
+        .unwrap()
+        .run()
+        .expect_err("the run cannot decide the state at 0.4032 s");
+    let SimulationError::Undecided {
+        t,
+        events,
+        span,
+        interfaces,
+    } = &failure.error
+    else {
+        panic!("not an undecided state: {}", failure.error)
+    };
+    assert!((t - 0.40316).abs() < 1e-4, "at {t} s");
+    assert_eq!(*events, crr_impact::UNDECIDED_UPLIFTS);
+    // The events came a round-off step apart, not a step of the motion.
+    let time_scale = (model.size / model.gravity).sqrt();
+    assert!(*span <= crr_impact::UNDECIDED_SPAN * time_scale, "{span} s");
+    // The load at that instant is beyond the wall's multiplier along its direction: rest is
+    // not an answer, so the stop is not a result withheld.
+    let a = ground.acceleration(*t).x / model.gravity;
+    let direction = Vector3::x() * a.signum();
+    let lambda = collapse_multiplier(&model, direction, &StaticsOptions::default())
+        .unwrap()
+        .lambda
+        .unwrap();
+    assert!(a.abs() > 1.5 * lambda, "{a} g against λ = {lambda}");
+    assert!(!interfaces.is_empty(), "the faces the program lifts off");
+    for name in interfaces {
+        assert!(model.interface_index(name).is_some(), "{name}");
+    }
+    // The results until then are kept: samples every 10 ms to the stop and its impacts.
+    let partial = &failure.partial;
+    assert!(
+        partial.samples.len() >= 40,
+        "{} samples",
+        partial.samples.len()
+    );
+    let last = partial.samples.iter().next_back().unwrap();
+    assert!((last.t - t).abs() < 1e-9, "last sample at {} s", last.t);
+    assert!(
+        partial.impacts.len() >= 2,
+        "{} impacts",
+        partial.impacts.len()
+    );
+}

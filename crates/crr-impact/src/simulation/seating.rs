@@ -1376,6 +1376,35 @@ impl Simulation<'_> {
         Ok(mode)
     }
 
+    /// An uplift event that released nothing: counted with those before it within
+    /// [`super::UNDECIDED_SPAN`] of the time scale; the run stops with
+    /// [`SimulationError::Undecided`] at the [`super::UNDECIDED_UPLIFTS`]th (the test would fire
+    /// again at once, one step of round-off later, for ever).
+    pub(super) fn count_undecided_uplift(&mut self) -> Result<(), SimulationError> {
+        let span = super::UNDECIDED_SPAN * (self.model.size / self.model.gravity).sqrt();
+        let (count, since, (named_at, faces)) = &mut self.undecided;
+        if self.t - *since > span {
+            (*count, *since) = (0, self.t);
+        }
+        *count += 1;
+        if *count < super::UNDECIDED_UPLIFTS {
+            return Ok(());
+        }
+        let error = SimulationError::Undecided {
+            t: self.t,
+            events: *count,
+            span: self.t - *since,
+            // The faces of a lift-off contradicted during these events, not an earlier one.
+            interfaces: if *named_at >= *since {
+                faces.clone()
+            } else {
+                Vec::new()
+            },
+        };
+        self.record_final_sample();
+        Err(error)
+    }
+
     /// Every slot seated and every rate within 1e-12 of the rate scale √(g/L): the structure
     /// at rest.
     pub(super) fn at_rest(&self) -> bool {
@@ -1470,6 +1499,7 @@ impl Simulation<'_> {
     /// before (kind `lift_off`, the face first by name; no force is computed: N = 0, |F_t|/N undefined,
     /// infinite as for a tension).
     fn record_undecided_lift_off(&mut self, interfaces: &[String]) {
+        self.undecided.2 = (self.t, interfaces.to_vec());
         if self.violation.is_some() {
             return;
         }
@@ -1613,10 +1643,11 @@ impl Simulation<'_> {
         }
         self.t = t_end;
         self.reset_solver();
-        if found.is_some()
-            && let Some(mode) = self.release_if_opening()?
-        {
-            return Ok(Some(StopReason::Uplift(self.t, self.file_slots(mode))));
+        if found.is_some() {
+            match self.release_if_opening()? {
+                Some(mode) => return Ok(Some(StopReason::Uplift(self.t, self.file_slots(mode)))),
+                None => self.count_undecided_uplift()?,
+            }
         }
         if self.t >= self.params.duration {
             self.finished = true;
