@@ -519,9 +519,9 @@ impl FaceProgram {
 /// 10). Every answer these programs give is checked by its reader (a certificate's equilibrium to
 /// [`CARRIED_RESIDUAL`] and its margins, the monitor's tolerance of 5e-4 W, the impulses'
 /// threshold), and the interior point's own stopping test is on the unregularised residuals: one
-/// step gives the same histories as ten on every bundled model, the 84 runs of the walls' sweep
-/// and the temple at 0.8 of its record, whose 6 s it runs about a tenth faster
-/// (docs/performance.md).
+/// step gives the same histories as ten on every bundled model, the 82 runs of the walls' sweep
+/// that end (two stall with either) and the temple at 0.8 of its record, whose 6 s it runs about
+/// a tenth faster (docs/performance.md).
 const REFINEMENT_STEPS: u32 = 1;
 
 /// `clarabel` on the problem min ½xᵀPx + qᵀx subject to Ax + s = b, s ∈ cones; None unless it

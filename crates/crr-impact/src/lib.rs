@@ -54,5 +54,5 @@ pub mod statics;
 
 pub use simulation::{
     Interrupted, Parameters, Sample, Samples, Simulation, SimulationError, SlotState, StopReason,
-    Trajectory, UNDECIDED_SPAN, UNDECIDED_UPLIFTS,
+    Trajectory, UNDECIDED_GAP, UNDECIDED_UPLIFTS,
 };

@@ -277,15 +277,20 @@ pub enum SimulationError {
         /// The interfaces they involve.
         interfaces: Vec<String>,
     },
-    /// The uplift test keeps finding that the structure moves while no release it proposes is
-    /// confirmed: [`UNDECIDED_UPLIFTS`] uplift events in a row released nothing within
-    /// [`UNDECIDED_SPAN`] of the structure's time scale √(L/g), each a step of round-off length.
-    /// The contact program's mechanism lifts faces off that the chain without them drives into
-    /// their supports, and the chain with them finds no motion of its own: the engine cannot
-    /// decide this state, and the run stops instead of stepping by 1e-13 s for ever.
+    /// The uplift test keeps finding that the seated state cannot hold while no release is
+    /// confirmed: [`UNDECIDED_UPLIFTS`] uplift events in a row released nothing, each within
+    /// [`UNDECIDED_GAP`] of the one before (a step of round-off length, with no release or impact
+    /// between them). Where the contact program lifts faces off that the chain without them
+    /// drives into their supports, and the chain with them finds no motion of its own, the
+    /// engine cannot decide the state, and the run stops instead of stepping by 1e-13 s for
+    /// ever.
     #[error(
-        "at t = {t} s the uplift test fired {events} times within {span:.3e} s without a release: the contacts' decision finds that the structure moves{}, but the chain's own equations confirm none of its releases; the engine cannot decide this state (docs/simulation.md, \"Limitations\")",
-        if interfaces.is_empty() { String::new() } else { format!(" with {} lifting off", interfaces.join(", ")) }
+        "at t = {t} s the uplift test fired {events} times within {span:.3e} s without a release: {}; the engine cannot decide this state (docs/simulation.md, \"Limitations\")",
+        if interfaces.is_empty() {
+            "the seated state cannot hold, but no release is confirmed by the chain's own equations".to_string()
+        } else {
+            format!("the contact program lifts {} off a support, the chain without them drives one into it, and the chain with them confirms none of the program's other releases", interfaces.join(", "))
+        }
     )]
     Undecided {
         /// Time (s).
@@ -294,8 +299,8 @@ pub enum SimulationError {
         events: u32,
         /// Time from the first of them to the last (s).
         span: f64,
-        /// The faces the contact program last lifted off and the chain contradicted (empty when
-        /// none did).
+        /// The faces the contact program lifted off and the chain contradicted during these
+        /// events (empty when none did).
         interfaces: Vec<String>,
     },
     /// More output samples in memory than the caller allows.
@@ -467,9 +472,10 @@ pub struct Simulation<'a> {
     energy_at_snaps: f64,
     /// The snaps and the impacts' losses when the monitor first found a hypothesis failing.
     snaps_at_violation: Option<SnapsAndLosses>,
-    /// Uplift events in a row that released nothing: how many, the time of the first, and the
-    /// time and faces of the last contradicted lift-off ([`SimulationError::Undecided`]).
-    undecided: (u32, f64, (f64, Vec<String>)),
+    /// Uplift events in a row that released nothing: how many, the time of the first and of the
+    /// last, and the time and faces of the last contradicted lift-off
+    /// ([`SimulationError::Undecided`]). A release or an impact ends the row.
+    undecided: (u32, (f64, f64), (f64, Vec<String>)),
     u_rest: f64,
     energy_start: f64,
     next_sample: usize,
@@ -625,15 +631,17 @@ pub const MIN_IMPACT_INTERVAL_MAX: f64 = 0.01;
 /// within the interval, so a sequence of hundreds on the same few joints is no rocking.
 pub const CHATTER_IMPACTS: usize = 200;
 
-/// Uplift events in a row that release nothing, within [`UNDECIDED_SPAN`] of the time scale,
+/// Uplift events in a row that release nothing, each within [`UNDECIDED_GAP`] of the one before,
 /// that stop a run as [`SimulationError::Undecided`].
 pub const UNDECIDED_UPLIFTS: u32 = 100;
 
-/// The span, as a fraction of the structure's time scale √(L/g), within which
-/// [`UNDECIDED_UPLIFTS`] uplift events that release nothing are a stall: a step after such an
-/// event is of round-off length (about 1e-13 s on a 5 × 5 wall), while an event that the motion
-/// itself brings back comes a step of the motion later.
-pub const UNDECIDED_SPAN: f64 = 1e-9;
+/// The gap (s, relative to max(1, t)) within which an uplift event that releases nothing follows
+/// the one before as a stall: event times are located to 1e-13·max(1, t) (the integrator's
+/// events and the rest scan's bisection), and after such an event the next came 5.8e-14 s later
+/// on a 5 × 5 wall; an event that the motion itself brings back comes a step of the motion
+/// later. A hundred times the location's precision, so that it scales with t as the steps of a
+/// stall do.
+pub const UNDECIDED_GAP: f64 = 1e-11;
 
 /// Largest `collapse_drop` (a fraction of weight × model size): a structure whose potential
 /// energy has dropped by half its weight times its size has fallen.
@@ -887,7 +895,11 @@ impl<'a> Simulation<'a> {
             dissipated_at_impacts: 0.0,
             energy_at_snaps: 0.0,
             snaps_at_violation: None,
-            undecided: (0, f64::NEG_INFINITY, (f64::NEG_INFINITY, Vec::new())),
+            undecided: (
+                0,
+                (f64::NEG_INFINITY, f64::NEG_INFINITY),
+                (f64::NEG_INFINITY, Vec::new()),
+            ),
             u_rest,
             energy_start: 0.0,
             next_sample: 0,
@@ -1601,7 +1613,10 @@ impl<'a> Simulation<'a> {
                 } else {
                     let mode = self.release_if_opening()?;
                     Ok(match mode {
-                        Some(m) => StopReason::Uplift(self.t, self.file_slots(m)),
+                        Some(m) => {
+                            self.undecided.0 = 0;
+                            StopReason::Uplift(self.t, self.file_slots(m))
+                        }
                         None => {
                             self.count_undecided_uplift()?;
                             self.reset_solver();

@@ -262,6 +262,8 @@ impl Simulation<'_> {
         self.impacts.push(record);
         // Faces kept on their pivots after a contradicted lift-off are offered it again.
         self.spare.rest.held_faces.clear();
+        // An impact ends a row of uplift events without a release (SimulationError::Undecided).
+        self.undecided.0 = 0;
     }
 
     /// The faces `lifting` (names of the chain's interfaces) open entirely: the chain goes on

@@ -1376,17 +1376,18 @@ impl Simulation<'_> {
         Ok(mode)
     }
 
-    /// An uplift event that released nothing: counted with those before it within
-    /// [`super::UNDECIDED_SPAN`] of the time scale; the run stops with
-    /// [`SimulationError::Undecided`] at the [`super::UNDECIDED_UPLIFTS`]th (the test would fire
-    /// again at once, one step of round-off later, for ever).
+    /// An uplift event that released nothing: counted with those before it while each follows
+    /// the last within [`super::UNDECIDED_GAP`]·max(1, t) (a release or an impact ends the row);
+    /// the run stops with [`SimulationError::Undecided`] at the [`super::UNDECIDED_UPLIFTS`]th
+    /// (the test would fire again at once, one step of round-off later, for ever).
     pub(super) fn count_undecided_uplift(&mut self) -> Result<(), SimulationError> {
-        let span = super::UNDECIDED_SPAN * (self.model.size / self.model.gravity).sqrt();
-        let (count, since, (named_at, faces)) = &mut self.undecided;
-        if self.t - *since > span {
+        let gap = super::UNDECIDED_GAP * self.t.abs().max(1.0);
+        let (count, (since, last), (named_at, faces)) = &mut self.undecided;
+        if *count == 0 || self.t - *last > gap {
             (*count, *since) = (0, self.t);
         }
         *count += 1;
+        *last = self.t;
         if *count < super::UNDECIDED_UPLIFTS {
             return Ok(());
         }
@@ -1497,7 +1498,8 @@ impl Simulation<'_> {
     /// their supports while they lift. The run goes on with the faces closed, as after a
     /// hypotheses monitor's violation, and this is recorded as its first violation if none came
     /// before (kind `lift_off`, the face first by name; no force is computed: N = 0, |F_t|/N undefined,
-    /// infinite as for a tension).
+    /// infinite as for a tension). The faces and the time are kept for
+    /// [`SimulationError::Undecided`] in any case.
     fn record_undecided_lift_off(&mut self, interfaces: &[String]) {
         self.undecided.2 = (self.t, interfaces.to_vec());
         if self.violation.is_some() {
@@ -1645,7 +1647,10 @@ impl Simulation<'_> {
         self.reset_solver();
         if found.is_some() {
             match self.release_if_opening()? {
-                Some(mode) => return Ok(Some(StopReason::Uplift(self.t, self.file_slots(mode)))),
+                Some(mode) => {
+                    self.undecided.0 = 0;
+                    return Ok(Some(StopReason::Uplift(self.t, self.file_slots(mode))));
+                }
                 None => self.count_undecided_uplift()?,
             }
         }
