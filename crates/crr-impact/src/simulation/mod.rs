@@ -66,9 +66,9 @@ pub use opening_qp::{
     offers_both_pivots, opening_qp, opening_qp_holding,
 };
 pub use samples::{FaceOpening, Iter as SampleIter, Sample, Samples};
-use seating::opening_mode_in;
 pub(crate) use seating::other_pivot_rest;
 pub use seating::{CERTIFIED_CLOSURE_RESIDUAL, opening_mode, openings_slide_nowhere};
+use seating::{UndecidedRow, opening_mode_in};
 pub use slots::check_initial_state;
 pub(crate) use slots::slot_interface;
 use slots::*;
@@ -472,10 +472,8 @@ pub struct Simulation<'a> {
     energy_at_snaps: f64,
     /// The snaps and the impacts' losses when the monitor first found a hypothesis failing.
     snaps_at_violation: Option<SnapsAndLosses>,
-    /// Uplift events in a row that released nothing: how many, the time of the first and of the
-    /// last, and the time and faces of the last contradicted lift-off
-    /// ([`SimulationError::Undecided`]). A release or an impact ends the row.
-    undecided: (u32, (f64, f64), (f64, Vec<String>)),
+    /// Uplift events in a row that released nothing ([`SimulationError::Undecided`]).
+    undecided: UndecidedRow,
     u_rest: f64,
     energy_start: f64,
     next_sample: usize,
@@ -895,11 +893,7 @@ impl<'a> Simulation<'a> {
             dissipated_at_impacts: 0.0,
             energy_at_snaps: 0.0,
             snaps_at_violation: None,
-            undecided: (
-                0,
-                (f64::NEG_INFINITY, f64::NEG_INFINITY),
-                (f64::NEG_INFINITY, Vec::new()),
-            ),
+            undecided: UndecidedRow::default(),
             u_rest,
             energy_start: 0.0,
             next_sample: 0,
@@ -1611,14 +1605,10 @@ impl<'a> Simulation<'a> {
                     self.reset_solver();
                     Ok(StopReason::Breakpoint(self.t))
                 } else {
-                    let mode = self.release_if_opening()?;
+                    let mode = self.release_at_uplift_event()?;
                     Ok(match mode {
-                        Some(m) => {
-                            self.undecided.0 = 0;
-                            StopReason::Uplift(self.t, self.file_slots(m))
-                        }
+                        Some(m) => StopReason::Uplift(self.t, self.file_slots(m)),
                         None => {
-                            self.count_undecided_uplift()?;
                             self.reset_solver();
                             StopReason::Breakpoint(self.t)
                         }

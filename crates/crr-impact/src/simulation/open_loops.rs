@@ -263,7 +263,7 @@ impl Simulation<'_> {
         // Faces kept on their pivots after a contradicted lift-off are offered it again.
         self.spare.rest.held_faces.clear();
         // An impact ends a row of uplift events without a release (SimulationError::Undecided).
-        self.undecided.0 = 0;
+        self.undecided.end();
     }
 
     /// The faces `lifting` (names of the chain's interfaces) open entirely: the chain goes on

@@ -1376,31 +1376,20 @@ impl Simulation<'_> {
         Ok(mode)
     }
 
-    /// An uplift event that released nothing: counted with those before it while each follows
-    /// the last within [`super::UNDECIDED_GAP`]·max(1, t) (a release or an impact ends the row);
-    /// the run stops with [`SimulationError::Undecided`] at the [`super::UNDECIDED_UPLIFTS`]th
-    /// (the test would fire again at once, one step of round-off later, for ever).
-    pub(super) fn count_undecided_uplift(&mut self) -> Result<(), SimulationError> {
-        let gap = super::UNDECIDED_GAP * self.t.abs().max(1.0);
-        let (count, (since, last), (named_at, faces)) = &mut self.undecided;
-        if *count == 0 || self.t - *last > gap {
-            (*count, *since) = (0, self.t);
+    /// The releases of an uplift event ([`Self::release_if_opening`]): one ends the row of
+    /// events without a release; none extends it, and the run stops with
+    /// [`SimulationError::Undecided`] at the [`super::UNDECIDED_UPLIFTS`]th (the test would fire
+    /// again at once, one step of round-off later, for ever).
+    pub(super) fn release_at_uplift_event(
+        &mut self,
+    ) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
+        let mode = self.release_if_opening()?;
+        if mode.is_some() {
+            self.undecided.end();
+            return Ok(mode);
         }
-        *count += 1;
-        *last = self.t;
-        if *count < super::UNDECIDED_UPLIFTS {
-            return Ok(());
-        }
-        let error = SimulationError::Undecided {
-            t: self.t,
-            events: *count,
-            span: self.t - *since,
-            // The faces of a lift-off contradicted during these events, not an earlier one.
-            interfaces: if *named_at >= *since {
-                faces.clone()
-            } else {
-                Vec::new()
-            },
+        let Some(error) = self.undecided.extend(self.t) else {
+            return Ok(None);
         };
         self.record_final_sample();
         Err(error)
@@ -1501,7 +1490,7 @@ impl Simulation<'_> {
     /// infinite as for a tension). The faces and the time are kept for
     /// [`SimulationError::Undecided`] in any case.
     fn record_undecided_lift_off(&mut self, interfaces: &[String]) {
-        self.undecided.2 = (self.t, interfaces.to_vec());
+        self.undecided.contradicted(self.t, interfaces);
         if self.violation.is_some() {
             return;
         }
@@ -1645,14 +1634,10 @@ impl Simulation<'_> {
         }
         self.t = t_end;
         self.reset_solver();
-        if found.is_some() {
-            match self.release_if_opening()? {
-                Some(mode) => {
-                    self.undecided.0 = 0;
-                    return Ok(Some(StopReason::Uplift(self.t, self.file_slots(mode))));
-                }
-                None => self.count_undecided_uplift()?,
-            }
+        if found.is_some()
+            && let Some(mode) = self.release_at_uplift_event()?
+        {
+            return Ok(Some(StopReason::Uplift(self.t, self.file_slots(mode))));
         }
         if self.t >= self.params.duration {
             self.finished = true;
@@ -1805,6 +1790,66 @@ impl Simulation<'_> {
         self.reset_solver();
         self.release_if_opening()?;
         Ok(None)
+    }
+}
+
+/// Uplift events in a row that released nothing ([`SimulationError::Undecided`]), each within
+/// [`super::UNDECIDED_GAP`]·max(1, t) of the one before; a release or an impact ends the row.
+#[derive(Clone, Debug)]
+pub(super) struct UndecidedRow {
+    /// Events in the row (0: no row).
+    count: u32,
+    /// Time of the row's first event and of its last (s).
+    first: f64,
+    last: f64,
+    /// Time of the last contradicted lift-off and its faces, by name in alphabetical order.
+    contradicted: (f64, Vec<String>),
+}
+
+impl Default for UndecidedRow {
+    fn default() -> Self {
+        UndecidedRow {
+            count: 0,
+            first: f64::NEG_INFINITY,
+            last: f64::NEG_INFINITY,
+            contradicted: (f64::NEG_INFINITY, Vec::new()),
+        }
+    }
+}
+
+impl UndecidedRow {
+    /// A release or an impact: the row ends.
+    pub(super) fn end(&mut self) {
+        self.count = 0;
+    }
+
+    /// A lift-off of `faces` contradicted at `t`, named in the error if the row reaches its
+    /// limit (sorted, so that the message does not depend on the order of the file).
+    pub(super) fn contradicted(&mut self, t: f64, faces: &[String]) {
+        let mut faces = faces.to_vec();
+        faces.sort();
+        self.contradicted = (t, faces);
+    }
+
+    /// An event without a release at `t`: it continues the row when it follows the last within
+    /// the gap, else starts one; the error once the row counts [`super::UNDECIDED_UPLIFTS`].
+    fn extend(&mut self, t: f64) -> Option<SimulationError> {
+        if self.count == 0 || t - self.last > super::UNDECIDED_GAP * t.abs().max(1.0) {
+            (self.count, self.first) = (0, t);
+        }
+        self.count += 1;
+        self.last = t;
+        (self.count >= super::UNDECIDED_UPLIFTS).then(|| SimulationError::Undecided {
+            t,
+            events: self.count,
+            span: t - self.first,
+            // The faces of a lift-off contradicted during these events, not an earlier one.
+            interfaces: if self.contradicted.0 >= self.first {
+                self.contradicted.1.clone()
+            } else {
+                Vec::new()
+            },
+        })
     }
 }
 
