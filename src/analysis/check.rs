@@ -372,6 +372,15 @@ pub fn to_text(r: &CheckReport) -> String {
             } else {
                 format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2])
             };
+            // Along a planar model's hinge axis the hinges hold the load, not the structure.
+            if m.out_of_plane > 1.0 - 1e-9 {
+                s += &format!(
+                    "  d = {dir}: not answered: along the hinges' common axis, which the hinges of \
+                     a planar model carry bilaterally (out-of-plane overturning or sliding is \
+                     outside the model)\n"
+                );
+                continue;
+            }
             match m.lambda {
                 Some(l) => {
                     let joints: Vec<String> =
@@ -413,6 +422,14 @@ pub fn to_text(r: &CheckReport) -> String {
                         crate::analysis::static_multiplier::LAMBDA_MAX
                     )
                 }
+            }
+            if m.out_of_plane > 0.0 {
+                s += &format!(
+                    "    {:.1} % of d lies along the hinges' common axis, which they carry \
+                     bilaterally: only its part in the plane of motion is answered (a planar \
+                     model)\n",
+                    100.0 * m.out_of_plane
+                );
             }
         }
     }

@@ -663,6 +663,31 @@ impl Prepared {
     }
 }
 
+/// The warning for a planar model (every interface a hinge about one common axis a,
+/// [`Model::planar_axis`]) under a ground motion with a part along a: its hinges carry that part
+/// bilaterally, so the run answers for the in-plane part only. The part's peak is bounded by
+/// Σₖ |aₖ| PGAₖ over the components (exact where a is a coordinate axis, as in every planar
+/// model the project bundles). None when the model is not planar or nothing acts along a.
+fn out_of_plane_ground_motion(model: &Model, ground: &GroundMotion) -> Option<String> {
+    let axis = model.planar_axis()?;
+    let pga = ground.pga();
+    let along = axis.abs().dot(&pga);
+    // Below 1e-12 g the part is round-off of a turned axis.
+    (along > 1e-12 * model.gravity).then(|| {
+        format!(
+            "the ground motion has a part along the hinges' common axis ({:.3}, {:.3}, {:.3}) \
+             (peak up to {:.3e} m/s², {:.3} g): the hinges of a planar model carry it \
+             bilaterally, so this run answers for the motion in the plane normal to that axis \
+             only; out-of-plane rocking, overturning or sliding is outside the model",
+            axis.x,
+            axis.y,
+            axis.z,
+            along,
+            along / model.gravity
+        )
+    })
+}
+
 fn num(x: f64) -> String {
     format!("{x:e}")
 }
@@ -730,6 +755,9 @@ fn warnings(
             loops.largest,
             loops.largest / p.model.gravity
         ));
+    }
+    if let Some(part) = out_of_plane_ground_motion(&p.model, &p.ground) {
+        out.push(part);
     }
     let analysis = p.file.analysis.clone().unwrap_or_default();
     if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)

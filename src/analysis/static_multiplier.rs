@@ -56,6 +56,13 @@ pub struct StaticMultiplier {
     /// The smallest Coulomb friction coefficient with which λ is reached (the no-sliding answer
     /// relies on it); `None` when `lambda` is.
     pub required_friction: Option<f64>,
+    /// |d·a| for a planar model (every interface a hinge about one common unit axis a,
+    /// [`Model::planar_axis`]), 0 for any other model: the part of the load along a, which the
+    /// hinges carry bilaterally. Above 0, λ answers for the part of the load in the plane of
+    /// motion only; at 1 (d along a) the model says nothing (`lambda` is `None` there because
+    /// the hinges hold it, not the structure): out-of-plane overturning or sliding is outside a
+    /// planar model.
+    pub out_of_plane: f64,
 }
 
 impl StaticMultiplier {
@@ -145,6 +152,15 @@ pub fn static_multipliers(model: &Model) -> Result<Vec<StaticMultiplier>, String
         .collect()
 }
 
+/// The part |d̂·a| of the unit `direction` along a planar model's common hinge axis a, which its
+/// hinges carry bilaterally (below 1e-12: 0); 0 for a model that is not planar.
+pub fn out_of_plane(model: &Model, direction: &Vector3<f64>) -> f64 {
+    model.planar_axis().map_or(0.0, |a| {
+        let part = a.dot(&direction.normalize()).abs().min(1.0);
+        if part < 1e-12 { 0.0 } else { part }
+    })
+}
+
 /// The report of one collapse.
 fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMultiplier {
     let moving = || {
@@ -180,5 +196,6 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         opening,
         mechanism,
         required_friction: friction,
+        out_of_plane: out_of_plane(model, &Vector3::from(collapse.direction)),
     }
 }

@@ -16,6 +16,7 @@ mod loop_residual;
 mod mirror_invariance;
 mod opening_program;
 mod order_invariance;
+mod out_of_plane;
 mod streaming;
 mod temple;
 mod twist_closure;

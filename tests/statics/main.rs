@@ -9,5 +9,6 @@ mod duality;
 mod friction;
 mod independent;
 mod invariance;
+mod out_of_plane;
 mod rest_loads;
 mod static_multiplier;

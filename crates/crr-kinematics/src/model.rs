@@ -830,6 +830,26 @@ impl Model {
         self.coords.len()
     }
 
+    /// The common axis a of a planar model: every interface a hinge, their axes parallel (the
+    /// sines of their angles to the first below 1e-9). Every body then turns about axes along a
+    /// and moves in planes normal to it, and the hinges carry any load along a bilaterally (a
+    /// hinge's pivot lines are lines, not contacts that can open across them): the model answers
+    /// for the ground motion's part normal to a only. Unit, with the first hinge's sense; None
+    /// for a model with a rocking base, with hinges about different axes or without interfaces.
+    pub fn planar_axis(&self) -> Option<Vector3<f64>> {
+        let mut axes = self.interfaces.iter().map(|i| match &i.kind {
+            InterfaceKind::Hinge { axis, .. } => Some(axis.normalize()),
+            InterfaceKind::RockingBase { .. } => None,
+        });
+        let first = axes.next()??;
+        for axis in axes {
+            if axis?.cross(&first).norm() > 1e-9 {
+                return None;
+            }
+        }
+        Some(first)
+    }
+
     /// The name of a pivot slot: its interface's name, with `.1`/`.2` for the tilts of a rocking
     /// base (the names of `crr inspect`; a closure's slots are named like a tree interface's).
     pub fn slot_name(&self, slot: usize) -> String {
