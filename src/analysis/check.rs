@@ -373,7 +373,7 @@ pub fn to_text(r: &CheckReport) -> String {
                 format!("({:.3}, {:.3}, {:.3})", d[0], d[1], d[2])
             };
             // Along a planar model's hinge axis the hinges hold the load, not the structure.
-            if m.out_of_plane > 1.0 - 1e-9 {
+            if m.out_of_plane == Some(1.0) && m.lambda.is_none() {
                 s += &format!(
                     "  d = {dir}: not answered: along the hinges' common axis, which the hinges of \
                      a planar model carry bilaterally (out-of-plane overturning or sliding is \
@@ -423,12 +423,24 @@ pub fn to_text(r: &CheckReport) -> String {
                     )
                 }
             }
-            if m.out_of_plane > 0.0 {
+            if let Some(part) = m.out_of_plane.filter(|&p| p > 0.0) {
+                // The load's part in the plane of motion, |d − (d·a)a| = √(1 − (d·a)²).
+                let in_plane = (1.0 - part * part).max(0.0).sqrt();
+                let answer = match m.lambda {
+                    Some(l) => format!(
+                        "the in-plane multiplier is λ·{in_plane:.4} = {:.6}",
+                        l * in_plane
+                    ),
+                    None => format!(
+                        "the in-plane part holds up to λ·{in_plane:.4} = {:.4}",
+                        crate::analysis::static_multiplier::LAMBDA_MAX * in_plane
+                    ),
+                };
                 s += &format!(
-                    "    {:.1} % of d lies along the hinges' common axis, which they carry \
-                     bilaterally: only its part in the plane of motion is answered (a planar \
-                     model)\n",
-                    100.0 * m.out_of_plane
+                    "    d is {:.1}° out of the plane of motion (|d·a| = {part:.4}, a the hinges' \
+                     common axis, which they carry bilaterally): only its in-plane part is \
+                     answered; {answer}\n",
+                    part.asin().to_degrees()
                 );
             }
         }

@@ -56,13 +56,13 @@ pub struct StaticMultiplier {
     /// The smallest Coulomb friction coefficient with which λ is reached (the no-sliding answer
     /// relies on it); `None` when `lambda` is.
     pub required_friction: Option<f64>,
-    /// |d·a| for a planar model (every interface a hinge about one common unit axis a,
-    /// [`Model::planar_axis`]), 0 for any other model: the part of the load along a, which the
-    /// hinges carry bilaterally. Above 0, λ answers for the part of the load in the plane of
-    /// motion only; at 1 (d along a) the model says nothing (`lambda` is `None` there because
-    /// the hinges hold it, not the structure): out-of-plane overturning or sliding is outside a
-    /// planar model.
-    pub out_of_plane: f64,
+    /// For a planar model (every interface a hinge about one common unit axis a,
+    /// [`Model::planar_axis`]): |d·a|, the part of the load along a, which the hinges carry
+    /// bilaterally; `None` for any other model. Above 0, λ answers for the load's part in the
+    /// plane of motion only (the in-plane multiplier is λ·√(1 − |d·a|²)); exactly 1 (d along a,
+    /// to 1e-9 rad) the model says nothing and `lambda` is `None`: out-of-plane overturning or
+    /// sliding is outside a planar model.
+    pub out_of_plane: Option<f64>,
 }
 
 impl StaticMultiplier {
@@ -90,6 +90,19 @@ pub fn static_multiplier_with(
     direction: Vector3<f64>,
     friction: Option<f64>,
 ) -> Result<StaticMultiplier, String> {
+    let along_axis = out_of_plane(model, &direction);
+    if along_axis == Some(1.0) {
+        // Along a planar model's hinge axis the hinges hold any load: nothing to solve.
+        return Ok(StaticMultiplier {
+            // + 0.0: −0.0 components print as 0.0, as the statics' own directions do.
+            direction: direction.normalize().map(|x| x + 0.0).into(),
+            lambda: None,
+            opening: BTreeMap::new(),
+            mechanism: Vec::new(),
+            required_friction: None,
+            out_of_plane: along_axis,
+        });
+    }
     let options = StaticsOptions {
         friction: friction.map_or(Friction::NoSliding, Friction::Pyramid),
         ..StaticsOptions::default()
@@ -152,12 +165,25 @@ pub fn static_multipliers(model: &Model) -> Result<Vec<StaticMultiplier>, String
         .collect()
 }
 
-/// The part |d̂·a| of the unit `direction` along a planar model's common hinge axis a, which its
-/// hinges carry bilaterally (below 1e-12: 0); 0 for a model that is not planar.
-pub fn out_of_plane(model: &Model, direction: &Vector3<f64>) -> f64 {
-    model.planar_axis().map_or(0.0, |a| {
-        let part = a.dot(&direction.normalize()).abs().min(1.0);
-        if part < 1e-12 { 0.0 } else { part }
+/// For a planar model (common hinge axis a), the part |d̂·a| of `direction` (unit d̂) along a,
+/// which its hinges carry bilaterally: exactly 0 within 1e-12 of the plane and exactly 1 within
+/// 1e-9 rad of the axis (the rule [`Model::planar_axis`] applies to the hinges' own axes). None
+/// for a model that is not planar; Some(0.0) for a zero or non-finite direction (which the
+/// statics refuses).
+pub fn out_of_plane(model: &Model, direction: &Vector3<f64>) -> Option<f64> {
+    let a = model.planar_axis()?;
+    let norm = direction.norm();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Some(0.0);
+    }
+    let d = direction / norm;
+    let part = a.dot(&d).abs().min(1.0);
+    Some(if a.cross(&d).norm() < 1e-9 {
+        1.0
+    } else if part < 1e-12 {
+        0.0
+    } else {
+        part
     })
 }
 

@@ -104,7 +104,18 @@ pub fn mechanism_text(m: &MechanismModel) -> String {
     );
     for c in &m.collapses {
         let label = direction_label(c.direction);
+        let along_axis = crate::analysis::static_multiplier::out_of_plane(
+            &m.all_contacts.model,
+            &nalgebra::Vector3::from(c.direction),
+        ) == Some(1.0);
         match c.lambda {
+            None if along_axis => {
+                let _ = writeln!(
+                    s,
+                    "  {label}: not answered: along the hinges' common axis, which the hinges of \
+                     a planar model carry bilaterally"
+                );
+            }
             None => {
                 let _ = writeln!(
                     s,

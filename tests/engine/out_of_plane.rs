@@ -1,8 +1,10 @@
 //! A planar model (every interface a hinge about y) under a ground motion with a y part: the
 //! hinges carry that part bilaterally, so it does no work on any coordinate (Qₖ = m a_y
-//! ŷ·(ŷ × r) = 0 for every hinge about ŷ) and the run is the one without it; the run says so in
-//! a warning. A model with rocking bases under the same two components gets no such warning (it
-//! answers for both).
+//! ŷ·(ŷ × (r − pₖ)) = 0 for every hinge about ŷ through pₖ) and the motion is the one without
+//! it (while the x part does change it); the run says so in a warning. The hypotheses monitor
+//! still sees it: with `friction` set, the friction a y pulse demands at the hinges (sliding out
+//! of plane) is reported. A model with rocking bases under two components gets no such warning
+//! (it answers for both).
 //!
 //! The histories with and without the y part agree to 1e-10 (relative to the largest |q|, |q̇|
 //! and t): the y part enters the equations only through products that vanish, leaving terms of
@@ -14,15 +16,19 @@ use crate::common::{bundled_text, write_model};
 const OUT_OF_PLANE: &str = "the hinges of a planar model carry it bilaterally";
 
 fn run(tag: &str, text: &str) -> crr::Run {
+    let run = run_any(tag, text);
+    assert!(run.completed(), "{tag}: {:?}", run.summary.error);
+    run
+}
+
+fn run_any(tag: &str, text: &str) -> crr::Run {
     let path = write_model(tag, text);
     let model = crr::ModelInput::read(&path).unwrap_or_else(|e| panic!("{tag}: {e}"));
     let opts = crr::RunOptions {
         duration: Some(3.0),
         ..Default::default()
     };
-    let run = crr::run(&model, &opts).unwrap_or_else(|e| panic!("{tag}: {e}"));
-    assert!(run.completed(), "{tag}: {:?}", run.summary.error);
-    run
+    crr::run(&model, &opts).unwrap_or_else(|e| panic!("{tag}: {e}"))
 }
 
 fn with_ground_motion(name: &str, ground_motion: &str) -> String {
@@ -58,7 +64,18 @@ fn a_planar_model_ignores_and_names_the_part_along_its_hinges() {
     );
 
     let (a, b) = (&in_plane.trajectory, &both.trajectory);
-    assert!(!a.impacts.is_empty(), "the trilithon does not rock");
+    // The x pulse acts: the trilithon rocks otherwise without it (from its initial tilt).
+    let free = run("trilithon_free", &crate::common::bundled_text("trilithon"));
+    let moved = a
+        .samples
+        .q()
+        .iter()
+        .zip(free.trajectory.samples.q())
+        .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()));
+    assert!(
+        moved > 1e-3,
+        "the x pulse moves the trilithon by {moved:e} rad only"
+    );
     assert_eq!(a.impacts.len(), b.impacts.len(), "impacts differ");
     assert_eq!(a.samples.len(), b.samples.len(), "sample counts differ");
     for (label, u, v) in [
@@ -88,4 +105,36 @@ fn a_model_with_rocking_bases_answers_for_both_components() {
         "{:?}",
         run.warnings()
     );
+}
+
+#[test]
+fn the_monitor_still_prices_the_friction_the_part_along_the_hinges_needs() {
+    // A y pulse of 0.61 g against μ = 0.5: the lintel would slide out of plane.
+    let tail = "[analysis]\nfriction = 0.5\n";
+    let x = "x = { one_sine_pulse = { amplitude = 2.0, period = 0.8 } }";
+    let y = "y = { one_sine_pulse = { amplitude = 6.0, period = 0.5 } }";
+    let in_plane = run_any(
+        "trilithon_mu_x",
+        &format!("{}\n{tail}", with_ground_motion("trilithon", x)),
+    );
+    let both = run_any(
+        "trilithon_mu_xy",
+        &format!(
+            "{}\n{tail}",
+            with_ground_motion("trilithon", &format!("{x}\n{y}"))
+        ),
+    );
+    assert!(
+        in_plane.trajectory.violation.is_none(),
+        "{:?}",
+        in_plane.trajectory.violation
+    );
+    let v = both
+        .trajectory
+        .violation
+        .as_ref()
+        .expect("the y pulse's friction demand is reported");
+    assert_eq!(v.kind, "sliding", "{v:?}");
+    // A sliding violation is a demand |F_t|/N above μ.
+    assert!(v.friction_demand > 0.5, "{v:?}");
 }

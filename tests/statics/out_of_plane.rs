@@ -2,56 +2,89 @@
 //! with a part along y, which its hinges carry bilaterally: `out_of_plane` gives that part
 //! |d̂·ŷ|, λ answers for the in-plane part only (λ(d)·|d̂ₓ| = λ(+x): the y load is held by the
 //! hinges for any λ, so only the x part can open a mechanism), and `crr check` says that ±y is
-//! not answered rather than "holds up to 10". Models with rocking bases answer every direction
-//! (`out_of_plane` = 0).
+//! not answered rather than "holds up to 10". The same holds with the hinges about −y (the
+//! structure mirrored by x → −x). Models with rocking bases answer every direction
+//! (`out_of_plane` null).
 //!
 //! Tolerances: `out_of_plane` is a dot product of unit vectors (1e-12); λ agrees to 1e-8
 //! relative, the linear program's accuracy (docs/check.md).
 
 use nalgebra::Vector3;
 
-use crate::common::{bundled_model as bundled, bundled_path, crr};
+use crate::common::{bundled_model as bundled, bundled_path, crr, mirrored_x};
 use crr::analysis::static_multiplier::{static_multiplier, static_multipliers};
+use crr::kinematics::Model;
+
+/// Every bundled model whose interfaces are all hinges about y.
+const PLANAR: [&str; 9] = [
+    "arch",
+    "arch_dirac",
+    "block_record",
+    "drum_column",
+    "single_block",
+    "trilithon",
+    "trilithon_dirac",
+    "two_block_stack",
+    "wall",
+];
 
 #[test]
 fn planar_models_answer_in_their_plane_only() {
-    for name in ["wall", "trilithon", "arch", "drum_column", "single_block"] {
-        let model = bundled(name);
-        let all = static_multipliers(&model).unwrap();
-        let plus_x = all[0]
-            .lambda
-            .expect("every bundled planar model has λ along +x");
-        for m in &all {
-            let expected = m.direction[1].abs();
-            assert!(
-                (m.out_of_plane - expected).abs() < 1e-12,
-                "{name} {:?}: out_of_plane {}",
-                m.direction,
-                m.out_of_plane
-            );
-        }
-        // 30° from x towards y: the x part is cos 30°, the y part sin 30° = 1/2.
-        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
-        let m = static_multiplier(&model, Vector3::new(c, s, 0.0)).unwrap();
-        assert!(
-            (m.out_of_plane - s).abs() < 1e-12,
-            "{name}: {}",
-            m.out_of_plane
-        );
-        let lambda = m.lambda.expect("the x part opens a mechanism");
-        assert!(
-            (lambda * c - plus_x).abs() <= 1e-8 * plus_x,
-            "{name}: λ(30°) cos 30° = {} against λ(+x) = {plus_x}",
-            lambda * c
-        );
+    for name in PLANAR {
+        in_plane_answers(name, &bundled(name));
     }
+    // The hinges about −y of the mirrored structures (those made of boxes, which the mirror
+    // handles).
+    for name in ["single_block", "trilithon", "two_block_stack", "wall"] {
+        let path = bundled_path(name);
+        let spec = crr::load_model(&path).unwrap().0.structure();
+        let mirrored = Model::from_spec(&mirrored_x(&spec)).unwrap();
+        let axis = mirrored
+            .planar_axis()
+            .expect("a mirrored planar model is planar");
+        assert!(axis.cross(&Vector3::y()).norm() < 1e-12, "{name}: {axis:?}");
+        in_plane_answers(&format!("{name} mirrored"), &mirrored);
+    }
+}
+
+/// ±x lie in the plane, ±y along the axis (λ `None`), and along 30° from x towards y, λ·cos 30°
+/// is the multiplier along +x.
+fn in_plane_answers(name: &str, model: &Model) {
+    let all = static_multipliers(model).unwrap();
+    let plus_x = all[0]
+        .lambda
+        .expect("every bundled planar model has λ along +x");
+    for m in &all {
+        let expected = m.direction[1].abs();
+        let part = m.out_of_plane.expect("a planar model");
+        assert!(
+            (part - expected).abs() < 1e-12,
+            "{name} {:?}: out_of_plane {part}",
+            m.direction
+        );
+        if expected == 1.0 {
+            assert_eq!(m.lambda, None, "{name} {:?}", m.direction);
+        }
+    }
+    // The x part is cos 30°, the y part sin 30° = 1/2.
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let m = static_multiplier(model, Vector3::new(c, s, 0.0)).unwrap();
+    let part = m.out_of_plane.expect("a planar model");
+    assert!((part - s).abs() < 1e-12, "{name}: {part}");
+    let lambda = m.lambda.expect("the x part opens a mechanism");
+    assert!(
+        (lambda * c - plus_x).abs() <= 1e-8 * plus_x,
+        "{name}: λ(30°) cos 30° = {} against λ(+x) = {plus_x}",
+        lambda * c
+    );
 }
 
 #[test]
 fn models_with_rocking_bases_answer_every_direction() {
     for name in ["arch_3d", "baldachin", "temple"] {
         for m in static_multipliers(&bundled(name)).unwrap() {
-            assert_eq!(m.out_of_plane, 0.0, "{name} {:?}", m.direction);
+            assert_eq!(m.out_of_plane, None, "{name} {:?}", m.direction);
+            assert!(m.lambda.is_some(), "{name} {:?}", m.direction);
         }
     }
 }
@@ -79,7 +112,18 @@ fn check_says_what_a_planar_model_does_not_answer() {
         .as_array()
         .unwrap()
         .iter()
-        .map(|m| m["out_of_plane"].as_f64().unwrap())
+        .map(|m| {
+            m["out_of_plane"]
+                .as_f64()
+                .expect("a planar model gives its part")
+        })
         .collect();
     assert_eq!(parts, [0.0, 0.0, 1.0, 1.0]);
+    // The 3D arch (rocking bases): no out-of-plane part to give.
+    let arch = bundled_path("arch_3d");
+    let o = crr(&["check", arch.to_str().unwrap(), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for m in json["static_multipliers"].as_array().unwrap() {
+        assert!(m["out_of_plane"].is_null(), "{m}");
+    }
 }
