@@ -423,6 +423,15 @@ pub fn to_text(r: &CheckReport) -> String {
                     )
                 }
             }
+            if !m.hinges_out_of_plane.is_empty() {
+                s += &format!(
+                    "    the program's forces at λ load hinges out of their plane: {} (a hinge is a \
+                     line, which transmits couples out of its plane and forces along its axis \
+                     whatever they are, with no out-of-plane geometry to limit them: λ may rely \
+                     on that; model those joints as rocking bases)\n",
+                    m.hinges_out_of_plane.join(", ")
+                );
+            }
             if let Some(part) = m.out_of_plane.filter(|&p| p > 0.0) {
                 // The load's part in the plane of motion, |d − (d·a)a| = √(1 − (d·a)²).
                 let in_plane = (1.0 - part * part).max(0.0).sqrt();

@@ -19,7 +19,7 @@ use serde::Serialize;
 use crr_impact::statics::{
     Collapse, Friction, Motion, StaticsOptions, collapse_multiplier, required_friction,
 };
-use crr_kinematics::{Model, Side};
+use crr_kinematics::{InterfaceKind, Model, Side};
 
 pub use crr_impact::statics::LAMBDA_MAX;
 
@@ -63,6 +63,14 @@ pub struct StaticMultiplier {
     /// to 1e-9 rad) the model says nothing and `lambda` is `None`: out-of-plane overturning or
     /// sliding is outside a planar model.
     pub out_of_plane: Option<f64>,
+    /// In a model that is not planar, the hinges that carry a couple out of their plane or a
+    /// force along their axis in the program's distribution at λ (above 1e-6 of W·L or W, W the
+    /// weight, L the model size): a hinge is a line that transmits those bilaterally, so λ may
+    /// rely on a capacity the model gives it without geometry (the out-of-plane width of the
+    /// joint). Empty where the distribution uses none: λ is then reached without that capacity.
+    /// A name here says that the distribution found uses it, not that every one at λ must (the
+    /// split is not unique where the structure is hyperstatic).
+    pub hinges_out_of_plane: Vec<String>,
 }
 
 impl StaticMultiplier {
@@ -101,6 +109,7 @@ pub fn static_multiplier_with(
             mechanism: Vec::new(),
             required_friction: None,
             out_of_plane: along_axis,
+            hinges_out_of_plane: Vec::new(),
         });
     }
     let options = StaticsOptions {
@@ -223,5 +232,34 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         mechanism,
         required_friction: friction,
         out_of_plane: out_of_plane(model, &Vector3::from(collapse.direction)),
+        hinges_out_of_plane: hinges_out_of_plane(model, collapse),
     }
+}
+
+/// The hinges of a model that is not planar whose out-of-plane capacity the collapse's
+/// distribution uses ([`StaticMultiplier::hinges_out_of_plane`]); none for a planar model,
+/// whose out-of-plane part `out_of_plane` gives.
+fn hinges_out_of_plane(model: &Model, collapse: &Collapse) -> Vec<String> {
+    if model.planar_axis().is_some() {
+        return Vec::new();
+    }
+    let weight = model.total_mass() * model.gravity;
+    let floor = 1e-6 * weight;
+    collapse
+        .interfaces
+        .iter()
+        .filter(|i| {
+            if !matches!(
+                model.interfaces[i.interface].kind,
+                InterfaceKind::Hinge { .. }
+            ) {
+                return false;
+            }
+            let couple = Vector3::from(i.bilateral_couple).norm();
+            // The force along the axis: a hinge face's second tangent t₂ is its axis u.
+            let along: f64 = i.forces.iter().map(|f| f.tangential[1]).sum::<f64>().abs();
+            couple > floor * model.size || along > floor
+        })
+        .map(|i| i.name.clone())
+        .collect()
 }

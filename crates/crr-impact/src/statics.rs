@@ -149,6 +149,11 @@ pub struct InterfaceCollapse {
     pub slip_rate: f64,
     /// Relative angular velocity ω_child − ω_parent in the mechanism (rad/s at unit scale).
     pub rotation: [f64; 3],
+    /// The couple it carries bilaterally at λ_c (N m, world): a hinge's couples about its face's
+    /// n and t₁ (a hinge is a line: out of its plane it transmits whatever is needed); zero for a
+    /// rocking base. One split among the program's optimal ones where the structure is
+    /// hyperstatic.
+    pub bilateral_couple: [f64; 3],
 }
 
 /// The virtual velocity of one body in the mechanism (at its centre of mass).
@@ -757,6 +762,14 @@ impl Program {
                         })
                         .collect()
                 };
+                let couple: Vector3<f64> = self
+                    .unknowns
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, u)| u.interface == face.interface && u.point.is_none())
+                    .map(|(j, u)| u.direction * solution.x[j + 1])
+                    .sum::<Vector3<f64>>()
+                    * (self.weight * size);
                 InterfaceCollapse {
                     interface: face.interface,
                     name: interface.name.clone(),
@@ -767,6 +780,7 @@ impl Program {
                     gap_rates,
                     slip_rate,
                     rotation: [rotation.x, rotation.y, rotation.z],
+                    bilateral_couple: [couple.x, couple.y, couple.z],
                 }
             })
             .collect();
