@@ -425,10 +425,10 @@ pub fn to_text(r: &CheckReport) -> String {
             }
             if !m.hinges_out_of_plane.is_empty() {
                 s += &format!(
-                    "    the program's forces at λ load hinges out of their plane: {} (a hinge is a \
-                     line, which transmits couples out of its plane and forces along its axis \
-                     whatever they are, with no out-of-plane geometry to limit them: λ may rely \
-                     on that; model those joints as rocking bases)\n",
+                    "    relies on hinges carrying loads out of their plane: {} (every distribution \
+                     at λ loads them so; a hinge is a line, which transmits couples out of its \
+                     plane and forces along its axis whatever they are, with no out-of-plane \
+                     geometry to limit them: model those joints as rocking bases)\n",
                     m.hinges_out_of_plane.join(", ")
                 );
             }

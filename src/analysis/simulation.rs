@@ -688,6 +688,31 @@ fn out_of_plane_ground_motion(model: &Model, ground: &GroundMotion) -> Option<St
     })
 }
 
+/// The warning for hinges in a model that is not planar: a hinge is a line, which holds any
+/// couple out of its plane and any force along its axis, so the run excludes tipping out of
+/// the hinges' planes at those joints (`crr check` names them where λ uses that,
+/// `hinges_out_of_plane`). None for a planar model or one without hinges.
+fn hinges_in_three_dimensions(model: &Model) -> Option<String> {
+    if model.planar_axis().is_some() {
+        return None;
+    }
+    let hinges: Vec<&str> = model
+        .interfaces
+        .iter()
+        .filter(|i| matches!(i.kind, InterfaceKind::Hinge { .. }))
+        .map(|i| i.name.as_str())
+        .collect();
+    (!hinges.is_empty()).then(|| {
+        format!(
+            "the model is not planar but has hinges ({}): a hinge is a line that holds any \
+             couple out of its plane and any force along its axis, so the run excludes tipping \
+             out of the hinges' planes at those joints; model them as rocking bases where that \
+             matters",
+            hinges.join(", ")
+        )
+    })
+}
+
 fn num(x: f64) -> String {
     format!("{x:e}")
 }
@@ -758,6 +783,9 @@ fn warnings(
     }
     if let Some(part) = out_of_plane_ground_motion(&p.model, &p.ground) {
         out.push(part);
+    }
+    if let Some(hinges) = hinges_in_three_dimensions(&p.model) {
+        out.push(hinges);
     }
     let analysis = p.file.analysis.clone().unwrap_or_default();
     if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)

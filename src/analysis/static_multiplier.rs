@@ -17,9 +17,10 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crr_impact::statics::{
-    Collapse, Friction, Motion, StaticsOptions, collapse_multiplier, required_friction,
+    Collapse, Friction, Motion, StaticsOptions, collapse_multiplier, hinges_out_of_plane,
+    required_friction,
 };
-use crr_kinematics::{InterfaceKind, Model, Side};
+use crr_kinematics::{Model, Side};
 
 pub use crr_impact::statics::LAMBDA_MAX;
 
@@ -63,13 +64,12 @@ pub struct StaticMultiplier {
     /// to 1e-9 rad) the model says nothing and `lambda` is `None`: out-of-plane overturning or
     /// sliding is outside a planar model.
     pub out_of_plane: Option<f64>,
-    /// In a model that is not planar, the hinges that carry a couple out of their plane or a
-    /// force along their axis in the program's distribution at λ (above 1e-6 of W·L or W, W the
-    /// weight, L the model size): a hinge is a line that transmits those bilaterally, so λ may
-    /// rely on a capacity the model gives it without geometry (the out-of-plane width of the
-    /// joint). Empty where the distribution uses none: λ is then reached without that capacity.
-    /// A name here says that the distribution found uses it, not that every one at λ must (the
-    /// split is not unique where the structure is hyperstatic).
+    /// In a model that is not planar, the hinges that every distribution of the contact forces
+    /// at λ (at λ_max where the structure holds) loads out of their plane, with a force along
+    /// their axis or a couple not about it above 1e-6 of W or W·L (W the weight, L the model
+    /// size; [`crr_impact::statics::hinges_out_of_plane`]): a hinge is a line that transmits
+    /// those whatever they are, so λ relies on a capacity the model gives it without geometry
+    /// (the out-of-plane width of the joint). Empty where some distribution spares them all.
     pub hinges_out_of_plane: Vec<String>,
 }
 
@@ -124,7 +124,18 @@ pub fn static_multiplier_with(
         ),
         _ => None,
     };
-    Ok(report(model, &collapse, required))
+    let mut report = report(model, &collapse, required);
+    // A planar model's out-of-plane part is `out_of_plane`; elsewhere the hinges that every
+    // distribution at λ loads out of their plane (at λ_max where it holds).
+    if model.planar_axis().is_none() {
+        let at = collapse.lambda.unwrap_or(options.lambda_max);
+        report.hinges_out_of_plane = hinges_out_of_plane(model, direction, &options, at)
+            .map_err(|e| e.to_string())?
+            .into_iter()
+            .map(|h| h.name)
+            .collect();
+    }
+    Ok(report)
 }
 
 /// A direction of the ground acceleration from the command line: `+x`, `-x`, `+y`, `-y`, `+z`,
@@ -232,34 +243,6 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         mechanism,
         required_friction: friction,
         out_of_plane: out_of_plane(model, &Vector3::from(collapse.direction)),
-        hinges_out_of_plane: hinges_out_of_plane(model, collapse),
+        hinges_out_of_plane: Vec::new(),
     }
-}
-
-/// The hinges of a model that is not planar whose out-of-plane capacity the collapse's
-/// distribution uses ([`StaticMultiplier::hinges_out_of_plane`]); none for a planar model,
-/// whose out-of-plane part `out_of_plane` gives.
-fn hinges_out_of_plane(model: &Model, collapse: &Collapse) -> Vec<String> {
-    if model.planar_axis().is_some() {
-        return Vec::new();
-    }
-    let weight = model.total_mass() * model.gravity;
-    let floor = 1e-6 * weight;
-    collapse
-        .interfaces
-        .iter()
-        .filter(|i| {
-            if !matches!(
-                model.interfaces[i.interface].kind,
-                InterfaceKind::Hinge { .. }
-            ) {
-                return false;
-            }
-            let couple = Vector3::from(i.bilateral_couple).norm();
-            // The force along the axis: a hinge face's second tangent t₂ is its axis u.
-            let along: f64 = i.forces.iter().map(|f| f.tangential[1]).sum::<f64>().abs();
-            couple > floor * model.size || along > floor
-        })
-        .map(|i| i.name.clone())
-        .collect()
 }

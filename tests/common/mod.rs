@@ -121,6 +121,22 @@ pub fn simulate_failing(tag: &str, text: &str) -> (String, PathBuf) {
     (String::from_utf8_lossy(&o.stderr).into_owned(), out)
 }
 
+/// The bundled baldachin's text with the base of its first column a hinge about y instead of a
+/// rocking base (a line across the column's foot, at its centre line): a model that is not
+/// planar with one hinge.
+#[allow(dead_code)]
+pub fn baldachin_with_a_hinge_base() -> String {
+    let text = bundled_text_with_records("baldachin").replace(
+        "rocking_base = { corners = [[-1.4, -1.4, 0.0], [-1.0, -1.4, 0.0], [-1.0, -1.0, 0.0], [-1.4, -1.0, 0.0]] }",
+        "axis = [0.0, 1.0, 0.0]\npivot_positive = [-1.0, -1.2, 0.0]\npivot_negative = [-1.4, -1.2, 0.0]",
+    );
+    assert!(
+        text.contains("pivot_positive = [-1.0, -1.2, 0.0]"),
+        "the base was not replaced"
+    );
+    text
+}
+
 /// The structure of the bundled model `examples/models/<name>.toml`.
 pub fn bundled_model(name: &str) -> crr::kinematics::Model {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("examples/models/{name}.toml"));

@@ -14,6 +14,7 @@
 use crate::common::{bundled_text, write_model};
 
 const OUT_OF_PLANE: &str = "the hinges of a planar model carry it bilaterally";
+const HINGES: &str = "the model is not planar but has hinges";
 
 fn run(tag: &str, text: &str) -> crr::Run {
     let run = run_any(tag, text);
@@ -101,10 +102,34 @@ fn a_model_with_rocking_bases_answers_for_both_components() {
     let text = crate::common::bundled_text_with_records("baldachin");
     let run = run("baldachin_xy", &text);
     assert!(
-        run.warnings().iter().all(|w| !w.contains(OUT_OF_PLANE)),
+        run.warnings()
+            .iter()
+            .all(|w| !w.contains(OUT_OF_PLANE) && !w.contains(HINGES)),
         "{:?}",
         run.warnings()
     );
+}
+
+#[test]
+fn hinges_in_a_three_dimensional_model_are_named() {
+    // One base of the baldachin a hinge about y: the run names it (and only it).
+    let mixed = run(
+        "baldachin_hinge_base",
+        &crate::common::baldachin_with_a_hinge_base(),
+    );
+    let named: Vec<&String> = mixed
+        .warnings()
+        .iter()
+        .filter(|w| w.contains(HINGES))
+        .collect();
+    assert_eq!(named.len(), 1, "{:?}", mixed.warnings());
+    assert!(named[0].contains("(base_1)"), "{}", named[0]);
+    // A planar model's hinges are its model, not a warning.
+    let planar = run(
+        "trilithon_planar",
+        &crate::common::bundled_text("trilithon"),
+    );
+    assert!(planar.warnings().iter().all(|w| !w.contains(HINGES)));
 }
 
 #[test]

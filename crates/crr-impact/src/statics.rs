@@ -34,7 +34,7 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
-use crr_kinematics::{ContactFace, Model, Parent, Side, contact_faces};
+use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent, Side, contact_faces};
 
 /// Largest multiplier sought by default (a ground acceleration of 10 g): a structure that holds
 /// beyond it is reported as holding.
@@ -149,11 +149,6 @@ pub struct InterfaceCollapse {
     pub slip_rate: f64,
     /// Relative angular velocity ω_child − ω_parent in the mechanism (rad/s at unit scale).
     pub rotation: [f64; 3],
-    /// The couple it carries bilaterally at λ_c (N m, world): a hinge's couples about its face's
-    /// n and t₁ (a hinge is a line: out of its plane it transmits whatever is needed); zero for a
-    /// rocking base. One split among the program's optimal ones where the structure is
-    /// hyperstatic.
-    pub bilateral_couple: [f64; 3],
 }
 
 /// The virtual velocity of one body in the mechanism (at its centre of mass).
@@ -217,6 +212,98 @@ pub fn collapse_multiplier(
         return Ok(convex);
     }
     sliding_lift_offs(model, &faces, d, options, &mut free, convex)
+}
+
+/// A hinge's load out of its plane at a multiplier: a hinge is a line, which transmits any
+/// force along its axis u and any couple not about u, with no geometry to limit them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HingeOutOfPlane {
+    /// Index into [`Model::interfaces`].
+    pub interface: usize,
+    /// The interface's name.
+    pub name: String,
+    /// |F·u|, the force along the axis (N).
+    pub axial: f64,
+    /// |M − (M·u)u|, the couple out of the hinge's plane (N m), about its first pivot point.
+    pub couple: f64,
+}
+
+/// The hinges that every distribution of the contact forces at multiplier `lambda` along
+/// `direction` loads out of their plane (above 1e-6 of W or W·L, W the weight, L the model
+/// size): the program with λ fixed at lambda·(1 − 1e-7) (inside its feasible interval
+/// [0, λ_c]) and ½Σx² of the hinges' out-of-plane unknowns (their bilateral couples and their
+/// points' forces along the axis) minimised, so that a hinge is named only where no
+/// distribution spares it, not where the interior point's central answer happens to load it.
+/// Each one's load is its wrench about its first pivot point in that distribution. Empty for a
+/// model without hinges. Errors as [`collapse_multiplier`]'s.
+pub fn hinges_out_of_plane(
+    model: &Model,
+    direction: Vector3<f64>,
+    options: &StaticsOptions,
+    lambda: f64,
+) -> Result<Vec<HingeOutOfPlane>, StaticsError> {
+    let is_hinge = |k: usize| matches!(model.interfaces[k].kind, InterfaceKind::Hinge { .. });
+    if !(0..model.interfaces.len()).any(is_hinge) {
+        return Ok(Vec::new());
+    }
+    let norm = direction.norm();
+    if !(norm.is_finite() && norm > 0.0) {
+        return Err(StaticsError::Direction(
+            direction.x,
+            direction.y,
+            direction.z,
+        ));
+    }
+    let faces = contact_faces(model);
+    let free = vec![false; faces.len()];
+    let program = Program::build(model, &faces, direction / norm, options, &free);
+    let columns: Vec<usize> = program
+        .unknowns
+        .iter()
+        .enumerate()
+        .filter(|(_, u)| {
+            is_hinge(u.interface)
+                && u.point.is_none_or(|_| {
+                    let axis = faces[u.interface].tangents[1];
+                    u.direction.dot(&axis).abs() > 1.0 - 1e-12
+                })
+        })
+        .map(|(j, _)| j + 1)
+        .collect();
+    let solution = program.solve_least(lambda.max(0.0) * (1.0 - 1e-7), &columns)?;
+    let (weight, size) = (program.weight, model.size);
+    let mut loaded = Vec::new();
+    for face in faces.iter().filter(|f| is_hinge(f.interface)) {
+        let axis = face.tangents[1];
+        let origin = face.points[0];
+        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+        for (j, u) in program.unknowns.iter().enumerate() {
+            if u.interface != face.interface {
+                continue;
+            }
+            let value = weight * solution.x[j + 1];
+            match u.point {
+                Some(p) => {
+                    let f = u.direction * value;
+                    force += f;
+                    moment += (face.points[p] - origin).cross(&f);
+                }
+                // The couples' rows are M/(W·L) with entries direction/L: x is C/W.
+                None => moment += u.direction * value,
+            }
+        }
+        let axial = force.dot(&axis).abs();
+        let couple = (moment - axis * moment.dot(&axis)).norm();
+        if axial > 1e-6 * weight || couple > 1e-6 * weight * size {
+            loaded.push(HingeOutOfPlane {
+                interface: face.interface,
+                name: model.interfaces[face.interface].name.clone(),
+                axial,
+                couple,
+            });
+        }
+    }
+    Ok(loaded)
 }
 
 /// One program: `free` marks the interfaces whose points carry normal forces only (they may
@@ -619,6 +706,34 @@ impl Program {
         self.rows = row;
     }
 
+    /// The program with λ fixed at `lambda` (one more zero-cone row) and ½Σx² over `columns`
+    /// minimised instead of −λ.
+    fn solve_least(
+        &self,
+        lambda: f64,
+        columns: &[usize],
+    ) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
+        let n = 1 + self.unknowns.len();
+        let p = CscMatrix::new_from_triplets(
+            n,
+            n,
+            columns.to_vec(),
+            columns.to_vec(),
+            vec![1.0; columns.len()],
+        );
+        let q = vec![0.0; n];
+        let (mut rows, mut cols, mut values) = self.triplets.clone();
+        rows.push(self.rows);
+        cols.push(0);
+        values.push(1.0);
+        let a = CscMatrix::new_from_triplets(self.rows + 1, n, rows, cols, values);
+        let mut b = self.b.clone();
+        b.push(lambda);
+        let mut cones = self.cones.clone();
+        cones.push(SupportedConeT::ZeroConeT(1));
+        self.run_solver(&p, &q, &a, &b, &cones)
+    }
+
     fn solve(&self) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
         let n = 1 + self.unknowns.len();
         let p = CscMatrix::zeros((n, n));
@@ -631,6 +746,18 @@ impl Program {
             self.triplets.1.clone(),
             self.triplets.2.clone(),
         );
+        self.run_solver(&p, &q, &a, &self.b, &self.cones)
+    }
+
+    /// clarabel on min ½xᵀPx + qᵀx s.t. Ax + s = b, s ∈ cones.
+    fn run_solver(
+        &self,
+        p: &CscMatrix<f64>,
+        q: &[f64],
+        a: &CscMatrix<f64>,
+        b: &[f64],
+        cones: &[SupportedConeT<f64>],
+    ) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
         let settings = DefaultSettingsBuilder::default()
             .verbose(false)
             .tol_gap_abs(1e-12)
@@ -640,7 +767,7 @@ impl Program {
             .max_iter(400)
             .build()
             .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
-        let mut solver = DefaultSolver::new(&p, &q, &a, &self.b, &self.cones, settings)
+        let mut solver = DefaultSolver::new(p, q, a, b, cones, settings)
             .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
         solver.solve();
         let solution = solver.solution;
@@ -762,14 +889,6 @@ impl Program {
                         })
                         .collect()
                 };
-                let couple: Vector3<f64> = self
-                    .unknowns
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, u)| u.interface == face.interface && u.point.is_none())
-                    .map(|(j, u)| u.direction * solution.x[j + 1])
-                    .sum::<Vector3<f64>>()
-                    * (self.weight * size);
                 InterfaceCollapse {
                     interface: face.interface,
                     name: interface.name.clone(),
@@ -780,7 +899,6 @@ impl Program {
                     gap_rates,
                     slip_rate,
                     rotation: [rotation.x, rotation.y, rotation.z],
-                    bilateral_couple: [couple.x, couple.y, couple.z],
                 }
             })
             .collect();
