@@ -184,6 +184,20 @@ impl Collapse {
     }
 }
 
+/// `direction` made unit; an error for a zero or non-finite one.
+fn unit_direction(direction: Vector3<f64>) -> Result<Vector3<f64>, StaticsError> {
+    let norm = direction.norm();
+    if norm.is_finite() && norm > 0.0 {
+        Ok(direction / norm)
+    } else {
+        Err(StaticsError::Direction(
+            direction.x,
+            direction.y,
+            direction.z,
+        ))
+    }
+}
+
 /// The collapse multiplier of `model` at rest under gravity plus a constant ground acceleration
 /// λ g `direction` (see the module's docs).
 pub fn collapse_multiplier(
@@ -191,20 +205,12 @@ pub fn collapse_multiplier(
     direction: Vector3<f64>,
     options: &StaticsOptions,
 ) -> Result<Collapse, StaticsError> {
-    let norm = direction.norm();
-    if !(norm.is_finite() && norm > 0.0) {
-        return Err(StaticsError::Direction(
-            direction.x,
-            direction.y,
-            direction.z,
-        ));
-    }
+    let d = unit_direction(direction)?;
     if let Friction::Pyramid(mu) | Friction::Cone(mu) = options.friction
         && !(mu.is_finite() && mu >= 0.0)
     {
         return Err(StaticsError::Friction(mu));
     }
-    let d = direction / norm;
     let faces = contact_faces(model);
     let mut free = vec![false; faces.len()];
     let convex = solve_program(model, &faces, d, options, &free)?;
@@ -246,17 +252,10 @@ pub fn hinges_out_of_plane(
     if !(0..model.interfaces.len()).any(is_hinge) {
         return Ok(Vec::new());
     }
-    let norm = direction.norm();
-    if !(norm.is_finite() && norm > 0.0) {
-        return Err(StaticsError::Direction(
-            direction.x,
-            direction.y,
-            direction.z,
-        ));
-    }
+    let d = unit_direction(direction)?;
     let faces = contact_faces(model);
     let free = vec![false; faces.len()];
-    let program = Program::build(model, &faces, direction / norm, options, &free);
+    let program = Program::build(model, &faces, d, options, &free);
     let columns: Vec<usize> = program
         .unknowns
         .iter()
