@@ -107,6 +107,9 @@ pub struct CheckReport {
     pub static_multipliers: Vec<StaticMultiplier>,
     /// Why `static_multipliers` is empty, else `None`.
     pub static_multipliers_note: Option<String>,
+    /// What to know before trusting the report (a planar model whose hinge axis is not
+    /// horizontal, [`crate::analysis::static_multiplier::gravity_along_axis_warning`]).
+    pub warnings: Vec<String>,
 }
 
 /// Housner's linearised frequency (Hz) at amplitude θ_m.
@@ -299,6 +302,9 @@ pub fn check_with(
         note,
         static_multipliers: statics,
         static_multipliers_note: statics_note,
+        warnings: crate::analysis::static_multiplier::gravity_along_axis_warning(model)
+            .into_iter()
+            .collect(),
     }
 }
 
@@ -306,6 +312,9 @@ pub fn check_with(
 pub fn to_text(r: &CheckReport) -> String {
     let m = &r.mobility;
     let mut s = format!("model: {}\n", r.model);
+    for w in &r.warnings {
+        s += &format!("warning: {w}\n");
+    }
     s += &format!(
         "DOF(1) = {} (coordinates: {})\n",
         m.dof1,
@@ -390,10 +399,13 @@ pub fn to_text(r: &CheckReport) -> String {
                         Some(_) => " (needs μ > 1000)".to_string(),
                         None => String::new(),
                     };
-                    s += &format!(
-                        "  d = {dir}: λ = {l:.6}{friction} opening {}\n",
-                        joints.join(", ")
-                    );
+                    // A mechanism of lift-offs alone opens no CRR angle (the lines below say).
+                    let opening = if joints.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" opening {}", joints.join(", "))
+                    };
+                    s += &format!("  d = {dir}: λ = {l:.6}{friction}{opening}\n");
                     let with = |motion: crr_impact::statics::Motion| -> Vec<&str> {
                         m.mechanism
                             .iter()

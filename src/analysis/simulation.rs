@@ -787,6 +787,9 @@ fn warnings(
     if let Some(hinges) = hinges_in_three_dimensions(&p.model) {
         out.push(hinges);
     }
+    if let Some(tilt) = crate::analysis::static_multiplier::gravity_along_axis_warning(&p.model) {
+        out.push(tilt);
+    }
     let analysis = p.file.analysis.clone().unwrap_or_default();
     if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)
         && analysis.rtol > crr_dynamics::analysis::RTOL_WARNING

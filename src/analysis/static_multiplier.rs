@@ -98,9 +98,17 @@ pub fn static_multiplier_with(
     direction: Vector3<f64>,
     friction: Option<f64>,
 ) -> Result<StaticMultiplier, String> {
+    let options = StaticsOptions {
+        friction: friction.map_or(Friction::NoSliding, Friction::Pyramid),
+        ..StaticsOptions::default()
+    };
     let along_axis = out_of_plane(model, &direction);
     if along_axis == Some(1.0) {
-        // Along a planar model's hinge axis the hinges hold any load: nothing to solve.
+        // Along a planar model's hinge axis the hinges hold any load, so there is no multiplier
+        // to report; the program still runs, because the load along the axis leaves the in-plane
+        // equilibrium as it is under gravity alone, and one that does not stand at rest must say
+        // so here as along ±x (the program has no solution for any λ then).
+        collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
         return Ok(StaticMultiplier {
             // + 0.0: −0.0 components print as 0.0, as the statics' own directions do.
             direction: direction.normalize().map(|x| x + 0.0).into(),
@@ -112,10 +120,6 @@ pub fn static_multiplier_with(
             hinges_out_of_plane: Vec::new(),
         });
     }
-    let options = StaticsOptions {
-        friction: friction.map_or(Friction::NoSliding, Friction::Pyramid),
-        ..StaticsOptions::default()
-    };
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
     let required = match (collapse.lambda, friction) {
         (Some(lambda), None) => Some(
@@ -205,6 +209,37 @@ pub fn out_of_plane(model: &Model, direction: &Vector3<f64>) -> Option<f64> {
     } else {
         part
     })
+}
+
+/// For a planar model whose common axis a is not horizontal, the part |a·ẑ| of gravity along a
+/// (the sine of the axis' angle to the horizontal): its hinges carry g|a·ẑ| per unit mass
+/// bilaterally, and the bodies move under g√(1 − (a·ẑ)²) in their plane. None for a model that
+/// is not planar or whose axis is horizontal to within 1e-9 rad (the rule of
+/// [`Model::planar_axis`]).
+pub fn gravity_along_axis(model: &Model) -> Option<f64> {
+    let a = model.planar_axis()?;
+    let part = a.z.abs().min(1.0);
+    (part > 1e-9).then_some(part)
+}
+
+/// The warning of `crr check` and `crr simulate` for a planar model whose axis is not
+/// horizontal ([`gravity_along_axis`]), else None.
+pub fn gravity_along_axis_warning(model: &Model) -> Option<String> {
+    let part = gravity_along_axis(model)?;
+    let a = model.planar_axis()?;
+    Some(format!(
+        "the hinges' common axis ({:.3}, {:.3}, {:.3}) is {:.1}° from the horizontal: the hinges \
+         of a planar model carry the part of gravity along it ({:.4} g) bilaterally, and the \
+         structure rocks under the rest ({:.4} g) in the plane normal to the axis; a real \
+         structure on joints so inclined could also slide or overturn along the axis, which is \
+         outside the model",
+        a.x + 0.0,
+        a.y + 0.0,
+        a.z + 0.0,
+        part.asin().to_degrees(),
+        part,
+        (1.0 - part * part).sqrt()
+    ))
 }
 
 /// The report of one collapse.

@@ -184,3 +184,26 @@ pub fn mirrored_x(
     }
     out
 }
+
+/// The bundled single block (2 m tall, 0.4 m wide: b/h = 0.2) turned by θ about x, so that its
+/// hinge axis R_x(θ)ŷ = (0, cos θ, sin θ) rises θ from the horizontal. Written out, pivots and
+/// centre turned by R_x(θ): (x, y, z) ↦ (x, y cos θ − z sin θ, y sin θ + z cos θ).
+#[allow(dead_code)]
+pub fn tilted_block(theta: f64) -> String {
+    let (c, s) = (theta.cos(), theta.sin());
+    let turn =
+        |x: f64, y: f64, z: f64| format!("[{x:?}, {:?}, {:?}]", y * c - z * s, y * s + z * c);
+    format!(
+        "name = \"tilted_block\"\ngravity = 9.81\n\n\
+         [[body]]\nname = \"block\"\ndensity = 2500.0\n\
+         box = {{ center = {}, size = [0.4, 0.4, 2.0], rotation = [{theta:?}, 0.0, 0.0] }}\n\n\
+         [[interface]]\nname = \"base\"\nparent = \"ground\"\nchild = \"block\"\n\
+         axis = [0.0, {c:?}, {s:?}]\n\
+         pivot_positive = [{}, {}]\npivot_negative = [{}, {}]\n",
+        turn(0.0, 0.0, 1.0),
+        turn(0.2, -0.2, 0.0),
+        turn(0.2, 0.2, 0.0),
+        turn(-0.2, -0.2, 0.0),
+        turn(-0.2, 0.2, 0.0),
+    )
+}

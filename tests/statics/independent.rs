@@ -610,6 +610,15 @@ fn arch_near_its_minimum_thickness() {
             s.lambda
         ),
     }
+    // Along the hinges' common axis (y) there is no multiplier to give, but the arch still does
+    // not stand: a load along y leaves its in-plane equilibrium as under gravity alone.
+    for dy in [1.0, -1.0] {
+        let got = static_multiplier(&model(&spec), Vector3::new(0.0, dy, 0.0));
+        assert!(
+            matches!(&got, Err(e) if e.contains("does not hold at rest")),
+            "below the minimum thickness, along {dy:+} y: {got:?}"
+        );
+    }
 }
 
 /// A panel of half-width b and height 2h overturns about a base edge at λ = b/h, one block or cut

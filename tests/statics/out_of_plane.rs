@@ -162,3 +162,51 @@ fn a_hinge_in_a_three_dimensional_model_is_named_where_lambda_relies_on_it() {
         assert_eq!(m.out_of_plane, None);
     }
 }
+
+/// A planar model whose hinge axis is not horizontal: the hinges carry gravity's part along it
+/// (g sin θ) bilaterally and the block rocks under g cos θ in its plane, which x lies in (x is
+/// normal to the axis). The load λ g x against g cos θ overturns it at λ/cos θ = b/h, so
+/// λ = (b/h) cos θ, a closed form the program does not know (1e-8 relative, its accuracy);
+/// `crr check` warns about the inclined axis in its text and JSON, the untilted block not.
+#[test]
+fn an_inclined_hinge_axis_carries_part_of_gravity_and_is_warned_about() {
+    let theta: f64 = 0.3;
+    let path = crate::common::write_model("tilted_block", &crate::common::tilted_block(theta));
+    let model = crr::load_model(&path).unwrap().1;
+    let axis = model.planar_axis().expect("one hinge is planar");
+    assert!((axis - Vector3::new(0.0, theta.cos(), theta.sin())).norm() < 1e-12);
+    let part = crr::analysis::static_multiplier::gravity_along_axis(&model).unwrap();
+    assert!((part - theta.sin()).abs() < 1e-12, "{part}");
+    for dx in [1.0, -1.0] {
+        let m = static_multiplier(&model, Vector3::new(dx, 0.0, 0.0)).unwrap();
+        let lambda = m.lambda.expect("the block overturns");
+        let expected = 0.2 * theta.cos();
+        assert!(
+            (lambda - expected).abs() <= 1e-8 * expected,
+            "dx = {dx:+}: λ = {lambda}, (b/h) cos θ = {expected}"
+        );
+        assert_eq!(m.out_of_plane, Some(0.0));
+    }
+
+    let o = crr(&["check", path.to_str().unwrap()]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains(
+            "warning: the hinges' common axis (0.000, 0.955, 0.296) is 17.2° from the horizontal"
+        ) && text.contains("(0.2955 g) bilaterally"),
+        "{text}"
+    );
+    let o = crr(&["check", path.to_str().unwrap(), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(json["warnings"].as_array().unwrap().len(), 1, "{json}");
+    // The bundled block, axis y: nothing to warn about.
+    let upright = bundled_path("single_block");
+    let o = crr(&["check", upright.to_str().unwrap(), "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(json["warnings"], serde_json::json!([]));
+    assert_eq!(
+        crr::analysis::static_multiplier::gravity_along_axis(&bundled("single_block")),
+        None
+    );
+}
