@@ -211,8 +211,12 @@ class Model:
     def check(self) -> Dict[str, Any]:
         """The mobility report of ``crr check --json``: DOF, closures, and for a one-DOF
         mechanism the activation multiplier λ, the equivalent block, r and the free-rocking
-        frequencies (keys and units in ``docs/outputs.md``)."""
-        return json.loads(self._native.check_json())
+        frequencies (keys and units in ``docs/outputs.md``). Its ``warnings`` (a planar
+        model whose hinge axis is not horizontal) are also issued as :class:`CrrWarning`."""
+        report = json.loads(self._native.check_json())
+        for message in report.get("warnings") or []:
+            warnings.warn(CrrWarning(message), stacklevel=2)
+        return report
 
     def inspect(self, q: Union[None, Mapping[str, float], npt.ArrayLike] = None) -> Dict[str, Any]:
         """The report of ``crr inspect --json`` at configuration ``q`` (rad): a mapping of

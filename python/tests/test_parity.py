@@ -326,3 +326,34 @@ def test_summary_warnings_are_python_warnings_with_the_command_lines_text(cli, i
         crr.simulate(model, duration=2.0)
         with pytest.raises(crr.CrrWarning, match="rtol"):
             crr.simulate(model, duration=2.0, rtol=1e-3)
+
+
+def test_check_warnings_are_python_warnings_with_the_command_lines_text(cli, in_root, tmp_path):
+    import math
+    import warnings
+
+    # The single block turned by 0.3 rad about x: its hinge axis rises 17.2° from the horizontal,
+    # which `crr check` warns about; Python issues the same text as a CrrWarning.
+    c, s = math.cos(0.3), math.sin(0.3)
+
+    def turn(x, y, z):
+        return [x, y * c - z * s, y * s + z * c]
+
+    text = (
+        'name = "tilted_block"\ngravity = 9.81\n[[body]]\nname = "block"\ndensity = 2500.0\n'
+        f"box = {{ center = {turn(0.0, 0.0, 1.0)}, size = [0.4, 0.4, 2.0], rotation = [0.3, 0.0, 0.0] }}\n"
+        '[[interface]]\nname = "base"\nparent = "ground"\nchild = "block"\n'
+        f"axis = [0.0, {c!r}, {s!r}]\n"
+        f"pivot_positive = [{turn(0.2, -0.2, 0.0)}, {turn(0.2, 0.2, 0.0)}]\n"
+        f"pivot_negative = [{turn(-0.2, -0.2, 0.0)}, {turn(-0.2, 0.2, 0.0)}]\n"
+    )
+    path = tmp_path / "tilted.toml"
+    path.write_text(text)
+    printed = json.loads(run_cli(cli, ["check", str(path), "--json"]).stdout)["warnings"]
+    assert len(printed) == 1 and "17.2° from the horizontal" in printed[0]
+    with pytest.warns(crr.CrrWarning) as caught:
+        report = crr.Model.from_file(str(path)).check()
+    assert [str(w.message) for w in caught] == printed == report["warnings"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", crr.CrrWarning)
+        assert crr.Model.from_file("examples/models/single_block.toml").check()["warnings"] == []

@@ -17,8 +17,8 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crr_impact::statics::{
-    Collapse, Friction, Motion, StaticsOptions, collapse_multiplier, hinges_out_of_plane,
-    required_friction,
+    Collapse, Friction, Motion, StaticsError, StaticsOptions, collapse_multiplier,
+    hinges_out_of_plane, required_friction,
 };
 use crr_kinematics::{Model, Side};
 
@@ -62,7 +62,8 @@ pub struct StaticMultiplier {
     /// bilaterally; `None` for any other model. Above 0, λ answers for the load's part in the
     /// plane of motion only (the in-plane multiplier is λ·√(1 − |d·a|²)); exactly 1 (d along a,
     /// to 1e-9 rad) the model says nothing and `lambda` is `None`: out-of-plane overturning or
-    /// sliding is outside a planar model.
+    /// sliding is outside a planar model (a structure that does not stand under its own weight
+    /// is an error there as along any direction).
     pub out_of_plane: Option<f64>,
     /// In a model that is not planar, the hinges that every distribution of the contact forces
     /// at λ (at λ_max where the structure holds) loads out of their plane, with a force along
@@ -108,7 +109,13 @@ pub fn static_multiplier_with(
         // to report; the program still runs, because the load along the axis leaves the in-plane
         // equilibrium as it is under gravity alone, and one that does not stand at rest must say
         // so here as along ±x (the program has no solution for any λ then).
-        collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
+        // Only that verdict is kept: the program along the axis is degenerate (every λ or
+        // none), and a solver's trouble with it must not hide the in-plane answers.
+        if let Err(e @ StaticsError::DoesNotHold(_)) =
+            collapse_multiplier(model, direction, &options)
+        {
+            return Err(e.to_string());
+        }
         return Ok(StaticMultiplier {
             // + 0.0: −0.0 components print as 0.0, as the statics' own directions do.
             direction: direction.normalize().map(|x| x + 0.0).into(),

@@ -187,6 +187,22 @@ fn an_inclined_hinge_axis_carries_part_of_gravity_and_is_warned_about() {
         );
         assert_eq!(m.out_of_plane, Some(0.0));
     }
+    // Along ±y the in-plane part of the load, sin θ (0, sin θ, −cos θ), lies along the block's
+    // own vertical R_x(θ)ẑ: along +y it cancels g cos θ at λ sin θ = cos θ, and the block lifts
+    // off (λ = cot θ); along −y it adds to it, and the block holds.
+    let up = static_multiplier(&model, Vector3::y()).unwrap();
+    let lambda = up.lambda.expect("the block lifts off");
+    let cot = 1.0 / theta.tan();
+    assert!(
+        (lambda - cot).abs() <= 1e-8 * cot,
+        "+y: λ = {lambda}, cot θ = {cot}"
+    );
+    assert!(up.lifts_off(), "+y: {:?}", up.mechanism);
+    assert!((up.out_of_plane.unwrap() - theta.cos()).abs() < 1e-12);
+    assert_eq!(
+        static_multiplier(&model, -Vector3::y()).unwrap().lambda,
+        None
+    );
 
     let o = crr(&["check", path.to_str().unwrap()]);
     assert!(o.status.success());
