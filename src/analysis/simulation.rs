@@ -630,6 +630,7 @@ impl Prepared {
                 max_impacts: p.max_impacts,
                 collapse_drop: p.collapse_drop,
                 friction: p.friction,
+                hold_seated_at_impacts: p.hold_seated_at_impacts,
             },
             solver_stats: SolverStats {
                 steps: t.solver_stats.steps,
@@ -889,6 +890,7 @@ mod tests {
             energy_lost: lost,
             energy_gain: true,
             seated: Vec::new(),
+            released: Vec::new(),
         }
     }
 

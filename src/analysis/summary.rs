@@ -139,6 +139,10 @@ pub struct SolverSettings {
     pub collapse_drop: f64,
     /// Friction coefficient μ checked by the monitor, if given.
     pub friction: Option<f64>,
+    /// Seated joints held through momentum-law impacts even where that pulls (`[analysis]`
+    /// `hold_seated_at_impacts`).
+    #[serde(default)]
+    pub hold_seated_at_impacts: bool,
 }
 
 /// The integrator's work over the run.

@@ -1,16 +1,186 @@
-//! An impact whose impulse needs tension is reported (docs/simulation.md, "Impulses at landings
-//! and impacts"), checked by hand on the bundled two-block stack: the impulse the stack's
-//! impact needs at its base's bed, from the bodies' velocities before and after it and the
-//! statics of the impulses on each block, independently of the engine's linear program.
+//! A momentum-law impact that would pull at a seated joint opens it instead (docs/simulation.md,
+//! "Impulses at landings and impacts"), checked by hand on the bundled two-block stack: from the
+//! bodies' velocities before the impact, their masses and their box inertias, independently of
+//! the engine's mass matrix, its impulse program and its linear program. With
+//! `hold_seated_at_impacts` (the paper's law) the joint is held and the pull is recorded, checked
+//! by hand against the statics of the impulses on each block.
 
 use crr::impact::SlotState;
 
+/// y-component of r × v for vectors in the xz-plane.
+fn cross_y(r: [f64; 2], v: [f64; 2]) -> f64 {
+    r[1] * v[0] - r[0] * v[1]
+}
+
+/// Velocity (x, z) of point `x` of a body turning at ω about y through `pivot`: ω ŷ × (x − p).
+fn turning(omega: f64, x: [f64; 2], pivot: [f64; 2]) -> [f64; 2] {
+    [omega * (x[1] - pivot[1]), -omega * (x[0] - pivot[0])]
+}
+
+fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+/// A body's angular momentum about y through `a`: I_c ω + m (c − a) × v_c.
+fn momentum_about(a: [f64; 2], (m, i, c): (f64, f64, [f64; 2]), omega: f64, v: [f64; 2]) -> f64 {
+    i * omega + m * cross_y(sub(c, a), v)
+}
+
+/// The two-block stack (`examples/models/two_block_stack.toml`: a 0.6 × 0.6 × 1.5 m base on the
+/// ground, pivots at x = ±0.3 m; a 0.4 × 0.4 × 1.6 m block on it, pivots at x = ±0.2 m, z = 1.5 m;
+/// 2400 kg/m³) rocks on its top block after the pulse, the base seated. At the impact of
+/// 1.8045 s the top block switches from its pivot P to P′ on the base's top face.
+///
+/// Holding the base (the momentum law with "the other hinges persisting") would pull: the top
+/// block's angular momentum about P′ kept gives its rate ω_h, its momentum change m(v⁺ − v⁻) is
+/// the impulse J it takes at P′, and the base, at rest, can pass J to the ground only through
+/// its pivot lines G± = (±0.3, 0): n⁺ + n⁻ = J_z and 0.6 n⁺ = r_x J_z − r_z J_x (r = P′ − G⁻),
+/// one of them below −1e-3 W √(L/g).
+///
+/// The engine opens the base instead (Moreau's impact): after it the base turns about one ground
+/// pivot G, the top block about P′. The impulses act at P′ (on the top block) and at G (on the
+/// structure) only, so the top block's angular momentum about P′ and the whole stack's about G are
+/// kept: two equations for the two rates (ω_b, ω_j), solved here, which the engine's rates match
+/// to 1e-9 of the rate before. Then the impulse at G pushes up, the top block is pushed up at P′,
+/// the base's other corner and the top block's old pivot rise, and T falls.
+#[test]
+fn the_two_block_stack_s_impact_opens_its_base_as_computed_by_hand() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/models/two_block_stack.toml");
+    let input = crr::ModelInput::read(&path).unwrap();
+    let run = crr::run(&input, &crr::RunOptions::default()).unwrap();
+    let (model, traj) = (&run.model, &run.trajectory);
+    let impact = traj
+        .impacts
+        .iter()
+        .find(|i| (i.t - 1.8045).abs() < 1e-4)
+        .expect("the top block's impact at 1.8045 s");
+    assert_eq!(impact.interfaces, ["joint"]);
+    assert_eq!(impact.released, [0], "the base opens at the impact");
+    // No tension recorded up to and at that impact.
+    if let Some(v) = &traj.violation {
+        assert!(v.t > impact.t, "{} at {} s", v.kind, v.t);
+    }
+    let at: Vec<_> = traj.samples.iter().filter(|s| s.t == impact.t).collect();
+    let (before, after) = (at.first().unwrap(), at.last().unwrap());
+    let (base, joint) = (0, 1);
+    assert_eq!(before.states[base], SlotState::Seated);
+    assert_eq!(before.qdot[base], 0.0);
+    assert_ne!(after.states[base], SlotState::Seated);
+    for s in [before, after] {
+        assert!(s.q[base].abs() < 1e-12 && s.q[joint].abs() < 1e-9);
+    }
+
+    // The bodies by hand: (mass, I_yy about the centre, centre (x, z)).
+    let lower = (2400.0 * 0.6 * 0.6 * 1.5, 0.0, [0.0, 0.75]);
+    let lower = (lower.0, lower.0 * (0.36 + 2.25) / 12.0, lower.2);
+    let upper = (2400.0 * 0.4 * 0.4 * 1.6, 0.0, [0.0, 2.3]);
+    let upper = (upper.0, upper.0 * (0.16 + 2.56) / 12.0, upper.2);
+    let top_pivot = |state: SlotState| match state {
+        SlotState::Positive => [0.2, 1.5],
+        SlotState::Negative => [-0.2, 1.5],
+        other => panic!("the top block rocks: {other:?}"),
+    };
+    let (p, p_new) = (
+        top_pivot(before.states[joint]),
+        top_pivot(after.states[joint]),
+    );
+    assert_ne!(p, p_new, "the top block switches pivot");
+    let g = match after.states[base] {
+        SlotState::Positive => [0.3, 0.0],
+        SlotState::Negative => [-0.3, 0.0],
+        other => panic!("the base rocks: {other:?}"),
+    };
+    let g_other = [-g[0], 0.0];
+
+    // Before: the base at rest, the top block turning about P.
+    let w = before.qdot[joint];
+    let v_top_minus = turning(w, upper.2, p);
+    let kinetic_minus =
+        0.5 * upper.0 * (v_top_minus[0].powi(2) + v_top_minus[1].powi(2)) + 0.5 * upper.1 * w * w;
+    assert!((kinetic_minus - before.kinetic).abs() < 1e-9 * kinetic_minus);
+    let h_top_minus = momentum_about(p_new, upper, w, v_top_minus);
+    let h_all_minus = momentum_about(g, upper, w, v_top_minus);
+
+    // After, for rates (ω_b, ω_j): the base about G, the top block about P′ carried by the base.
+    let velocities = |wb: f64, wj: f64| {
+        let v_low = turning(wb, lower.2, g);
+        let v_top = {
+            let a = turning(wb, upper.2, g);
+            let b = turning(wj, upper.2, p_new);
+            [a[0] + b[0], a[1] + b[1]]
+        };
+        (v_low, v_top)
+    };
+    let conserved = |wb: f64, wj: f64| {
+        let (v_low, v_top) = velocities(wb, wj);
+        (
+            momentum_about(p_new, upper, wb + wj, v_top),
+            momentum_about(g, upper, wb + wj, v_top) + momentum_about(g, lower, wb, v_low),
+        )
+    };
+    let (a11, a21) = conserved(1.0, 0.0);
+    let (a12, a22) = conserved(0.0, 1.0);
+    let det = a11 * a22 - a12 * a21;
+    let wb = (h_top_minus * a22 - a12 * h_all_minus) / det;
+    let wj = (a11 * h_all_minus - a21 * h_top_minus) / det;
+    println!(
+        "by hand ω_b = {wb}, ω_j = {wj}; engine {} and {}",
+        after.qdot[base], after.qdot[joint]
+    );
+    assert!((after.qdot[base] - wb).abs() < 1e-9 * w.abs(), "ω_b");
+    assert!((after.qdot[joint] - wj).abs() < 1e-9 * w.abs(), "ω_j");
+
+    // Moreau's conditions, by hand: compressive impulses where contacts stay, contacts that
+    // leave rise, and energy lost.
+    let (v_low, v_top) = velocities(wb, wj);
+    let on_top = [
+        upper.0 * (v_top[0] - v_top_minus[0]),
+        upper.0 * (v_top[1] - v_top_minus[1]),
+    ];
+    let from_ground = [
+        on_top[0] + lower.0 * v_low[0],
+        on_top[1] + lower.0 * v_low[1],
+    ];
+    assert!(on_top[1] > 0.0, "P′ pushes the top block up: {on_top:?}");
+    assert!(from_ground[1] > 0.0, "G pushes up: {from_ground:?}");
+    assert!(
+        turning(wb, g_other, g)[1] > 0.0,
+        "the base's other corner rises"
+    );
+    let p_relative = turning(wj, p, p_new);
+    assert!(p_relative[1] > 0.0, "the old pivot P rises off the base");
+    let kinetic_plus = 0.5 * lower.0 * (v_low[0].powi(2) + v_low[1].powi(2))
+        + 0.5 * lower.1 * wb * wb
+        + 0.5 * upper.0 * (v_top[0].powi(2) + v_top[1].powi(2))
+        + 0.5 * upper.1 * (wb + wj).powi(2);
+    assert!((kinetic_plus - after.kinetic).abs() < 1e-9 * kinetic_minus);
+    assert!(kinetic_plus < kinetic_minus);
+
+    // Holding the base would have pulled at the ground: the top block alone turning about P′,
+    // its angular momentum about P′ kept.
+    let (h11, _) = conserved(0.0, 1.0);
+    let w_held = h_top_minus / h11;
+    let v_held = turning(w_held, upper.2, p_new);
+    let j = [
+        upper.0 * (v_held[0] - v_top_minus[0]),
+        upper.0 * (v_held[1] - v_top_minus[1]),
+    ];
+    let r = sub(p_new, [-0.3, 0.0]);
+    let n_plus = (r[0] * j[1] - r[1] * j[0]) / 0.6;
+    let n_minus = j[1] - n_plus;
+    let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
+    println!("held: n⁺ = {n_plus} N s, n⁻ = {n_minus} N s (unit {unit} N s)");
+    assert!(n_plus.min(n_minus) < -1e-3 * unit);
+}
+
 /// The two-block stack (`examples/models/two_block_stack.toml`: a 0.6 × 0.6 × 1.5 m base on the
 /// ground, pivots at x = ±0.3 m; a 0.4 × 0.4 × 1.6 m block on it, pivots at x = ±0.2 m, z = 1.5 m)
-/// rocks on its top block after the pulse; the base stays seated through the top block's
-/// impacts (the engine holds it: "the other hinges persist"). At the impact of 1.8045 s the
-/// top block's impulse on the base's top face presses the base's edge under the new pivot and
-/// would lift the other one: the ground can balance it only by pulling at that far edge.
+/// rocks on its top block after the pulse; with `hold_seated_at_impacts` the base stays seated
+/// through the top block's impacts ("the other hinges persist", the paper's law). At the impact
+/// of 1.8045 s the top block's impulse on the base's top face presses the base's edge under the
+/// new pivot and would lift the other one: the ground can balance it only by pulling at that
+/// far edge, which the run records.
 ///
 /// By hand, from the samples just before and after the impact (the base at rest in both, the
 /// stack at its rest pose, the top block turning about its old pivot P before and its new one
@@ -23,9 +193,13 @@ use crr::impact::SlotState;
 /// program's impulses are of order one in its units of W √(L/g), solved to 1e-8 there), below
 /// the tolerance of 1e-3 W √(L/g).
 #[test]
-fn the_two_block_stack_s_impact_pulls_at_its_base_as_computed_by_hand() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples/models/two_block_stack.toml");
+fn held_through_the_impact_the_base_pulls_as_computed_by_hand() {
+    let text = crate::common::bundled_text("two_block_stack").replace(
+        "duration = 6.0",
+        "duration = 6.0\nhold_seated_at_impacts = true",
+    );
+    assert!(text.contains("hold_seated_at_impacts = true"));
+    let path = crate::common::write_model("two_block_stack_held", &text);
     let input = crr::ModelInput::read(&path).unwrap();
     let run = crr::run(&input, &crr::RunOptions::default()).unwrap();
     let (model, traj) = (&run.model, &run.trajectory);

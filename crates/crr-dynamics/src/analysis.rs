@@ -55,6 +55,10 @@ pub struct AnalysisSpec {
     pub friction: Option<f64>,
     /// Collapse when U drops below rest by this fraction of weight × model size. Default 1e-3.
     pub collapse_drop: f64,
+    /// Keep every seated joint seated through a momentum-law impact even where that pulls at
+    /// its contacts (the paper's "other hinges persisting", recorded as `impulse_tension`),
+    /// instead of opening those joints by Moreau's impact. Default false.
+    pub hold_seated_at_impacts: bool,
 }
 
 impl Default for AnalysisSpec {
@@ -73,6 +77,7 @@ impl Default for AnalysisSpec {
             max_impacts: 1_000_000,
             friction: None,
             collapse_drop: 1e-3,
+            hold_seated_at_impacts: false,
         }
     }
 }

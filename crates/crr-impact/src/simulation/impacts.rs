@@ -250,7 +250,7 @@ impl Simulation<'_> {
         // A rocking joint at φ ≈ 0 that the impact sends into its closed side impacts too (its
         // pivot switches): enlarge the impacting set until no joint penetrates.
         // Each round leaves its pivots in `after` and its configuration in `q_at`.
-        let (result, mut qdot_after, mut kinetic_after) = loop {
+        let (mut result, mut qdot_after, mut kinetic_after) = loop {
             after.clone_from(&before);
             for &s in &impacting {
                 after.sides[s] = before.sides[s].flipped();
@@ -313,6 +313,52 @@ impl Simulation<'_> {
             }
             impacting.extend_from_slice(&wrong);
         };
+        // Seated joints the impact opens, where holding them through a momentum-law impact
+        // would pull (module `impact_releases`: Moreau's impact, confirmed on the chain).
+        let momentum_law = impacting.iter().any(|&s| {
+            matches!(
+                model.interfaces[slot_interface(model, s)].impact,
+                ImpactLaw::Momentum
+            )
+        });
+        let mut released: Vec<usize> = Vec::new();
+        // Open chains only: on loops, following Moreau's impact led to flights and to states
+        // past their pivots at the next impacts (arches and walls, docs/simulation.md).
+        if momentum_law
+            && !held.is_empty()
+            && model.closures.is_empty()
+            && !self.params.hold_seated_at_impacts
+        {
+            let state = super::impact_releases::ImpactState {
+                t,
+                q: &q_at,
+                before: (&before, &qdot),
+                impacting: &impacting,
+                seat_rate: self.params.seat_rate,
+                simultaneity: self.params.simultaneity,
+            };
+            let opened = super::impact_releases::seated_joints_opened(
+                model,
+                &mut kin,
+                &mut laws,
+                &mut work,
+                self.ground,
+                &state,
+                (&after, &held),
+                (&result.qdot, &qdot_after),
+            )?;
+            if let Some(opened) = opened {
+                after = opened.after;
+                held = opened.held;
+                released = opened.slots;
+                result = opened.result;
+                qdot_after = opened.qdot;
+                kinetic_after = opened.kinetic;
+                forward_kinematics(model, &mut kin, &q_at, &after);
+                crr_kinematics::velocities(model, &mut kin, &qdot_after);
+                slot_rates(model, &kin, &qdot_after, &mut rates);
+            }
+        }
         let rates_after: Vec<f64> = impacting.iter().map(|&s| rates[s]).collect();
         // Seating of the impacting interfaces that come to rest. Seating one joint of a loop can
         // lock the others: seat, recompute the rates, and seat every impacting slot brought below
@@ -379,12 +425,6 @@ impl Simulation<'_> {
         // their interfaces take whatever impulse the law needs there (its own hypothesis), and
         // the contacts the impact holds besides (seated joints, other pivots, loops) are
         // checked; where every interface is the impact's, nothing is left to check.
-        let momentum_law = impacting.iter().any(|&s| {
-            matches!(
-                model.interfaces[slot_interface(model, s)].impact,
-                ImpactLaw::Momentum
-            )
-        });
         let set_by_law: &[usize] = if momentum_law { &[] } else { &impacting };
         let left_to_check = (0..model.interfaces.len()).any(|i| {
             !model.interfaces[i]
@@ -419,6 +459,7 @@ impl Simulation<'_> {
             energy_lost: lost,
             energy_gain: result.kinetic_after > result.kinetic_before * (1.0 + 1e-9) + 1e-12,
             seated: to_seat,
+            released,
         };
         // Sample just before the impact, then switch.
         self.record_current_sample(t);
@@ -427,7 +468,13 @@ impl Simulation<'_> {
         }
         // The switch; the pivots before go back to the scratch.
         std::mem::swap(&mut self.dynamics.pivots, &mut after);
-        self.set_seated(record.seated.iter().map(|&s| (s, true)));
+        self.set_seated(
+            record
+                .seated
+                .iter()
+                .map(|&s| (s, true))
+                .chain(record.released.iter().map(|&s| (s, false))),
+        );
         // The snaps (the impacting angles to 0 before the law, the seated ones and the loops
         // after it) change T + U: booked too.
         let u_snap = u_located - u_snapped + kinetic_after - t_snapped;

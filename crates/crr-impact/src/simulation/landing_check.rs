@@ -99,7 +99,7 @@ impl Simulation<'_> {
 /// `qdot_minus` to `qdot_after` (their momentum changes from their own velocities, ċ = J_c q̇
 /// and ω = J_ω q̇) on the touching points of the state in `d` (evaluated at q), the slots
 /// `set_by_law` touching on both pivots and their interfaces taking any impulse.
-fn least_tension(
+pub(super) fn least_tension(
     model: &Model,
     d: &Dynamics,
     q: &DVector<f64>,

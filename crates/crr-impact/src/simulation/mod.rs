@@ -46,6 +46,7 @@ use crate::laws::{
 
 mod certificate_audit;
 mod events;
+mod impact_releases;
 mod impacts;
 mod landing_check;
 mod open_loops;
@@ -116,6 +117,10 @@ pub struct Parameters {
     /// Collapse is declared when U falls below its rest value by this fraction of W·L (total
     /// weight times the model size) while the rotations grow. Default 1e-3.
     pub collapse_drop: f64,
+    /// Keep every seated joint seated through a momentum-law impact even where that pulls
+    /// (recorded as `impulse_tension`) instead of opening them by Moreau's impact
+    /// (`simulation::impact_releases`). Default false.
+    pub hold_seated_at_impacts: bool,
 }
 
 impl Default for Parameters {
@@ -146,6 +151,7 @@ impl Parameters {
             max_impacts: a.max_impacts,
             friction: a.friction,
             collapse_drop: a.collapse_drop,
+            hold_seated_at_impacts: a.hold_seated_at_impacts,
         })
     }
 }
@@ -195,6 +201,10 @@ pub struct ImpactRecord {
     pub energy_gain: bool,
     /// Slots seated at this impact.
     pub seated: Vec<usize>,
+    /// Seated slots this impact opened (a momentum-law impact that would otherwise pull at
+    /// them: Moreau's impact, `simulation::impact_releases`), now rocking on the pivot of
+    /// their state after it.
+    pub released: Vec<usize>,
 }
 
 /// A local extremum of a rocking coordinate (q̇ = 0), located on the dense output.
@@ -1805,6 +1815,7 @@ mod invariant_tests {
             energy_lost: 1.0,
             energy_gain: false,
             seated: Vec::new(),
+            released: Vec::new(),
         });
         match sim.check_invariant() {
             Err(SimulationError::Invariant(m)) => {
@@ -1950,6 +1961,7 @@ mod chatter_tests {
             energy_lost: 0.0,
             energy_gain: false,
             seated: vec![],
+            released: vec![],
         }
     }
 

@@ -711,6 +711,7 @@ impl Simulation<'_> {
             energy_lost: lost,
             energy_gain: lost < -1e-12 * t_minus.abs().max(1e-300),
             seated: to_seat,
+            released: Vec::new(),
         };
         for &s in &slots {
             self.last_impact[s] = t;

@@ -918,7 +918,7 @@ pub(super) fn closure_other_side_reaction(
 }
 
 /// Whether slot `k` is a tilt of a loop-closing seat that may twist.
-fn is_twisting_closure_slot(model: &Model, k: usize) -> bool {
+pub(super) fn is_twisting_closure_slot(model: &Model, k: usize) -> bool {
     k >= model.dof()
         && matches!(
             model.interfaces[slot_interface(model, k)].kind,
