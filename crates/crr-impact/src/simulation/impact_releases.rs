@@ -31,12 +31,16 @@ use landing_check::{IMPULSE_TENSION_TOLERANCE, least_tension};
 pub(super) struct Released {
     /// The pivots after the impact, the released joints on their new sides.
     pub after: ActivePivots,
-    /// The joints still held through the impact.
+    /// The joints seated before the impact and still held through it (the impacting or rocking
+    /// joints it brings to rest are at rate 0 in `qdot`, and the impact seats them).
     pub held: Vec<usize>,
     /// The released slots.
     pub slots: Vec<usize>,
     /// The law's result on that chain (T⁻ and the free velocities).
     pub result: crate::laws::ImpactResult,
+    /// q at the impact with the released tree joints at exactly 0 (a seated angle can carry the
+    /// round-off of the step that seated it, which on the other pivot is its wrong side).
+    pub q: DVector<f64>,
     /// q̇⁺ with `held` held, and T⁺.
     pub qdot: DVector<f64>,
     /// T⁺ (J).
@@ -44,6 +48,7 @@ pub(super) struct Released {
 }
 
 /// What a momentum-law impact needs to be re-posed: the state at φ = 0 and before it.
+#[derive(Clone, Copy)]
 pub(super) struct ImpactState<'a> {
     pub t: f64,
     /// q at the impact (the impacting angles at 0).
@@ -52,6 +57,10 @@ pub(super) struct ImpactState<'a> {
     pub before: (&'a ActivePivots, &'a DVector<f64>),
     /// The impacting slots.
     pub impacting: &'a [usize],
+    /// The impacting slots that impacted within `min_impact_interval` (they seat at this one).
+    pub recent: &'a [usize],
+    /// The chain has faces lifted off (a structure with loops, opened): nothing is released.
+    pub open_faces: bool,
     /// The minimum rate of a joint that opens (rad/s).
     pub seat_rate: f64,
     /// The angle within which joints count as at their seats (rad).
@@ -96,7 +105,12 @@ pub(super) fn seated_joints_opened(
     (after, held): (&ActivePivots, &[usize]),
     (free, qdot_after): (&DVector<f64>, &DVector<f64>),
 ) -> Result<Option<Released>, SimulationError> {
-    if held.is_empty() || pulls(model, work, ground, s, after, held, qdot_after) != Some(true) {
+    // A chain with faces lifted off (a structure with loops, opened): the joints stay held
+    // (see the module's docs).
+    if held.is_empty()
+        || s.open_faces
+        || pulls(model, work, ground, s, after, held, qdot_after) != Some(true)
+    {
         return Ok(None);
     }
     // Moreau's impact from the law's free velocities: `work` holds the chain after the impact
@@ -120,8 +134,15 @@ pub(super) fn seated_joints_opened(
     // The program's releases, less those the chain sends back into their seats: a release
     // whose rate is of the order of the program's tolerance may close on the chain, and is held
     // again (at most one round per release).
+    // The program's releases, less those the chain sends back into their seats (a release
+    // slower than `seat_rate`, as the program's tolerance allows, is held again); and the
+    // impact's seating candidates (the impacting joints, those rocking near their seats) that
+    // the chain brings to rest or sends into their seats, seated with it as the impact does
+    // (held here, seated by the impact after this). Each round holds at least one more joint.
     let mut releases = decision.releases;
+    let mut seating: Vec<usize> = s.recent.to_vec();
     let (before, qdot) = s.before;
+    let mut q = s.q.clone();
     let mut angles = vec![0.0; model.slot_count];
     let mut rates = vec![0.0; model.slot_count];
     let (opened, still, slots, result, qdot_released, kinetic) = loop {
@@ -133,11 +154,16 @@ pub(super) fn seated_joints_opened(
             opened.sides[k] = side;
         }
         let slots: Vec<usize> = releases.iter().map(|&(k, _)| k).collect();
+        q.clone_from(s.q);
+        for &k in slots.iter().filter(|&&k| k < model.dof()) {
+            q[k] = 0.0;
+        }
         let still: Vec<usize> = held
             .iter()
             .copied()
             .filter(|k| !slots.contains(k))
             .collect();
+        let holding: Vec<usize> = still.iter().chain(&seating).copied().collect();
         // The law again, on the chain with the released joints on their new pivots (at φ = 0
         // both pivots place the bodies alike), and the joints still seated held.
         let Ok(result) = apply_law(
@@ -147,47 +173,65 @@ pub(super) fn seated_joints_opened(
             work,
             ground,
             s.t,
-            s.q,
+            &q,
             qdot,
             before,
             &opened,
             s.impacting,
-            &still,
+            &holding,
         ) else {
             return Ok(None);
         };
-        let (qdot_released, kinetic) =
-            plastic_projection(model, work, ground, s.t, s.q, &result.qdot, &opened, &still)?;
-        slot_angles(model, kin, s.q, &opened, &mut angles);
+        let Ok((qdot_released, kinetic)) = plastic_projection(
+            model,
+            work,
+            ground,
+            s.t,
+            &q,
+            &result.qdot,
+            &opened,
+            &holding,
+        ) else {
+            return Ok(None);
+        };
+        slot_angles(model, kin, &q, &opened, &mut angles);
         crr_kinematics::velocities(model, kin, &qdot_released);
         slot_rates(model, kin, &qdot_released, &mut rates);
-        let closing = releases.len();
+        let count = releases.len() + seating.len();
         releases.retain(|&(k, side)| side.sign() * rates[k] >= s.seat_rate);
-        if releases.len() == closing {
-            break (opened, still, slots, result, qdot_released, kinetic);
+        seating.extend((0..model.slot_count).filter(|&k| {
+            !holding.contains(&k)
+                && !slots.contains(&k)
+                && (s.impacting.contains(&k) || angles[k].abs() <= s.simultaneity)
+                && (rates[k].abs() < s.seat_rate || opened.sides[k].sign() * rates[k] < 0.0)
+        }));
+        if releases.len() + seating.len() == count {
+            break (opened, holding, slots, result, qdot_released, kinetic);
         }
     };
-    // Moreau's conditions on the answer: each released joint opens on its new pivot (above),
-    // no joint near its seat turns into it, T does not grow, and every contact that stays
+    // Moreau's conditions on the answer: each released joint opens on its new pivot and no
+    // joint near its seat turns into it (above), T does not grow, and every contact that stays
     // pushes.
-    let into_a_seat = (0..model.slot_count).any(|k| {
-        !still.contains(&k)
-            && !slots.contains(&k)
-            && !s.impacting.contains(&k)
-            && angles[k].abs() <= s.simultaneity
-            && opened.sides[k].sign() * rates[k] < -1e-12
-    });
-    if into_a_seat
-        || kinetic > result.kinetic_before * (1.0 + 1e-9)
-        || pulls(model, work, ground, s, &opened, &still, &qdot_released) != Some(false)
+    if kinetic > result.kinetic_before * (1.0 + 1e-9)
+        || pulls(
+            model,
+            work,
+            ground,
+            &ImpactState { q: &q, ..*s },
+            &opened,
+            &still,
+            &qdot_released,
+        ) != Some(false)
     {
         return Ok(None);
     }
+    let still: Vec<usize> = still.into_iter().filter(|k| held.contains(k)).collect();
     Ok(Some(Released {
         after: opened,
         held: still,
         slots,
         result,
+        q,
         qdot: qdot_released,
         kinetic,
     }))

@@ -329,11 +329,18 @@ impl Simulation<'_> {
             && model.closures.is_empty()
             && !self.params.hold_seated_at_impacts
         {
+            let recent: Vec<usize> = impacting
+                .iter()
+                .copied()
+                .filter(|&s| t - self.last_impact[s] < self.params.min_impact_interval)
+                .collect();
             let state = super::impact_releases::ImpactState {
                 t,
                 q: &q_at,
                 before: (&before, &qdot),
                 impacting: &impacting,
+                recent: &recent,
+                open_faces: !self.open.faces.is_empty(),
                 seat_rate: self.params.seat_rate,
                 simultaneity: self.params.simultaneity,
             };
@@ -352,6 +359,7 @@ impl Simulation<'_> {
                 held = opened.held;
                 released = opened.slots;
                 result = opened.result;
+                q_at = opened.q;
                 qdot_after = opened.qdot;
                 kinetic_after = opened.kinetic;
                 forward_kinematics(model, &mut kin, &q_at, &after);
