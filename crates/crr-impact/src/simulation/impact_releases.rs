@@ -25,7 +25,7 @@
 //! loop-closing seats that may twist (a flip of their pivot moves their loop's rows).
 
 use super::*;
-use landing_check::{IMPULSE_TENSION_TOLERANCE, least_tension};
+use landing_check::{least_tension, pulls_beyond_tolerance};
 
 /// The chain after an impact with seated joints opened (see the module's docs).
 pub(super) struct Released {
@@ -85,8 +85,7 @@ fn pulls(
     work.seated.dedup();
     work.evaluate(model, ground, s.t, s.q, qdot_after);
     let least = least_tension(model, work, s.q, s.before, qdot_after, &[])?;
-    let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
-    Some(least.min_normal < -IMPULSE_TENSION_TOLERANCE * unit)
+    Some(pulls_beyond_tolerance(model, &least))
 }
 
 /// The chain after a momentum-law impact whose held joints would pull, with the seated joints
@@ -131,9 +130,6 @@ pub(super) fn seated_joints_opened(
     {
         return Ok(None);
     }
-    // The program's releases, less those the chain sends back into their seats: a release
-    // whose rate is of the order of the program's tolerance may close on the chain, and is held
-    // again (at most one round per release).
     // The program's releases, less those the chain sends back into their seats (a release
     // slower than `seat_rate`, as the program's tolerance allows, is held again); and the
     // impact's seating candidates (the impacting joints, those rocking near their seats) that

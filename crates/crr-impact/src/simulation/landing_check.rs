@@ -70,13 +70,9 @@ impl Simulation<'_> {
         model: &Model,
         least: Option<crate::face_forces::MostCompressive>,
     ) {
-        let Some(least) = least else {
+        let Some(least) = least.filter(|l| pulls_beyond_tolerance(model, l)) else {
             return;
         };
-        let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
-        if least.min_normal >= -IMPULSE_TENSION_TOLERANCE * unit {
-            return;
-        }
         let Some(limiting) = least.limiting else {
             return;
         };
@@ -93,6 +89,16 @@ impl Simulation<'_> {
             lost: self.lost_at_impacts(),
         });
     }
+}
+
+/// Whether the least normal impulse of `least` is below −[`IMPULSE_TENSION_TOLERANCE`]
+/// W·√(L/g): an impulse that pulls.
+pub(super) fn pulls_beyond_tolerance(
+    model: &Model,
+    least: &crate::face_forces::MostCompressive,
+) -> bool {
+    let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
+    least.min_normal < -IMPULSE_TENSION_TOLERANCE * unit
 }
 
 /// The most compressive distribution of the contact impulses that take the bodies from
