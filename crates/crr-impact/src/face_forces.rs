@@ -43,6 +43,9 @@ use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent, Role, Side};
 use crate::least_norm::LeastNorm;
 use crate::monitor::ForceWork;
 
+mod tree;
+pub use tree::{LeastNormal, least_normal_impulse_on_tree};
+
 /// Weight ε of the proximal term ½ε‖f‖² added to the program (forces in units of the weight W).
 /// It makes the program strictly convex in the forces, so that among the optimal distributions
 /// it takes the least-norm one and the interior point's systems stay well conditioned on
@@ -70,6 +73,8 @@ pub struct MostCompressive {
 #[derive(Clone, Debug)]
 struct Unknown {
     interface: usize,
+    /// Whether it is a normal force that must push (fₙ ≥ s).
+    unilateral: bool,
     /// The point (world, current), None for a couple.
     point: Option<Vector3<f64>>,
     /// Direction (world, current).
@@ -190,73 +195,20 @@ impl FaceProgram {
         }
         let mut unknowns = Vec::new();
         let mut unilateral = Vec::new();
-        for (index, iface) in model.interfaces.iter().enumerate() {
-            let face = ContactFace::of_interface(model, index);
-            let frame = model.frame_of(iface.parent);
-            let rot = if posed_on == FaceAxes::Leaving
-                && leaves_along_child_normal(&iface.kind, &is_seated[iface.slots.clone()])
-            {
-                dynamics.kin.rot_ops[model.body_coord[iface.child]]
-            } else {
-                frame.map_or_else(Matrix3::identity, |k| dynamics.kin.rot_ops[k])
-            };
-            let axes = [
-                rot * face.normal,
-                rot * face.tangents[0],
-                rot * face.tangents[1],
-            ];
-            let by_law = iface.slots.clone().any(|k| set_by_law.contains(&k));
-            let points = touching_points(
-                &iface.kind,
-                &is_seated[iface.slots.clone()],
-                dynamics.pivots.of_interface(model, index),
+        for index in 0..model.interfaces.len() {
+            let first = unknowns.len();
+            interface_columns(
+                model,
+                dynamics,
+                index,
+                (&is_seated, set_by_law),
+                posed_on,
+                &mut unknowns,
             );
-            let twist = matches!(iface.kind, InterfaceKind::RockingBase { twist: true, .. });
-            for (p, rest) in points.iter().enumerate() {
-                let point = frame_point(&dynamics.kin, frame, rest);
-                let along = if twist && p > 0 {
-                    &axes[..1]
-                } else {
-                    &axes[..]
-                };
-                for (k, &direction) in along.iter().enumerate() {
-                    if k == 0 && !face.pin && !by_law {
-                        unilateral.push(1 + unknowns.len());
-                    }
-                    unknowns.push(Unknown {
-                        interface: index,
-                        point: Some(point),
-                        direction,
-                        key: UnknownKey {
-                            interface: index,
-                            rest: Some([rest.x.to_bits(), rest.y.to_bits(), rest.z.to_bits()]),
-                            along: k,
-                        },
-                    });
-                }
-            }
-            let mut couples: Vec<Vector3<f64>> =
-                face.bilateral_couples.iter().map(|c| rot * c).collect();
-            if !twist
-                && points.len() == 1
-                && matches!(iface.kind, InterfaceKind::RockingBase { .. })
-            {
-                couples.push(torsion_axis(model, &dynamics.kin, index));
-            }
-            unknowns.extend(
-                couples
-                    .into_iter()
-                    .enumerate()
-                    .map(|(k, direction)| Unknown {
-                        interface: index,
-                        point: None,
-                        direction,
-                        key: UnknownKey {
-                            interface: index,
-                            rest: None,
-                            along: k,
-                        },
-                    }),
+            unilateral.extend(
+                (first..unknowns.len())
+                    .filter(|&j| unknowns[j].unilateral)
+                    .map(|j| 1 + j),
             );
         }
         // Six rows per body: force / W, moment about the centre / (W·size); every entry kept
@@ -857,6 +809,83 @@ fn torsion_axis(model: &Model, kin: &crr_kinematics::Data, index: usize) -> Vect
         }
     };
     w1.cross(&w2).normalize()
+}
+
+/// Appends to `unknowns` the columns of interface `index` at the state in `dynamics`: a force
+/// along each of the face's axes at every touching point (a normal one `unilateral` unless the
+/// face is a pin or its slots are `set_by_law`), then its bilateral couples. `is_seated` marks
+/// the seated slots (and those set by law), every slot of the model.
+fn interface_columns(
+    model: &Model,
+    dynamics: &Dynamics,
+    index: usize,
+    (is_seated, set_by_law): (&[bool], &[usize]),
+    posed_on: FaceAxes,
+    unknowns: &mut Vec<Unknown>,
+) {
+    let iface = &model.interfaces[index];
+    let face = ContactFace::of_interface(model, index);
+    let frame = model.frame_of(iface.parent);
+    let rot = if posed_on == FaceAxes::Leaving
+        && leaves_along_child_normal(&iface.kind, &is_seated[iface.slots.clone()])
+    {
+        dynamics.kin.rot_ops[model.body_coord[iface.child]]
+    } else {
+        frame.map_or_else(Matrix3::identity, |k| dynamics.kin.rot_ops[k])
+    };
+    let axes = [
+        rot * face.normal,
+        rot * face.tangents[0],
+        rot * face.tangents[1],
+    ];
+    let by_law = iface.slots.clone().any(|k| set_by_law.contains(&k));
+    let points = touching_points(
+        &iface.kind,
+        &is_seated[iface.slots.clone()],
+        dynamics.pivots.of_interface(model, index),
+    );
+    let twist = matches!(iface.kind, InterfaceKind::RockingBase { twist: true, .. });
+    for (p, rest) in points.iter().enumerate() {
+        let point = frame_point(&dynamics.kin, frame, rest);
+        let along = if twist && p > 0 {
+            &axes[..1]
+        } else {
+            &axes[..]
+        };
+        for (k, &direction) in along.iter().enumerate() {
+            unknowns.push(Unknown {
+                interface: index,
+                unilateral: k == 0 && !face.pin && !by_law,
+                point: Some(point),
+                direction,
+                key: UnknownKey {
+                    interface: index,
+                    rest: Some([rest.x.to_bits(), rest.y.to_bits(), rest.z.to_bits()]),
+                    along: k,
+                },
+            });
+        }
+    }
+    let mut couples: Vec<Vector3<f64>> = face.bilateral_couples.iter().map(|c| rot * c).collect();
+    if !twist && points.len() == 1 && matches!(iface.kind, InterfaceKind::RockingBase { .. }) {
+        couples.push(torsion_axis(model, &dynamics.kin, index));
+    }
+    unknowns.extend(
+        couples
+            .into_iter()
+            .enumerate()
+            .map(|(k, direction)| Unknown {
+                interface: index,
+                unilateral: false,
+                point: None,
+                direction,
+                key: UnknownKey {
+                    interface: index,
+                    rest: None,
+                    along: k,
+                },
+            }),
+    );
 }
 
 /// The points (world at rest) on which interface `kind` touches with its slots seated as

@@ -14,7 +14,7 @@
 //! answer is taken only when it meets Moreau's conditions, checked on the bodies' velocities
 //! and the contact points' impulses, not on the program's own numbers: every released joint
 //! opens (its rate on its new pivot above `seat_rate`), no other joint near its seat turns into
-//! it, and the impulse now pushes at every contact ([`least_tension`] within the tolerance).
+//! it, and the impulse now pushes at every contact ([`least_normal_impulse`] within the tolerance).
 //! Where the momentum law's hinges persist with compressive impulses, the two laws agree
 //! (Moreau's optimality conditions hold at the plastic impulse exactly when compressive contact
 //! impulses give it) and nothing here runs.
@@ -25,7 +25,7 @@
 //! loop-closing seats that may twist (a flip of their pivot moves their loop's rows).
 
 use super::*;
-use landing_check::{least_tension, pulls_beyond_tolerance};
+use landing_check::{least_normal_impulse, pulls_beyond_tolerance};
 
 /// The chain after an impact with seated joints opened (see the module's docs).
 pub(super) struct Released {
@@ -84,8 +84,8 @@ fn pulls(
     work.seated.sort_unstable();
     work.seated.dedup();
     work.evaluate(model, ground, s.t, s.q, qdot_after);
-    let least = least_tension(model, work, s.q, s.before, qdot_after, &[])?;
-    Some(pulls_beyond_tolerance(model, &least))
+    let least = least_normal_impulse(model, work, s.q, s.before, qdot_after, &[])?;
+    Some(pulls_beyond_tolerance(model, least.min_normal))
 }
 
 /// The chain after a momentum-law impact whose held joints would pull, with the seated joints

@@ -8,7 +8,9 @@
 //! through it (`impacts`). Physically each contact can only push. Whether some distribution of
 //! compressive contact impulses (tangential ones free: no sliding) gives the impulse is a
 //! linear program on the touching points after it, with each body's momentum change as its
-//! load ([`least_tension`], `face_forces::most_compressive_impulses`); the first impulse whose
+//! load ([`least_normal_impulse`]: on an open chain, whose interfaces' impulses statics fixes,
+//! a check of each face on its own; otherwise `face_forces::most_compressive_impulses`); the
+//! first impulse whose
 //! least normal impulse is below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g) is recorded as a
 //! hypothesis violation (`impulse_tension`). The run goes on with the impulse as it was: the
 //! check records, it changes nothing.
@@ -25,6 +27,7 @@
 //! the walls measured the chain without them drove most of them back into their supports.
 
 use super::*;
+use crate::face_forces::LeastNormal;
 
 /// The least tension of a landing's impulse that is recorded, in W·√(L/g) (W the structure's
 /// weight, L its size): the monitor's 1e-3 W on the contact forces, over the structure's time
@@ -36,7 +39,7 @@ impl Simulation<'_> {
     /// tension: from `qdot_minus` on the chain `pivots_before` to `qdot_after` on the chain
     /// evaluated in `d` (at q, its pivots and seated slots those after the impulse), the most
     /// compressive distribution of the contact impulses over the touching points after it
-    /// ([`least_tension`]) has a normal impulse below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g).
+    /// ([`least_normal_impulse`]) has a normal impulse below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g).
     /// The record names the contact that limits it, with that impulse (N s) as its `normal`.
     /// The slots `set_by_law` (an impact's whose law sets the rates) touch on both pivots and
     /// their interfaces take any impulse there: only the other contacts are checked.
@@ -52,7 +55,7 @@ impl Simulation<'_> {
             return;
         }
         let model = Arc::clone(&self.model);
-        let least = least_tension(
+        let least = least_normal_impulse(
             &model,
             d,
             q,
@@ -65,12 +68,8 @@ impl Simulation<'_> {
 
     /// Records `least` as the first violation when its least normal impulse is below the
     /// tolerance.
-    fn record_impulse_tension(
-        &mut self,
-        model: &Model,
-        least: Option<crate::face_forces::MostCompressive>,
-    ) {
-        let Some(least) = least.filter(|l| pulls_beyond_tolerance(model, l)) else {
+    fn record_impulse_tension(&mut self, model: &Model, least: Option<LeastNormal>) {
+        let Some(least) = least.filter(|l| pulls_beyond_tolerance(model, l.min_normal)) else {
             return;
         };
         let Some(limiting) = least.limiting else {
@@ -91,28 +90,51 @@ impl Simulation<'_> {
     }
 }
 
-/// Whether the least normal impulse of `least` is below −[`IMPULSE_TENSION_TOLERANCE`]
+/// Whether the least normal impulse `min_normal` (N s) is below −[`IMPULSE_TENSION_TOLERANCE`]
 /// W·√(L/g): an impulse that pulls.
-pub(super) fn pulls_beyond_tolerance(
-    model: &Model,
-    least: &crate::face_forces::MostCompressive,
-) -> bool {
+pub(super) fn pulls_beyond_tolerance(model: &Model, min_normal: f64) -> bool {
     let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
-    least.min_normal < -IMPULSE_TENSION_TOLERANCE * unit
+    min_normal < -IMPULSE_TENSION_TOLERANCE * unit
 }
 
-/// The most compressive distribution of the contact impulses that take the bodies from
-/// `qdot_minus` to `qdot_after` (their momentum changes from their own velocities, ċ = J_c q̇
-/// and ω = J_ω q̇) on the touching points of the state in `d` (evaluated at q), the slots
-/// `set_by_law` touching on both pivots and their interfaces taking any impulse.
-pub(super) fn least_tension(
+/// The least normal impulse (N s) of the most compressive distribution of the contact impulses
+/// that take the bodies from `qdot_minus` on `pivots_before` to `qdot_after` (their momentum
+/// changes from their own velocities, [`momentum_changes`]) on the touching points of the state
+/// in `d` (evaluated at q), the slots `set_by_law` touching on both pivots and their interfaces
+/// taking any impulse; and the contact that limits it. On an open chain each interface's
+/// impulse is fixed by statics and checked on its own face
+/// ([`crate::face_forces::least_normal_impulse_on_tree`]); otherwise, or where that does not
+/// answer, one linear program over every touching point
+/// ([`crate::face_forces::most_compressive_impulses`]).
+pub(super) fn least_normal_impulse(
     model: &Model,
     d: &Dynamics,
     q: &DVector<f64>,
     (pivots_before, qdot_minus): (&ActivePivots, &DVector<f64>),
     qdot_after: &DVector<f64>,
     set_by_law: &[usize],
-) -> Option<crate::face_forces::MostCompressive> {
+) -> Option<LeastNormal> {
+    let changes = momentum_changes(model, d, q, (pivots_before, qdot_minus), qdot_after);
+    crate::face_forces::least_normal_impulse_on_tree(model, d, &changes, set_by_law).or_else(|| {
+        crate::face_forces::most_compressive_impulses(model, d, &changes, set_by_law).map(|least| {
+            LeastNormal {
+                min_normal: least.min_normal,
+                limiting: least.limiting,
+            }
+        })
+    })
+}
+
+/// Every body's momentum change (m_b Δċ_b, I_b Δω_b) from `qdot_minus` on the chain
+/// `pivots_before` to `qdot_after` on the chain of `d`, at q, from the bodies' own velocities
+/// (ċ = J_c q̇ and ω = J_ω q̇).
+fn momentum_changes(
+    model: &Model,
+    d: &Dynamics,
+    q: &DVector<f64>,
+    (pivots_before, qdot_minus): (&ActivePivots, &DVector<f64>),
+    qdot_after: &DVector<f64>,
+) -> Vec<(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)> {
     let velocities = |pivots: &ActivePivots, qdot: &DVector<f64>| {
         let mut kin = Data::new(model);
         forward_kinematics(model, &mut kin, q, pivots);
@@ -122,7 +144,7 @@ pub(super) fn least_tension(
     let (v_minus, w_minus, _) = velocities(pivots_before, qdot_minus);
     let (v_plus, w_plus, kin) = velocities(&d.pivots, qdot_after);
     let (dv, dw) = (v_plus - v_minus, w_plus - w_minus);
-    let changes: Vec<(nalgebra::Vector3<f64>, nalgebra::Vector3<f64>)> = model
+    model
         .bodies
         .iter()
         .enumerate()
@@ -134,8 +156,7 @@ pub(super) fn least_tension(
                 inertia * dw.fixed_rows::<3>(3 * b),
             )
         })
-        .collect();
-    crate::face_forces::most_compressive_impulses(model, d, &changes, set_by_law)
+        .collect()
 }
 
 #[cfg(test)]
@@ -198,7 +219,8 @@ mod tests {
             let decision = impulse_qp(&model, &d, &qdot).expect("the impulse program solves");
             let momentum = &d.kin.mass_matrix * &qdot;
             let after = d.solve_impulse(&model, 0.0, &momentum).unwrap().clone();
-            let lp = least_tension(&model, &d, &q, (&d.pivots, &qdot), &after, &[])
+            let changes = momentum_changes(&model, &d, &q, (&d.pivots, &qdot), &after);
+            let lp = crate::face_forces::most_compressive_impulses(&model, &d, &changes, &[])
                 .expect("the LP solves");
             let s = lp.min_normal / unit;
             if decision.releases.is_empty() && decision.lifting_off.is_empty() {
