@@ -353,7 +353,8 @@ class Result:
             rocking base joined by ``/``), shape (n, interfaces), dtype str.
         coordinates, interfaces: the column names.
         impacts: the impact log, one dict per impact (``t`` s, ``interfaces``, ``rates_before``
-            and ``rates_after`` rad/s, ``energy_lost`` J).
+            and ``rates_after`` rad/s, ``energy_lost`` J, ``opened``: the seated joints the
+            impact opened, by slot name).
         summary: the content of ``summary.json`` (peaks, peak/α, impacts, uplift, collapse,
             energy balance, warnings).
     """
@@ -493,13 +494,13 @@ class Result:
 
     def impacts_frame(self) -> "pandas.DataFrame":
         """The impact log as a pandas DataFrame (columns ``t``, ``interfaces``,
-        ``rates_before``, ``rates_after``, ``energy_lost``; the list-valued columns hold
-        lists)."""
+        ``rates_before``, ``rates_after``, ``energy_lost``, ``opened``; the list-valued columns
+        hold lists)."""
         pd = _pandas("Result.impacts_frame")
 
         return pd.DataFrame(
             self.impacts,
-            columns=["t", "interfaces", "rates_before", "rates_after", "energy_lost"],
+            columns=["t", "interfaces", "rates_before", "rates_after", "energy_lost", "opened"],
         )
 
     def write(self, folder: PathLike) -> None:

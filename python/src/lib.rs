@@ -22,7 +22,7 @@ use crr::dynamics::ground_motion::{Axis, Record, RecordFormat, Units};
 use crr::impact::{SlotState, Trajectory};
 use crr::input::model_file::{ModelFile, build_model, load_model, parse_model_text};
 use crr::kinematics::Model as Structure;
-use crr::output::history::{history_csv, impacts_csv, openings_csv};
+use crr::output::history::{history_csv, impacts_csv, opened_names, openings_csv};
 use crr::output::study::folder::header;
 use crr::output::study::{StudyOptions, case_rows_cancellable, cases_csv, run_study};
 use crr::{ModelInput, RecordFile, RecordSamples, RunOptions};
@@ -308,7 +308,7 @@ impl PyRun {
     }
 
     /// The impact log: one dict per impact (t in s, interfaces, rates before and after in
-    /// rad/s, energy lost in J).
+    /// rad/s, energy lost in J, the seated joints it opened).
     fn impacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let list = PyList::empty(py);
         for i in &self.trajectory.impacts {
@@ -318,6 +318,7 @@ impl PyRun {
             d.set_item("rates_before", i.rates_before.clone())?;
             d.set_item("rates_after", i.rates_after.clone())?;
             d.set_item("energy_lost", i.energy_lost)?;
+            d.set_item("opened", opened_names(&self.structure, &i.released))?;
             list.append(d)?;
         }
         Ok(list)
@@ -342,7 +343,7 @@ impl PyRun {
 
     /// The text of impacts.csv, as `crr simulate` writes it.
     fn impacts_csv(&self) -> String {
-        impacts_csv(&self.trajectory)
+        impacts_csv(&self.structure, &self.trajectory)
     }
 
     /// The text of openings.csv, as `crr simulate` writes it: the offset of every face open at

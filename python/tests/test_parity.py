@@ -49,12 +49,13 @@ def assert_same_run(result: crr.Result, out: Path) -> None:
     assert len(result.impacts) == summary["impacts"]
     lines = (out / "impacts.csv").read_text().splitlines()[1:]
     for record, line in zip(result.impacts, lines):
-        t, interfaces, before, after, lost = line.split(",")
+        t, interfaces, before, after, lost, opened = line.split(",")
         assert record["t"] == float(t)
         assert record["interfaces"] == interfaces.split(";")
         assert record["rates_before"] == [float(x) for x in before.split(";")]
         assert record["rates_after"] == [float(x) for x in after.split(";")]
         assert record["energy_lost"] == float(lost)
+        assert record["opened"] == [s for s in opened.split(";") if s]
 
 
 @pytest.mark.parametrize("model", MODELS)

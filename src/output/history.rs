@@ -92,19 +92,26 @@ pub fn history_csv(model: &Model, t: &Trajectory) -> String {
     s
 }
 
-/// The text of `impacts.csv`.
-pub fn impacts_csv(t: &Trajectory) -> String {
-    let mut s = String::from("t,interfaces,rates_before,rates_after,energy_lost\n");
+/// The text of `impacts.csv`: one row per impact, with the seated joints it opened (slot names,
+/// as `crr inspect` names them) last.
+pub fn impacts_csv(model: &Model, t: &Trajectory) -> String {
+    let mut s = String::from("t,interfaces,rates_before,rates_after,energy_lost,opened\n");
     let join = |v: &[f64]| v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(";");
     for i in &t.impacts {
         s.push_str(&format!(
-            "{},{},{},{},{}\n",
+            "{},{},{},{},{},{}\n",
             num(i.t),
             i.interfaces.join(";"),
             join(&i.rates_before),
             join(&i.rates_after),
-            num(i.energy_lost)
+            num(i.energy_lost),
+            opened_names(model, &i.released).join(";")
         ));
     }
     s
+}
+
+/// The names of the seated joints an impact opened (`ImpactRecord::released`), by slot.
+pub fn opened_names(model: &Model, released: &[usize]) -> Vec<String> {
+    released.iter().map(|&k| model.slot_name(k)).collect()
 }

@@ -100,7 +100,7 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
         file.sync_all().map_err(output_error)?;
     }
     let files = [
-        ("impacts.csv", impacts_csv(&run.trajectory)),
+        ("impacts.csv", impacts_csv(&p.model, &run.trajectory)),
         ("summary.json", run.summary.to_json()),
     ];
     write_outputs_with(out, &["history.csv", "openings.csv"], &files).map_err(output_error)?;

@@ -66,7 +66,7 @@ fn single_block_files_columns_and_closed_forms() {
     let imp = std::fs::read_to_string(out.join("impacts.csv")).unwrap();
     assert_eq!(
         imp.lines().next().unwrap(),
-        "t,interfaces,rates_before,rates_after,energy_lost"
+        "t,interfaces,rates_before,rates_after,energy_lost,opened"
     );
     // Closed forms: θ̈ = −p² sin(α − θ) for θ > 0; a quarter cycle from θm takes
     // τ = ∫₀^θm dθ / √(2p²(cos(α − θm) − cos(α − θ))); at each impact θ̇⁺ = r θ̇⁻ with
@@ -335,4 +335,41 @@ fn errors_name_the_file_or_item_and_exit_2() {
     fails(&["check", "no/such/model.toml"], "no/such/model.toml");
     // clap's own usage errors also exit with 2.
     assert_eq!(crr(&["simulate"]).status.code(), Some(2));
+}
+
+/// impacts.csv's `opened` column names the seated joints each impact opened: on the bundled
+/// drum column the impact of 0.4021 s opens `bed_3`, `bed_4` and `bed_5` (checked by hand from
+/// the bodies' momenta in tests/engine/impulse_tension.rs), and every row names exactly the
+/// joints of the library's `ImpactRecord::released` (by slot name), empty where none opened.
+#[test]
+fn the_impacts_file_names_the_joints_an_impact_opened() {
+    let out = scratch("drum_column_opened");
+    simulate("examples/models/drum_column.toml", &out, &[]);
+    let text = std::fs::read_to_string(out.join("impacts.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let (model, trajectory) = crate::common::run_model_text(
+        "drum_column_opened",
+        &crate::common::bundled_text_with_records("drum_column"),
+        None,
+    );
+    assert_eq!(rows.len(), trajectory.impacts.len());
+    for (row, impact) in rows.iter().zip(&trajectory.impacts) {
+        assert_eq!(row.len(), 6, "{row:?}");
+        let named: Vec<String> = impact
+            .released
+            .iter()
+            .map(|&k| model.slot_name(k))
+            .collect();
+        assert_eq!(row[5], named.join(";"), "the impact at {}", row[0]);
+    }
+    let at = rows
+        .iter()
+        .find(|r| (r[0].parse::<f64>().unwrap() - 0.4021).abs() < 1e-4)
+        .expect("the impact at 0.4021 s");
+    assert_eq!(at[5], "bed_3;bed_4;bed_5");
+    assert!(rows.iter().filter(|r| r[5].is_empty()).count() > rows.len() / 2);
 }

@@ -15,19 +15,24 @@
 //! corners: three rows, the force along n and the two tilting moments), where
 //! max over α of minᵢ (f₀ᵢ + α vᵢ) is reached where two of the lines cross. s* is the least of
 //! the interfaces' optima (capped at 0, as the global program's), the global program's answer
-//! without its proximal term: a few 6 × 6 eigenproblems instead of an interior point.
+//! without its proximal term: a few Gram–Schmidt steps and a small QR factorisation per
+//! interface instead of an interior point.
 
-use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen, Vector3, Vector6};
+use nalgebra::allocator::Allocator;
+use nalgebra::{DMatrix, DVector, DefaultAllocator, Dim, Dyn, OVector, U1, U6, Vector3, Vector6};
 
 use crr_dynamics::eom::Dynamics;
 use crr_kinematics::{Model, Parent};
 
 use super::{FaceAxes, Unknown, interface_columns};
 
-/// Eigenvalues of the projected systems' Gram matrices below this fraction of the largest (and
-/// below this in absolute value for the free columns' span, whose columns are of order one)
-/// count as zero: the directions they belong to are a null space.
-const RANK_TOLERANCE: f64 = 1e-12;
+/// A vector whose part off the span of the ones before it is below this fraction of the longest
+/// counts as dependent on them: the free columns' span and the rank of the normal impulses' rows
+/// are decided with it. Far above the round-off of Gram–Schmidt (about 1e-16 of the longest) and
+/// far below what a real face gives: the rows of a hinge whose two pivot lines are
+/// `GEOMETRY_TOLERANCE` (1e-6 of the model's size) apart have a part of about 7e-7 off each
+/// other.
+const RANK_TOLERANCE: f64 = 1e-9;
 
 /// The residual of an interface's rows, relative to the larger of its wrench and the impulse
 /// unit, beyond which the wrench is taken as not carried (the global program's equality rows
@@ -40,8 +45,8 @@ pub struct LeastNormal {
     /// s* (N s, at most 0), as [`super::MostCompressive::min_normal`].
     pub min_normal: f64,
     /// The interface whose touching points reach the least normal impulse of all (the lowest
-    /// index among equals), None when no interface has a unilateral point: the contact that
-    /// limits s*, as [`super::MostCompressive::limiting`] names it.
+    /// index among equals), None when no interface has a unilateral point: where s* < 0 the
+    /// contact that limits it, as [`super::MostCompressive::limiting`] names it.
     pub limiting: Option<usize>,
 }
 
@@ -51,8 +56,8 @@ pub struct LeastNormal {
 /// pivots with impulses of either sign, when the interfaces form a tree (see the module's
 /// docs); the answer of [`super::most_compressive_impulses`]'s `min_normal` up to its proximal
 /// term. None where the interfaces do not form a tree, where an interface's normal impulses
-/// are free in more than one direction, or where an interface cannot carry its wrench: the
-/// caller then asks the global program.
+/// are free in more than one direction, where an interface cannot carry its wrench, or where a
+/// number is not finite: the caller then asks the global program.
 pub fn least_normal_impulse_on_tree(
     model: &Model,
     dynamics: &Dynamics,
@@ -65,10 +70,8 @@ pub fn least_normal_impulse_on_tree(
         is_seated[k] = true;
     }
     let unit = model.total_mass() * model.gravity * (model.size / model.gravity).sqrt();
-    let mut least = LeastNormal {
-        min_normal: 0.0,
-        limiting: None,
-    };
+    // The least of the faces' optima, uncapped, and its interface.
+    let mut least: Option<(f64, usize)> = None;
     let mut columns = Vec::new();
     for (index, wrench) in wrenches.iter().enumerate() {
         columns.clear();
@@ -80,22 +83,23 @@ pub fn least_normal_impulse_on_tree(
             FaceAxes::Parent,
             &mut columns,
         );
-        let Some(s) = interface_least_normal(&columns, wrench, model.size, unit)? else {
+        let at = (wrench, reference(dynamics));
+        let Some(s) = interface_least_normal(&columns, at, model.size, unit)? else {
             continue;
         };
-        if least.limiting.is_none() || s < least.min_normal {
-            least = LeastNormal {
-                min_normal: s.min(0.0),
-                limiting: Some(index),
-            };
+        if least.is_none_or(|(m, _)| s < m) {
+            least = Some((s, index));
         }
     }
-    Some(least)
+    Some(LeastNormal {
+        min_normal: least.map_or(0.0, |(s, _)| s.min(0.0)),
+        limiting: least.map(|(_, index)| index),
+    })
 }
 
-/// The wrench every interface gives its child's subtree (force; moment about the world's
-/// origin), from the bodies' momentum changes; None where the interfaces do not form a tree
-/// rooted on the ground.
+/// The wrench every interface gives its child's subtree (force; moment about [`reference`]),
+/// from the bodies' momentum changes; None where the interfaces do not form a tree rooted on
+/// the ground.
 fn subtree_wrenches(
     model: &Model,
     dynamics: &Dynamics,
@@ -112,7 +116,7 @@ fn subtree_wrenches(
     }
     let mut wrenches = vec![Vector6::zeros(); model.interfaces.len()];
     for (b, (linear, angular)) in momentum_change.iter().enumerate() {
-        let moment = angular + dynamics.kin.com[b].cross(linear);
+        let moment = angular + (dynamics.kin.com[b] - reference(dynamics)).cross(linear);
         let wrench = Vector6::new(linear.x, linear.y, linear.z, moment.x, moment.y, moment.z);
         // Down the chain from body b to the ground: every interface on the way carries it.
         // A path longer than the bodies is a cycle.
@@ -136,95 +140,161 @@ fn subtree_wrenches(
     Some(wrenches)
 }
 
-/// max s over the forces of `columns` that give `wrench` (moment about the world's origin), with
-/// every unilateral column at least s (N s; Some(None) where no column is unilateral); None
-/// where the normal impulses are free in more than one direction or the columns cannot give the
-/// wrench.
+/// The point the subtrees' moments are taken about: the first body's centre of mass, near the
+/// structure (about the world's origin a structure far from it would lose digits).
+fn reference(dynamics: &Dynamics) -> Vector3<f64> {
+    dynamics
+        .kin
+        .com
+        .first()
+        .copied()
+        .unwrap_or_else(Vector3::zeros)
+}
+
+/// max s over the forces of `columns` that give `wrench` (moment about `reference`), with every
+/// unilateral column at least s (N s; Some(None) where no column is unilateral); None where the
+/// normal impulses are free in more than one direction, where the columns cannot give the
+/// wrench, or where a number is not finite.
 fn interface_least_normal(
     columns: &[Unknown],
-    wrench: &Vector6<f64>,
+    (wrench, reference): (&Vector6<f64>, Vector3<f64>),
     size: f64,
     unit: f64,
 ) -> Option<Option<f64>> {
     // Moments about the interface's first point, over `size`, so that the rows are of one scale.
-    let origin = columns
-        .iter()
-        .find_map(|u| u.point)
-        .unwrap_or_else(Vector3::zeros);
+    let origin = columns.iter().find_map(|u| u.point).unwrap_or(reference);
     let force = wrench.fixed_rows::<3>(0).into_owned();
-    let moment = wrench.fixed_rows::<3>(3) - origin.cross(&force);
+    let moment = wrench.fixed_rows::<3>(3) - (origin - reference).cross(&force);
     let mut rhs = Vector6::zeros();
     rhs.fixed_rows_mut::<3>(0).copy_from(&(force / unit));
     rhs.fixed_rows_mut::<3>(3)
         .copy_from(&(moment / (unit * size)));
-    let column = |u: &Unknown| {
-        let turn = match u.point {
-            Some(p) => (p - origin).cross(&u.direction) / size,
-            None => u.direction,
-        };
-        let force = if u.point.is_some() {
-            u.direction
-        } else {
-            Vector3::zeros()
-        };
-        Vector6::new(force.x, force.y, force.z, turn.x, turn.y, turn.z)
-    };
-    // The complement Z of the free columns' span (an orthonormal basis, 6 × r).
-    let mut gram = Matrix6::zeros();
-    for u in columns.iter().filter(|u| !u.unilateral) {
-        let a = column(u);
-        gram += a * a.transpose();
+    if !rhs.iter().all(|x| x.is_finite()) {
+        return None;
     }
-    let free = SymmetricEigen::new(gram);
-    let largest = free.eigenvalues.max().max(1.0);
-    let kept: Vec<usize> = (0..6)
-        .filter(|&i| free.eigenvalues[i] <= RANK_TOLERANCE * largest)
+    let column = |u: &Unknown| match u.point {
+        Some(p) => {
+            let turn = (p - origin).cross(&u.direction) / size;
+            let d = u.direction;
+            Vector6::new(d.x, d.y, d.z, turn.x, turn.y, turn.z)
+        }
+        None => Vector6::new(0.0, 0.0, 0.0, u.direction.x, u.direction.y, u.direction.z),
+    };
+    // The complement Z of the free columns' span (an orthonormal basis), and B fₙ = c on it.
+    let free: Vec<Vector6<f64>> = columns
+        .iter()
+        .filter(|u| !u.unilateral)
+        .map(column)
         .collect();
+    let complement = completion(&orthonormal_basis(&free), U6);
     let normals: Vec<Vector6<f64>> = columns
         .iter()
         .filter(|u| u.unilateral)
         .map(column)
         .collect();
-    // B fₙ = c on the complement.
-    let b = DMatrix::from_fn(kept.len(), normals.len(), |r, j| {
-        free.eigenvectors.column(kept[r]).dot(&normals[j])
+    let b = DMatrix::from_fn(complement.len(), normals.len(), |r, j| {
+        complement[r].dot(&normals[j])
     });
-    let c = DVector::from_iterator(
-        kept.len(),
-        kept.iter().map(|&i| free.eigenvectors.column(i).dot(&rhs)),
-    );
+    let c = DVector::from_iterator(complement.len(), complement.iter().map(|z| z.dot(&rhs)));
     let scale = rhs.norm().max(1.0);
+    let consistent = |residual: f64| residual <= CONSISTENCY_TOLERANCE * scale;
     if normals.is_empty() {
         // Nothing unilateral (a pin, a face set by law): the wrench need only be carried.
-        return (c.norm() <= CONSISTENCY_TOLERANCE * scale).then_some(None);
+        return consistent(c.norm()).then_some(None);
     }
-    // The least-norm solution f₀ = B⁺c and the null space of B, from BᵀB's eigenvectors.
-    let normal = SymmetricEigen::new(b.transpose() * &b);
-    let largest = normal.eigenvalues.max();
-    if largest <= 0.0 {
+    // The least-norm solution f₀ of B fₙ = c lies in B's row space R (orthonormal basis as the
+    // columns of Q): f₀ = Q y with (B Q) y = c in the least-squares sense, B Q of full column
+    // rank; the null space of B is R's completion.
+    let rows: Vec<DVector<f64>> = (0..b.nrows()).map(|r| b.row(r).transpose()).collect();
+    let row_space = orthonormal_basis(&rows);
+    if row_space.is_empty() {
         return None;
     }
-    let btc = b.transpose() * &c;
-    let mut f0 = DVector::zeros(normals.len());
-    let mut null = Vec::new();
-    for i in 0..normals.len() {
-        let v = normal.eigenvectors.column(i);
-        let lambda = normal.eigenvalues[i];
-        if lambda <= RANK_TOLERANCE * largest {
-            null.push(v.into_owned());
-        } else {
-            f0 += v * (v.dot(&btc) / lambda);
-        }
-    }
-    if (&b * &f0 - &c).norm() > CONSISTENCY_TOLERANCE * scale {
+    let q = DMatrix::from_columns(&row_space);
+    let bq = &b * &q;
+    let y = if bq.nrows() >= bq.ncols() {
+        let qr = bq.clone().qr();
+        let qtc = qr.q().transpose() * &c;
+        qr.r().solve_upper_triangular(&qtc)?
+    } else {
+        return None;
+    };
+    let f0 = &q * y;
+    if !consistent((&b * &f0 - &c).norm()) {
         return None;
     }
+    let null = completion(&row_space, Dyn(normals.len()));
     let best = match null.as_slice() {
         [] => f0.min(),
         [v] => max_of_min_lines(f0.as_slice(), v.as_slice()),
         _ => return None,
     };
-    Some(Some(best * unit))
+    (!best.is_nan()).then_some(Some(best * unit))
+}
+
+/// An orthonormal basis of the span of `vectors`, by modified Gram–Schmidt applied twice: a
+/// vector whose part off the basis so far is below [`RANK_TOLERANCE`] of the longest is taken
+/// as dependent.
+fn orthonormal_basis<D: Dim>(vectors: &[OVector<f64, D>]) -> Vec<OVector<f64, D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let longest = vectors.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let mut basis: Vec<OVector<f64, D>> = Vec::new();
+    for v in vectors {
+        let residual = off_basis(v.clone(), &basis);
+        let norm = residual.norm();
+        if norm > RANK_TOLERANCE * longest {
+            basis.push(residual / norm);
+        }
+    }
+    basis
+}
+
+/// An orthonormal basis of the orthogonal complement of the span of the orthonormal `basis` in
+/// dimension `dim`: the unit axes' parts off it, the longest first (each at least 1/√dim long
+/// while a direction is missing).
+fn completion<D: Dim>(basis: &[OVector<f64, D>], dim: D) -> Vec<OVector<f64, D>>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    let n = dim.value();
+    let mut all: Vec<OVector<f64, D>> = basis.to_vec();
+    let mut added = Vec::new();
+    while all.len() < n {
+        let (norm, residual) = (0..n)
+            .map(|i| {
+                let axis =
+                    OVector::<f64, D>::from_fn_generic(dim, U1, |k, _| f64::from(u8::from(k == i)));
+                let r = off_basis(axis, &all);
+                (r.norm(), r)
+            })
+            .fold(
+                (0.0, OVector::<f64, D>::zeros_generic(dim, U1)),
+                |best, x| {
+                    if x.0 > best.0 { x } else { best }
+                },
+            );
+        let unit = residual / norm;
+        all.push(unit.clone());
+        added.push(unit);
+    }
+    added
+}
+
+/// `v` less its projections on the orthonormal `basis`, twice (modified Gram–Schmidt with one
+/// reorthogonalisation, accurate to round-off).
+fn off_basis<D: Dim>(mut v: OVector<f64, D>, basis: &[OVector<f64, D>]) -> OVector<f64, D>
+where
+    DefaultAllocator: Allocator<D>,
+{
+    for _ in 0..2 {
+        for q in basis {
+            let along = q.dot(&v);
+            v.axpy(-along, q, 1.0);
+        }
+    }
+    v
 }
 
 /// max over α of minᵢ (aᵢ + α vᵢ): a concave piecewise-linear function whose maximum lies where
@@ -393,12 +463,112 @@ mod tests {
 
     /// max over α of min(α, 1 − α) is ½ at α = ½ (two lines crossing); min(2 + α, 3) with the
     /// second line level is 3 (α → ∞, the level line bounds it); min(α, 2α) has no maximum (+∞,
-    /// every line rising); min(1 − α, 4, −1 + α) is 0 at α = 1 (a level line above the crossing).
+    /// every line rising), nor min(1 − α, 2 − 3α); min(1 − α, 4, −1 + α) is 0 at α = 1 (a level
+    /// line above the crossing); min(α, 1 + α, 2 − α) is 1 at α = 1 (two lines of one slope).
     #[test]
     fn the_best_of_the_least_of_lines_is_where_two_cross_or_at_infinity() {
         assert!((max_of_min_lines(&[0.0, 1.0], &[1.0, -1.0]) - 0.5).abs() < 1e-15);
         assert_eq!(max_of_min_lines(&[2.0, 3.0], &[1.0, 0.0]), 3.0);
         assert_eq!(max_of_min_lines(&[0.0, 0.0], &[1.0, 2.0]), f64::INFINITY);
         assert!(max_of_min_lines(&[1.0, 4.0, -1.0], &[-1.0, 0.0, 1.0]).abs() < 1e-15);
+        // Every line falling: no maximum either (α → −∞).
+        assert_eq!(max_of_min_lines(&[1.0, 2.0], &[-1.0, -3.0]), f64::INFINITY);
+        // Equal slopes and a crossing: min(α, 1 + α, 2 − α) is 1 at α = 1.
+        assert!((max_of_min_lines(&[0.0, 1.0, 2.0], &[1.0, 1.0, -1.0]) - 1.0).abs() < 1e-15);
+    }
+
+    /// The columns of a hinge about y at `centre` whose pivot lines are `gap` apart along x
+    /// (face normal z): at each point a normal force (unilateral) and two tangential ones, and
+    /// the couples about n and t₁ = x; `both` false keeps the + line alone (rocking on it).
+    fn hinge_columns(centre: Vector3<f64>, gap: f64, both: bool) -> Vec<Unknown> {
+        let (x, y, z) = (Vector3::x(), Vector3::y(), Vector3::z());
+        let key = |along| super::super::UnknownKey {
+            interface: 0,
+            rest: None,
+            along,
+        };
+        let mut columns = Vec::new();
+        let sides: &[f64] = if both { &[0.5, -0.5] } else { &[0.5] };
+        for &side in sides {
+            for (k, d) in [z, x, y].into_iter().enumerate() {
+                columns.push(Unknown {
+                    interface: 0,
+                    unilateral: k == 0,
+                    point: Some(centre + x * (side * gap)),
+                    direction: d,
+                    key: key(k),
+                });
+            }
+        }
+        for (k, d) in [z, x].into_iter().enumerate() {
+            columns.push(Unknown {
+                interface: 0,
+                unilateral: false,
+                point: None,
+                direction: d,
+                key: key(k),
+            });
+        }
+        columns
+    }
+
+    /// A seated hinge about y whose pivot lines are a gap d apart along x, under a wrench (F, M)
+    /// taken about a point r away from the hinge's middle: by hand, the normal impulses are
+    /// f± = (F_z ∓ 2 M_y / d) / 2 with M_y the moment about y at the middle, M − (m − r) × F,
+    /// so s* = min(f₊, f₋) whatever the other components (the tangential impulses and the
+    /// couples take them). For gaps from 1.5e-6 of the size (just above `GEOMETRY_TOLERANCE`,
+    /// where M_y/d is a million times the wrench) to the size itself, 50 wrenches each: agreement
+    /// to 1e-9 of the largest normal impulse. A hinge rocking on its + line alone carries no
+    /// moment about its axis: a wrench with one is refused (None, for the global program to
+    /// judge), one without gives s* = F_z. A wrench that is not finite is refused.
+    #[test]
+    fn a_seated_hinge_shares_its_impulse_between_its_two_pivot_lines_by_statics() {
+        let (size, unit) = (2.0, 10.0);
+        let middle = Vector3::new(0.3, -0.2, 1.1);
+        let reference = Vector3::new(0.0, 0.0, 0.5);
+        let mut rng = SplitMix(7);
+        for gap in [1.5e-6 * size, 1e-4 * size, 0.05 * size, size] {
+            let columns = hinge_columns(middle, gap, true);
+            for _ in 0..50 {
+                let w = Vector6::from_fn(|_, _| rng.uniform(-1.0, 1.0) * unit);
+                let force = w.fixed_rows::<3>(0).into_owned();
+                let at_middle = w.fixed_rows::<3>(3) - (middle - reference).cross(&force);
+                let plus = (force.z - 2.0 * at_middle.y / gap) / 2.0;
+                let minus = (force.z + 2.0 * at_middle.y / gap) / 2.0;
+                let s = interface_least_normal(&columns, (&w, reference), size, unit)
+                    .expect("a seated hinge carries any wrench")
+                    .expect("its normal impulses are unilateral");
+                assert!(
+                    (s - plus.min(minus)).abs() <= 1e-9 * plus.abs().max(minus.abs()),
+                    "gap {gap}: {s} against {}",
+                    plus.min(minus)
+                );
+            }
+        }
+        let rocking = hinge_columns(middle, 0.1, false);
+        let plus = middle + Vector3::x() * 0.05;
+        let pushing = Vector6::new(0.5, -0.3, 4.0, 0.2, 0.0, -0.7);
+        // The same force and moment about the + line, then taken about the reference point.
+        let about_reference = |w: Vector6<f64>| {
+            let force = w.fixed_rows::<3>(0).into_owned();
+            let moment = w.fixed_rows::<3>(3) + (plus - reference).cross(&force);
+            Vector6::new(force.x, force.y, force.z, moment.x, moment.y, moment.z)
+        };
+        let s =
+            interface_least_normal(&rocking, (&about_reference(pushing), reference), size, unit)
+                .expect("no moment about the axis: carried")
+                .expect("unilateral");
+        assert!((s - 4.0).abs() <= 1e-12, "{s}");
+        let turning = pushing + Vector6::new(0.0, 0.0, 0.0, 0.0, 0.3, 0.0);
+        assert_eq!(
+            interface_least_normal(&rocking, (&about_reference(turning), reference), size, unit),
+            None
+        );
+        let columns = hinge_columns(middle, 0.1, true);
+        let broken = Vector6::new(0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0);
+        assert_eq!(
+            interface_least_normal(&columns, (&broken, reference), size, unit),
+            None
+        );
     }
 }

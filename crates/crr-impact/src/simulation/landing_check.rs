@@ -10,8 +10,7 @@
 //! linear program on the touching points after it, with each body's momentum change as its
 //! load ([`least_normal_impulse`]: on an open chain, whose interfaces' impulses statics fixes,
 //! a check of each face on its own; otherwise `face_forces::most_compressive_impulses`); the
-//! first impulse whose
-//! least normal impulse is below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g) is recorded as a
+//! first impulse whose least normal impulse is below −[`IMPULSE_TENSION_TOLERANCE`] W·√(L/g) is recorded as a
 //! hypothesis violation (`impulse_tension`). The run goes on with the impulse as it was: the
 //! check records, it changes nothing.
 //!
