@@ -26,12 +26,14 @@ use crr_kinematics::{Model, Parent};
 
 use super::{FaceAxes, Unknown, interface_columns};
 
-/// A vector whose part off the span of the ones before it is below this fraction of the longest
-/// counts as dependent on them: the free columns' span and the rank of the normal impulses' rows
-/// are decided with it. Far above the round-off of Gram–Schmidt (about 1e-16 of the longest) and
-/// far below what a real face gives: the rows of a hinge whose two pivot lines are
-/// `GEOMETRY_TOLERANCE` (1e-6 of the model's size) apart have a part of about 7e-7 off each
-/// other.
+/// A vector whose part off the span of the ones taken before it is below this fraction of the
+/// longest counts as dependent on them: the free columns' span and the rank of the normal
+/// impulses' rows are decided with it. The longest parts are taken first
+/// ([`orthonormal_basis`]), so a dependent vector's part is round-off of its own length (about
+/// 1e-16, and ulp(|p|)/size of the coordinates of a point p: 1e-14 at 100 sizes from the
+/// origin), and an independent one's is what the face gives: the rows of a hinge whose two
+/// pivot lines are `GEOMETRY_TOLERANCE` (1e-6 of the model's size) apart have a part of about
+/// 7e-7 off each other.
 const RANK_TOLERANCE: f64 = 1e-9;
 
 /// The residual of an interface's rows, relative to the larger of its wrench and the impulse
@@ -152,9 +154,10 @@ fn reference(dynamics: &Dynamics) -> Vector3<f64> {
 }
 
 /// max s over the forces of `columns` that give `wrench` (moment about `reference`), with every
-/// unilateral column at least s (N s; Some(None) where no column is unilateral); None where the
-/// normal impulses are free in more than one direction, where the columns cannot give the
-/// wrench, or where a number is not finite.
+/// unilateral column at least s (N s; Some(None) where no column is unilateral, Some(+∞) where
+/// the normal impulses can all grow without bound); None where they are free in more than one
+/// direction, where the columns cannot give the wrench, or where the wrench or a column is not
+/// finite.
 fn interface_least_normal(
     columns: &[Unknown],
     (wrench, reference): (&Vector6<f64>, Vector3<f64>),
@@ -169,7 +172,14 @@ fn interface_least_normal(
     rhs.fixed_rows_mut::<3>(0).copy_from(&(force / unit));
     rhs.fixed_rows_mut::<3>(3)
         .copy_from(&(moment / (unit * size)));
-    if !rhs.iter().all(|x| x.is_finite()) {
+    if !rhs.iter().all(|x| x.is_finite())
+        || !columns.iter().all(|u| {
+            u.direction
+                .iter()
+                .chain(u.point.iter().flatten())
+                .all(|x| x.is_finite())
+        })
+    {
         return None;
     }
     let column = |u: &Unknown| match u.point {
@@ -212,13 +222,9 @@ fn interface_least_normal(
     }
     let q = DMatrix::from_columns(&row_space);
     let bq = &b * &q;
-    let y = if bq.nrows() >= bq.ncols() {
-        let qr = bq.clone().qr();
-        let qtc = qr.q().transpose() * &c;
-        qr.r().solve_upper_triangular(&qtc)?
-    } else {
-        return None;
-    };
+    // B Q has as many rows as B, at least its rank, its columns' count.
+    let qr = bq.qr();
+    let y = qr.r().solve_upper_triangular(&(qr.q().transpose() * &c))?;
     let f0 = &q * y;
     if !consistent((&b * &f0 - &c).norm()) {
         return None;
@@ -232,21 +238,35 @@ fn interface_least_normal(
     (!best.is_nan()).then_some(Some(best * unit))
 }
 
-/// An orthonormal basis of the span of `vectors`, by modified Gram–Schmidt applied twice: a
-/// vector whose part off the basis so far is below [`RANK_TOLERANCE`] of the longest is taken
-/// as dependent.
+/// An orthonormal basis of the span of `vectors`, by modified Gram–Schmidt applied twice with
+/// pivoting: each step takes the vector with the longest part off the basis so far, and stops
+/// when that part is below [`RANK_TOLERANCE`] of the longest vector (the rest depend on the
+/// basis). Pivoting keeps a nearly dependent vector, whose part off the others is mostly
+/// round-off, from entering the basis before the vectors it nearly depends on.
 fn orthonormal_basis<D: Dim>(vectors: &[OVector<f64, D>]) -> Vec<OVector<f64, D>>
 where
     DefaultAllocator: Allocator<D>,
 {
     let longest = vectors.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let mut left: Vec<OVector<f64, D>> = vectors.to_vec();
     let mut basis: Vec<OVector<f64, D>> = Vec::new();
-    for v in vectors {
-        let residual = off_basis(v.clone(), &basis);
-        let norm = residual.norm();
-        if norm > RANK_TOLERANCE * longest {
-            basis.push(residual / norm);
+    while !left.is_empty() {
+        let parts: Vec<OVector<f64, D>> =
+            left.iter().map(|v| off_basis(v.clone(), &basis)).collect();
+        let (pick, norm) =
+            parts
+                .iter()
+                .map(|r| r.norm())
+                .enumerate()
+                .fold(
+                    (0, 0.0),
+                    |best, (i, n)| if n > best.1 { (i, n) } else { best },
+                );
+        if norm <= RANK_TOLERANCE * longest {
+            break;
         }
+        basis.push(&parts[pick] / norm);
+        left.swap_remove(pick);
     }
     basis
 }
@@ -477,11 +497,21 @@ mod tests {
         assert!((max_of_min_lines(&[0.0, 1.0, 2.0], &[1.0, 1.0, -1.0]) - 1.0).abs() < 1e-15);
     }
 
-    /// The columns of a hinge about y at `centre` whose pivot lines are `gap` apart along x
-    /// (face normal z): at each point a normal force (unilateral) and two tangential ones, and
-    /// the couples about n and t₁ = x; `both` false keeps the + line alone (rocking on it).
-    fn hinge_columns(centre: Vector3<f64>, gap: f64, both: bool) -> Vec<Unknown> {
-        let (x, y, z) = (Vector3::x(), Vector3::y(), Vector3::z());
+    /// The columns of a hinge about u = R y at `centre` whose pivot lines are `gap` apart along
+    /// t₁ = R x (face normal n = R z): at each point a normal force (unilateral) and two
+    /// tangential ones, and the couples about n and t₁; `both` false keeps the + line alone
+    /// (rocking on it).
+    fn hinge_columns(
+        centre: Vector3<f64>,
+        turn: &nalgebra::Rotation3<f64>,
+        gap: f64,
+        both: bool,
+    ) -> Vec<Unknown> {
+        let (x, y, z) = (
+            turn * Vector3::x(),
+            turn * Vector3::y(),
+            turn * Vector3::z(),
+        );
         let key = |along| super::super::UnknownKey {
             interface: 0,
             rest: None,
@@ -512,40 +542,57 @@ mod tests {
         columns
     }
 
-    /// A seated hinge about y whose pivot lines are a gap d apart along x, under a wrench (F, M)
-    /// taken about a point r away from the hinge's middle: by hand, the normal impulses are
-    /// f± = (F_z ∓ 2 M_y / d) / 2 with M_y the moment about y at the middle, M − (m − r) × F,
-    /// so s* = min(f₊, f₋) whatever the other components (the tangential impulses and the
-    /// couples take them). For gaps from 1.5e-6 of the size (just above `GEOMETRY_TOLERANCE`,
-    /// where M_y/d is a million times the wrench) to the size itself, 50 wrenches each: agreement
-    /// to 1e-9 of the largest normal impulse. A hinge rocking on its + line alone carries no
-    /// moment about its axis: a wrench with one is refused (None, for the global program to
-    /// judge), one without gives s* = F_z. A wrench that is not finite is refused.
+    /// A seated hinge about u whose pivot lines are a gap d apart along t₁ (normal n), under a
+    /// wrench (F, M) taken about a point r away from the hinge's middle m: by hand, the normal
+    /// impulses are f± = (F_n ∓ 2 M_u / d) / 2 with F_n = n·F and M_u = u·(M − (m − r) × F) the
+    /// moment about the axis at the middle, so s* = min(f₊, f₋) whatever the other components
+    /// (the tangential impulses and the couples take them). For gaps from 1.5e-6 of the size
+    /// (just above `GEOMETRY_TOLERANCE`, where M_u/d is some 1e5 times the wrench) to the size
+    /// itself, 50 wrenches each, on the axes and near the origin and also turned by a generic
+    /// rotation 100 sizes from the origin (where the columns are built in that order, a nearly
+    /// dependent free column before the couples it nearly depends on: the pivoting of
+    /// [`orthonormal_basis`] keeps it out): agreement to 1e-9 of the largest normal impulse, plus
+    /// the round-off of the points' coordinates over the gap (8 ε |m| / d). A hinge rocking on
+    /// its + line alone carries no moment about its axis: a wrench with one is refused (None,
+    /// for the global program to judge), one without gives s* = F_n. A wrench that is not finite
+    /// is refused.
     #[test]
     fn a_seated_hinge_shares_its_impulse_between_its_two_pivot_lines_by_statics() {
         let (size, unit) = (2.0, 10.0);
-        let middle = Vector3::new(0.3, -0.2, 1.1);
         let reference = Vector3::new(0.0, 0.0, 0.5);
         let mut rng = SplitMix(7);
-        for gap in [1.5e-6 * size, 1e-4 * size, 0.05 * size, size] {
-            let columns = hinge_columns(middle, gap, true);
-            for _ in 0..50 {
-                let w = Vector6::from_fn(|_, _| rng.uniform(-1.0, 1.0) * unit);
-                let force = w.fixed_rows::<3>(0).into_owned();
-                let at_middle = w.fixed_rows::<3>(3) - (middle - reference).cross(&force);
-                let plus = (force.z - 2.0 * at_middle.y / gap) / 2.0;
-                let minus = (force.z + 2.0 * at_middle.y / gap) / 2.0;
-                let s = interface_least_normal(&columns, (&w, reference), size, unit)
-                    .expect("a seated hinge carries any wrench")
-                    .expect("its normal impulses are unilateral");
-                assert!(
-                    (s - plus.min(minus)).abs() <= 1e-9 * plus.abs().max(minus.abs()),
-                    "gap {gap}: {s} against {}",
-                    plus.min(minus)
-                );
+        let generic = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.7, -1.3, 0.4));
+        for (middle, turn) in [
+            (
+                Vector3::new(0.3, -0.2, 1.1),
+                nalgebra::Rotation3::identity(),
+            ),
+            (Vector3::new(150.0, -120.0, 60.0), generic),
+        ] {
+            let (n, u) = (turn * Vector3::z(), turn * Vector3::y());
+            for gap in [1.5e-6 * size, 1e-4 * size, 0.05 * size, size] {
+                let columns = hinge_columns(middle, &turn, gap, true);
+                let tolerance = 1e-9 + 8.0 * f64::EPSILON * middle.norm() / gap;
+                for _ in 0..50 {
+                    let w = Vector6::from_fn(|_, _| rng.uniform(-1.0, 1.0) * unit);
+                    let force = w.fixed_rows::<3>(0).into_owned();
+                    let at_middle = w.fixed_rows::<3>(3) - (middle - reference).cross(&force);
+                    let (f_n, m_u) = (n.dot(&force), u.dot(&at_middle));
+                    let plus = (f_n - 2.0 * m_u / gap) / 2.0;
+                    let minus = (f_n + 2.0 * m_u / gap) / 2.0;
+                    let s = interface_least_normal(&columns, (&w, reference), size, unit)
+                        .expect("a seated hinge carries any wrench")
+                        .expect("its normal impulses are unilateral");
+                    assert!(
+                        (s - plus.min(minus)).abs() <= tolerance * plus.abs().max(minus.abs()),
+                        "gap {gap} at {middle:?}: {s} against {}",
+                        plus.min(minus)
+                    );
+                }
             }
         }
-        let rocking = hinge_columns(middle, 0.1, false);
+        let middle = Vector3::new(0.3, -0.2, 1.1);
+        let rocking = hinge_columns(middle, &nalgebra::Rotation3::identity(), 0.1, false);
         let plus = middle + Vector3::x() * 0.05;
         let pushing = Vector6::new(0.5, -0.3, 4.0, 0.2, 0.0, -0.7);
         // The same force and moment about the + line, then taken about the reference point.
@@ -564,7 +611,7 @@ mod tests {
             interface_least_normal(&rocking, (&about_reference(turning), reference), size, unit),
             None
         );
-        let columns = hinge_columns(middle, 0.1, true);
+        let columns = hinge_columns(middle, &nalgebra::Rotation3::identity(), 0.1, true);
         let broken = Vector6::new(0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0);
         assert_eq!(
             interface_least_normal(&columns, (&broken, reference), size, unit),

@@ -256,7 +256,12 @@ impl OpenLoops {
 impl Simulation<'_> {
     /// Appends an impact of the chain integrated, its slots numbered as the file's.
     pub(super) fn push_impact(&mut self, mut record: ImpactRecord) {
-        for s in record.slots.iter_mut().chain(record.seated.iter_mut()) {
+        for s in record
+            .slots
+            .iter_mut()
+            .chain(record.seated.iter_mut())
+            .chain(record.released.iter_mut())
+        {
             *s = self.open.original_slot(*s);
         }
         self.impacts.push(record);
