@@ -213,16 +213,18 @@ fn fragility_products() {
     assert_eq!(
         lines.next().unwrap(),
         "measure,threshold,median_pga_g,dispersion,log_likelihood,levels_used,cases_used,\
-         level_min,level_max"
+         level_min,level_max,cases_outside_model"
     );
     let rows: Vec<Vec<String>> = lines
         .map(|l| l.split(',').map(String::from).collect())
         .collect();
     assert_eq!(rows.len(), 4, "collapse and three thresholds");
+    let outside = violation_times(&out).iter().flatten().count();
     let mut fitted = 0;
     for r in &rows {
         assert_eq!(r[5], "8");
         assert_eq!(r[6], "32");
+        assert_eq!(r[9], outside.to_string(), "cases outside the model");
         let key = format!("{},{},", r[0], r[1]);
         let fr: Vec<(f64, f64)> = points
             .lines()
@@ -287,7 +289,7 @@ fn map_has_one_cell_per_case() {
         !out.join("fragility.csv").exists(),
         "no fragility for pulses"
     );
-    legend_hides_no_cell(&svg);
+    legend_hides_no_cell(&svg, 20);
 }
 
 /// The rectangles of an SVG, in document order: (x, y, width, height, the tag's text).
@@ -313,7 +315,7 @@ fn svg_rects(svg: &str) -> Vec<(f64, f64, f64, f64, String)> {
 
 /// The map's legend box overlaps none of its cells (before, it hid the top row of a map: the
 /// box is drawn over the cells, with their rectangles before it in the file).
-fn legend_hides_no_cell(svg: &str) {
+fn legend_hides_no_cell(svg: &str, cells_drawn: usize) {
     let rects = svg_rects(svg);
     let boxed = rects
         .iter()
@@ -322,7 +324,7 @@ fn legend_hides_no_cell(svg: &str) {
     let (lx, ly, lw, lh, _) = rects[boxed].clone();
     // Cells: every rectangle after the background and before the legend's own two.
     let cells = &rects[1..boxed - 1];
-    assert!(cells.len() >= 20, "{} cells", cells.len());
+    assert!(cells.len() >= cells_drawn, "{} cells", cells.len());
     for (x, y, w, h, _) in cells {
         let apart = x + w <= lx || *x >= lx + lw || y + h <= ly || *y >= ly + lh;
         assert!(
@@ -383,4 +385,218 @@ fn a_spectral_acceleration_study_is_read_against_sa() {
     assert_eq!(r.intensity.as_deref(), Some("sa_g"));
     let levels: Vec<Option<f64>> = r.cases.iter().map(|c| c.level).collect();
     assert_eq!(levels, vec![Some(0.2), Some(0.4)]);
+}
+
+/// The fields of one line of a CSV file, fields in double quotes taken whole (`""` a quote).
+fn csv_fields(line: &str) -> Vec<String> {
+    let (mut fields, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => fields.push(std::mem::take(&mut field)),
+            _ => field.push(c),
+        }
+    }
+    fields.push(field);
+    fields
+}
+
+/// The named columns of every row of `dir/cases.csv`, in the file's order.
+fn cases_columns(dir: &Path, names: &[&str]) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(dir.join("cases.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = csv_fields(lines.next().unwrap());
+    let at: Vec<usize> = names
+        .iter()
+        .map(|n| header.iter().position(|h| h == n).expect(n))
+        .collect();
+    lines
+        .map(|l| {
+            let f = csv_fields(l);
+            assert_eq!(f.len(), header.len(), "{l}");
+            at.iter().map(|&i| f[i].clone()).collect()
+        })
+        .collect()
+}
+
+/// Every case's `violation_time_s` (None where empty).
+fn violation_times(dir: &Path) -> Vec<Option<f64>> {
+    cases_columns(dir, &["violation_time_s"])
+        .into_iter()
+        .map(|r| (!r[0].is_empty()).then(|| r[0].parse().unwrap()))
+        .collect()
+}
+
+/// A case whose run leaves crr's model says so in its row, as `crr simulate` does for the same
+/// run. The bundled drum column under its own pulse (one sine of 2.5 m/s², 0.5 s, 4 s from rest)
+/// rocks, and at 0.5295 s the bed under the fourth drum would have to pull (the drums above
+/// fly; tests/cli/warnings.rs): the study's case of that pulse gives the same time, bit for bit,
+/// the same kind and interface as `summary.json`'s `hypothesis_violation` of `crr simulate` on
+/// the model file, and counts it in `study.json` (a run's and a merge's of its two shards), on
+/// stderr and in the map's caption and legend. Under 1.0 m/s², below the column's uplift acceleration g tan α ≈ 1.34 m/s² (the
+/// whole column rocking on its base), the column stays seated: no impact and no violation.
+#[test]
+fn a_case_that_leaves_the_model_says_so_as_crr_simulate_does() {
+    let dir = scratch("study_outside_model");
+    let model = models().join("drum_column.toml");
+    let study = write(
+        &dir,
+        "d.toml",
+        &format!(
+            "model = \"{}\"\nduration = 4.0\n\n[pulses]\nkind = \"one_sine_pulse\"\n\
+             amplitudes = [1.0, 2.5]\nperiods = [0.5]\n",
+            model.display()
+        ),
+    );
+    let out = dir.join("out");
+    let o = crr(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--plot",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("1 of the 2 case(s) of this part left crr's model"),
+        "{err}"
+    );
+    let rows = cases_columns(
+        &out,
+        &[
+            "impacts",
+            "violation_time_s",
+            "violation",
+            "violation_interface",
+        ],
+    );
+    assert_eq!(rows[0], ["0", "", "", ""], "below the uplift acceleration");
+    let single = dir.join("single");
+    run_ok(&[
+        "simulate",
+        model.to_str().unwrap(),
+        "--out",
+        single.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(single.join("summary.json")).unwrap())
+            .unwrap();
+    let v = &summary["hypothesis_violation"];
+    let t = v["time"].as_f64().unwrap();
+    assert!((t - 0.5295).abs() < 1e-4, "{v}");
+    assert_eq!(rows[1][1].parse::<f64>().unwrap().to_bits(), t.to_bits());
+    assert_eq!(rows[1][2], v["kind"].as_str().unwrap());
+    assert_eq!(rows[1][2], "tension");
+    assert_eq!(rows[1][3], v["interface"].as_str().unwrap());
+    assert_eq!(rows[1][0], summary["impacts"].to_string(), "the same run");
+    let info: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("study.json")).unwrap()).unwrap();
+    assert_eq!(info["cases_outside_model"], 1);
+    // Shards merged count it too.
+    let parts: Vec<PathBuf> = (1..=2).map(|i| dir.join(format!("part_{i}"))).collect();
+    for (i, part) in parts.iter().enumerate() {
+        let shard = format!("{}/2", i + 1);
+        run_ok(&[
+            "study",
+            study.to_str().unwrap(),
+            "--shard",
+            &shard,
+            "--out",
+            part.to_str().unwrap(),
+            "--quiet",
+        ]);
+    }
+    let merged = dir.join("merged");
+    run_ok(&[
+        "study",
+        "merge",
+        parts[0].to_str().unwrap(),
+        parts[1].to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    let info: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(merged.join("study.json")).unwrap()).unwrap();
+    assert_eq!(
+        (info["cases"].as_u64(), info["cases_outside_model"].as_u64()),
+        (Some(2), Some(1))
+    );
+    let svg = std::fs::read_to_string(out.join("map.svg")).unwrap();
+    assert!(svg.contains("(1 of 2 cases outside crr"), "the caption");
+    assert!(svg.contains("left crr"), "the legend");
+    legend_hides_no_cell(&svg, 2);
+}
+
+/// The fragility tables count, per level, the cases whose runs left crr's model, as their rows
+/// in `cases.csv` say: the drum column under two synthetic records at 0.1, 0.3 and 0.5 g for 8 s
+/// (at 0.1 g, below its uplift acceleration of about 0.14 g, it stays seated; at 0.3 and 0.5 g
+/// both records make a bed pull, measured 2026-12-01).
+#[test]
+fn fragility_tables_count_the_cases_outside_the_model() {
+    let dir = scratch("study_fragility_outside");
+    let study = write(
+        &dir,
+        "f.toml",
+        &format!(
+            "name = \"drums\"\nmodel = \"{}\"\nduration = 8.0\n\n[records]\n\
+             synthetic = {{ seeds = [1, 2] }}\n\n[intensity]\npga = [0.1, 0.3, 0.5]\n",
+            models().join("drum_column.toml").display()
+        ),
+    );
+    let out = dir.join("out");
+    let o = crr(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--plot",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // From the rows: the cases outside the model at each level.
+    let rows = cases_columns(&out, &["pga_g", "violation_time_s"]);
+    let count = |level: f64| {
+        rows.iter()
+            .filter(|r| (r[0].parse::<f64>().unwrap() - level).abs() < 1e-9 && !r[1].is_empty())
+            .count()
+    };
+    let expected = [count(0.1), count(0.3), count(0.5)];
+    assert_eq!(expected[0], 0, "at rest under 0.1 g");
+    assert!(expected[1] + expected[2] > 0, "some case leaves the model");
+    let points = std::fs::read_to_string(out.join("fragility_points.csv")).unwrap();
+    let mut lines = points.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "measure,threshold,level,trials,exceed,fraction,outside_model"
+    );
+    let mut curves = 0;
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        let level: f64 = f[2].parse().unwrap();
+        let i = [0.1, 0.3, 0.5]
+            .iter()
+            .position(|x| (x - level).abs() < 1e-9)
+            .unwrap();
+        assert_eq!(f[6], expected[i].to_string(), "{l}");
+        curves += usize::from(i == 0);
+    }
+    assert_eq!(curves, 4, "collapse and three thresholds");
+    let fits = std::fs::read_to_string(out.join("fragility.csv")).unwrap();
+    let total: usize = expected.iter().sum();
+    for l in fits.lines().skip(1) {
+        assert_eq!(l.rsplit(',').next().unwrap(), total.to_string(), "{l}");
+    }
+    let svg = std::fs::read_to_string(out.join("fragility.svg")).unwrap();
+    assert!(
+        svg.contains(&format!("({total} of 6 cases outside crr")),
+        "the caption"
+    );
 }

@@ -1,7 +1,9 @@
 //! One case of a study run to its end, keeping only its measures (peaks, collapse, impacts,
-//! residual tilt, dissipated energy) with memory flat in the duration.
+//! residual tilt, dissipated energy, the hypotheses monitor's first violation) with memory flat
+//! in the duration.
 
 use crr_impact::Samples;
+use crr_impact::monitor::Violation;
 
 use crate::analysis::simulation::{Cancel, simulate};
 use crr_impact::simulation::SimulationError;
@@ -23,6 +25,10 @@ pub struct Measures {
     pub dissipated: f64,
     /// Time reached (s).
     pub end_time: f64,
+    /// The first failure of the rigid-contact hypotheses in the run (the hypotheses monitor's:
+    /// a flight, a resultant outside its face, sliding, an impulse that pulls), if any: the
+    /// case's results after its time are outside crr's model, as `crr simulate` warns.
+    pub violation: Option<Violation>,
 }
 
 /// Runs one case to its end (or collapse) by the same loop as `crr::run`, keeping only its
@@ -94,5 +100,6 @@ fn measure(study: &Study, case: &Case, cancel: Option<&Cancel>) -> Result<Measur
         residual,
         dissipated,
         end_time: t.end_time,
+        violation: t.violation.clone(),
     })
 }

@@ -113,6 +113,18 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
             out.display()
         );
     }
+    // A warning, as `crr simulate`'s: shown with --quiet too.
+    if outcome.outside_model > 0 {
+        eprintln!(
+            "crr: warning: {} of the {} case(s) of this part left crr's model (the rigid-contact \
+                 hypotheses fail: a flight, a resultant outside its face, sliding or an impulse \
+                 that pulls; columns violation_time_s, violation, violation_interface of {}): \
+                 their results after that time are outside the model",
+            outcome.outside_model,
+            outcome.cases,
+            out.join("cases.csv").display()
+        );
+    }
     if plot {
         let files = crr::output::plot::plot_study(&out)?;
         if !quiet {

@@ -72,6 +72,13 @@ pub fn draw_map<DB: DrawingBackend>(
             Some((x, y, c.collapse?, c.peak_ratio.unwrap_or(0.0)))
         })
         .collect();
+    // The cells of cases whose runs left crr's model, marked with a cross.
+    let outside: Vec<(f64, f64)> = r
+        .cases
+        .iter()
+        .filter(|c| c.scale == first && c.outside_model)
+        .filter_map(|c| c.pulse)
+        .collect();
     let hx = half_gap(cells.iter().map(|c| c.0).collect());
     let hy = half_gap(cells.iter().map(|c| c.1).collect());
     let xr = padded(cells.iter().flat_map(|c| [c.0 - hx, c.0 + hx]));
@@ -93,7 +100,7 @@ pub fn draw_map<DB: DrawingBackend>(
     };
     // Room above the cells for the legend (its rows: the four keys and the boundary's line), so
     // that it hides none of them.
-    let rows = 4 + usize::from(!boundary.is_empty());
+    let rows = 4 + usize::from(!boundary.is_empty()) + usize::from(!outside.is_empty());
     let yr = headroom(
         padded(cells.iter().flat_map(|c| [c.1 - hy, c.1 + hy])),
         legend_headroom(rows),
@@ -105,7 +112,11 @@ pub fn draw_map<DB: DrawingBackend>(
     };
     let mut chart = ChartBuilder::on(root)
         .caption(
-            format!("{}: overturning map{sized}", r.name),
+            format!(
+                "{}: overturning map{sized}{}",
+                r.name,
+                outside_note(r.outside_model, r.cases.len())
+            ),
             caption_style(k),
         )
         .margin(20 * k)
@@ -139,6 +150,32 @@ pub fn draw_map<DB: DrawingBackend>(
             .map_err(err)?
             .label("Zhang & Makris (2001), linearised: minimum overturning")
             .legend(line_key(blue, k));
+    }
+    if !outside.is_empty() {
+        let arm = (hx * 0.45, hy * 0.45);
+        let cross = move |(x, y): (f64, f64)| {
+            [
+                PathElement::new(
+                    vec![(x - arm.0, y - arm.1), (x + arm.0, y + arm.1)],
+                    OUTSIDE_MARK.stroke_width(3 * k),
+                ),
+                PathElement::new(
+                    vec![(x - arm.0, y + arm.1), (x + arm.0, y - arm.1)],
+                    OUTSIDE_MARK.stroke_width(3 * k),
+                ),
+            ]
+        };
+        let w = 8 * k as i32;
+        chart
+            .draw_series(outside.iter().flat_map(|&p| cross(p)))
+            .map_err(err)?
+            .label("left crr's model (a hypotheses violation)")
+            .legend(move |(x, y): (i32, i32)| {
+                let style = OUTSIDE_MARK.stroke_width(3 * k);
+                EmptyElement::at((x, y))
+                    + PathElement::new(vec![(2, -w), (2 + 2 * w, w)], style)
+                    + PathElement::new(vec![(2, w), (2 + 2 * w, -w)], style)
+            });
     }
     let key = |c: RGBColor| {
         let w = 20 * k as i32;
@@ -179,7 +216,11 @@ pub fn draw_spectrum<DB: DrawingBackend>(
     let yr = 0.0..headroom(0.0..top, 0.45).end;
     let mut chart = ChartBuilder::on(root)
         .caption(
-            format!("{}: rocking spectrum (peak θ/α against size)", r.name),
+            format!(
+                "{}: rocking spectrum (peak θ/α against size){}",
+                r.name,
+                outside_note(r.outside_model, r.cases.len())
+            ),
             caption_style(k),
         )
         .margin(20 * k)
@@ -252,6 +293,23 @@ pub struct FragilityFigure {
     pub intensity: String,
     /// The curves.
     pub curves: Vec<FragilityCurve>,
+    /// The finished cases.
+    pub cases: usize,
+    /// Those of them whose runs left crr's model.
+    pub outside_model: usize,
+}
+
+/// The colour of the crosses on the cells of cases whose runs left crr's model: a blue that
+/// shows on the black of a collapse and on the pale to dark reds of the survivors.
+const OUTSIDE_MARK: RGBColor = RGBColor(0, 140, 255);
+
+/// The caption's note when some of the `cases` left crr's model: empty when none did.
+fn outside_note(outside: usize, cases: usize) -> String {
+    if outside == 0 {
+        String::new()
+    } else {
+        format!(" ({outside} of {cases} cases outside crr's model)")
+    }
 }
 
 /// The fragility curves: the empirical fractions as points, the lognormal fits as lines.
@@ -270,7 +328,14 @@ pub fn draw_fragility<DB: DrawingBackend>(
     let xr = 0.0..hi.max(1e-9);
     let yr = -0.02..1.45;
     let mut chart = ChartBuilder::on(root)
-        .caption(format!("{}: fragility curves", f.name), caption_style(k))
+        .caption(
+            format!(
+                "{}: fragility curves{}",
+                f.name,
+                outside_note(f.outside_model, f.cases)
+            ),
+            caption_style(k),
+        )
         .margin(20 * k)
         .x_label_area_size(55 * k)
         .y_label_area_size(85 * k)
@@ -381,6 +446,8 @@ pub fn plot_study(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
                     _ => "factor on the records".into(),
                 },
                 curves,
+                cases: r.cases.len(),
+                outside_model: r.outside_model,
             };
             files.extend(pair!(dir, "fragility", draw_fragility, &fig));
         }

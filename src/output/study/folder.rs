@@ -86,6 +86,9 @@ pub struct StudyOutcome {
     pub ran: usize,
     /// Cases whose row holds an error.
     pub failed: usize,
+    /// Cases whose run left crr's model (the hypotheses monitor's first violation in its
+    /// `violation_*` columns): their results after that time are outside the model.
+    pub outside_model: usize,
     /// The run was cancelled ([`StudyOptions::cancel`]): `ran` counts the rows written before,
     /// cases.csv is left in the order they ended and study.json is not written.
     pub interrupted: bool,
@@ -98,6 +101,26 @@ fn num(x: f64) -> String {
 
 fn quoted(s: &str) -> String {
     format!("\"{}\"", s.replace('"', "\"\""))
+}
+
+/// The column of `cases.csv` that holds the time of a case's first hypotheses violation (empty
+/// when its run kept every hypothesis): a case whose column is filled left crr's model then.
+pub const VIOLATION_TIME_COLUMN: &str = "violation_time_s";
+
+/// The rows among `rows` (of `cases.csv`, under `header`) of cases whose runs left crr's model:
+/// their `violation_time_s` is filled.
+fn count_outside_model<'a>(header: &str, rows: impl IntoIterator<Item = &'a String>) -> usize {
+    let columns = super::products::split_csv(header);
+    let Some(at) = columns.iter().position(|c| c == VIOLATION_TIME_COLUMN) else {
+        return 0;
+    };
+    rows.into_iter()
+        .filter(|r| {
+            super::products::split_csv(r)
+                .get(at)
+                .is_some_and(|f| !f.is_empty())
+        })
+        .count()
 }
 
 /// The header of `cases.csv`.
@@ -132,7 +155,18 @@ pub fn header(study: &Study) -> String {
             cols.push(format!("peak_{}_over_alpha", study.model.coords[k].name));
         }
     }
-    cols.extend(["residual_rad", "dissipated_j", "end_time_s", "error"].map(String::from));
+    cols.extend(
+        [
+            "residual_rad",
+            "dissipated_j",
+            "end_time_s",
+            VIOLATION_TIME_COLUMN,
+            "violation",
+            "violation_interface",
+            "error",
+        ]
+        .map(String::from),
+    );
     cols.join(",")
 }
 
@@ -187,16 +221,16 @@ pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> Str
                     cols.push(num(m.peak[k] / a));
                 }
             }
-            cols.extend([
-                num(m.residual),
-                num(m.dissipated),
-                num(m.end_time),
-                String::new(),
-            ]);
+            cols.extend([num(m.residual), num(m.dissipated), num(m.end_time)]);
+            match &m.violation {
+                Some(v) => cols.extend([num(v.t), v.kind.clone(), quoted(&v.interface)]),
+                None => cols.extend([String::new(), String::new(), String::new()]),
+            }
+            cols.push(String::new());
         }
         Err(e) => {
             cols.extend(["error".into(), String::new(), String::new(), String::new()]);
-            cols.extend(std::iter::repeat_n(String::new(), n + with_alpha + 3));
+            cols.extend(std::iter::repeat_n(String::new(), n + with_alpha + 6));
             cols.push(quoted(e));
         }
     }
@@ -544,6 +578,7 @@ pub fn run_study(
             skipped: done.len(),
             ran: rows.len() - done.len(),
             failed: rows.values().filter(|r| r.contains(",error,")).count(),
+            outside_model: count_outside_model(&header, rows.values()),
             interrupted: true,
         });
     }
@@ -554,6 +589,7 @@ pub fn run_study(
     std::fs::write(&tmp, &text).map_err(out_err)?;
     std::fs::rename(&tmp, &csv).map_err(out_err)?;
     let failed = rows.values().filter(|r| r.contains(",error,")).count();
+    let outside_model = count_outside_model(&header, rows.values());
     let info = StudyInfo {
         study: study.spec.clone(),
         study_file: study_file.display().to_string(),
@@ -567,6 +603,7 @@ pub fn run_study(
         cases_skipped: done.len(),
         cases_run: todo.len(),
         cases_failed: failed,
+        cases_outside_model: outside_model,
         threads: pool.current_num_threads(),
         wall_time_s: wall,
         lambda: study.lambda_p.map(|x| x.0),
@@ -592,6 +629,7 @@ pub fn run_study(
         skipped: done.len(),
         ran: todo.len(),
         failed,
+        outside_model,
         interrupted: false,
     })
 }
@@ -723,7 +761,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
     };
     std::fs::create_dir_all(out).map_err(out_err)?;
     let _lock = crate::output::folder_lock::FolderLock::acquire(out)?;
-    let mut text = header.unwrap_or_default() + "\n";
+    let header = header.unwrap_or_default();
+    let mut text = header.clone() + "\n";
     for r in rows.values() {
         text.push_str(r);
         text.push('\n');
@@ -736,6 +775,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
         fingerprint: first_json.as_ref().map(|j| j["fingerprint"].clone()),
         merged_from: dirs.iter().map(|d| d.display().to_string()).collect(),
         cases: rows.len(),
+        cases_outside_model: count_outside_model(&header, rows.values()),
         crr_version: env!("CARGO_PKG_VERSION").to_string(),
     };
     replace_file(&out.join("study.json"), to_json(&info)).map_err(out_err)?;

@@ -33,6 +33,10 @@ pub struct StudyInfo {
     pub cases_run: usize,
     /// Cases whose row holds an error.
     pub cases_failed: usize,
+    /// Cases whose run left crr's model (a hypotheses violation, in the row's `violation_*`
+    /// columns).
+    #[serde(default)]
+    pub cases_outside_model: usize,
     /// Worker threads.
     pub threads: usize,
     /// Wall-clock time of the run (s).
@@ -75,6 +79,9 @@ pub struct MergedStudyInfo {
     pub merged_from: Vec<String>,
     /// Cases in the merged `cases.csv`.
     pub cases: usize,
+    /// Of them, those whose run left crr's model (a hypotheses violation).
+    #[serde(default)]
+    pub cases_outside_model: usize,
     /// The version of crr that merged them.
     pub crr_version: String,
 }

@@ -8,7 +8,9 @@
 //! (`alpha_eq_rad` of `study.json`: α itself for one block; for a drum column the whole column
 //! rocking on its base joint, atan(b/h_cm)). Without α_eq (a model that is not a one-DOF
 //! mechanism at rest) it is the largest of the `peak_<coordinate>_over_alpha` columns. A collapsed case counts as exceeding every threshold and, in medians, as
-//! +∞; a case whose row holds an error is left out (and counted in `errors`).
+//! +∞; a case whose row holds an error is left out (and counted in `errors`). A case whose run
+//! left crr's model (a hypotheses violation, its `violation_*` columns) is kept with the measures
+//! its run reached and counted in `outside_model`, in `fragility.csv` and in the figures' captions.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -40,6 +42,9 @@ pub struct CaseResult {
     pub collapse: Option<bool>,
     /// Peak θ/α (None: failed, or no coordinate with a slenderness).
     pub peak_ratio: Option<f64>,
+    /// Its run left crr's model (a hypotheses violation in its `violation_time_s`): its
+    /// measures hold the motion past that time, which the model does not describe.
+    pub outside_model: bool,
 }
 
 /// A study folder read back.
@@ -61,10 +66,12 @@ pub struct StudyResults {
     pub cases: Vec<CaseResult>,
     /// Rows holding an error.
     pub errors: usize,
+    /// Finished cases whose run left crr's model ([`CaseResult::outside_model`]).
+    pub outside_model: usize,
 }
 
 /// Splits one CSV line (fields optionally in double quotes, `""` for a quote).
-fn split_csv(line: &str) -> Vec<String> {
+pub(crate) fn split_csv(line: &str) -> Vec<String> {
     let mut out = Vec::new();
     let mut cur = String::new();
     let mut quoted = false;
@@ -141,6 +148,8 @@ impl StudyResults {
             .filter(|(_, h)| h.starts_with("peak_") && h.ends_with("_over_alpha"))
             .map(|(i, _)| i)
             .collect();
+        // (Absent from the files of crr before 2026-12-01: no case is then known to be outside.)
+        let violation_time = col(super::folder::VIOLATION_TIME_COLUMN);
         let mut cases = Vec::new();
         let mut errors = 0;
         let mut ratios = pulses;
@@ -199,6 +208,7 @@ impl StudyResults {
                 level: intensity.as_deref().and_then(|n| num(col(n))),
                 collapse: Some(f[col("collapse").unwrap_or(status)] == "1"),
                 peak_ratio,
+                outside_model: violation_time.is_some_and(|i| !f[i].is_empty()),
             });
         }
         Ok(StudyResults {
@@ -208,6 +218,7 @@ impl StudyResults {
             ratios,
             sized: col("scale").is_some(),
             intensity,
+            outside_model: cases.iter().filter(|c| c.outside_model).count(),
             cases,
             errors,
         })
@@ -274,7 +285,7 @@ impl StudyResults {
         measures.extend(THRESHOLDS.iter().map(|t| Some(*t)));
         for threshold in measures {
             // Levels equal to 12 significant digits are one level.
-            let mut by_level: BTreeMap<String, FragilityPoint> = BTreeMap::new();
+            let mut by_level: BTreeMap<String, (FragilityPoint, usize)> = BTreeMap::new();
             for c in &self.cases {
                 let (Some(level), Some(collapse)) = (c.level, c.collapse) else {
                     continue;
@@ -286,24 +297,29 @@ impl StudyResults {
                     None => collapse,
                     Some(t) => collapse || c.peak_ratio.is_some_and(|p| p > t),
                 };
-                let p = by_level
-                    .entry(format!("{level:.11e}"))
-                    .or_insert(FragilityPoint {
+                let (p, outside) = by_level.entry(format!("{level:.11e}")).or_insert((
+                    FragilityPoint {
                         im: level,
                         trials: 0.0,
                         exceed: 0.0,
-                    });
+                    },
+                    0,
+                ));
                 p.trials += 1.0;
                 if exceed {
                     p.exceed += 1.0;
                 }
+                *outside += usize::from(c.outside_model);
             }
-            let mut points: Vec<FragilityPoint> = by_level.into_values().collect();
-            points.sort_by(|a, b| a.im.total_cmp(&b.im));
+            let mut levels: Vec<(FragilityPoint, usize)> = by_level.into_values().collect();
+            levels.sort_by(|a, b| a.0.im.total_cmp(&b.0.im));
+            let (points, outside_model): (Vec<FragilityPoint>, Vec<usize>) =
+                levels.into_iter().unzip();
             let fit = fit_lognormal(&points);
             curves.push(FragilityCurve {
                 threshold,
                 points,
+                outside_model,
                 fit,
             });
         }
@@ -319,6 +335,9 @@ pub struct FragilityCurve {
     pub threshold: Option<f64>,
     /// Levels ascending, with trials and exceedances.
     pub points: Vec<FragilityPoint>,
+    /// Per level (in the order of `points`), the cases whose run left crr's model: counted in
+    /// the trials with the measures their runs reached.
+    pub outside_model: Vec<usize>,
     /// The lognormal fit.
     pub fit: Option<LognormalFit>,
 }
@@ -334,13 +353,14 @@ impl FragilityCurve {
 }
 
 /// The texts of `fragility.csv`: one row per curve, `measure,threshold,median_<IM>,dispersion,
-/// log_likelihood,levels_used,cases_used,level_min,level_max` (median, dispersion and likelihood
-/// empty when there is no fit); and of `fragility_points.csv`, the empirical table
-/// `measure,threshold,level,trials,exceed,fraction`.
+/// log_likelihood,levels_used,cases_used,level_min,level_max,cases_outside_model` (median,
+/// dispersion and likelihood empty when there is no fit; the last the cases used whose run left
+/// crr's model); and of `fragility_points.csv`, the empirical table
+/// `measure,threshold,level,trials,exceed,fraction,outside_model`.
 pub fn fragility_csv(curves: &[FragilityCurve], intensity: &str) -> (String, String) {
     let mut s = format!(
         "measure,threshold,median_{intensity},dispersion,log_likelihood,levels_used,cases_used,\
-         level_min,level_max\n"
+         level_min,level_max,cases_outside_model\n"
     );
     let name = |c: &FragilityCurve| match c.threshold {
         None => ("collapse".to_string(), String::new()),
@@ -368,17 +388,18 @@ pub fn fragility_csv(curves: &[FragilityCurve], intensity: &str) -> (String, Str
                 .map(|p| format!("{}", p.im))
                 .unwrap_or_default(),
         );
+        let outside: usize = c.outside_model.iter().sum();
         s.push_str(&format!(
-            "{m},{t},{med},{disp},{ll},{},{cases},{lo},{hi}\n",
+            "{m},{t},{med},{disp},{ll},{},{cases},{lo},{hi},{outside}\n",
             c.points.len()
         ));
     }
-    let mut e = String::from("measure,threshold,level,trials,exceed,fraction\n");
+    let mut e = String::from("measure,threshold,level,trials,exceed,fraction,outside_model\n");
     for c in curves {
         let (m, t) = name(c);
-        for p in &c.points {
+        for (p, outside) in c.points.iter().zip(&c.outside_model) {
             e.push_str(&format!(
-                "{m},{t},{},{},{},{}\n",
+                "{m},{t},{},{},{},{},{outside}\n",
                 p.im,
                 p.trials,
                 p.exceed,
