@@ -756,7 +756,7 @@ class Study:
             text = self.csv(self._rows_with_progress(_jobs(jobs)))
         else:
             text = self.csv(self.run_rows(None, jobs))
-        return cases_frame(text)
+        return _warn_outside_model(cases_frame(text))
 
     def _rows_with_progress(self, jobs: Optional[int]) -> List[str]:
         """Every case's row, run in batches of a few cases per thread, with a tqdm bar when tqdm
@@ -844,6 +844,25 @@ def cases_frame(text: str) -> "pandas.DataFrame":
     return frame
 
 
+def _warn_outside_model(frame: "pandas.DataFrame") -> "pandas.DataFrame":
+    """Issues a :class:`CrrWarning`, as ``crr study`` warns on stderr, when some cases' runs left
+    crr's model (their ``violation_time_s`` is filled: the rigid-contact hypotheses fail, see
+    ``docs/studies.md``); returns ``frame``."""
+    if "violation_time_s" in frame.columns:
+        outside = int(frame["violation_time_s"].notna().sum())
+        if outside:
+            warnings.warn(
+                CrrWarning(
+                    f"{outside} of the {len(frame)} case(s) left crr's model (the rigid-contact "
+                    "hypotheses fail: a flight, a resultant outside its face, sliding or an "
+                    "impulse that pulls; columns violation_time_s, violation, "
+                    "violation_interface): their results after that time are outside the model"
+                ),
+                stacklevel=3,
+            )
+    return frame
+
+
 def study(
     study: Union[Study, PathLike, Mapping[str, Any]],
     jobs: Optional[int] = None,
@@ -862,6 +881,11 @@ def study(
         progress: show progress on stderr: with ``out``, the command line's progress line;
             otherwise a tqdm bar when tqdm is installed, else a line updated in place. The rows
             are the same either way.
+
+    Warns:
+        CrrWarning: when some cases' runs left crr's model (a hypotheses violation, in their
+            ``violation_time_s``, ``violation`` and ``violation_interface`` columns), with the
+            count, as ``crr study`` warns.
     """
     return _as_study(study).run(jobs=jobs, out=out, progress=progress)
 

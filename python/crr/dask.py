@@ -18,7 +18,7 @@ import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, List, Mapping, Optional, Sequence, Tuple, Union
 
-from . import Study, _as_study, _load_study, _pandas, cases_frame
+from . import Study, _as_study, _load_study, _pandas, _warn_outside_model, cases_frame
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas
@@ -60,6 +60,9 @@ def run_study(
         out: when given, ``cases.csv`` is also written into this folder (created if needed).
         progress: show the tasks' progress with ``distributed.progress`` (a bar in a terminal,
             a widget in a notebook) while the cluster works.
+
+    Warns:
+        CrrWarning: when some cases' runs left crr's model, as :func:`crr.study`.
     """
     # Before the cluster works: a missing pandas must not cost the computed rows.
     _pandas("crr.dask.run_study")
@@ -87,4 +90,4 @@ def run_study(
         d.mkdir(parents=True, exist_ok=True)
         with open(d / "cases.csv", "w", newline="") as f:
             f.write(text)
-    return cases_frame(text)
+    return _warn_outside_model(cases_frame(text))

@@ -600,3 +600,106 @@ fn fragility_tables_count_the_cases_outside_the_model() {
         "the caption"
     );
 }
+
+/// A case whose run stops part-way with an error keeps what its run computed: its row holds the
+/// error and the measures up to it, equal to those of `crr simulate` on the same model and pulse
+/// (partial results, `"completed": false`). The drum column under one sine of 3.3 m/s² and
+/// 0.84 s: at 0.8207 s the contacts' decision would lift the capital off every support (a
+/// flight, which stops the run), after the monitor's flight at `bed_4` at 0.8195 s. The collapse
+/// columns stay empty: the run neither collapsed nor lasted.
+#[test]
+fn a_case_stopped_by_an_error_keeps_the_measures_its_run_reached() {
+    let dir = scratch("study_error_measures");
+    let model_text = std::fs::read_to_string(models().join("drum_column.toml")).unwrap();
+    let bundled = "x = { one_sine_pulse = { amplitude = 2.5, period = 0.5 } }";
+    assert!(model_text.contains(bundled));
+    let model = write(
+        &dir,
+        "drums.toml",
+        &model_text.replace(
+            bundled,
+            "x = { one_sine_pulse = { amplitude = 3.3, period = 0.84 } }",
+        ),
+    );
+    let study = write(
+        &dir,
+        "d.toml",
+        &format!(
+            "model = \"{}\"\nduration = 4.0\n\n[pulses]\nkind = \"one_sine_pulse\"\n\
+             amplitudes = [3.3]\nperiods = [0.84]\n",
+            model.display()
+        ),
+    );
+    let out = dir.join("out");
+    run_ok(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let single = dir.join("single");
+    let o = crr(&[
+        "simulate",
+        model.to_str().unwrap(),
+        "--out",
+        single.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!o.status.success(), "the run stops with an error");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(single.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["completed"], false);
+    let coords: Vec<String> = summary["coordinates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap().to_string())
+        .collect();
+    let mut names: Vec<String> = [
+        "status",
+        "collapse",
+        "collapse_time_s",
+        "impacts",
+        "end_time_s",
+        "violation_time_s",
+        "violation_interface",
+        "error",
+    ]
+    .map(String::from)
+    .to_vec();
+    names.extend(coords.iter().map(|c| format!("peak_{c}_rad")));
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let row = &cases_columns(&out, &names)[0];
+    assert_eq!(row[..3], ["error", "", ""]);
+    assert_eq!(row[3], summary["impacts"].to_string());
+    let end = summary["end_time"].as_f64().unwrap();
+    assert!((end - 0.8207).abs() < 1e-4, "{end}");
+    assert_eq!(row[4].parse::<f64>().unwrap().to_bits(), end.to_bits());
+    let v = &summary["hypothesis_violation"];
+    assert_eq!(
+        row[5].parse::<f64>().unwrap().to_bits(),
+        v["time"].as_f64().unwrap().to_bits()
+    );
+    assert_eq!(row[6], v["interface"].as_str().unwrap());
+    assert_eq!(row[7], summary["error"].as_str().unwrap());
+    assert!(
+        row[7].contains("capital lose(s) every support"),
+        "{}",
+        row[7]
+    );
+    for (k, c) in summary["coordinates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .enumerate()
+    {
+        let peak = c["peak_abs"].as_f64().unwrap();
+        assert_eq!(row[8 + k].parse::<f64>().unwrap().to_bits(), peak.to_bits());
+    }
+    assert!(
+        row[8].parse::<f64>().unwrap() > 0.04,
+        "the base joint rocked"
+    );
+}

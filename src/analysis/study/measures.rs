@@ -31,10 +31,31 @@ pub struct Measures {
     pub violation: Option<Violation>,
 }
 
+/// A case that stopped with an error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CaseFailure {
+    /// The error.
+    pub message: String,
+    /// The measures of its run up to the error, when the run started and stopped part-way (a
+    /// flight the contact decision finds, impacts that do not settle…): computed results are
+    /// kept. None when the case could not start (a record that cannot be read, an initial
+    /// state that cannot be solved).
+    pub reached: Option<Box<Measures>>,
+}
+
+impl CaseFailure {
+    fn before_the_run(message: String) -> Self {
+        Self {
+            message,
+            reached: None,
+        }
+    }
+}
+
 /// Runs one case to its end (or collapse) by the same loop as `crr::run`, keeping only its
 /// measures: the samples are drained after every step, so memory does not grow with the
 /// duration.
-pub fn run_case(study: &Study, case: &Case) -> Result<Measures, String> {
+pub fn run_case(study: &Study, case: &Case) -> Result<Measures, CaseFailure> {
     run_case_cancellable(study, case, None).expect("a run without a flag is not cancelled")
 }
 
@@ -44,7 +65,7 @@ pub fn run_case_cancellable(
     study: &Study,
     case: &Case,
     cancel: Option<&Cancel>,
-) -> Option<Result<Measures, String>> {
+) -> Option<Result<Measures, CaseFailure>> {
     if cancel.is_some_and(Cancel::is_cancelled) {
         return None;
     }
@@ -55,14 +76,14 @@ pub fn run_case_cancellable(
     }
 }
 
-/// Why a case has no measures.
+/// Why a case has no complete measures.
 enum CaseStop {
-    Failed(String),
+    Failed(CaseFailure),
     Cancelled,
 }
 
 fn measure(study: &Study, case: &Case, cancel: Option<&Cancel>) -> Result<Measures, CaseStop> {
-    let failed = |e: String| CaseStop::Failed(e);
+    let failed = |e: String| CaseStop::Failed(CaseFailure::before_the_run(e));
     let ground = study.ground_motion(case).map_err(failed)?;
     let mut params = study.params.clone();
     params.duration = study.duration(&ground);
@@ -87,13 +108,8 @@ fn measure(study: &Study, case: &Case, cancel: Option<&Cancel>) -> Result<Measur
         None,
     )
     .map_err(|e| failed(e.to_string()))?;
-    match error {
-        Some(SimulationError::Cancelled { .. }) => return Err(CaseStop::Cancelled),
-        Some(e) => return Err(failed(e.to_string())),
-        None => {}
-    }
     let (residual, dissipated) = last.unwrap_or((0.0, 0.0));
-    Ok(Measures {
+    let measures = Measures {
         peak: t.peak_abs.clone(),
         collapse: t.collapse.as_ref().map(|c| c.t),
         impacts: t.impacts.len(),
@@ -101,5 +117,13 @@ fn measure(study: &Study, case: &Case, cancel: Option<&Cancel>) -> Result<Measur
         dissipated,
         end_time: t.end_time,
         violation: t.violation.clone(),
-    })
+    };
+    match error {
+        Some(SimulationError::Cancelled { .. }) => Err(CaseStop::Cancelled),
+        Some(e) => Err(CaseStop::Failed(CaseFailure {
+            message: e.to_string(),
+            reached: Some(Box::new(measures)),
+        })),
+        None => Ok(measures),
+    }
 }

@@ -17,5 +17,5 @@ pub mod spec;
 pub mod zhang_makris;
 
 pub use cases::{Case, Motion, Study};
-pub use measures::{Measures, run_case, run_case_cancellable};
+pub use measures::{CaseFailure, Measures, run_case, run_case_cancellable};
 pub use spec::StudySpec;

@@ -18,7 +18,7 @@ use crate::Error;
 use crate::analysis::simulation::Cancel;
 use crate::analysis::simulation::coordinate_alpha;
 use crate::analysis::study::cases::case_id;
-use crate::analysis::study::{Case, Measures, Motion, Study, run_case_cancellable};
+use crate::analysis::study::{Case, CaseFailure, Measures, Motion, Study, run_case_cancellable};
 use crate::output::replace_file::replace_file;
 
 /// `i/n`: the i-th (1-based) of n disjoint parts of a study; case k belongs to part k mod n + 1.
@@ -171,7 +171,7 @@ pub fn header(study: &Study) -> String {
 }
 
 /// The row of a case (without its newline).
-pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> String {
+pub fn row(study: &Study, case: &Case, result: &Result<Measures, CaseFailure>) -> String {
     let mut cols: Vec<String> = vec![case.id.clone()];
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     if study.sized {
@@ -207,6 +207,21 @@ pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> Str
     let n = study.model.dof();
     let alphas: Vec<Option<f64>> = (0..n).map(|k| coordinate_alpha(&study.model, k)).collect();
     let with_alpha = alphas.iter().filter(|a| a.is_some()).count();
+    // The measures of a run: complete, or up to the error that stopped it (its collapse columns
+    // empty: it neither collapsed nor survived).
+    let measures = |m: &Measures, cols: &mut Vec<String>| {
+        cols.extend(m.peak.iter().map(|p| num(*p)));
+        for (k, a) in alphas.iter().enumerate() {
+            if let Some(a) = a {
+                cols.push(num(m.peak[k] / a));
+            }
+        }
+        cols.extend([num(m.residual), num(m.dissipated), num(m.end_time)]);
+        match &m.violation {
+            Some(v) => cols.extend([num(v.t), v.kind.clone(), quoted(&v.interface)]),
+            None => cols.extend([String::new(), String::new(), String::new()]),
+        }
+    };
     match result {
         Ok(m) => {
             cols.extend([
@@ -215,23 +230,19 @@ pub fn row(study: &Study, case: &Case, result: &Result<Measures, String>) -> Str
                 opt(m.collapse),
                 m.impacts.to_string(),
             ]);
-            cols.extend(m.peak.iter().map(|p| num(*p)));
-            for (k, a) in alphas.iter().enumerate() {
-                if let Some(a) = a {
-                    cols.push(num(m.peak[k] / a));
-                }
-            }
-            cols.extend([num(m.residual), num(m.dissipated), num(m.end_time)]);
-            match &m.violation {
-                Some(v) => cols.extend([num(v.t), v.kind.clone(), quoted(&v.interface)]),
-                None => cols.extend([String::new(), String::new(), String::new()]),
-            }
+            measures(m, &mut cols);
             cols.push(String::new());
         }
-        Err(e) => {
-            cols.extend(["error".into(), String::new(), String::new(), String::new()]);
-            cols.extend(std::iter::repeat_n(String::new(), n + with_alpha + 6));
-            cols.push(quoted(e));
+        Err(failure) => {
+            cols.extend(["error".into(), String::new(), String::new()]);
+            match &failure.reached {
+                Some(m) => {
+                    cols.push(m.impacts.to_string());
+                    measures(m, &mut cols);
+                }
+                None => cols.extend(std::iter::repeat_n(String::new(), 1 + n + with_alpha + 6)),
+            }
+            cols.push(quoted(&failure.message));
         }
     }
     cols.join(",")
