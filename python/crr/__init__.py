@@ -749,6 +749,12 @@ class Study:
         self, jobs: Optional[int] = None, out: Optional[PathLike] = None, progress: bool = False
     ) -> "pandas.DataFrame":
         """Runs every case and returns the DataFrame of ``cases.csv``; see :func:`study`."""
+        return _warn_outside_model(self._frame(jobs, out, progress), stacklevel=2)
+
+    def _frame(
+        self, jobs: Optional[int], out: Optional[PathLike], progress: bool
+    ) -> "pandas.DataFrame":
+        """:meth:`run` without its warning."""
         if out is not None:
             self._native.run_into(_fspath(out), _jobs(jobs), progress)
             text = (Path(out) / "cases.csv").read_text()
@@ -756,7 +762,7 @@ class Study:
             text = self.csv(self._rows_with_progress(_jobs(jobs)))
         else:
             text = self.csv(self.run_rows(None, jobs))
-        return _warn_outside_model(cases_frame(text))
+        return cases_frame(text)
 
     def _rows_with_progress(self, jobs: Optional[int]) -> List[str]:
         """Every case's row, run in batches of a few cases per thread, with a tqdm bar when tqdm
@@ -844,21 +850,23 @@ def cases_frame(text: str) -> "pandas.DataFrame":
     return frame
 
 
-def _warn_outside_model(frame: "pandas.DataFrame") -> "pandas.DataFrame":
+def _warn_outside_model(frame: "pandas.DataFrame", stacklevel: int) -> "pandas.DataFrame":
     """Issues a :class:`CrrWarning`, as ``crr study`` warns on stderr, when some cases' runs left
     crr's model (their ``violation_time_s`` is filled: the rigid-contact hypotheses fail, see
-    ``docs/studies.md``); returns ``frame``."""
+    ``docs/studies.md``); returns ``frame``. ``stacklevel`` counts from the caller of this
+    function, as :func:`warnings.warn`'s does from its own caller."""
     if "violation_time_s" in frame.columns:
         outside = int(frame["violation_time_s"].notna().sum())
         if outside:
             warnings.warn(
                 CrrWarning(
                     f"{outside} of the {len(frame)} case(s) left crr's model (the rigid-contact "
-                    "hypotheses fail: a flight, a resultant outside its face, sliding or an "
-                    "impulse that pulls; columns violation_time_s, violation, "
-                    "violation_interface): their results after that time are outside the model"
+                    "hypotheses fail: a flight, a resultant outside its face, sliding, an "
+                    "impulse that pulls or a lift-off it cannot follow; columns "
+                    "violation_time_s, violation, violation_interface): their results after "
+                    "that time are outside the model"
                 ),
-                stacklevel=3,
+                stacklevel=stacklevel + 1,
             )
     return frame
 
@@ -887,7 +895,7 @@ def study(
             ``violation_time_s``, ``violation`` and ``violation_interface`` columns), with the
             count, as ``crr study`` warns.
     """
-    return _as_study(study).run(jobs=jobs, out=out, progress=progress)
+    return _warn_outside_model(_as_study(study)._frame(jobs, out, progress), stacklevel=2)
 
 
 def _as_study(study: Union[Study, PathLike, Mapping[str, Any]]) -> Study:

@@ -90,4 +90,4 @@ def run_study(
         d.mkdir(parents=True, exist_ok=True)
         with open(d / "cases.csv", "w", newline="") as f:
             f.write(text)
-    return _warn_outside_model(cases_frame(text))
+    return _warn_outside_model(cases_frame(text), stacklevel=2)

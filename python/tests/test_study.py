@@ -4,6 +4,7 @@ into a folder), from a file or a dict, and spread over a Dask LocalCluster of tw
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import pandas as pd
@@ -46,7 +47,11 @@ def cli_cases(cli, study: Path, out: Path) -> str:
 def test_a_study_equals_the_command_lines_cases_csv(cli, tmp_path):
     study = small_map(tmp_path)
     expected = cli_cases(cli, study, tmp_path / "cli")
-    frame = crr.study(study, jobs=2)
+    # Housner's block keeps every hypothesis on this map: no warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", crr.CrrWarning)
+        frame = crr.study(study, jobs=2)
+    assert frame["violation_time_s"].isna().all()
     assert frame.attrs["cases_csv"] == expected
     assert list(frame.columns) == expected.splitlines()[0].split(",")
     assert len(frame) == 36
@@ -81,8 +86,12 @@ def test_a_study_as_a_dict_and_its_rows_in_chunks(cli, tmp_path):
     assert s.csv(rows) == expected
     # Both records make a bed of the column pull at 0.4 g, and the first at 0.25 g too (the
     # drums above fly): the rows say so, and the frame comes with the command line's warning.
-    with pytest.warns(crr.CrrWarning, match="3 of the 6 case\\(s\\) left crr's model"):
+    with pytest.warns(crr.CrrWarning, match="3 of the 6 case\\(s\\) left crr's model") as told:
         frame = crr.study(d)
+    assert [w.filename for w in told] == [__file__], "the warning points at the caller"
+    with pytest.warns(crr.CrrWarning) as told:
+        s.run()
+    assert [w.filename for w in told] == [__file__]
     assert frame.attrs["cases_csv"] == expected
     outside = frame[frame["violation_time_s"].notna()]
     assert sorted(outside["pga_g"].round(9).tolist()) == [0.25, 0.4, 0.4]

@@ -561,11 +561,13 @@ fn fragility_tables_count_the_cases_outside_the_model() {
         "--plot",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    // From the rows: the cases outside the model at each level.
-    let rows = cases_columns(&out, &["pga_g", "violation_time_s"]);
+    // From the rows: the finished cases outside the model at each level (a case stopped by an
+    // error is not in the fragility tables).
+    let rows = cases_columns(&out, &["pga_g", "violation_time_s", "status"]);
     let count = |level: f64| {
         rows.iter()
-            .filter(|r| (r[0].parse::<f64>().unwrap() - level).abs() < 1e-9 && !r[1].is_empty())
+            .filter(|r| (r[0].parse::<f64>().unwrap() - level).abs() < 1e-9)
+            .filter(|r| !r[1].is_empty() && r[2] == "ok")
             .count()
     };
     let expected = [count(0.1), count(0.3), count(0.5)];
@@ -595,8 +597,9 @@ fn fragility_tables_count_the_cases_outside_the_model() {
         assert_eq!(l.rsplit(',').next().unwrap(), total.to_string(), "{l}");
     }
     let svg = std::fs::read_to_string(out.join("fragility.svg")).unwrap();
+    let finished = rows.iter().filter(|r| r[2] == "ok").count();
     assert!(
-        svg.contains(&format!("({total} of 6 cases outside crr")),
+        svg.contains(&format!("({total} of {finished} cases outside crr")),
         "the caption"
     );
 }
@@ -683,6 +686,8 @@ fn a_case_stopped_by_an_error_keeps_the_measures_its_run_reached() {
         v["time"].as_f64().unwrap().to_bits()
     );
     assert_eq!(row[6], v["interface"].as_str().unwrap());
+    let kind = &cases_columns(&out, &["violation"])[0][0];
+    assert_eq!(kind, v["kind"].as_str().unwrap());
     assert_eq!(row[7], summary["error"].as_str().unwrap());
     assert!(
         row[7].contains("capital lose(s) every support"),
@@ -701,5 +706,25 @@ fn a_case_stopped_by_an_error_keeps_the_measures_its_run_reached() {
     assert!(
         row[8].parse::<f64>().unwrap() > 0.04,
         "the base joint rocked"
+    );
+    // The residual rotation and the dissipated energy: those of the last row of the partial
+    // history.csv (its largest |angle| and its `dissipated`).
+    let history = std::fs::read_to_string(single.join("history.csv")).unwrap();
+    let header: Vec<&str> = history.lines().next().unwrap().split(',').collect();
+    let last: Vec<&str> = history.lines().last().unwrap().split(',').collect();
+    let value = |name: &str| -> f64 {
+        last[header.iter().position(|h| *h == name).unwrap()]
+            .parse()
+            .unwrap()
+    };
+    let residual = coords.iter().map(|c| value(c).abs()).fold(0.0f64, f64::max);
+    let measured = cases_columns(&out, &["residual_rad", "dissipated_j"]);
+    assert_eq!(
+        measured[0][0].parse::<f64>().unwrap().to_bits(),
+        residual.to_bits()
+    );
+    assert_eq!(
+        measured[0][1].parse::<f64>().unwrap().to_bits(),
+        value("dissipated").to_bits()
     );
 }

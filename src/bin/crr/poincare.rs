@@ -217,6 +217,20 @@ fn report_poincare(model: &std::path::Path, r: &PoincareResult, quiet: bool) -> 
                 cases.len()
             );
         }
+        let outside = cases
+            .iter()
+            .filter(|c| c.section.hypothesis_violation.is_some())
+            .count();
+        if outside > 0 {
+            eprintln!(
+                "crr: warning: {}: {outside} of {} case(s) left crr's model (the rigid-contact \
+                 hypotheses fail: their `hypothesis_violation` in {}): their points after that \
+                 time are outside the model",
+                model.display(),
+                cases.len(),
+                r.out.join("poincare.json").display()
+            );
+        }
         if failed > 0 {
             eprintln!(
                 "crr: {}: {failed} of {} case(s) stopped early with an error (listed in {})",

@@ -117,9 +117,9 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
     if outcome.outside_model > 0 {
         eprintln!(
             "crr: warning: {} of the {} case(s) of this part left crr's model (the rigid-contact \
-                 hypotheses fail: a flight, a resultant outside its face, sliding or an impulse \
-                 that pulls; columns violation_time_s, violation, violation_interface of {}): \
-                 their results after that time are outside the model",
+             hypotheses fail: a flight, a resultant outside its face, sliding, an impulse that \
+             pulls or a lift-off it cannot follow; columns violation_time_s, violation, \
+             violation_interface of {}): their results after that time are outside the model",
             outcome.outside_model,
             outcome.cases,
             out.join("cases.csv").display()

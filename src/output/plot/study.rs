@@ -98,8 +98,8 @@ pub fn draw_map<DB: DrawingBackend>(
     } else {
         Vec::new()
     };
-    // Room above the cells for the legend (its rows: the four keys and the boundary's line), so
-    // that it hides none of them.
+    // Room above the cells for the legend (its rows: the four keys, the boundary's line and the
+    // cross of the cases outside crr's model), so that it hides none of them.
     let rows = 4 + usize::from(!boundary.is_empty()) + usize::from(!outside.is_empty());
     let yr = headroom(
         padded(cells.iter().flat_map(|c| [c.1 - hy, c.1 + hy])),
@@ -115,7 +115,7 @@ pub fn draw_map<DB: DrawingBackend>(
             format!(
                 "{}: overturning map{sized}{}",
                 r.name,
-                outside_note(r.outside_model, r.cases.len())
+                outside_note(outside.len(), cells.len())
             ),
             caption_style(k),
         )

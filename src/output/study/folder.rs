@@ -323,7 +323,13 @@ impl std::fmt::Write for Fnv {
     }
 }
 
-/// The fingerprint of a study (16 hex digits): a hash of the crr version, the study file as read,
+/// The revision of what a row of `cases.csv` holds, part of the [`fingerprint`]: a folder written
+/// by a crr whose rows meant something else is not resumed or merged into. 2 (2026-12-01): the
+/// `violation_*` columns, and the measures a case stopped by an error reached.
+const CASES_FORMAT: u32 = 2;
+
+/// The fingerprint of a study (16 hex digits): a hash of the crr version and of the rows' format
+/// ([`CASES_FORMAT`]), the study file as read,
 /// the model at every scale with its initial state, every case and every record's samples. Two
 /// runs may share a folder only when their fingerprints agree: a resume after the study file, its
 /// model or a record was edited (or with another crr) would otherwise keep the old rows under
@@ -334,7 +340,11 @@ pub fn fingerprint(study: &Study) -> String {
     // Debug output of f64 is exact (it reads back to the same bits), and these types hold no
     // hash maps, so the text is the same on every run.
     let spec = serde_json::to_string(&study.spec).unwrap_or_default();
-    let _ = write!(h, "crr {}\n{spec}\n", env!("CARGO_PKG_VERSION"));
+    let _ = write!(
+        h,
+        "crr {} rows {CASES_FORMAT}\n{spec}\n",
+        env!("CARGO_PKG_VERSION")
+    );
     for v in &study.variants {
         let _ = write!(h, "{:?}\n{:?}\n{:?}\n", v.scale, v.model, v.initial);
     }
@@ -414,8 +424,8 @@ fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64
         if first {
             if body != header {
                 return Err(Error::Argument(format!(
-                    "{}: the folder holds the cases of another study (different columns); use \
-                     another --out folder",
+                    "{}: the folder holds the cases of another study, or of another version of \
+                     crr (different columns); use another --out folder",
                     path.display()
                 )));
             }
