@@ -326,7 +326,7 @@ impl std::fmt::Write for Fnv {
 /// The revision of what a row of `cases.csv` holds, part of the [`fingerprint`]: a folder written
 /// by a crr whose rows meant something else is not resumed or merged into. 2 (2026-12-01): the
 /// `violation_*` columns, and the measures a case stopped by an error reached.
-const CASES_FORMAT: u32 = 2;
+pub const CASES_FORMAT: u32 = 2;
 
 /// The fingerprint of a study (16 hex digits): a hash of the crr version and of the rows' format
 /// ([`CASES_FORMAT`]), the study file as read,
