@@ -111,6 +111,10 @@ pub struct Results {
     /// The energy levels of the first coordinate from the engine's M(θ) and U(θ), when the model
     /// is any other one-DOF mechanism (DOF(2) = 1, e.g. a trilithon or an arch).
     pub levels: Option<MechanismLevels>,
+    /// The run's first failure of the rigid-contact hypotheses (`hypothesis_violation` of
+    /// summary.json): its time (s) and "kind at interface". The figures shade the time after it,
+    /// which crr's model does not describe.
+    pub violation: Option<(f64, String)>,
 }
 
 fn read_text(file: &Path) -> Result<String, PlotError> {
@@ -258,6 +262,17 @@ pub fn parse_results(
         impacts: Vec::new(),
         free_rocking: free_rocking(&summary),
         levels: None,
+        violation: summary["hypothesis_violation"]["time"]
+            .as_f64()
+            .filter(|t| t.is_finite())
+            .map(|t| {
+                let v = &summary["hypothesis_violation"];
+                let (kind, at) = (
+                    v["kind"].as_str().unwrap_or("violation"),
+                    v["interface"].as_str().unwrap_or("?"),
+                );
+                (t, format!("{kind} at {at}"))
+            }),
     };
     if r.free_rocking.is_none() {
         r.levels = mechanism_levels_of(&summary);
@@ -547,6 +562,7 @@ pub fn draw_coordinates<DB: DrawingBackend>(
         &|v| tick(*v, &xr),
         &|v| tick(*v, &yr),
     )?;
+    shade_outside_model(&mut chart, r, &xr, &yr, k)?;
     let n = r.coordinates.len();
     for (i, name) in r.coordinates.iter().enumerate() {
         let c = colour(i);
@@ -592,6 +608,39 @@ pub fn draw_coordinates<DB: DrawingBackend>(
     legend(&mut chart, k, SeriesLabelPosition::UpperRight)
 }
 
+/// The grey of the time after a run's first hypotheses violation.
+const OUTSIDE_MODEL: RGBColor = RGBColor(150, 150, 150);
+
+/// Shades the time after the run's first hypotheses violation ([`Results::violation`]), with a
+/// legend entry naming it: what the figure shows there is outside crr's model.
+fn shade_outside_model<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    r: &Results,
+    xr: &std::ops::Range<f64>,
+    yr: &std::ops::Range<f64>,
+    k: u32,
+) -> DrawResult {
+    let Some((t, what)) = &r.violation else {
+        return Ok(());
+    };
+    if *t >= xr.end {
+        return Ok(());
+    }
+    let fill = OUTSIDE_MODEL.mix(0.25).filled();
+    let w = 10 * k as i32;
+    chart
+        .draw_series(std::iter::once(Rectangle::new(
+            [(t.max(xr.start), yr.start), (xr.end, yr.end)],
+            fill,
+        )))
+        .map_err(err)?
+        .label(format!("outside crr's model from t = {t:.4} s ({what})"))
+        .legend(move |(x, y): (i32, i32)| {
+            Rectangle::new([(x, y - w / 2), (x + 2 * w, y + w / 2)], fill)
+        });
+    Ok(())
+}
+
 /// (b) The energy balance: T, U, W, D on the upper panel, T + U − W + D − E(0) on the lower one.
 pub fn draw_energy<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -635,6 +684,7 @@ pub fn draw_energy<DB: DrawingBackend>(
         &|v| tick(*v, &xr),
         &|v| tick(*v, &yr),
     )?;
+    shade_outside_model(&mut chart, r, &xr, &yr, k)?;
     for (i, (name, v)) in series.iter().enumerate() {
         let c = colour(i);
         chart

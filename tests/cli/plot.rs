@@ -81,6 +81,51 @@ fn simulate_plot_writes_the_three_plots_of_the_single_block() {
     let listed = String::from_utf8_lossy(&o.stdout);
     assert_eq!(listed.lines().count(), 6, "{listed}");
     assert!(listed.contains("phase.svg"));
+    // A run that keeps every hypothesis shades nothing.
+    for stem in ["coordinates", "energy"] {
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
+        assert!(!svg.contains("outside crr"), "{stem}.svg");
+    }
+}
+
+/// The time histories and the energy balance of a run that leaves crr's model shade the time
+/// after its first hypotheses violation and name it in the legend, at the time and interface
+/// `summary.json` gives: the bundled drum column, whose bed under the fourth drum would have to
+/// pull at 0.5295 s (the drums above fly, tests/cli/warnings.rs).
+#[test]
+fn plots_shade_the_time_outside_the_model() {
+    let out = scratch("plot_outside_model");
+    let o = crr(&[
+        "simulate",
+        "examples/models/drum_column.toml",
+        "--out",
+        out.to_str().unwrap(),
+        "--plot",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let v = &summary["hypothesis_violation"];
+    let label = format!(
+        "outside crr's model from t = {:.4} s ({} at {})",
+        v["time"].as_f64().unwrap(),
+        v["kind"].as_str().unwrap(),
+        v["interface"].as_str().unwrap()
+    );
+    assert_eq!(
+        label,
+        "outside crr's model from t = 0.5295 s (tension at bed_4)"
+    );
+    for stem in ["coordinates", "energy"] {
+        assert_png(&out.join(format!("{stem}.png")));
+        // (plotters writes the apostrophe as an entity in SVG text.)
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg")))
+            .unwrap()
+            .replace("&apos;", "'")
+            .replace("&#39;", "'");
+        assert!(svg.contains(&label), "{stem}.svg: no {label:?}");
+    }
 }
 
 #[test]
