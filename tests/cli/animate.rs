@@ -696,3 +696,38 @@ fn bundled_models_gifs_are_under_5_mb() {
         eprintln!("{m}: {f} frames, {:.1} kB", b as f64 / 1000.0);
     }
 }
+
+/// An animation of a run that leaves crr's model says so on every frame after the run's first
+/// hypotheses violation (its time read from summary.json), and on none before: the bundled drum
+/// column, whose bed under the fourth drum would have to pull at 0.5295 s.
+#[test]
+fn frames_after_a_violation_say_they_are_outside_the_model() {
+    use crr::output::animate::{gif::caption, read_run};
+    let results = simulate("drum_column", "1.0", "outside_model");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(results.join("summary.json")).unwrap())
+            .unwrap();
+    let t_v = summary["hypothesis_violation"]["time"].as_f64().unwrap();
+    assert!((t_v - 0.5295).abs() < 1e-4, "{t_v}");
+    let run = read_run(&results).unwrap();
+    assert_eq!(run.violation_time, Some(t_v));
+    let (mut before, mut after) = (0, 0);
+    for state in run.states().unwrap() {
+        let state = state.unwrap();
+        let text = caption(&state, run.violation_time);
+        assert_eq!(
+            text.contains("outside crr's model"),
+            state.t > t_v,
+            "{text}"
+        );
+        if state.t > t_v {
+            after += 1;
+        } else {
+            before += 1;
+        }
+    }
+    assert!(before > 10 && after > 10, "{before} before, {after} after");
+    // The GIF is written with those captions.
+    ok(&["animate", s(&results), "--out", s(&results.join("anim"))]);
+    assert!(results.join("anim").join("animation.gif").is_file());
+}

@@ -108,8 +108,16 @@ pub fn delays(times: &[f64], speed: f64) -> Vec<u16> {
     out
 }
 
-/// The caption of a frame: its time and the largest |θ| of any coordinate so far.
-pub fn caption(state: &State) -> String {
+/// The caption of a frame: its time and the largest |θ| of any coordinate so far; after the
+/// run's first hypotheses violation (`outside_from`, s), that the motion shown is outside crr's
+/// model.
+pub fn caption(state: &State, outside_from: Option<f64>) -> String {
+    if outside_from.is_some_and(|t| state.t > t) {
+        return format!(
+            "t = {:.2} s   max |θ| {:.4} rad   outside crr's model",
+            state.t, state.peak_so_far
+        );
+    }
     format!(
         "t = {:.2} s    max |θ| so far = {:.4} rad ({:.2}°)",
         state.t,
@@ -130,6 +138,8 @@ pub struct GifWriter<W: std::io::Write> {
     rgb: Vec<u8>,
     previous: Option<Vec<u8>>,
     written: usize,
+    /// The time after which the run is outside crr's model (its first hypotheses violation).
+    outside_from: Option<f64>,
 }
 
 fn encode_error(e: ::gif::EncodingError) -> Error {
@@ -159,6 +169,7 @@ impl<W: std::io::Write> GifWriter<W> {
         ground: &Ground,
         times: &[f64],
         speed: f64,
+        outside_from: Option<f64>,
     ) -> Result<Self, Error> {
         let palette = palette();
         let flat: Vec<u8> = palette.iter().flatten().copied().collect();
@@ -176,6 +187,7 @@ impl<W: std::io::Write> GifWriter<W> {
             rgb: vec![0u8; 3 * (WIDTH * HEIGHT) as usize],
             previous: None,
             written: 0,
+            outside_from,
         })
     }
 
@@ -200,7 +212,8 @@ impl<W: std::io::Write> GifWriter<W> {
                 colour,
             }));
         }
-        self.renderer.draw(&faces, &caption(state), &mut self.rgb);
+        self.renderer
+            .draw(&faces, &caption(state, self.outside_from), &mut self.rgb);
         let indexed: Vec<u8> = self
             .rgb
             .chunks_exact(3)

@@ -143,6 +143,9 @@ pub struct Run {
     pub span: (f64, f64),
     /// The faces open at each row of history.csv that has any (`openings.csv`).
     pub openings: BTreeMap<usize, Vec<FaceOpening>>,
+    /// The time of the run's first hypotheses violation (`hypothesis_violation` of summary.json),
+    /// after which the motion is outside crr's model: the frames after it say so.
+    pub violation_time: Option<f64>,
 }
 
 impl Run {
@@ -220,6 +223,9 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
         count,
         span,
         openings,
+        violation_time: summary["hypothesis_violation"]["time"]
+            .as_f64()
+            .filter(|t| t.is_finite()),
     })
 }
 
@@ -830,6 +836,7 @@ pub fn animate(dir: &Path, opts: &AnimateOptions) -> Result<AnimateReport, Error
             &ground,
             &times,
             opts.speed,
+            run.violation_time,
         )?);
     }
     let names_of_bodies: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
