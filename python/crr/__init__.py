@@ -441,8 +441,10 @@ class Result:
         ``potential``, ``work_in``, ``dissipated`` (J) over ``t``; ``state`` over (``t``,
         ``interface``). Every variable and ``t`` carry ``units`` and ``long_name`` attributes; the
         dataset's attributes hold the model's name, the number of impacts, whether the run
-        completed or collapsed, and ``summary_json`` (the whole summary as text: netCDF
-        attributes are flat).
+        completed or collapsed, ``outside_model_from_s`` (the time of the run's first failure
+        of the rigid-contact hypotheses, ``summary["hypothesis_violation"]``, after which the
+        history is outside crr's model; NaN when the run kept them all) and ``summary_json``
+        (the whole summary as text: netCDF attributes are flat).
 
         ``t`` is not unique: at an impact the history has two rows at the same time, the rates
         before and then after it (as ``history.csv``). Select those by position (``isel``), or
@@ -487,6 +489,9 @@ class Result:
                 "impacts": int(self.summary["impacts"]),
                 "completed": int(self.completed),
                 "collapsed": int(self.summary["collapse"]["collapsed"]),
+                "outside_model_from_s": float(
+                    (self.summary.get("hypothesis_violation") or {}).get("time", float("nan"))
+                ),
                 "summary_json": json.dumps(self.summary, ensure_ascii=False),
             },
         )

@@ -29,6 +29,7 @@ def test_the_dataset_holds_the_history_with_units_and_the_impacts_twice():
     assert units == {"t": "s", "q": "rad", "qdot": "rad/s", "kinetic": "J", "work_in": "J"}
     assert json.loads(ds.attrs["summary_json"]) == result.summary
     assert ds.attrs["impacts"] == len(result.impacts) > 0
+    assert np.isnan(ds.attrs["outside_model_from_s"]), "the trilithon keeps the hypotheses"
     # Each impact is two rows at one time (rates before, then after): exactly the duplicates.
     duplicated = ds.indexes["t"].duplicated(keep="last")
     assert duplicated.sum() == len(result.impacts)
@@ -41,3 +42,17 @@ def test_the_dataset_holds_the_history_with_units_and_the_impacts_twice():
         kept = unique.sel(t=impact["t"])
         np.testing.assert_array_equal(kept["qdot"].values, result.qdot[rows[1]])
         assert not np.array_equal(result.qdot[rows[0]], result.qdot[rows[1]])
+
+
+def test_the_dataset_says_from_when_a_run_is_outside_the_model():
+    # The bundled drum column: a bed would pull at 0.5295 s (the drums above fly), which the
+    # run warns about; the dataset carries that time.
+    with pytest.warns(crr.CrrWarning, match="would need tension"):
+        result = crr.simulate(crr.Model.from_file(ROOT / "examples/models/drum_column.toml"))
+    ds = result.to_xarray()
+    t = result.summary["hypothesis_violation"]["time"]
+    assert abs(t - 0.5295) < 1e-4
+    assert ds.attrs["outside_model_from_s"] == t
+    # The part of the history inside the model, by that time.
+    inside = ds.sel(t=slice(None, t))
+    assert inside["t"].values.max() == t

@@ -542,7 +542,7 @@ pub fn draw_coordinates<DB: DrawingBackend>(
     let xr = 0f64.min(xr.start)..r.t.last().copied().unwrap_or(1.0).max(1e-9);
     let yr = headroom(
         padded(r.q.iter().flatten().copied().chain([0.0])),
-        0.06 * (r.coordinates.len() + 1) as f64,
+        0.06 * (r.coordinates.len() + 1 + usize::from(r.violation.is_some())) as f64,
     );
     let mut chart = ChartBuilder::on(root)
         .caption(
@@ -623,14 +623,13 @@ fn shade_outside_model<DB: DrawingBackend>(
     let Some((t, what)) = &r.violation else {
         return Ok(());
     };
-    if *t >= xr.end {
-        return Ok(());
-    }
+    // (A violation at the last sample shades nothing but is still named.)
+    let from = t.clamp(xr.start, xr.end);
     let fill = OUTSIDE_MODEL.mix(0.25).filled();
     let w = 10 * k as i32;
     chart
         .draw_series(std::iter::once(Rectangle::new(
-            [(t.max(xr.start), yr.start), (xr.end, yr.end)],
+            [(from, yr.start), (xr.end, yr.end)],
             fill,
         )))
         .map_err(err)?
@@ -663,7 +662,7 @@ pub fn draw_energy<DB: DrawingBackend>(
                 .flat_map(|(_, v)| v.iter().copied())
                 .chain([0.0]),
         ),
-        0.35,
+        if r.violation.is_some() { 0.45 } else { 0.35 },
     );
     let mut chart = ChartBuilder::on(&upper)
         .caption(
@@ -739,6 +738,7 @@ pub fn draw_energy<DB: DrawingBackend>(
             }
         },
     )?;
+    shade_outside_model(&mut chart, r, &xr, &yr, k)?;
     let c = RGBColor(0, 0, 0);
     chart
         .draw_series(LineSeries::new(balance, c.stroke_width(2 * k)))

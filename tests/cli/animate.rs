@@ -727,7 +727,36 @@ fn frames_after_a_violation_say_they_are_outside_the_model() {
         }
     }
     assert!(before > 10 && after > 10, "{before} before, {after} after");
-    // The GIF is written with those captions.
+    // The GIF is written with those captions: the same folder with the violation removed from
+    // its summary.json animates to other pixels (only the captions after 0.5295 s differ).
     ok(&["animate", s(&results), "--out", s(&results.join("anim"))]);
-    assert!(results.join("anim").join("animation.gif").is_file());
+    let clean = results.with_file_name("clean");
+    std::fs::create_dir_all(&clean).unwrap();
+    for name in ["history.csv", "impacts.csv", "openings.csv"] {
+        if results.join(name).is_file() {
+            std::fs::copy(results.join(name), clean.join(name)).unwrap();
+        }
+    }
+    let mut kept = summary.clone();
+    kept["hypothesis_violation"] = serde_json::Value::Null;
+    std::fs::write(clean.join("summary.json"), kept.to_string()).unwrap();
+    ok(&["animate", s(&clean), "--out", s(&clean.join("anim"))]);
+    let frames = |dir: &Path| -> Vec<Vec<u8>> {
+        let file = std::fs::File::open(dir.join("anim").join("animation.gif")).unwrap();
+        let mut options = gif::DecodeOptions::new();
+        options.set_color_output(gif::ColorOutput::RGBA);
+        let mut decoder = options.read_info(file).unwrap();
+        let mut out = Vec::new();
+        while let Some(frame) = decoder.read_next_frame().unwrap() {
+            out.push(frame.buffer.to_vec());
+        }
+        out
+    };
+    let (with, without) = (frames(&results), frames(&clean));
+    assert_eq!(with.len(), without.len());
+    let differing = with.iter().zip(&without).filter(|(a, b)| a != b).count();
+    assert!(
+        differing > 0,
+        "the captions after the violation reach the GIF"
+    );
 }
