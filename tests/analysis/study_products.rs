@@ -27,6 +27,26 @@ fn run_ok(args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// Runs `crr study STUDY --out OUT --quiet --plot`, which must succeed; returns its stderr.
+fn study_plotted(study: &Path, out: &Path) -> String {
+    let o = crr(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--plot",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(o.status.success(), "{err}");
+    err
+}
+
+/// A JSON file read back.
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 /// A PNG of the project's size that is not blank, and an SVG with at least `min_shapes` drawn
 /// elements.
 fn assert_figure(dir: &Path, stem: &str, min_shapes: usize) {
@@ -454,16 +474,7 @@ fn a_case_that_leaves_the_model_says_so_as_crr_simulate_does() {
         ),
     );
     let out = dir.join("out");
-    let o = crr(&[
-        "study",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--plot",
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "{err}");
+    let err = study_plotted(&study, &out);
     assert!(
         err.contains("1 of the 2 case(s) of this part left crr's model"),
         "{err}"
@@ -486,9 +497,7 @@ fn a_case_that_leaves_the_model_says_so_as_crr_simulate_does() {
         single.to_str().unwrap(),
         "--quiet",
     ]);
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(single.join("summary.json")).unwrap())
-            .unwrap();
+    let summary = read_json(&single.join("summary.json"));
     let v = &summary["hypothesis_violation"];
     let t = v["time"].as_f64().unwrap();
     assert!((t - 0.5295).abs() < 1e-4, "{v}");
@@ -497,8 +506,7 @@ fn a_case_that_leaves_the_model_says_so_as_crr_simulate_does() {
     assert_eq!(rows[1][2], "tension");
     assert_eq!(rows[1][3], v["interface"].as_str().unwrap());
     assert_eq!(rows[1][0], summary["impacts"].to_string(), "the same run");
-    let info: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("study.json")).unwrap()).unwrap();
+    let info = read_json(&out.join("study.json"));
     assert_eq!(info["cases_outside_model"], 1);
     // Shards merged count it too.
     let parts: Vec<PathBuf> = (1..=2).map(|i| dir.join(format!("part_{i}"))).collect();
@@ -523,8 +531,7 @@ fn a_case_that_leaves_the_model_says_so_as_crr_simulate_does() {
         "--out",
         merged.to_str().unwrap(),
     ]);
-    let info: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(merged.join("study.json")).unwrap()).unwrap();
+    let info = read_json(&merged.join("study.json"));
     assert_eq!(
         (info["cases"].as_u64(), info["cases_outside_model"].as_u64()),
         (Some(2), Some(1))
@@ -552,15 +559,7 @@ fn fragility_tables_count_the_cases_outside_the_model() {
         ),
     );
     let out = dir.join("out");
-    let o = crr(&[
-        "study",
-        study.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--plot",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    study_plotted(&study, &out);
     // From the rows: the finished cases outside the model at each level (a case stopped by an
     // error is not in the fragility tables).
     let rows = cases_columns(&out, &["pga_g", "violation_time_s", "status"]);
@@ -650,9 +649,7 @@ fn a_case_stopped_by_an_error_keeps_the_measures_its_run_reached() {
         "--quiet",
     ]);
     assert!(!o.status.success(), "the run stops with an error");
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(single.join("summary.json")).unwrap())
-            .unwrap();
+    let summary = read_json(&single.join("summary.json"));
     assert_eq!(summary["completed"], false);
     let coords: Vec<String> = summary["coordinates"]
         .as_array()
