@@ -22,8 +22,8 @@ use crr_impact::simulation::{
 use crr_kinematics::{InterfaceKind, Model};
 
 use super::summary::{
-    CollapseSummary, CoordinateSummary, GroundMotionSummary, InitialSummary, RecordSummary,
-    SolverSettings, SolverStats, Summary, ViolationSummary,
+    CollapseSummary, CoordinateSummary, GroundMotionSummary, HopsSummary, InitialSummary,
+    RecordSummary, SolverSettings, SolverStats, Summary, ViolationSummary,
 };
 use crate::Error;
 use crate::input::model_file::{ModelFile, ModelInput};
@@ -631,6 +631,7 @@ impl Prepared {
                 collapse_drop: p.collapse_drop,
                 friction: p.friction,
                 hold_seated_at_impacts: p.hold_seated_at_impacts,
+                hop_tolerance: p.hop_tolerance,
             },
             solver_stats: SolverStats {
                 steps: t.solver_stats.steps,
@@ -659,8 +660,46 @@ impl Prepared {
                 kind: v.kind.clone(),
                 normal_force: v.normal,
                 friction_demand: finite(v.friction_demand),
+                hop: v.hop.as_deref().cloned(),
             }),
+            hops: HopsSummary {
+                count: t.hops.len(),
+                beyond_tolerance: t.hops.iter().filter(|h| !h.within(p.hop_tolerance)).count(),
+                largest_separation: t.hops.iter().map(|h| h.separation).reduce(f64::max),
+                largest_pull: t.hops.iter().map(|h| h.largest_pull).reduce(f64::max),
+            },
         }
+    }
+}
+
+/// The words of a `tension` violation that is a pull just after an impact, measured by the
+/// motion with the face released (docs/simulation.md, "Hops").
+fn hop_words(h: &crr_impact::simulation::Hop, tolerance: f64) -> String {
+    if !h.opens {
+        return ", although released the face would not open (its tangential force holds it \
+                down): no rigid motion answers"
+            .to_string();
+    }
+    if !h.short {
+        return format!(
+            ", from {} s on: the bodies released would tumble away from crr's motion",
+            h.start
+        );
+    }
+    let size = format!(
+        "; released, the face would open by {:.1e} m and the bodies depart from crr's motion by \
+         at most {:.1e} m before it lands",
+        h.separation, h.departure
+    );
+    if h.closed {
+        format!(
+            "{size} {:.2e} s later (a hop: `[analysis] hop_tolerance`, {} m here, accepts hops \
+             up to a length)",
+            h.end - h.start,
+            num(tolerance)
+        )
+    } else {
+        format!("{size} (not landed when the run ended)")
     }
 }
 
@@ -835,8 +874,12 @@ fn warnings(
     if let Some(v) = &t.violation {
         let what = if v.kind == "tension" {
             format!(
-                "would need tension (N = {:.4e} N): the bodies separate (flight)",
-                v.normal
+                "would need tension (N = {:.4e} N): the bodies separate (flight){}",
+                v.normal,
+                v.hop
+                    .as_ref()
+                    .map(|h| hop_words(h, p.params.hop_tolerance))
+                    .unwrap_or_default()
             )
         } else if v.kind == "outside_face" {
             format!(

@@ -63,6 +63,24 @@ pub struct Summary {
     /// The first failure of the rigid-contact hypotheses (flight, a resultant outside its face,
     /// sliding), if any.
     pub hypothesis_violation: Option<ViolationSummary>,
+    /// The pulls at pivots where a segment started (just after an impact), each measured by the
+    /// bound on how far its face would open (docs/simulation.md, "Hops"). Absent from a summary
+    /// written before 2026-12-01.
+    #[serde(default)]
+    pub hops: HopsSummary,
+}
+
+/// The hops of a run (`hops` of summary.json; each one in hops.csv).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HopsSummary {
+    /// How many.
+    pub count: usize,
+    /// How many exceeded `hop_tolerance` (each a violation; with the default 0, every one).
+    pub beyond_tolerance: usize,
+    /// The largest separation bound (m); None without hops.
+    pub largest_separation: Option<f64>,
+    /// The largest pull (N); None without hops.
+    pub largest_pull: Option<f64>,
 }
 
 impl Summary {
@@ -143,6 +161,9 @@ pub struct SolverSettings {
     /// `hold_seated_at_impacts`).
     #[serde(default)]
     pub hold_seated_at_impacts: bool,
+    /// `hop_tolerance` (m; read as 0 from a summary written before 2026-12-01).
+    #[serde(default)]
+    pub hop_tolerance: f64,
 }
 
 /// The integrator's work over the run.
@@ -200,4 +221,9 @@ pub struct ViolationSummary {
     pub normal_force: f64,
     /// |F_t|/N needed; `None` when undefined.
     pub friction_demand: Option<f64>,
+    /// For a `tension` at a face that pulls on its pivot where a segment starts (just after an
+    /// impact): that pull measured by the motion with the face released (docs/simulation.md,
+    /// "Hops"); None otherwise.
+    #[serde(default)]
+    pub hop: Option<crr_impact::simulation::Hop>,
 }

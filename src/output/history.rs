@@ -111,6 +111,33 @@ pub fn impacts_csv(model: &Model, t: &Trajectory) -> String {
     s
 }
 
+/// The text of `hops.csv`: one row per pull at a pivot where a segment started (just after an
+/// impact), measured by the motion with that face released (docs/simulation.md, "Hops"), in
+/// the order they ended; `within_tolerance` against the run's `hop_tolerance`.
+pub fn hops_csv(t: &Trajectory, tolerance: f64) -> String {
+    let mut s = String::from(
+        "interface,start,pull_end,end,largest_pull,separation,departure,closed,opens,short,\
+         within_tolerance\n",
+    );
+    for h in &t.hops {
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{}\n",
+            h.interface,
+            num(h.start),
+            h.pull_end.map(num).unwrap_or_default(),
+            num(h.end),
+            num(h.largest_pull),
+            num(h.separation),
+            num(h.departure),
+            h.closed,
+            h.opens,
+            h.short,
+            h.within(tolerance)
+        ));
+    }
+    s
+}
+
 /// The names of the seated joints an impact opened (`ImpactRecord::released`), by slot.
 pub fn opened_names(model: &Model, released: &[usize]) -> Vec<String> {
     released.iter().map(|&k| model.slot_name(k)).collect()

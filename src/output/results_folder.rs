@@ -12,12 +12,13 @@ use crate::Error;
 /// The files `crr simulate` writes, and those `--plot` and `--animate` add (the animation's
 /// index and GIF; its frames go with them): an earlier run's set is replaced whole (with
 /// `--force`), never mixed with a new one.
-pub const RESULT_FILES: [&str; 12] = [
+pub const RESULT_FILES: [&str; 13] = [
     "animation/animation.pvd",
     "animation/animation.gif",
     "history.csv",
     "openings.csv",
     "impacts.csv",
+    "hops.csv",
     "summary.json",
     "coordinates.png",
     "coordinates.svg",

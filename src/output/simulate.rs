@@ -9,7 +9,7 @@ use crr_impact::simulation::Samples;
 
 use super::folder_lock::FolderLock;
 use super::history::{
-    OPENINGS_HEADER, history_header, impacts_csv, push_history_row, push_openings_rows,
+    OPENINGS_HEADER, history_header, hops_csv, impacts_csv, push_history_row, push_openings_rows,
 };
 use super::results_folder::{check_out_dir, default_out_dir, partial_name, write_outputs_with};
 use crate::Error;
@@ -101,6 +101,10 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
     }
     let files = [
         ("impacts.csv", impacts_csv(&p.model, &run.trajectory)),
+        (
+            "hops.csv",
+            hops_csv(&run.trajectory, run.summary.solver.hop_tolerance),
+        ),
         ("summary.json", run.summary.to_json()),
     ];
     write_outputs_with(out, &["history.csv", "openings.csv"], &files).map_err(output_error)?;

@@ -78,10 +78,16 @@ fn model_names_never_lead_outside_results() {
             String::from_utf8_lossy(&o.stderr)
         );
         let written = files_below(&cwd);
-        let expected: Vec<PathBuf> = ["history.csv", "impacts.csv", "openings.csv", "summary.json"]
-            .iter()
-            .map(|f| Path::new("results").join(folder).join(f))
-            .collect();
+        let expected: Vec<PathBuf> = [
+            "history.csv",
+            "hops.csv",
+            "impacts.csv",
+            "openings.csv",
+            "summary.json",
+        ]
+        .iter()
+        .map(|f| Path::new("results").join(folder).join(f))
+        .collect();
         assert_eq!(written, expected, "{name:?}");
         // Nothing beside the working folder either.
         let mut around = files_below(&work);
@@ -131,10 +137,16 @@ fn an_earlier_run_is_replaced_only_with_force_and_whole() {
     assert_eq!(summary["end_time"], 1.0);
     assert_eq!(
         files_below(&out),
-        ["history.csv", "impacts.csv", "openings.csv", "summary.json"]
-            .iter()
-            .map(PathBuf::from)
-            .collect::<Vec<_>>()
+        [
+            "history.csv",
+            "hops.csv",
+            "impacts.csv",
+            "openings.csv",
+            "summary.json",
+        ]
+        .iter()
+        .map(PathBuf::from)
+        .collect::<Vec<_>>()
     );
     // A folder with other files but no results is written to without --force.
     let other = work.join("other");

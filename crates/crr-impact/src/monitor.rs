@@ -103,6 +103,10 @@ pub struct Violation {
     pub normal: f64,
     /// |F_t|/N at that time.
     pub friction_demand: f64,
+    /// For a `"tension"` at a face rocking on a pivot that alone carries the bodies above it,
+    /// pulling where a segment starts (just after an impact): that pull measured by the motion
+    /// with the face released (`simulation::Hop`); None otherwise.
+    pub hop: Option<Box<crate::simulation::Hop>>,
 }
 
 fn top(v: &Vector6<f64>) -> Vector3<f64> {
@@ -677,6 +681,7 @@ fn judge_distribution(
             kind: kind.into(),
             normal: reported,
             friction_demand: forces[i].map_or(f64::INFINITY, |f| f.friction_demand()),
+            hop: None,
         });
     }
     // Compressive: every edge split reads as its smallest point force (at most 0).
@@ -705,6 +710,7 @@ pub(crate) fn judge(
         kind: kind.into(),
         normal,
         friction_demand: f.friction_demand(),
+        hop: None,
     };
     for (i, f) in forces.iter().enumerate() {
         let Some(f) = f else { continue };

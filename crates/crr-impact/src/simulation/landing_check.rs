@@ -80,6 +80,7 @@ impl Simulation<'_> {
             kind: "impulse_tension".to_string(),
             normal: least.min_normal,
             friction_demand: f64::INFINITY,
+            hop: None,
         });
         self.snaps_at_violation = Some(super::SnapsAndLosses {
             t: self.t,

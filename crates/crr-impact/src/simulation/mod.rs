@@ -46,6 +46,7 @@ use crate::laws::{
 
 mod certificate_audit;
 mod events;
+mod hops;
 mod impact_releases;
 mod impacts;
 mod landing_check;
@@ -59,6 +60,7 @@ mod uplift_from_rest;
 
 pub use certificate_audit::{CertificateAudit, CertificateDisagreement};
 use events::*;
+pub use hops::Hop;
 use impacts::*;
 use open_loops::OpenLoops;
 pub use open_loops::body_offsets;
@@ -121,6 +123,9 @@ pub struct Parameters {
     /// (recorded as `impulse_tension`) instead of opening them by Moreau's impact
     /// (`simulation::impact_releases`). Default false.
     pub hold_seated_at_impacts: bool,
+    /// A pull at a pivot where a segment starts whose separation bound stays within this (m)
+    /// is not a violation (module `hops`). Default 0: every such pull is one.
+    pub hop_tolerance: f64,
 }
 
 impl Default for Parameters {
@@ -152,6 +157,7 @@ impl Parameters {
             friction: a.friction,
             collapse_drop: a.collapse_drop,
             hold_seated_at_impacts: a.hold_seated_at_impacts,
+            hop_tolerance: a.hop_tolerance,
         })
     }
 }
@@ -509,6 +515,8 @@ pub struct Simulation<'a> {
     pub violation: Option<crate::monitor::Violation>,
     /// The largest opening of the loops at acceleration level left by the monitor's solves.
     loop_residual: LoopResidual,
+    /// The pulls at pivots where segments start, measured (module `hops`).
+    hops: hops::Hops,
 }
 
 /// The largest opening of the loops at acceleration level (Φ_q q̈ + Φ̇_q q̇ of a closure row,
@@ -922,6 +930,7 @@ impl<'a> Simulation<'a> {
             collapse: None,
             violation: None,
             loop_residual: LoopResidual::default(),
+            hops: hops::Hops::default(),
         };
         let y = std::mem::take(&mut sim.y);
         let first = sim.sample_at(0.0, &y);
@@ -1251,6 +1260,10 @@ impl<'a> Simulation<'a> {
         if let Some(k) = self.held_face_pulling(&pressing) {
             return Err(self.flight_of(k));
         }
+        self.hops_at_segment_start(&pressing);
+        let mut hop_log = std::mem::take(&mut self.hops.log);
+        hop_log.clear();
+        let hop_logging = self.hops.logging();
         let mut seg = self.spare.segment.take().unwrap_or_default();
         seg.rocking.clear();
         seg.rocking.extend(
@@ -1341,6 +1354,20 @@ impl<'a> Simulation<'a> {
         buf.clear();
         buf.resize(2 * n + 2, 0.0);
         let mut on_step = |step: &DenseStep| {
+            // The states where an open hop's face is read: eight per step (module `hops`).
+            if hop_logging {
+                for i in 1..=hops::READINGS_PER_STEP {
+                    let f = i as f64 / hops::READINGS_PER_STEP as f64;
+                    let ts = if i == hops::READINGS_PER_STEP {
+                        step.t1()
+                    } else {
+                        step.t0() + f * (step.t1() - step.t0())
+                    };
+                    step.eval(ts, &mut buf);
+                    hop_log.push(ts);
+                    extend_short(&mut hop_log, &buf[..2 * n]);
+                }
+            }
             while (next_sample as f64) * dt <= step.t1() + 1e-12 * dt
                 && (next_sample as f64) * dt <= self.params.duration + 1e-12 * dt
             {
@@ -1436,6 +1463,8 @@ impl<'a> Simulation<'a> {
             self.record_sample(s);
         }
         self.spare.pending = pending;
+        self.hops.log = hop_log;
+        self.hops_read_log();
         let stop = stop?;
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());
@@ -1667,7 +1696,9 @@ impl<'a> Simulation<'a> {
     }
 
     /// The results so far.
-    pub fn into_trajectory(self) -> Trajectory {
+    pub fn into_trajectory(mut self) -> Trajectory {
+        // A pull still being measured ends here, with what it reached.
+        self.finish_hops();
         let mut peak_abs = self.peak_abs.clone();
         for p in &self.peaks {
             peak_abs[p.coordinate] = peak_abs[p.coordinate].max(p.value.abs());
@@ -1698,6 +1729,7 @@ impl<'a> Simulation<'a> {
             end_time: self.t,
             solver_stats: self.solver.stats(),
             loop_residual: self.loop_residual,
+            hops: self.hops.done,
         }
     }
 }
@@ -1736,6 +1768,9 @@ pub struct Trajectory {
     pub solver_stats: crr_dynamics::integrator::Stats,
     /// How far the closed-chain solves left the loops open at acceleration level.
     pub loop_residual: LoopResidual,
+    /// Every pull at a pivot where a segment started, with the bound on how far its face would
+    /// open (module `hops`), in the order they ended.
+    pub hops: Vec<Hop>,
 }
 
 impl Trajectory {
@@ -1756,6 +1791,7 @@ impl Trajectory {
             end_time: 0.0,
             solver_stats: Default::default(),
             loop_residual: LoopResidual::default(),
+            hops: Vec::new(),
         }
     }
 }

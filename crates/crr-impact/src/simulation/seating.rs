@@ -970,7 +970,7 @@ pub(super) fn flip_moves_a_free_axis(
 
 /// mᵢ(aᵢ − g_eff) of every body i at the solve in `trial`, aᵢ its centre of mass' acceleration
 /// Σⱼ (uⱼ × (cᵢ − pⱼ)) q̈ⱼ over the coordinates carrying it plus the bias acceleration of cᵢ (N).
-fn body_forces(model: &Model, trial: &Dynamics) -> Vec<Vector3<f64>> {
+pub(super) fn body_forces(model: &Model, trial: &Dynamics) -> Vec<Vector3<f64>> {
     let kin = &trial.kin;
     let g_eff = trial.effective_gravity();
     (0..model.bodies.len())
@@ -1505,6 +1505,7 @@ impl Simulation<'_> {
             kind: "lift_off".to_string(),
             normal: 0.0,
             friction_demand: f64::INFINITY,
+            hop: None,
         });
         self.snaps_at_violation = Some(super::SnapsAndLosses {
             t: self.t,

@@ -1,0 +1,572 @@
+//! Hops: a pivot that pulls where a segment starts, and how far its face would open.
+//!
+//! A face rocking on a pivot that alone carries the bodies above it ([`pressing_faces`]) is
+//! watched by an event for the instant its normal force N falls through 0 (a flight). Just after
+//! an impact or a release the chain's new motion can make that force a pull from the segment's
+//! first instant: the event cannot fire (it starts below its zero), and the rigid-contact model
+//! holds a contact that, in fact, lets go. Such pulls are short (the next impact follows
+//! microseconds to a millisecond later on the bundled drum column) and small, so the bodies
+//! they would lift move apart by far less than a micrometre; or they are the start of a real
+//! flight. This module measures which, as an episode per face.
+//!
+//! **The gap of the face released.** Let S be the bodies the face carries and L the rest of the
+//! chain. At the state of the chain (q, q̇, and its q̈ from the solve), Newton–Euler on S gives
+//! the wrench F = (f, m_P) the face transmits to S at its pivot P: f = Σ_S mᵢ(aᵢ − g_eff),
+//! m_P = Σ_S [(cᵢ − P) × mᵢ(aᵢ − g_eff) + Iᵢαᵢ + ωᵢ × Iᵢωᵢ]; N = f·n, n the face's normal
+//! (from L into S). Released, the same bodies have the coordinates of L, a free twist of S's
+//! lowest body at P (6) and the coordinates inside S, with mass matrix M′ = Σ mᵢJ_cᵢᵀJ_cᵢ +
+//! J_ωᵢᵀIᵢJ_ωᵢ; G maps them to the twist of S's lowest body at P less that of the body under the
+//! face. The chain's motion is that system's under the constraint force Gᵀ F, and the free
+//! motion has the same velocities at that instant, so the free motion's accelerations differ by
+//! −M′⁻¹GᵀF and the gap's acceleration is a = −n·(G M′⁻¹ Gᵀ F)_linear. Both the normal and the
+//! tangential parts of F go when the face lets go: on a block turning about a corner of the
+//! ground at θ = 0 with rate θ̇, a = h θ̇² − g, the corner's own acceleration in free flight,
+//! while N = m g (1 − ¾ sin²α) − m h θ̇².
+//!
+//! **The episode.** From g = ġ = 0 where the pull starts, g̈ = a is integrated over the
+//! readings of (N, a): at the state where each segment starts and at the middle and end of every
+//! accepted step while an episode is open (a solve of the chain and one of M′ each), each
+//! interval between two readings taking the larger of its two ends' a (the gap opens at least
+//! as fast as the motion released would open it where a varies monotonically between readings). The
+//! episode ends where ġ comes back to 0 (the gap's largest value, its separation, is then
+//! reached; the free motion would land there after), or where the face changes its pivot or
+//! seats, or at the end of the run (`closed` false, the largest g so far). An impact at another
+//! face carries g and ġ on unchanged (the impulse the face transmits to S is compressive unless
+//! the impact records an `impulse_tension`; removed, it would close the gap faster). To first
+//! order in g: a hop of a micrometre changes the forces by what a micrometre changes the
+//! geometry. A pull where the released motion would not open the gap (a ≤ 0 with N < 0: the
+//! tangential part of F holds the face down) has no consistent rigid answer, and counts as
+//! beyond any tolerance.
+//!
+//! With `hop_tolerance` (m) above 0, a pull whose separation stays within it is not a violation
+//! of the hypotheses (the monitor's `tension` at that face is deferred until the episode ends);
+//! one that exceeds it is recorded at the episode's start, as the monitor would have. With the
+//! default 0 every pull is recorded at once, and the violation carries its separation. Chains
+//! with loops are not measured (their faces' pulls stay the monitor's).
+
+use super::*;
+use crr_kinematics::kinematics::{body_rotation, frame_point};
+use nalgebra::{DMatrix, Matrix3, Vector3, Vector6};
+
+/// A pull at a pivot where a segment started, measured to its end ([`Trajectory::hops`]).
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct Hop {
+    /// Interface name.
+    pub interface: String,
+    /// Where the pull started (s): an impact's or a release's instant.
+    pub start: f64,
+    /// The first reading at which the pivot pressed again (s), None if it never did.
+    pub pull_end: Option<f64>,
+    /// Where the gap's rate came back to 0 (s), or where the episode was cut short.
+    pub end: f64,
+    /// The largest pull read (N, positive).
+    pub largest_pull: f64,
+    /// How far the face would open (m): the largest gap of the motion released, to first order.
+    pub separation: f64,
+    /// The bound on how far any point of the bodies departs from crr's motion until the face
+    /// lands again (m): every body's centre of mass and its rotation times the model's size,
+    /// times the growth factor e^{2ΩT} of the deviation over the episode's duration T.
+    pub departure: f64,
+    /// False when a change of the face's pivot or seat, or the end of the run, cut the episode
+    /// short before the face landed again.
+    pub closed: bool,
+    /// False when the motion released would not open the face where the pull started (its
+    /// tangential force holds it down): no rigid answer, beyond any tolerance.
+    pub opens: bool,
+    /// False when the episode lasted too long for its first-order reading (2ΩT > 0.2, Ω the
+    /// fastest rotation of a body plus √(g/L)): the bodies released would tumble away from the
+    /// chain's motion, beyond any tolerance.
+    pub short: bool,
+}
+
+/// Readings per accepted step while an episode is open, evenly spaced, the last at the step's
+/// end: the bound takes the larger acceleration of each interval's two ends, so the finer the
+/// readings the closer it is to the motion released.
+pub(super) const READINGS_PER_STEP: usize = 8;
+
+/// The largest 2ΩT of an episode read to first order: the deviation's growth factor e^{2ΩT}
+/// is then at most 1.22.
+const SHORT: f64 = 0.2;
+
+impl Hop {
+    /// Whether the hop stays within `tolerance` (m): it opens, lands again within a short
+    /// episode, and departs from crr's motion by no more than that.
+    pub fn within(&self, tolerance: f64) -> bool {
+        self.opens && self.closed && self.short && self.departure <= tolerance
+    }
+}
+
+/// One reading of a face released ([`released_face`]).
+#[derive(Clone, Copy, Debug)]
+struct Reading {
+    /// The pivot's normal force (N, positive pressing).
+    normal: f64,
+    /// The gap's acceleration in the motion released (m/s²).
+    gap: f64,
+    /// The largest |Δa_c| + L |Δα| of a body, the motion released against the chain's (m/s²).
+    departure: f64,
+    /// Ω: the fastest rotation of a body plus √(|g_eff| / L) (rad/s).
+    omega: f64,
+}
+
+/// One open episode.
+#[derive(Clone, Debug)]
+pub(super) struct Episode {
+    slot: usize,
+    side: Side,
+    start: f64,
+    last_t: f64,
+    /// The last reading.
+    last: Reading,
+    gap: f64,
+    rate: f64,
+    largest_gap: f64,
+    /// The departure's bound before its growth factor, and its rate.
+    departure: f64,
+    departure_rate: f64,
+    omega: f64,
+    largest_pull: f64,
+    pull_end: Option<f64>,
+    /// The monitor's `tension` at this face, deferred (`hop_tolerance` > 0).
+    deferred: Option<Deferred>,
+}
+
+/// A violation the monitor found at a face pulling, waiting for its episode's separation.
+#[derive(Clone, Debug)]
+pub(super) struct Deferred {
+    slot: usize,
+    violation: crate::monitor::Violation,
+    snaps: SnapsAndLosses,
+}
+
+/// The episodes of a run.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Hops {
+    open: Vec<Episode>,
+    /// Deferred violations whose episode has not opened yet (the monitor's sample at an impact
+    /// comes before the segment that follows it).
+    waiting: Vec<Deferred>,
+    pub(super) done: Vec<Hop>,
+    /// [t, q, q̇] of the readings a segment's steps pass while an episode is open.
+    pub(super) log: Vec<f64>,
+    /// Each face read.
+    readings: Vec<Reading>,
+    slots: Vec<usize>,
+}
+
+impl Hops {
+    /// Whether an episode is open (a segment then logs its steps' states).
+    pub(super) fn logging(&self) -> bool {
+        !self.open.is_empty()
+    }
+
+    /// Whether a `tension` at `slot`'s face is that of a pull being measured.
+    fn measuring(&self, slot: usize) -> bool {
+        self.open.iter().any(|e| e.slot == slot) || self.waiting.iter().any(|d| d.slot == slot)
+    }
+}
+
+impl Episode {
+    fn new(
+        slot: usize,
+        side: Side,
+        start: f64,
+        t: f64,
+        r: Reading,
+        deferred: Option<Deferred>,
+    ) -> Self {
+        Self {
+            slot,
+            side,
+            start,
+            last_t: t,
+            last: r,
+            gap: 0.0,
+            rate: 0.0,
+            largest_gap: 0.0,
+            departure: 0.0,
+            departure_rate: 0.0,
+            omega: r.omega,
+            largest_pull: -r.normal,
+            pull_end: None,
+            deferred,
+        }
+    }
+
+    /// Adds the reading `r` at t; returns true when the gap has closed again (the face lands:
+    /// the episode is over). Over each interval the larger of its two ends' accelerations.
+    fn read(&mut self, t: f64, r: Reading) -> bool {
+        let h = t - self.last_t;
+        if h > 0.0 {
+            let accel = r.gap.max(self.last.gap);
+            let opened = self.gap > 0.0;
+            self.gap += self.rate * h + 0.5 * accel * h * h;
+            self.rate += accel * h;
+            self.largest_gap = self.largest_gap.max(self.gap);
+            let spread = r.departure.max(self.last.departure);
+            self.departure += self.departure_rate * h + 0.5 * spread * h * h;
+            self.departure_rate += spread * h;
+            self.omega = self.omega.max(r.omega);
+            if opened && self.gap <= 0.0 {
+                self.last_t = t;
+                return true;
+            }
+        }
+        self.largest_pull = self.largest_pull.max(-r.normal);
+        if r.normal >= 0.0 && self.pull_end.is_none() {
+            self.pull_end = Some(t);
+        }
+        self.last_t = t;
+        self.last = r;
+        false
+    }
+}
+
+/// The coordinates carrying frame `frame`, from the ground up.
+fn path(model: &Model, frame: Option<usize>) -> Vec<usize> {
+    let mut p = Vec::new();
+    let mut j = frame;
+    while let Some(jj) = j {
+        p.push(jj);
+        j = model.coords[jj].parent;
+    }
+    p.reverse();
+    p
+}
+
+/// The face of tree slot k (a face of [`pressing_faces`]) released at the solve in `trial`
+/// (q̈ and the kinematics of the state, q̇ given): its pivot's normal force N (N, positive
+/// pressing) and the acceleration of its gap in the motion released (m/s²), as the module's
+/// documentation derives them. `seated` by slot. None where M′ is singular.
+fn released_face(
+    model: &Model,
+    trial: &Dynamics,
+    pivots: &ActivePivots,
+    seated: &[bool],
+    qdot: &DVector<f64>,
+    k: usize,
+    g_eff: &Vector3<f64>,
+) -> Option<Reading> {
+    let kin = &trial.kin;
+    let coord = &model.coords[k];
+    let iface = &model.interfaces[coord.interface];
+    let p = kin.pivot[k];
+    let other = frame_point(
+        kin,
+        coord.parent,
+        &super::seating::other_pivot_rest(iface, pivots, k),
+    );
+    let shift = kin.axis[k].cross(&(p - other));
+    // The face's normal, from L into S: the line of the pivot's pressing force.
+    let normal = pivots.sides[k].flipped().sign() * shift / shift.norm();
+    let qddot = &trial.qddot;
+    let face = |j: usize| iface.slots.contains(&j);
+    let in_s = |frame: usize| model.carries(k, Some(frame));
+    // The released coordinates: L's free ones, the twist (ω, v_P) of S's lowest body, S's own.
+    let dof = model.dof();
+    let mut column = vec![usize::MAX; dof];
+    let mut count = 0;
+    for j in (0..dof).filter(|&j| !seated[j] && !in_s(j)) {
+        column[j] = count;
+        count += 1;
+    }
+    let base = count;
+    count += 6;
+    for j in (0..dof).filter(|&j| !seated[j] && in_s(j) && !face(j)) {
+        column[j] = count;
+        count += 1;
+    }
+    let forces = super::seating::body_forces(model, trial);
+    let mut jacobians = Vec::with_capacity(model.bodies.len());
+    let mut fastest: f64 = 0.0;
+    let mut mass = DMatrix::<f64>::zeros(count, count);
+    let (mut jc, mut jw) = (DMatrix::zeros(3, count), DMatrix::zeros(3, count));
+    let mut wrench = Vector6::zeros();
+    for (b, body) in model.bodies.iter().enumerate() {
+        let frame = model.body_coord[b];
+        let c = kin.com[b];
+        let rot = body_rotation(model, kin, b);
+        let inertia = rot * body.inertia * rot.transpose();
+        jc.fill(0.0);
+        jw.fill(0.0);
+        let (mut omega, mut alpha) = (Vector3::zeros(), Vector3::zeros());
+        for j in path(model, Some(frame)) {
+            let u = kin.axis[j];
+            alpha += u * qddot[j] + omega.cross(&u) * qdot[j];
+            omega += u * qdot[j];
+            if column[j] != usize::MAX {
+                jc.set_column(column[j], &u.cross(&(c - kin.pivot[j])));
+                jw.set_column(column[j], &u);
+            }
+        }
+        if in_s(frame) {
+            let f = forces[b];
+            let moment = (c - p).cross(&f) + inertia * alpha + omega.cross(&(inertia * omega));
+            wrench += Vector6::new(f.x, f.y, f.z, moment.x, moment.y, moment.z);
+            // v = v_P + ω × (c − P) = v_P − [c − P]× ω.
+            let arm = c - p;
+            let cross = Matrix3::new(0.0, -arm.z, arm.y, arm.z, 0.0, -arm.x, -arm.y, arm.x, 0.0);
+            jc.fixed_view_mut::<3, 3>(0, base).copy_from(&(-cross));
+            jc.fixed_view_mut::<3, 3>(0, base + 3)
+                .copy_from(&Matrix3::identity());
+            jw.fixed_view_mut::<3, 3>(0, base)
+                .copy_from(&Matrix3::identity());
+        }
+        mass += jc.transpose() * &jc * body.mass + jw.transpose() * inertia * &jw;
+        fastest = fastest.max(omega.norm());
+        jacobians.push((jc.clone(), jw.clone()));
+    }
+    // G: the twist at P of S's lowest body ([v; ω]) less that of the body under the face.
+    let mut g = DMatrix::<f64>::zeros(6, count);
+    g.fixed_view_mut::<3, 3>(0, base + 3)
+        .copy_from(&Matrix3::identity());
+    g.fixed_view_mut::<3, 3>(3, base)
+        .copy_from(&Matrix3::identity());
+    for j in path(model, coord.parent) {
+        if column[j] != usize::MAX {
+            let u = kin.axis[j];
+            let v = u.cross(&(p - kin.pivot[j]));
+            for r in 0..3 {
+                g[(r, column[j])] -= v[r];
+                g[(3 + r, column[j])] -= u[r];
+            }
+        }
+    }
+    // Released, the accelerations change by −M′⁻¹GᵀF.
+    let change = -(mass.cholesky()?.solve(&g.transpose()) * wrench);
+    let relative = &g * &change;
+    let size = model.size;
+    let departure = jacobians
+        .iter()
+        .map(|(jc, jw)| (jc * &change).norm() + size * (jw * &change).norm())
+        .fold(0.0, f64::max);
+    Some(Reading {
+        normal: normal.dot(&Vector3::new(wrench[0], wrench[1], wrench[2])),
+        gap: normal.dot(&Vector3::new(relative[0], relative[1], relative[2])),
+        departure,
+        omega: fastest + (g_eff.norm() / size).sqrt(),
+    })
+}
+
+impl Simulation<'_> {
+    /// Reads each face of `slots` released at (t, q, q̇) ([`released_face`]) into
+    /// `self.hops.readings`. False where the chain's solve or a face's M′ fails.
+    fn read_faces(
+        &mut self,
+        slots: &[usize],
+        (t, q, qdot): (f64, &DVector<f64>, &DVector<f64>),
+    ) -> bool {
+        let model = Arc::clone(&self.model);
+        let model = &*model;
+        let mut trial = self.take_pressing_trial();
+        self.hops.readings.clear();
+        let mut solved = trial.accelerations(model, self.ground, t, q, qdot).is_ok();
+        let g_eff = trial.effective_gravity();
+        if solved {
+            for &k in slots {
+                let pivots = &self.dynamics.pivots;
+                match released_face(model, &trial, pivots, &self.seated, qdot, k, &g_eff) {
+                    Some(r) => self.hops.readings.push(r),
+                    None => {
+                        solved = false;
+                        break;
+                    }
+                }
+            }
+        }
+        self.spare.pressing = Some(trial);
+        solved
+    }
+
+    /// At a segment's start, with `pressing` the faces watched in it: ends the episodes whose
+    /// face is no longer watched on the same pivot, reads the others at this state, and opens an
+    /// episode at each watched face whose pivot pulls here beyond the monitor's tolerance. A
+    /// violation deferred at a face that does not pull here after all is recorded. Chains with
+    /// loops are not measured.
+    pub(super) fn hops_at_segment_start(&mut self, pressing: &[usize]) {
+        let t = self.t;
+        let sides = self.dynamics.pivots.sides.clone();
+        let mut i = 0;
+        while i < self.hops.open.len() {
+            let e = &self.hops.open[i];
+            if pressing.contains(&e.slot) && sides[e.slot] == e.side {
+                i += 1;
+            } else {
+                // An impact at the face itself turned it onto its other pivot or seated it:
+                // the face has landed.
+                let e = self.hops.open.remove(i);
+                self.finish_hop(e, true, true);
+            }
+        }
+        let measured = self.model.constraint_rows == 0 && !pressing.is_empty();
+        let mut slots = std::mem::take(&mut self.hops.slots);
+        slots.clear();
+        slots.extend_from_slice(pressing);
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        if measured && self.read_faces(&slots, (t, &q, &qdot)) {
+            let model = &self.model;
+            let tol = crate::monitor::TENSION_TOLERANCE * model.total_mass() * model.gravity;
+            let mut over = Vec::new();
+            for (j, &k) in slots.iter().enumerate() {
+                let r = self.hops.readings[j];
+                if let Some(e) = self.hops.open.iter_mut().find(|e| e.slot == k) {
+                    if e.read(t, r) {
+                        over.push((k, true));
+                    }
+                } else if r.normal < -tol {
+                    let deferred = self
+                        .hops
+                        .waiting
+                        .iter()
+                        .position(|d| d.slot == k)
+                        .map(|i| self.hops.waiting.remove(i));
+                    let start = deferred.as_ref().map_or(t, |d| d.violation.t.min(t));
+                    let e = Episode::new(k, sides[k], start, t, r, deferred);
+                    self.hops.open.push(e);
+                    if r.gap <= 0.0 {
+                        // Released, the face would not open: no rigid answer.
+                        over.push((k, false));
+                    }
+                }
+            }
+            for (k, opens) in over {
+                let i = self.hops.open.iter().position(|e| e.slot == k).unwrap();
+                let e = self.hops.open.remove(i);
+                self.finish_hop(e, true, opens);
+            }
+        }
+        self.hops.slots = slots;
+        // A deferral no episode took: the monitor's word stands.
+        for d in std::mem::take(&mut self.hops.waiting) {
+            self.record_violation(d.violation, d.snaps);
+        }
+    }
+
+    /// Reads the open episodes' faces at the states a segment logged ([t, q, q̇] each).
+    pub(super) fn hops_read_log(&mut self) {
+        let n = self.model.dof();
+        let log = std::mem::take(&mut self.hops.log);
+        let mut slots = std::mem::take(&mut self.hops.slots);
+        let (mut q, mut qdot) = (DVector::zeros(n), DVector::zeros(n));
+        for state in log.chunks_exact(1 + 2 * n) {
+            if self.hops.open.is_empty() {
+                break;
+            }
+            slots.clear();
+            slots.extend(self.hops.open.iter().map(|e| e.slot));
+            q.as_mut_slice().copy_from_slice(&state[1..=n]);
+            qdot.as_mut_slice().copy_from_slice(&state[1 + n..]);
+            for k in 0..n {
+                if self.seated[k] {
+                    q[k] = 0.0;
+                    qdot[k] = 0.0;
+                }
+            }
+            if !self.read_faces(&slots, (state[0], &q, &qdot)) {
+                continue;
+            }
+            for (j, &k) in slots.iter().enumerate() {
+                let r = self.hops.readings[j];
+                let i = self.hops.open.iter().position(|e| e.slot == k).unwrap();
+                if self.hops.open[i].read(state[0], r) {
+                    let e = self.hops.open.remove(i);
+                    self.finish_hop(e, true, true);
+                }
+            }
+        }
+        self.hops.slots = slots;
+        let mut log = log;
+        log.clear();
+        self.hops.log = log;
+    }
+
+    /// Ends every open episode (the end of the run) and records any deferral left.
+    pub(super) fn finish_hops(&mut self) {
+        for e in std::mem::take(&mut self.hops.open) {
+            self.finish_hop(e, false, true);
+        }
+        for d in std::mem::take(&mut self.hops.waiting) {
+            self.record_violation(d.violation, d.snaps);
+        }
+    }
+
+    /// Records episode `e`'s hop, and decides its violation: beyond `hop_tolerance` (with the
+    /// default 0, any pull), or where the face would not open, the face let go: recorded at the
+    /// episode's start, with the separation.
+    fn finish_hop(&mut self, e: Episode, closed: bool, opens: bool) {
+        let interface = self.model.interfaces[self.model.coords[e.slot].interface]
+            .name
+            .clone();
+        let separation = e.largest_gap;
+        let spread = 2.0 * e.omega * (e.last_t - e.start);
+        let hop = Hop {
+            interface: interface.clone(),
+            start: e.start,
+            pull_end: e.pull_end,
+            end: e.last_t,
+            largest_pull: e.largest_pull,
+            separation,
+            departure: (e.departure * spread.exp()).max(separation),
+            closed,
+            opens,
+            short: spread <= SHORT,
+        };
+        let within = hop.within(self.params.hop_tolerance);
+        if let Some(d) = e.deferred {
+            if !within {
+                let mut v = d.violation;
+                v.hop = Some(Box::new(hop.clone()));
+                self.record_violation(v, d.snaps);
+            }
+        } else if let Some(v) = self.violation.as_mut()
+            && v.kind == "tension"
+            && v.interface == interface
+            && v.hop.is_none()
+            && v.t >= e.start
+            && v.t <= e.last_t
+        {
+            v.hop = Some(Box::new(hop.clone()));
+        }
+        self.hops.done.push(hop);
+    }
+
+    /// Keeps `v` as the run's first violation if it is earlier than the one recorded.
+    pub(super) fn record_violation(&mut self, v: crate::monitor::Violation, snaps: SnapsAndLosses) {
+        if self.violation.as_ref().is_none_or(|w| v.t < w.t) {
+            self.violation = Some(v);
+            self.snaps_at_violation = Some(snaps);
+        }
+    }
+
+    /// Whether the monitor's `tension` `v` is at a face whose pull is measured as a hop
+    /// (`hop_tolerance` > 0, a chain without loops, the face watched now): it is then deferred
+    /// to the episode, and true is returned.
+    pub(super) fn defer_tension(
+        &mut self,
+        v: &crate::monitor::Violation,
+        snaps: SnapsAndLosses,
+    ) -> bool {
+        if self.params.hop_tolerance <= 0.0 || v.kind != "tension" || self.model.constraint_rows > 0
+        {
+            return false;
+        }
+        let Some(i) = self.model.interface_index(&v.interface) else {
+            return false;
+        };
+        let Some(k) = self
+            .pressing_faces_now()
+            .into_iter()
+            .find(|&k| self.model.coords[k].interface == i)
+        else {
+            return false;
+        };
+        if !self.hops.measuring(k) {
+            self.hops.waiting.push(Deferred {
+                slot: k,
+                violation: v.clone(),
+                snaps,
+            });
+        }
+        true
+    }
+}
