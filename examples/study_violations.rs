@@ -2,8 +2,10 @@
 //! `crr study` runs it, and its first hypotheses violation is set against the run's impacts.
 //! For a `tension` (a face that would pull, the bodies it carries flying) it prints |N|, the
 //! time to the next impact Δt and the lift ½ |N|/m Δt² the pull would give the bodies the face
-//! carries (mass m) if it held its first value until then. The numbers of docs/studies.md,
-//! "Cases that leave the model", come from
+//! carries (mass m) if it held its first value until then, and the pull measured as a hop
+//! (docs/simulation.md, "Hops": whether the face released opens, lands again, and how far the
+//! bodies depart from crr's motion meanwhile). The numbers of docs/studies.md, "Cases that leave
+//! the model", come from
 //!
 //! ```sh
 //! cargo run --release --example study_violations -- examples/studies/drum_fragility.toml
@@ -37,8 +39,16 @@ fn carried_mass(model: &Model, i: usize) -> f64 {
 }
 
 /// One case's violation: (case id, kind, at an impact's instant, |N| in N, Δt to the next
-/// impact in s, lift in m).
-type Row = (String, String, bool, f64, Option<f64>, Option<f64>);
+/// impact in s, lift in m, its hop).
+type Row = (
+    String,
+    String,
+    bool,
+    f64,
+    Option<f64>,
+    Option<f64>,
+    Option<crr::impact::simulation::Hop>,
+);
 
 fn main() {
     let path = std::env::args()
@@ -89,14 +99,50 @@ fn main() {
                 viol.normal.abs(),
                 gap,
                 lift,
+                viol.hop.as_deref().cloned(),
             ))
         })
         .collect();
-    for (id, kind, at_impact, n, gap, lift) in &rows {
+    for (id, kind, at_impact, n, gap, lift, hop) in &rows {
+        let hop = hop.as_ref().map(|h| {
+            format!(
+                "opens={} landed={} separation={:.2e} m departure={:.2e} m",
+                h.opens, h.closed, h.separation, h.departure
+            )
+        });
         println!(
-            "{id} {kind} at_impact={at_impact} |N|={n:.1} N next_impact={gap:?} s lift={lift:?} m"
+            "{id} {kind} at_impact={at_impact} |N|={n:.1} N next_impact={gap:?} s lift={lift:?} m \
+             hop: {}",
+            hop.unwrap_or_default()
         );
     }
+    let hops: Vec<&crr::impact::simulation::Hop> =
+        rows.iter().filter_map(|r| r.6.as_ref()).collect();
+    let mut departures: Vec<f64> = hops
+        .iter()
+        .filter(|h| h.opens && h.closed)
+        .map(|h| h.departure)
+        .collect();
+    departures.sort_by(f64::total_cmp);
+    let at = |q: f64| {
+        departures
+            .get(((departures.len() as f64 - 1.0) * q).round() as usize)
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
+    println!(
+        "hops: {} of the violations; {} do not open, {} not landed by the run's end; the {} that \
+         land depart from crr's motion by {:.2e} m (least), {:.2e} (median), {:.2e} (90 %), \
+         {:.2e} m (largest)",
+        hops.len(),
+        hops.iter().filter(|h| !h.opens).count(),
+        hops.iter().filter(|h| h.opens && !h.closed).count(),
+        departures.len(),
+        at(0.0),
+        at(0.5),
+        at(0.9),
+        at(1.0)
+    );
     let weight = study.model.total_mass() * study.model.gravity;
     let forces: Vec<f64> = rows.iter().map(|r| r.3).collect();
     let mut gaps: Vec<f64> = rows.iter().filter_map(|r| r.4).collect();

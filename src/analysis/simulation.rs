@@ -676,30 +676,25 @@ impl Prepared {
 /// motion with the face released (docs/simulation.md, "Hops").
 fn hop_words(h: &crr_impact::simulation::Hop, tolerance: f64) -> String {
     if !h.opens {
-        return ", although released the face would not open (its tangential force holds it \
-                down): no rigid motion answers"
-            .to_string();
-    }
-    if !h.short {
-        return format!(
-            ", from {} s on: the bodies released would tumble away from crr's motion",
-            h.start
-        );
-    }
-    let size = format!(
-        "; released, the face would open by {:.1e} m and the bodies depart from crr's motion by \
-         at most {:.1e} m before it lands",
-        h.separation, h.departure
-    );
-    if h.closed {
+        ", although released the face would not open (its tangential force holds it down): no \
+         rigid motion answers"
+            .to_string()
+    } else if h.closed {
         format!(
-            "{size} {:.2e} s later (a hop: `[analysis] hop_tolerance`, {} m here, accepts hops \
-             up to a length)",
+            "; released, the face would open by {:.1e} m and the bodies depart from crr's motion \
+             by at most {:.1e} m before it lands {:.2e} s later (a hop: `[analysis] \
+             hop_tolerance`, {} m here, accepts hops up to a length)",
+            h.separation,
+            h.departure,
             h.end - h.start,
             num(tolerance)
         )
     } else {
-        format!("{size} (not landed when the run ended)")
+        format!(
+            "; released, the bodies are not shown to land before the run ended (the face open \
+             by {:.1e} m, the bodies {:.1e} m from crr's motion)",
+            h.separation, h.departure
+        )
     }
 }
 

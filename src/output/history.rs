@@ -116,12 +116,12 @@ pub fn impacts_csv(model: &Model, t: &Trajectory) -> String {
 /// the order they ended; `within_tolerance` against the run's `hop_tolerance`.
 pub fn hops_csv(t: &Trajectory, tolerance: f64) -> String {
     let mut s = String::from(
-        "interface,start,pull_end,end,largest_pull,separation,departure,closed,opens,short,\
+        "interface,start,pull_end,end,largest_pull,separation,departure,closed,opens,\
          within_tolerance\n",
     );
     for h in &t.hops {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{}\n",
             h.interface,
             num(h.start),
             h.pull_end.map(num).unwrap_or_default(),
@@ -131,7 +131,6 @@ pub fn hops_csv(t: &Trajectory, tolerance: f64) -> String {
             num(h.departure),
             h.closed,
             h.opens,
-            h.short,
             h.within(tolerance)
         ));
     }

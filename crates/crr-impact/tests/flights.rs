@@ -531,6 +531,30 @@ fn a_drum_column_s_pivot_that_pulls_after_an_impact_pulls_by_newton() {
         v.iter()
             .fold((f64::MAX, f64::MIN), |(l, m), &(_, f)| (l.min(f), m.max(f)))
     };
+    // The pull measured as a hop (`simulation::hops`): from the impact, by the motion with
+    // bed_3 released. The carried bodies' centre of mass, released, departs from the chain's
+    // along the face's normal by Δz(t) = ∫ (t − s) (−N(s) / m_c) ds, N by Newton above: each
+    // body's departure is bounded by the hop's, so their centre's is too.
+    let hop = traj
+        .hops
+        .iter()
+        .find(|h| h.interface == "bed_3" && h.start == impact)
+        .expect("the pull after bed_2's impact is measured");
+    let lift: f64 = inside
+        .iter()
+        .map(|&(t, f)| (next - t) * f.max(-1.0) * -model.gravity * 1e-5)
+        .sum();
+    assert!(lift > 0.0 && hop.opens && hop.closed, "{hop:?}, {lift:e}");
+    assert!(
+        hop.departure >= lift,
+        "{hop:?}: the centre of mass departs by {lift:e} m"
+    );
+    let newton_pull = -range(&inside).0 * weight;
+    assert!(
+        hop.largest_pull >= 0.9 * newton_pull && hop.largest_pull <= 0.02 * weight,
+        "{hop:?}: Newton's largest pull {newton_pull} N"
+    );
+    println!("{hop:?}; the carried centre of mass departs by {lift:e} m by the next impact");
     println!(
         "bed_2's impact at {impact} s, the next at {next} s; between: {:?} of the weight ({} \
          samples), outside: {:?}",

@@ -281,8 +281,18 @@ impl Study {
         };
         let initial = solve_initial(&model, &initial_spec)
             .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
-        let params = Parameters::from_analysis(&file.analysis.clone().unwrap_or_default(), 10.0)
-            .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
+        let mut params =
+            Parameters::from_analysis(&file.analysis.clone().unwrap_or_default(), 10.0)
+                .map_err(|e| bad(path, format!("model {}: {e}", spec.model.display())))?;
+        if let Some(tolerance) = spec.hop_tolerance {
+            if !(tolerance.is_finite() && tolerance >= 0.0) {
+                return Err(bad(
+                    path,
+                    format!("hop_tolerance must be a length of 0 or more (m), got {tolerance}"),
+                ));
+            }
+            params.hop_tolerance = tolerance;
+        }
         let mechanism = mechanism_scales(&model, axis);
         let lambda_p = mechanism.map(|m| (m.0, m.1));
         let alpha_eq = mechanism.map(|m| m.2).filter(|a| a.is_finite() && *a > 0.0);

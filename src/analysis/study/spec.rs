@@ -219,6 +219,11 @@ pub struct StudySpec {
     /// key: `"momentum"`, `{ restitution = r }`, `{ dirac = { r, c } }`, …).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub impact: Option<crr_kinematics::ImpactLaw>,
+    /// Replaces the model's `[analysis] hop_tolerance` (m): a pull at a pivot just after an
+    /// impact whose motion released departs from crr's by no more than this is not a
+    /// violation (docs/simulation.md, "Hops").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hop_tolerance: Option<f64>,
     /// Where every case starts: `"rest"` (default; maps and fragility studies start at rest) or
     /// `"model"` (the model file's `[initial]` state).
     #[serde(default)]

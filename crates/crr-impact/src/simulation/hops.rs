@@ -64,37 +64,29 @@ pub struct Hop {
     /// How far the face would open (m): the largest gap of the motion released, to first order.
     pub separation: f64,
     /// The bound on how far any point of the bodies departs from crr's motion until the face
-    /// lands again (m): every body's centre of mass and its rotation times the model's size,
-    /// times the growth factor e^{2ΩT} of the deviation over the episode's duration T.
+    /// lands again (m): a body's centre of mass plus its rotation times the model's size, and
+    /// at least the separation.
     pub departure: f64,
-    /// False when a change of the face's pivot or seat, or the end of the run, cut the episode
-    /// short before the face landed again.
+    /// False when the bound's gap had not closed again when the episode ended (the end of the
+    /// run): the bodies released may not land; beyond any tolerance.
     pub closed: bool,
     /// False when the motion released would not open the face where the pull started (its
     /// tangential force holds it down): no rigid answer, beyond any tolerance.
     pub opens: bool,
-    /// False when the episode lasted too long for its first-order reading (2ΩT > 0.2, Ω the
-    /// fastest rotation of a body plus √(g/L)): the bodies released would tumble away from the
-    /// chain's motion, beyond any tolerance.
-    pub short: bool,
+}
+
+impl Hop {
+    /// Whether the hop stays within `tolerance` (m): it opens, lands again, and departs from
+    /// crr's motion by no more than that.
+    pub fn within(&self, tolerance: f64) -> bool {
+        self.opens && self.closed && self.departure <= tolerance
+    }
 }
 
 /// Readings per accepted step while an episode is open, evenly spaced, the last at the step's
 /// end: the bound takes the larger acceleration of each interval's two ends, so the finer the
 /// readings the closer it is to the motion released.
 pub(super) const READINGS_PER_STEP: usize = 8;
-
-/// The largest 2ΩT of an episode read to first order: the deviation's growth factor e^{2ΩT}
-/// is then at most 1.22.
-const SHORT: f64 = 0.2;
-
-impl Hop {
-    /// Whether the hop stays within `tolerance` (m): it opens, lands again within a short
-    /// episode, and departs from crr's motion by no more than that.
-    pub fn within(&self, tolerance: f64) -> bool {
-        self.opens && self.closed && self.short && self.departure <= tolerance
-    }
-}
 
 /// One reading of a face released ([`released_face`]).
 #[derive(Clone, Copy, Debug)]
@@ -121,10 +113,9 @@ pub(super) struct Episode {
     gap: f64,
     rate: f64,
     largest_gap: f64,
-    /// The departure's bound before its growth factor, and its rate.
+    /// The departure's bound D and its rate.
     departure: f64,
     departure_rate: f64,
-    omega: f64,
     largest_pull: f64,
     pull_end: Option<f64>,
     /// The monitor's `tension` at this face, deferred (`hop_tolerance` > 0).
@@ -151,6 +142,8 @@ pub(super) struct Hops {
     pub(super) log: Vec<f64>,
     /// Each face read.
     readings: Vec<Reading>,
+    /// Each body's largest distance from its centre of mass ([`body_radii`]), once per run.
+    radii: Vec<f64>,
     slots: Vec<usize>,
 }
 
@@ -186,31 +179,48 @@ impl Episode {
             largest_gap: 0.0,
             departure: 0.0,
             departure_rate: 0.0,
-            omega: r.omega,
             largest_pull: -r.normal,
             pull_end: None,
             deferred,
         }
     }
 
-    /// Adds the reading `r` at t; returns true when the gap has closed again (the face lands:
-    /// the episode is over). Over each interval the larger of its two ends' accelerations.
+    /// Adds the reading `r` at t; returns true when the gap's bound has closed again (the face
+    /// lands: the episode is over). Over each interval, with the larger of its two ends' Ω, gap
+    /// acceleration a and departure acceleration A:
+    /// D̈ = A + 2ΩḊ + Ω²D bounds how far the motion released departs from the chain's (a point
+    /// whose velocity is off by Ḋ and position by D has its centripetal, Coriolis and weight's
+    /// terms off by at most about 2ΩḊ + Ω²D), and g̈ = a + 2ΩḊ + Ω²D bounds the gap, whose own
+    /// acceleration a is read on the chain's state, not the released one's.
     fn read(&mut self, t: f64, r: Reading) -> bool {
         let h = t - self.last_t;
         if h > 0.0 {
-            let accel = r.gap.max(self.last.gap);
+            let a = r.gap.max(self.last.gap);
+            let big_a = r.departure.max(self.last.departure);
+            let omega = r.omega.max(self.last.omega);
             let opened = self.gap > 0.0;
-            self.gap += self.rate * h + 0.5 * accel * h * h;
-            self.rate += accel * h;
-            self.largest_gap = self.largest_gap.max(self.gap);
-            let spread = r.departure.max(self.last.departure);
-            self.departure += self.departure_rate * h + 0.5 * spread * h * h;
-            self.departure_rate += spread * h;
-            self.omega = self.omega.max(r.omega);
-            if opened && self.gap <= 0.0 {
-                self.last_t = t;
+            // RK4 on (g, ġ, D, Ḋ), linear with constant coefficients over the interval.
+            let y0 = [self.gap, self.rate, self.departure, self.departure_rate];
+            let mut y = bound_step(y0, h, a, big_a, omega);
+            if opened && y[0] <= 0.0 {
+                // The face lands within the interval: where, by bisection on its length.
+                let (mut lo, mut hi) = (0.0, h);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if bound_step(y0, mid, a, big_a, omega)[0] > 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                y = bound_step(y0, hi, a, big_a, omega);
+                (self.gap, self.rate, self.departure, self.departure_rate) =
+                    (y[0], y[1], y[2], y[3]);
+                self.last_t += hi;
                 return true;
             }
+            (self.gap, self.rate, self.departure, self.departure_rate) = (y[0], y[1], y[2], y[3]);
+            self.largest_gap = self.largest_gap.max(self.gap);
         }
         self.largest_pull = self.largest_pull.max(-r.normal);
         if r.normal >= 0.0 && self.pull_end.is_none() {
@@ -220,6 +230,41 @@ impl Episode {
         self.last = r;
         false
     }
+}
+
+/// (g, ġ, D, Ḋ) after `h` s of g̈ = a + 2ΩḊ + Ω²D, D̈ = A + 2ΩḊ + Ω²D from `y0` (one RK4 step:
+/// the coefficients are constant over a reading's interval, and h Ω ≪ 1).
+fn bound_step(y0: [f64; 4], h: f64, a: f64, big_a: f64, omega: f64) -> [f64; 4] {
+    let f = |y: [f64; 4]| {
+        let feedback = 2.0 * omega * y[3] + omega * omega * y[2];
+        [y[1], a + feedback, y[3], big_a + feedback]
+    };
+    let add =
+        |y: [f64; 4], k: [f64; 4], c: f64| -> [f64; 4] { std::array::from_fn(|i| y[i] + c * k[i]) };
+    let k1 = f(y0);
+    let k2 = f(add(y0, k1, 0.5 * h));
+    let k3 = f(add(y0, k2, 0.5 * h));
+    let k4 = f(add(y0, k3, h));
+    std::array::from_fn(|i| y0[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+}
+
+/// The largest distance of each body's points from its centre of mass (m), from its surface's
+/// vertices, 0.1 % over (an annular sector's arcs are inscribed polygons, within 5e-4 of them).
+fn body_radii(model: &Model) -> Vec<f64> {
+    model
+        .bodies
+        .iter()
+        .map(|body| {
+            body.shape.surface().map_or(model.size, |surface| {
+                let far = surface
+                    .vertices
+                    .iter()
+                    .map(|v| (v - body.com).norm())
+                    .fold(0.0, f64::max);
+                1.001 * far
+            })
+        })
+        .collect()
 }
 
 /// The coordinates carrying frame `frame`, from the ground up.
@@ -246,6 +291,7 @@ fn released_face(
     qdot: &DVector<f64>,
     k: usize,
     g_eff: &Vector3<f64>,
+    radii: &[f64],
 ) -> Option<Reading> {
     let kin = &trial.kin;
     let coord = &model.coords[k];
@@ -335,16 +381,17 @@ fn released_face(
     // Released, the accelerations change by −M′⁻¹GᵀF.
     let change = -(mass.cholesky()?.solve(&g.transpose()) * wrench);
     let relative = &g * &change;
-    let size = model.size;
     let departure = jacobians
         .iter()
-        .map(|(jc, jw)| (jc * &change).norm() + size * (jw * &change).norm())
+        .zip(radii)
+        .map(|((jc, jw), radius)| (jc * &change).norm() + radius * (jw * &change).norm())
         .fold(0.0, f64::max);
+    let smallest = radii.iter().copied().fold(f64::INFINITY, f64::min);
     Some(Reading {
         normal: normal.dot(&Vector3::new(wrench[0], wrench[1], wrench[2])),
         gap: normal.dot(&Vector3::new(relative[0], relative[1], relative[2])),
         departure,
-        omega: fastest + (g_eff.norm() / size).sqrt(),
+        omega: fastest + (g_eff.norm() / smallest).sqrt(),
     })
 }
 
@@ -358,6 +405,9 @@ impl Simulation<'_> {
     ) -> bool {
         let model = Arc::clone(&self.model);
         let model = &*model;
+        if self.hops.radii.len() != model.bodies.len() {
+            self.hops.radii = body_radii(model);
+        }
         let mut trial = self.take_pressing_trial();
         self.hops.readings.clear();
         let mut solved = trial.accelerations(model, self.ground, t, q, qdot).is_ok();
@@ -365,7 +415,8 @@ impl Simulation<'_> {
         if solved {
             for &k in slots {
                 let pivots = &self.dynamics.pivots;
-                match released_face(model, &trial, pivots, &self.seated, qdot, k, &g_eff) {
+                let radii = &self.hops.radii;
+                match released_face(model, &trial, pivots, &self.seated, qdot, k, &g_eff, radii) {
                     Some(r) => self.hops.readings.push(r),
                     None => {
                         solved = false;
@@ -498,7 +549,6 @@ impl Simulation<'_> {
             .name
             .clone();
         let separation = e.largest_gap;
-        let spread = 2.0 * e.omega * (e.last_t - e.start);
         let hop = Hop {
             interface: interface.clone(),
             start: e.start,
@@ -506,10 +556,9 @@ impl Simulation<'_> {
             end: e.last_t,
             largest_pull: e.largest_pull,
             separation,
-            departure: (e.departure * spread.exp()).max(separation),
+            departure: e.departure.max(separation),
             closed,
             opens,
-            short: spread <= SHORT,
         };
         let within = hop.within(self.params.hop_tolerance);
         if let Some(d) = e.deferred {
