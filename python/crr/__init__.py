@@ -415,6 +415,12 @@ class Result:
         """The text of ``impacts.csv``, as ``crr simulate`` writes it."""
         return self._run.impacts_csv()
 
+    def hops_csv(self) -> str:
+        """The text of ``hops.csv``, as ``crr simulate`` writes it: every pull at a pivot just
+        after an impact, measured by the motion with that face released (docs/simulation.md,
+        "Hops"; the header alone when there is none)."""
+        return self._run.hops_csv()
+
     def openings_csv(self) -> str:
         """The text of ``openings.csv``, as ``crr simulate`` writes it: the offset of every face
         open at a row of ``history.csv`` (the header alone when no face lifts off)."""
@@ -509,13 +515,14 @@ class Result:
         )
 
     def write(self, folder: PathLike) -> None:
-        """Writes ``history.csv``, ``impacts.csv``, ``openings.csv`` and ``summary.json`` into
-        ``folder`` (created if needed), the files of ``crr simulate``."""
+        """Writes ``history.csv``, ``impacts.csv``, ``hops.csv``, ``openings.csv`` and
+        ``summary.json`` into ``folder`` (created if needed), the files of ``crr simulate``."""
         d = Path(folder)
         d.mkdir(parents=True, exist_ok=True)
         for name, text in (
             ("history.csv", self.history_csv()),
             ("impacts.csv", self.impacts_csv()),
+            ("hops.csv", self.hops_csv()),
             ("openings.csv", self.openings_csv()),
             ("summary.json", json.dumps(self.summary, indent=2, ensure_ascii=False) + "\n"),
         ):
@@ -524,20 +531,22 @@ class Result:
 
     def __getstate__(self) -> Dict[str, Any]:
         # The native run does not pickle: its arrays do, and its CSV texts go as strings
-        # (history_csv, impacts_csv and openings_csv give the same bytes after a round trip).
+        # (history_csv, impacts_csv, hops_csv and openings_csv give the same bytes after a
+        # round trip).
         _ = (self.states, self.impacts)  # built now: the native run that builds them does not pickle
         state = {k: v for k, v in self.__dict__.items() if k != "_run"}
         state["_csv"] = (
             self._run.history_csv(),
             self._run.impacts_csv(),
             self._run.openings_csv(),
+            self._run.hops_csv(),
         )
         return state
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
-        history, impacts, openings = state.pop("_csv")
+        history, impacts, openings, hops = state.pop("_csv")
         self.__dict__.update(state)
-        self._run = _CsvTexts(history, impacts, openings)
+        self._run = _CsvTexts(history, impacts, openings, hops)
 
     def __repr__(self) -> str:
         s = self.summary
@@ -550,18 +559,22 @@ class Result:
 class _CsvTexts:
     """What an unpickled :class:`Result` keeps of its native run: the texts of its CSV files."""
 
-    __slots__ = ("_history", "_impacts", "_openings")
+    __slots__ = ("_history", "_impacts", "_openings", "_hops")
 
-    def __init__(self, history: str, impacts: str, openings: str) -> None:
+    def __init__(self, history: str, impacts: str, openings: str, hops: str) -> None:
         self._history = history
         self._impacts = impacts
         self._openings = openings
+        self._hops = hops
 
     def history_csv(self) -> str:
         return self._history
 
     def impacts_csv(self) -> str:
         return self._impacts
+
+    def hops_csv(self) -> str:
+        return self._hops
 
     def openings_csv(self) -> str:
         return self._openings

@@ -22,7 +22,7 @@ use crr::dynamics::ground_motion::{Axis, Record, RecordFormat, Units};
 use crr::impact::{SlotState, Trajectory};
 use crr::input::model_file::{ModelFile, build_model, load_model, parse_model_text};
 use crr::kinematics::Model as Structure;
-use crr::output::history::{history_csv, impacts_csv, opened_names, openings_csv};
+use crr::output::history::{history_csv, hops_csv, impacts_csv, opened_names, openings_csv};
 use crr::output::study::folder::header;
 use crr::output::study::{StudyOptions, case_rows_cancellable, cases_csv, run_study};
 use crr::{ModelInput, RecordFile, RecordSamples, RunOptions};
@@ -214,6 +214,8 @@ struct PyRun {
     trajectory: Trajectory,
     summary: String,
     error: Option<String>,
+    /// `[analysis] hop_tolerance` of the run (m), for hops.csv.
+    hop_tolerance: f64,
 }
 
 #[pymethods]
@@ -346,6 +348,12 @@ impl PyRun {
         impacts_csv(&self.structure, &self.trajectory)
     }
 
+    /// The text of hops.csv, as `crr simulate` writes it: every pull at a pivot just after an
+    /// impact, measured by the motion with that face released (the header alone when none).
+    fn hops_csv(&self) -> String {
+        hops_csv(&self.trajectory, self.hop_tolerance)
+    }
+
     /// The text of openings.csv, as `crr simulate` writes it: the offset of every face open at
     /// a row of history.csv (the header alone when no face lifts off).
     fn openings_csv(&self) -> String {
@@ -464,6 +472,7 @@ fn simulate(
         PyRun {
             summary: serde_json::to_string(&summary).expect("a JSON value prints"),
             error: run.summary.error,
+            hop_tolerance: run.summary.solver.hop_tolerance,
             structure: run.model,
             trajectory: run.trajectory,
         }

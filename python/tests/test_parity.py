@@ -34,6 +34,7 @@ def assert_same_run(result: crr.Result, out: Path) -> None:
     assert result.history_csv() == history
     assert result.impacts_csv() == (out / "impacts.csv").read_text()
     assert result.openings_csv() == (out / "openings.csv").read_text()
+    assert result.hops_csv() == (out / "hops.csv").read_text()
     summary = json.loads((out / "summary.json").read_text())
     assert result.summary == summary
     dof = len(result.coordinates)
@@ -135,7 +136,7 @@ def test_the_offsets_of_open_faces_are_those_of_the_command_line(cli, in_root, t
     assert result.history_csv() == (out / "history.csv").read_text()
     # Result.write writes the same files as the command line.
     result.write(tmp_path / "py")
-    for name in ("history.csv", "impacts.csv", "openings.csv"):
+    for name in ("history.csv", "impacts.csv", "hops.csv", "openings.csv"):
         assert (tmp_path / "py" / name).read_text() == (out / name).read_text()
     rows = text.splitlines()
     assert rows[0] == "row,t,interface,dx,dy,dz"

@@ -28,6 +28,7 @@ def _same_result(a: crr.Result, b: crr.Result) -> None:
     assert a.history_csv() == b.history_csv()
     assert a.impacts_csv() == b.impacts_csv()
     assert a.openings_csv() == b.openings_csv()
+    assert a.hops_csv() == b.hops_csv()
 
 
 def _simulate(duration: float) -> crr.Result:

@@ -677,13 +677,13 @@ impl Prepared {
 fn hop_words(h: &crr_impact::simulation::Hop, tolerance: f64) -> String {
     if !h.opens {
         ", although released the face would not open (its tangential force holds it down): no \
-         rigid motion answers"
+         answer without sliding"
             .to_string()
     } else if h.closed {
         format!(
-            "; released, the face would open by {:.1e} m and the bodies depart from crr's motion \
-             by at most {:.1e} m before it lands {:.2e} s later (a hop: `[analysis] \
-             hop_tolerance`, {} m here, accepts hops up to a length)",
+            "; released, the face would open by at most {:.1e} m and the bodies depart from \
+             crr's motion by at most {:.1e} m before it lands {:.2e} s later (a hop: \
+             `[analysis] hop_tolerance`, {} m here, accepts hops up to a length)",
             h.separation,
             h.departure,
             h.end - h.start,

@@ -75,7 +75,8 @@ pub struct Summary {
 pub struct HopsSummary {
     /// How many.
     pub count: usize,
-    /// How many exceeded `hop_tolerance` (each a violation; with the default 0, every one).
+    /// How many are not within `hop_tolerance` (with the default 0, every one): each is a
+    /// violation of the hypotheses, of which `hypothesis_violation` holds the first.
     pub beyond_tolerance: usize,
     /// The largest separation bound (m); None without hops.
     pub largest_separation: Option<f64>,

@@ -725,3 +725,53 @@ fn a_case_stopped_by_an_error_keeps_the_measures_its_run_reached() {
         value("dissipated").to_bits()
     );
 }
+
+/// A study's `hop_tolerance` replaces the model's: the drum column's pull at 0.5295 s under its
+/// own pulse is a hop of 1.5e-10 m (docs/simulation.md, "Hops"), so with a tolerance of 1 µm the
+/// case stays inside the model, with the same impacts; a negative tolerance is refused, naming
+/// the key.
+#[test]
+fn a_study_s_hop_tolerance_accepts_the_hops_that_land_within_it() {
+    let dir = scratch("study_hop_tolerance");
+    let model = models().join("drum_column.toml");
+    let text = |tolerance: &str| {
+        format!(
+            "model = \"{}\"\nduration = 4.0\nhop_tolerance = {tolerance}\n\n[pulses]\n\
+             kind = \"one_sine_pulse\"\namplitudes = [2.5]\nperiods = [0.5]\n",
+            model.display()
+        )
+    };
+    let columns = ["impacts", "violation_time_s", "violation"];
+    let mut rows = Vec::new();
+    for (name, tolerance) in [("strict", "0.0"), ("micrometre", "1e-6")] {
+        let study = write(&dir, &format!("{name}.toml"), &text(tolerance));
+        let out = dir.join(name);
+        let o = crr(&[
+            "study",
+            study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert_eq!(err.contains("left crr's model"), name == "strict", "{err}");
+        rows.push(cases_columns(&out, &columns).remove(0));
+    }
+    assert_eq!(rows[0][2], "tension");
+    assert_eq!((rows[1][1].as_str(), rows[1][2].as_str()), ("", ""));
+    assert_eq!(rows[0][0], rows[1][0], "the same impacts");
+    let bad = write(&dir, "bad.toml", &text("-1.0"));
+    let o = crr(&[
+        "study",
+        bad.to_str().unwrap(),
+        "--out",
+        dir.join("bad").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("hop_tolerance") && err.contains("bad.toml"),
+        "{err}"
+    );
+}

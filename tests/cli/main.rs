@@ -9,6 +9,7 @@ mod animate;
 mod assemble;
 mod check;
 mod fuzz_corpus;
+mod hops;
 mod hostile_inputs;
 mod input_checks;
 mod inspect;

@@ -7,7 +7,7 @@
 //! - released, the block flies freely: its centre rises at b θ̇ and falls at g, it turns at θ̇,
 //!   and its corner's height is z(t) = h (1 − cos θ̇t) + b (θ̇t − sin θ̇t) − ½ g t², whose
 //!   acceleration at t = 0 is h θ̇² − g: the face opens only if h θ̇² > g. Between the two
-//!   thresholds the pull has no rigid answer (the block would slide), and above the second the
+//!   thresholds the pull has no answer without sliding (the block would slide), and above the second the
 //!   corner keeps rising (z grows like ½(hθ̇² − g)t² + bθ̇³t³/6): a flight, whatever tolerance.
 
 use std::collections::BTreeMap;
@@ -135,6 +135,7 @@ fn a_block_whose_corner_keeps_rising_is_a_flight_whatever_the_tolerance() {
         "{hop:?}: the free corner is at {height:e} m"
     );
     assert!(hop.departure >= hop.separation, "{hop:?}");
+    println!("{hop:?}; the free corner at {height:e} m");
 }
 
 /// The face opens where the free corner's acceleration h θ̇² − g is positive: 0.1 % on either

@@ -1458,13 +1458,15 @@ impl<'a> Simulation<'a> {
         (seg.rocking, seg.pivots, seg.angles, seg.q, seg.qdot) = (rocking, pivots, angles, q, qdot);
         (seg.peaks, seg.rocking_coords, seg.y) = (peaks, rocking_coords, buf);
         self.spare.segment = Some(seg);
+        // The hops first: the monitor's samples within an episode that ended in this segment
+        // are that pull's (module `hops`).
+        self.hops.log = hop_log;
+        self.hops_read_log();
         for sample in pending.chunks_exact(stride) {
             let s = self.sample_at(sample[0], &sample[1..]);
             self.record_sample(s);
         }
         self.spare.pending = pending;
-        self.hops.log = hop_log;
-        self.hops_read_log();
         let stop = stop?;
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());

@@ -469,6 +469,8 @@ impl Simulation<'_> {
         (loops, chain): (OpenLoops, Model),
         closing: &[(usize, Side)],
     ) -> Result<(), SimulationError> {
+        // The hops being measured name the old chain's slots: they end here, not landed.
+        self.finish_hops();
         let (q, qdot) = self.state_on(&chain, &loops);
         let n_old = self.model.dof();
         let (work_in, dissipated) = (self.y[2 * n_old], self.y[2 * n_old + 1]);
