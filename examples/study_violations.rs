@@ -131,7 +131,7 @@ fn main() {
             .unwrap_or(f64::NAN)
     };
     println!(
-        "hops: {} of the violations; {} do not open, {} not landed by the run's end; the {} that \
+        "hops: {} of the violations; {} do not open, {} not shown to land; the {} that \
          land depart from crr's motion by {:.2e} m (least), {:.2e} (median), {:.2e} (90 %), \
          {:.2e} m (largest)",
         hops.len(),

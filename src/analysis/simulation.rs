@@ -691,8 +691,10 @@ fn hop_words(h: &crr_impact::simulation::Hop, tolerance: f64) -> String {
         )
     } else {
         format!(
-            "; released, the bodies are not shown to land before the run ended (the face open \
-             by {:.1e} m, the bodies {:.1e} m from crr's motion)",
+            "; released, the bodies are not shown to land (the face open by {:.1e} m, the \
+             bodies {:.1e} m from crr's motion when the measure stopped: at the run's end, a \
+             change of the dynamic chain, a departure past 1e-3 of the model's size or the \
+             tolerance, or a gap closing while the chain still pulled)",
             h.separation, h.departure
         )
     }

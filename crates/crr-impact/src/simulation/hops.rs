@@ -33,16 +33,18 @@
 //! what that changes. The episode ends where the bound on the gap comes back to 0 (the face
 //! lands, located within its interval), where an impact at the face itself turns it onto its
 //! other pivot or seats it (it has landed), or, not landed (`closed` false), where D passes the
-//! larger of `hop_tolerance` and 1e-3 of the model's size or the run ends. An impact at another
+//! larger of `hop_tolerance` and 1e-3 of the model's size, where the dynamic chain changes or
+//! where the run ends (a gap that closes while the chain still pulls has not landed either). An impact at another
 //! face carries g and D on unchanged (the impulse the face transmits to S is compressive unless
 //! the impact records an `impulse_tension`; removed, it would close the gap faster). A pull
 //! where the released motion would not open the gap (a ≤ 0 with N < 0: the tangential part of
 //! F holds the face down) has no answer without sliding.
 //!
 //! With `hop_tolerance` (m) above 0, a hop that opens, lands and departs by no more than it is
-//! not a violation of the hypotheses (the monitor's `tension` at that face is deferred until the
-//! episode ends); any other is recorded at the episode's start, as the monitor would have. With
-//! the default 0 every pull is recorded at once, and the violation carries its hop. Chains with
+//! not a violation of the hypotheses (the monitor's `tension` at that face, sampled after the
+//! impact, is deferred until the episode ends); any other is a `tension` at the episode's start,
+//! as the monitor would have recorded it. With the default 0 every pull is a violation, and the
+//! run's first violation, if a pull, carries its hop. Chains with
 //! loops are not measured (their faces' pulls stay the monitor's).
 
 use super::*;
@@ -69,9 +71,10 @@ pub struct Hop {
     /// lands again (m): a body's centre of mass plus its rotation times the model's size, and
     /// at least the separation.
     pub departure: f64,
-    /// False when the bound's gap had not closed again when the episode ended (the end of the
-    /// run, or its departure past the larger of `hop_tolerance` and 1e-3 of the model's size):
-    /// the bodies released may not land; beyond any tolerance.
+    /// False when the face was not shown to land: the bound on its gap had not closed again
+    /// when the run ended, the dynamic chain changed or the departure passed the larger of
+    /// `hop_tolerance` and 1e-3 of the model's size, or it closed while the chain still pulled;
+    /// beyond any tolerance. True for a pull that does not open (`opens` false).
     pub closed: bool,
     /// False when the motion released would not open the face where the pull started (its
     /// tangential force holds it down): no answer without sliding, beyond any tolerance.
@@ -157,6 +160,9 @@ pub(super) struct Hops {
     /// (slot, start, end) of the episodes ended since the current segment started: the
     /// monitor's samples within one are that pull's.
     windows: Vec<(usize, f64, f64)>,
+    /// Set while the sample after an impact or a landing is taken: the state the next segment
+    /// starts from, whose pulls that segment measures.
+    pub(super) after_impact: bool,
     slots: Vec<usize>,
 }
 
@@ -224,11 +230,16 @@ impl Episode {
                         hi = mid;
                     }
                 }
+                for i in 1..16 {
+                    let top = bound_step(y0, hi * i as f64 / 16.0, a, big_a, omega)[0];
+                    self.largest_gap = self.largest_gap.max(top);
+                }
                 y = bound_step(y0, hi, a, big_a, omega);
                 (self.gap, self.rate, self.departure, self.departure_rate) =
                     (y[0], y[1], y[2], y[3]);
                 self.last_t += hi;
-                return Some(true);
+                // Landed while the chain still pulls: the face would lift again at once.
+                return Some(r.normal >= 0.0);
             }
             if y0[1] > 0.0 && y[1] < 0.0 {
                 // The gap's top lies within the interval.
@@ -502,7 +513,7 @@ impl Simulation<'_> {
                         .hops
                         .waiting
                         .iter()
-                        .position(|d| d.slot == k)
+                        .position(|d| d.slot == k && d.violation.t == t)
                         .map(|i| self.hops.waiting.remove(i));
                     let snaps = SnapsAndLosses {
                         t,
@@ -575,7 +586,8 @@ impl Simulation<'_> {
         self.hops.log = log;
     }
 
-    /// Ends every open episode (the end of the run) and records any deferral left.
+    /// Ends every open episode (the end of the run, a change of chain) and records any
+    /// deferral left.
     pub(super) fn finish_hops(&mut self) {
         for e in std::mem::take(&mut self.hops.open) {
             self.finish_hop(e, false, true);
@@ -583,6 +595,8 @@ impl Simulation<'_> {
         for d in std::mem::take(&mut self.hops.waiting) {
             self.record_violation(d.violation, d.snaps);
         }
+        self.hops.windows.clear();
+        self.attach_hop();
     }
 
     /// Records episode `e`'s hop, and decides its violation: beyond `hop_tolerance` (with the
@@ -606,7 +620,7 @@ impl Simulation<'_> {
         };
         let within = hop.within(self.params.hop_tolerance);
         self.hops.windows.push((e.slot, e.start, e.last_t));
-        if self.params.hop_tolerance > 0.0 && !within {
+        if !within {
             // Beyond the tolerance: the monitor's deferred word, or this pull's own (the monitor
             // took no sample where it started, or one whose solve failed).
             let (mut v, snaps) = match e.deferred {
@@ -625,16 +639,31 @@ impl Simulation<'_> {
             };
             v.hop = Some(Box::new(hop.clone()));
             self.record_violation(v, snaps);
-        } else if let Some(v) = self.violation.as_mut()
-            && v.kind == "tension"
-            && v.interface == interface
-            && v.hop.is_none()
-            && v.t >= e.start
-            && v.t <= e.last_t
-        {
-            v.hop = Some(Box::new(hop.clone()));
         }
         self.hops.done.push(hop);
+        // The monitor's own `tension` in this window (recorded first, at the same instant or
+        // inside the pull) carries the hop too.
+        self.attach_hop();
+    }
+
+    /// Gives the run's first violation, a `tension` without its hop, the hop that ended and
+    /// covers it (the monitor's sample inside an episode already ended when it was judged).
+    pub(super) fn attach_hop(&mut self) {
+        let Some(v) = self.violation.as_mut() else {
+            return;
+        };
+        if v.kind != "tension" || v.hop.is_some() {
+            return;
+        }
+        if let Some(h) = self
+            .hops
+            .done
+            .iter()
+            .rev()
+            .find(|h| h.interface == v.interface && h.start <= v.t && v.t <= h.end)
+        {
+            v.hop = Some(Box::new(h.clone()));
+        }
     }
 
     /// Keeps `v` as the run's first violation if it is earlier than the one recorded.
@@ -677,7 +706,7 @@ impl Simulation<'_> {
         {
             return true;
         }
-        if v.t != self.t {
+        if !(self.hops.after_impact && v.t == self.t) {
             return false;
         }
         if !self.hops.waiting.iter().any(|d| d.slot == k) {

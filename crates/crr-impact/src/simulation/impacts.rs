@@ -513,7 +513,9 @@ impl Simulation<'_> {
         // that its contact forces are those of the motion that follows (with the impact's
         // mode alone, a joint that must open at once shows a spurious tension).
         let released = self.release_if_opening();
+        self.hops.after_impact = true;
         self.record_current_sample(t);
+        self.hops.after_impact = false;
         released?;
         Ok(self.impacts.len() - 1)
     }

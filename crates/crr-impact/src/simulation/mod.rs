@@ -123,8 +123,9 @@ pub struct Parameters {
     /// (recorded as `impulse_tension`) instead of opening them by Moreau's impact
     /// (`simulation::impact_releases`). Default false.
     pub hold_seated_at_impacts: bool,
-    /// A pull at a pivot where a segment starts whose separation bound stays within this (m)
-    /// is not a violation (module `hops`). Default 0: every such pull is one.
+    /// A pull at a pivot where a segment starts whose hop opens, lands and departs from the
+    /// chain's motion by no more than this (m) is not a violation (module `hops`). Default 0:
+    /// every such pull is one.
     pub hop_tolerance: f64,
 }
 
@@ -1467,6 +1468,7 @@ impl<'a> Simulation<'a> {
             self.record_sample(s);
         }
         self.spare.pending = pending;
+        self.attach_hop();
         let stop = stop?;
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());

@@ -738,7 +738,9 @@ impl Simulation<'_> {
         // A face that lands and must open again, or joints the landing releases, open before
         // the sample after it.
         self.release_if_opening()?;
+        self.hops.after_impact = true;
         self.record_current_sample(t);
+        self.hops.after_impact = false;
         Ok(self.impacts.len() - 1)
     }
 
