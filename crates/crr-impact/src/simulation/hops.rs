@@ -49,6 +49,7 @@
 
 use super::*;
 use crr_kinematics::kinematics::{body_rotation, frame_point};
+use crr_kinematics::rotation::skew;
 use nalgebra::{DMatrix, Matrix3, Vector3, Vector6};
 
 /// A pull at a pivot where a segment started, measured to its end ([`Trajectory::hops`]).
@@ -397,9 +398,8 @@ fn released_face(
             let moment = (c - p).cross(&f) + inertia * alpha + omega.cross(&(inertia * omega));
             wrench += Vector6::new(f.x, f.y, f.z, moment.x, moment.y, moment.z);
             // v = v_P + ω × (c − P) = v_P − [c − P]× ω.
-            let arm = c - p;
-            let cross = Matrix3::new(0.0, -arm.z, arm.y, arm.z, 0.0, -arm.x, -arm.y, arm.x, 0.0);
-            jc.fixed_view_mut::<3, 3>(0, base).copy_from(&(-cross));
+            jc.fixed_view_mut::<3, 3>(0, base)
+                .copy_from(&(-skew(&(c - p))));
             jc.fixed_view_mut::<3, 3>(0, base + 3)
                 .copy_from(&Matrix3::identity());
             jw.fixed_view_mut::<3, 3>(0, base)
@@ -480,11 +480,14 @@ impl Simulation<'_> {
     pub(super) fn hops_at_segment_start(&mut self, pressing: &[usize]) {
         let t = self.t;
         self.hops.windows.clear();
-        let sides = self.dynamics.pivots.sides.clone();
+        let measured = self.model.constraint_rows == 0 && !pressing.is_empty();
+        if !measured && self.hops.open.is_empty() && self.hops.waiting.is_empty() {
+            return;
+        }
         let mut i = 0;
         while i < self.hops.open.len() {
             let e = &self.hops.open[i];
-            if pressing.contains(&e.slot) && sides[e.slot] == e.side {
+            if pressing.contains(&e.slot) && self.dynamics.pivots.sides[e.slot] == e.side {
                 i += 1;
             } else {
                 // An impact at the face itself turned it onto its other pivot or seated it:
@@ -493,7 +496,6 @@ impl Simulation<'_> {
                 self.finish_hop(e, true, true);
             }
         }
-        let measured = self.model.constraint_rows == 0 && !pressing.is_empty();
         let mut slots = std::mem::take(&mut self.hops.slots);
         slots.clear();
         slots.extend_from_slice(pressing);
@@ -520,7 +522,8 @@ impl Simulation<'_> {
                         snaps: self.energy_at_snaps,
                         lost: self.lost_at_impacts(),
                     };
-                    let e = Episode::new(k, sides[k], t, r, deferred, snaps);
+                    let side = self.dynamics.pivots.sides[k];
+                    let e = Episode::new(k, side, t, r, deferred, snaps);
                     self.hops.open.push(e);
                     if r.gap <= 0.0 {
                         // Released, the face would not open: no answer without sliding.
@@ -666,9 +669,13 @@ impl Simulation<'_> {
         }
     }
 
-    /// Keeps `v` as the run's first violation if it is earlier than the one recorded.
+    /// Keeps `v` as the run's first violation if it is earlier than the one recorded; at the
+    /// same instant, the first by interface name (the same face whatever order the file lists
+    /// them in, or the order the hops ended in).
     pub(super) fn record_violation(&mut self, v: crate::monitor::Violation, snaps: SnapsAndLosses) {
-        if self.violation.as_ref().is_none_or(|w| v.t < w.t) {
+        let first =
+            |w: &crate::monitor::Violation| v.t < w.t || (v.t == w.t && v.interface < w.interface);
+        if self.violation.as_ref().is_none_or(first) {
             self.violation = Some(v);
             self.snaps_at_violation = Some(snaps);
         }
@@ -727,10 +734,6 @@ mod tests {
     use crr_kinematics::fixtures::{box_body, hinge};
     use crr_kinematics::spec::StructureSpec;
     use nalgebra::{DMatrix, DVector};
-
-    fn cross_matrix(v: &Vector3<f64>) -> Matrix3<f64> {
-        Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
-    }
 
     /// A block on a rocking block, both turning: the released upper face read by
     /// [`released_face`] (relative coordinates: the lower block's angle and the upper block's
@@ -802,7 +805,7 @@ mod tests {
         let mut g = DMatrix::<f64>::zeros(6, 7);
         let vp = u1.cross(&(p - kin.pivot[0]));
         g.view_mut((0, 1), (3, 3))
-            .copy_from(&(-cross_matrix(&(p - kin.com[b]))));
+            .copy_from(&(-skew(&(p - kin.com[b]))));
         g.view_mut((0, 4), (3, 3)).copy_from(&Matrix3::identity());
         g.view_mut((3, 1), (3, 3)).copy_from(&Matrix3::identity());
         for i in 0..3 {
