@@ -262,17 +262,14 @@ pub fn parse_results(
         impacts: Vec::new(),
         free_rocking: free_rocking(&summary),
         levels: None,
-        violation: summary["hypothesis_violation"]["time"]
-            .as_f64()
-            .filter(|t| t.is_finite())
-            .map(|t| {
-                let v = &summary["hypothesis_violation"];
-                let (kind, at) = (
-                    v["kind"].as_str().unwrap_or("violation"),
-                    v["interface"].as_str().unwrap_or("?"),
-                );
-                (t, format!("{kind} at {at}"))
-            }),
+        violation: crate::output::results_folder::violation_time(&summary).map(|t| {
+            let v = &summary["hypothesis_violation"];
+            let (kind, at) = (
+                v["kind"].as_str().unwrap_or("violation"),
+                v["interface"].as_str().unwrap_or("?"),
+            );
+            (t, format!("{kind} at {at}"))
+        }),
     };
     if r.free_rocking.is_none() {
         r.levels = mechanism_levels_of(&summary);

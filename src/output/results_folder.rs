@@ -9,6 +9,15 @@ use std::path::{Path, PathBuf};
 
 use crate::Error;
 
+/// The time of a run's first hypotheses violation as its summary.json records it
+/// (`hypothesis_violation.time`), None where the run has none: what `--plot` shades and
+/// `--animate` marks, read back from a results folder.
+pub fn violation_time(summary: &serde_json::Value) -> Option<f64> {
+    summary["hypothesis_violation"]["time"]
+        .as_f64()
+        .filter(|t| t.is_finite())
+}
+
 /// The files `crr simulate` writes, and those `--plot` and `--animate` add (the animation's
 /// index and GIF; its frames go with them): an earlier run's set is replaced whole (with
 /// `--force`), never mixed with a new one.

@@ -223,9 +223,7 @@ pub fn read_run(dir: &Path) -> Result<Run, Error> {
         count,
         span,
         openings,
-        violation_time: summary["hypothesis_violation"]["time"]
-            .as_f64()
-            .filter(|t| t.is_finite()),
+        violation_time: crate::output::results_folder::violation_time(&summary),
     })
 }
 

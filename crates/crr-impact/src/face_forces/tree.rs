@@ -242,30 +242,36 @@ fn interface_least_normal(
 /// pivoting: each step takes the vector with the longest part off the basis so far, and stops
 /// when that part is below [`RANK_TOLERANCE`] of the longest vector (the rest depend on the
 /// basis). Pivoting keeps a nearly dependent vector, whose part off the others is mostly
-/// round-off, from entering the basis before the vectors it nearly depends on.
+/// round-off, from entering the basis before the vectors it nearly depends on. Each step
+/// computes every remaining vector's part afresh from the vector itself (not updated from the
+/// step before), in two work vectors: no allocation but the basis and the indices left.
 fn orthonormal_basis<D: Dim>(vectors: &[OVector<f64, D>]) -> Vec<OVector<f64, D>>
 where
     DefaultAllocator: Allocator<D>,
 {
+    let mut basis: Vec<OVector<f64, D>> = Vec::with_capacity(vectors.len());
+    let Some(first) = vectors.first() else {
+        return basis;
+    };
     let longest = vectors.iter().map(|v| v.norm()).fold(0.0, f64::max);
-    let mut left: Vec<OVector<f64, D>> = vectors.to_vec();
-    let mut basis: Vec<OVector<f64, D>> = Vec::new();
+    let mut left: Vec<usize> = (0..vectors.len()).collect();
+    let (mut part, mut longest_part) = (first.clone(), first.clone());
     while !left.is_empty() {
-        let parts: Vec<OVector<f64, D>> =
-            left.iter().map(|v| off_basis(v.clone(), &basis)).collect();
-        let (pick, norm) =
-            parts
-                .iter()
-                .map(|r| r.norm())
-                .enumerate()
-                .fold(
-                    (0, 0.0),
-                    |best, (i, n)| if n > best.1 { (i, n) } else { best },
-                );
+        // The first of the longest parts (a part of length 0 is never taken).
+        let (mut pick, mut norm) = (0, 0.0);
+        for (i, &v) in left.iter().enumerate() {
+            part.copy_from(&vectors[v]);
+            off_basis(&mut part, &basis);
+            let n = part.norm();
+            if n > norm {
+                (pick, norm) = (i, n);
+                std::mem::swap(&mut part, &mut longest_part);
+            }
+        }
         if norm <= RANK_TOLERANCE * longest {
             break;
         }
-        basis.push(&parts[pick] / norm);
+        basis.push(&longest_part / norm);
         left.swap_remove(pick);
     }
     basis
@@ -279,42 +285,40 @@ where
     DefaultAllocator: Allocator<D>,
 {
     let n = dim.value();
-    let mut all: Vec<OVector<f64, D>> = basis.to_vec();
-    let mut added = Vec::new();
+    let mut all: Vec<OVector<f64, D>> = Vec::with_capacity(n);
+    all.extend_from_slice(basis);
+    let mut axis = OVector::<f64, D>::zeros_generic(dim, U1);
+    let mut longest_part = axis.clone();
     while all.len() < n {
-        let (norm, residual) = (0..n)
-            .map(|i| {
-                let axis =
-                    OVector::<f64, D>::from_fn_generic(dim, U1, |k, _| f64::from(u8::from(k == i)));
-                let r = off_basis(axis, &all);
-                (r.norm(), r)
-            })
-            .fold(
-                (0.0, OVector::<f64, D>::zeros_generic(dim, U1)),
-                |best, x| {
-                    if x.0 > best.0 { x } else { best }
-                },
-            );
-        let unit = residual / norm;
-        all.push(unit.clone());
-        added.push(unit);
+        let mut norm = 0.0;
+        longest_part.fill(0.0);
+        for i in 0..n {
+            axis.fill(0.0);
+            axis[i] = 1.0;
+            off_basis(&mut axis, &all);
+            let r = axis.norm();
+            if r > norm {
+                norm = r;
+                std::mem::swap(&mut axis, &mut longest_part);
+            }
+        }
+        all.push(&longest_part / norm);
     }
-    added
+    all.split_off(basis.len())
 }
 
-/// `v` less its projections on the orthonormal `basis`, twice (modified Gram–Schmidt with one
-/// reorthogonalisation, accurate to round-off).
-fn off_basis<D: Dim>(mut v: OVector<f64, D>, basis: &[OVector<f64, D>]) -> OVector<f64, D>
+/// Takes from `v` its projections on the orthonormal `basis`, twice (modified Gram–Schmidt with
+/// one reorthogonalisation, accurate to round-off).
+fn off_basis<D: Dim>(v: &mut OVector<f64, D>, basis: &[OVector<f64, D>])
 where
     DefaultAllocator: Allocator<D>,
 {
     for _ in 0..2 {
         for q in basis {
-            let along = q.dot(&v);
+            let along = q.dot(v);
             v.axpy(-along, q, 1.0);
         }
     }
-    v
 }
 
 /// max over α of minᵢ (aᵢ + α vᵢ): a concave piecewise-linear function whose maximum lies where
@@ -479,6 +483,62 @@ mod tests {
             pulling >= 20 && pushing >= 20,
             "{pulling} pulling, {pushing} pushing"
         );
+    }
+
+    /// The basis of a span and its completion, on vectors with a dependence: in R⁶, v₁, v₂, v₄
+    /// random, v₃ = 2v₁ − 3v₂ and v₅ = 1e-12 v₁ + v₄ (in the span of v₁ and v₄, though nearly
+    /// parallel to v₄ alone); the basis has three vectors,
+    /// orthonormal to 1e-14, every vᵢ lies in their span to 1e-13 of its length, and with the
+    /// completion they make an orthonormal basis of R⁶. In R³ (a dynamic dimension, as the normal
+    /// impulses' rows are), two parallel vectors give one direction and a completion of two.
+    #[test]
+    fn the_basis_spans_the_vectors_and_its_completion_the_rest() {
+        let mut rng = SplitMix(7);
+        let random = |rng: &mut SplitMix| Vector6::from_fn(|_, _| rng.uniform(-1.0, 1.0));
+        let (v1, v2, v4) = (random(&mut rng), random(&mut rng), random(&mut rng));
+        let vectors = [v1, v2, 2.0 * v1 - 3.0 * v2, v4, 1e-12 * v1 + v4];
+        let basis = orthonormal_basis(&vectors);
+        assert_eq!(basis.len(), 3);
+        let off_span = |v: &Vector6<f64>, basis: &[Vector6<f64>]| {
+            let mut r = *v;
+            for b in basis {
+                r -= b * b.dot(v);
+            }
+            r.norm()
+        };
+        for v in &vectors {
+            assert!(
+                off_span(v, &basis) <= 1e-13 * v.norm(),
+                "{}",
+                off_span(v, &basis)
+            );
+        }
+        let complement = completion(&basis, U6);
+        assert_eq!(complement.len(), 3);
+        let all: Vec<Vector6<f64>> = basis.iter().chain(&complement).copied().collect();
+        for (i, a) in all.iter().enumerate() {
+            for (j, b) in all.iter().enumerate() {
+                let expected = if i == j { 1.0 } else { 0.0 };
+                assert!(
+                    (a.dot(b) - expected).abs() <= 1e-14,
+                    "{i} {j}: {}",
+                    a.dot(b)
+                );
+            }
+        }
+        let parallel = [
+            DVector::from_vec(vec![1.0, 2.0, 2.0]),
+            DVector::from_vec(vec![-2.0, -4.0, -4.0]),
+        ];
+        let line = orthonormal_basis(&parallel);
+        assert_eq!(line.len(), 1);
+        assert!((line[0].dot(&parallel[0]).abs() - 3.0).abs() <= 1e-15);
+        let rest = completion(&line, Dyn(3));
+        assert_eq!(rest.len(), 2);
+        for r in &rest {
+            assert!((r.norm() - 1.0).abs() <= 1e-15 && line[0].dot(r).abs() <= 1e-15);
+        }
+        assert!(rest[0].dot(&rest[1]).abs() <= 1e-15);
     }
 
     /// max over α of min(α, 1 − α) is ½ at α = ½ (two lines crossing); min(2 + α, 3) with the

@@ -360,7 +360,7 @@ pub(super) fn only_support(model: &Model, k: usize) -> bool {
 /// The normal force of each pivot of `pressing` (tree slots of faces rocking on a pivot,
 /// [`pressing_faces`]) at the state (t, q, q̇), over W L, into `out`: σ′r′, r′ the joint's
 /// reaction about its other pivot P′ of side σ′ while it carries no moment about its pivot P
-/// (`seating::SubtreeLoads`, from a solve by M in `trial`, the current pivots and seats), as
+/// (`seating::SubtreeLoads`, from a solve in `trial` with the current pivots and seats), as
 /// the contact program reads a rocking face's lift (module `opening_qp`). Positive while the
 /// pivot presses. Where the solve fails, +1 (no event) and false. `roundoff`, when given,
 /// receives each value's round-off (that of the reaction's transfer to P′, over W L).

@@ -224,10 +224,11 @@ pub(super) fn opening_mode_local(
         if may_open.is_none() {
             trial.evaluate(model, ground, t, q, qdot);
         } else if certificate
-            && locked_loops_closed(model, trial)
+            && let Some(residual) = closed_loops_residual(model, trial)
             && pressing_carried(model, trial, rest)
         {
-            audit_certified(model, ground, template, trial, rest, t, q, qdot, tol);
+            let state = (t, q, qdot);
+            audit_certified(model, ground, template, trial, rest, state, residual, tol);
             return None;
         }
         if let Some(mode) = loop_opening(model, ground, template, trial, rest, t, q, qdot, tol) {
@@ -297,10 +298,11 @@ pub fn openings_slide_nowhere(model: &Model) -> bool {
 /// (`tests/engine/certificate_audit.rs`, 2026-11-30).
 pub const CERTIFIED_CLOSURE_RESIDUAL: f64 = 1e-11;
 
-/// Whether the locked solve in `trial` keeps every loop closed at acceleration level to
-/// [`CERTIFIED_CLOSURE_RESIDUAL`] g.
-fn locked_loops_closed(model: &Model, trial: &Dynamics) -> bool {
-    trial.loop_residual(model) <= CERTIFIED_CLOSURE_RESIDUAL * model.gravity
+/// The locked solve's closure residual (m/s², [`Dynamics::loop_residual`]) where it keeps every
+/// loop closed at acceleration level to [`CERTIFIED_CLOSURE_RESIDUAL`] g; None where it does not.
+fn closed_loops_residual(model: &Model, trial: &Dynamics) -> Option<f64> {
+    let residual = trial.loop_residual(model);
+    (residual <= CERTIFIED_CLOSURE_RESIDUAL * model.gravity).then_some(residual)
 }
 
 /// Whether the locked motion solved in `trial` (every seated slot held, every rocking face on its
@@ -318,7 +320,8 @@ fn pressing_carried(model: &Model, trial: &Dynamics, rest: &mut RestCache) -> bo
 /// With the run audited ([`super::Simulation::audit_certificate`]), the contact program's answer
 /// at a state the certificate decided, recorded: the uplift test's own [`loop_opening`] (the
 /// program, its releases confirmed by the chain's exact solve) on a copy of `trial`, with the
-/// lift-off it may name taken back, so that the run goes on as unaudited.
+/// lift-off it may name taken back, so that the run goes on as unaudited. `residual` is the
+/// locked solve's closure residual ([`closed_loops_residual`]), recorded with the answer.
 #[allow(clippy::too_many_arguments)]
 fn audit_certified(
     model: &Model,
@@ -326,15 +329,13 @@ fn audit_certified(
     template: &Dynamics,
     trial: &Dynamics,
     rest: &mut RestCache,
-    t: f64,
-    q: &DVector<f64>,
-    qdot: &DVector<f64>,
+    (t, q, qdot): (f64, &DVector<f64>, &DVector<f64>),
+    residual: f64,
     tol: f64,
 ) {
     let Some(mut audit) = rest.audit.take() else {
         return;
     };
-    let residual = trial.loop_residual(model);
     let mut scratch = trial.clone();
     let kept = rest.lift_off.take();
     let answer = loop_opening(model, ground, template, &mut scratch, rest, t, q, qdot, tol);
@@ -996,8 +997,8 @@ pub(super) struct SubtreeLoads {
 }
 
 impl SubtreeLoads {
-    /// From the solve in `trial` (q̈, λ and the kinematics of its state; not the
-    /// articulated-body path, which leaves no bias accelerations).
+    /// From the solve in `trial` (q̈, λ and the kinematics of its state, its velocities and
+    /// bias accelerations included, which the articulated-body path fills as well).
     pub(super) fn new(model: &Model, trial: &Dynamics) -> Self {
         // Every fₖ at once: each body's load added along its frame's path to the ground, each
         // loop's point force λ along its two frames' paths (−λ on the parent's side, +λ on the
@@ -1128,19 +1129,18 @@ impl Simulation<'_> {
     }
 
     /// The dynamics the pivots' normal forces are solved with ([`pressing_forces`]): the spare
-    /// one kept between uses, loaded with the current pivots and seats, solved by M (give it
-    /// back to `spare.pressing` after use).
+    /// one kept between uses, loaded with the current pivots and seats, solved as the run's own
+    /// dynamics are (on open chains by the articulated-body algorithm, without forming M; give
+    /// it back to `spare.pressing` after use).
     pub(super) fn take_pressing_trial(&mut self) -> Box<Dynamics> {
-        let mut d = match self.spare.pressing.take() {
+        match self.spare.pressing.take() {
             Some(mut d) => {
                 d.pivots.clone_from(&self.dynamics.pivots);
                 d.seated.clone_from(&self.dynamics.seated);
                 d
             }
             None => Box::new(self.dynamics.clone()),
-        };
-        d.solver = crr_dynamics::eom::ForwardSolver::Cholesky;
-        d
+        }
     }
 
     /// The faces whose pivots' normal forces are watched now ([`pressing_faces`]).
