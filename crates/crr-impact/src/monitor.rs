@@ -500,9 +500,10 @@ pub fn self_stress_normals(
 /// at its first sample beyond with 1 ms samples, −5e-3 W with 10 ms).
 pub const TENSION_TOLERANCE: f64 = 1e-3;
 
-/// The first violation among the given contact forces and seated edges at time t, in interface
-/// order: tension, then a resultant outside the face, then sliding when μ is given. A tension
-/// smaller than `tolerance` (N) is round-off, not flight.
+/// The gravest violation among the given contact forces and seated edges at time t (`judge`):
+/// tension, then a resultant outside the face, then sliding when μ is given, the most negative
+/// force first within a kind, whatever the order of the interfaces. A tension smaller than
+/// `tolerance` (N) is round-off, not flight.
 ///
 /// With `self_stress` ([`self_stress_normals`]) a tension counts only if no distribution of the
 /// hyperstatic forces is compressive: the nearest change ν of the least-norm one with every
@@ -690,10 +691,14 @@ fn judge_distribution(
     judge(model, forces, edges, &values, t, friction, tolerance)
 }
 
-/// The first violation among the forces and edges, read from `values` where it has them (every
+/// The gravest violation among the forces and edges, read from `values` where it has them (every
 /// interface's normal force, then (far, near) of each edge split: a distribution other than the
-/// given one), from the given forces otherwise: tension, then a resultant outside the face, then
-/// sliding (the given tangential force against μ times the normal force read).
+/// given one), from the given forces otherwise. Each contact's own failure is its tension, else
+/// a resultant outside its face, else sliding (the given tangential force against μ times the
+/// normal force read). Of the contacts that fail, a tension comes before a resultant outside a
+/// face and that before a slide; within one kind the most negative force (for a slide, the
+/// largest tangential force beyond μN) and then the interface's name decide, so that the contact
+/// reported does not depend on the order in which the file lists the interfaces.
 pub(crate) fn judge(
     model: &Model,
     forces: &[Option<ContactForce>],
@@ -704,32 +709,147 @@ pub(crate) fn judge(
     tolerance: f64,
 ) -> Option<Violation> {
     let value = |i: usize, given: f64| values.get(i).copied().unwrap_or(given);
-    let violation = |i: usize, kind: &str, normal: f64, f: &ContactForce| Violation {
+    // (kind's rank, severity: lower is graver; interface, kind, reported normal force)
+    let mut gravest: Option<((u8, f64), usize, &str, f64)> = None;
+    for (i, f) in forces.iter().enumerate() {
+        let Some(f) = f else { continue };
+        let normal = value(i, f.normal);
+        let outside = edges
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.interface == i)
+            .map(|(e, edge)| {
+                let far = value(forces.len() + 2 * e, edge.far);
+                let near = value(forces.len() + 2 * e + 1, edge.near);
+                far.min(near)
+            })
+            .fold(f64::INFINITY, f64::min);
+        let outside = (outside < -tolerance).then_some(outside);
+        let excess = friction.map(|mu| f.tangential - mu * normal.max(0.0));
+        let failure = if normal < -tolerance {
+            Some(((0, normal), "tension", normal))
+        } else if let Some(least) = outside {
+            Some(((1, least), "outside_face", least))
+        } else {
+            excess
+                .filter(|&x| x > tolerance)
+                .map(|excess| ((2, -excess), "sliding", normal))
+        };
+        let Some((key, kind, reported)) = failure else {
+            continue;
+        };
+        let graver = gravest.as_ref().is_none_or(|(best, j, ..)| {
+            key.0
+                .cmp(&best.0)
+                .then(key.1.total_cmp(&best.1))
+                .then_with(|| model.interfaces[i].name.cmp(&model.interfaces[*j].name))
+                .is_lt()
+        });
+        if graver {
+            gravest = Some((key, i, kind, reported));
+        }
+    }
+    gravest.map(|(_, i, kind, normal)| Violation {
         t,
         interface: model.interfaces[i].name.clone(),
         kind: kind.into(),
         normal,
-        friction_demand: f.friction_demand(),
+        friction_demand: forces[i].map_or(f64::INFINITY, |f| f.friction_demand()),
         hop: None,
-    };
-    for (i, f) in forces.iter().enumerate() {
-        let Some(f) = f else { continue };
-        let normal = value(i, f.normal);
-        if normal < -tolerance {
-            return Some(violation(i, "tension", normal, f));
-        }
-        for (e, edge) in edges.iter().enumerate().filter(|(_, e)| e.interface == i) {
-            let far = value(forces.len() + 2 * e, edge.far);
-            let near = value(forces.len() + 2 * e + 1, edge.near);
-            if far.min(near) < -tolerance {
-                return Some(violation(i, "outside_face", far.min(near), f));
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crr_kinematics::fixtures::serial_chain;
+
+    fn force(normal: f64, tangential: f64) -> Option<ContactForce> {
+        Some(ContactForce {
+            force: [tangential, 0.0, normal],
+            normal,
+            tangential,
+        })
+    }
+
+    /// Which contact `judge` reports depends on the forces, not on where the interfaces stand:
+    /// of the chain's three interfaces j0, j1, j2, each failing set is judged in every one of its
+    /// orders (the forces permuted with the names). Two tensions: the more negative (−8 N against
+    /// −5 N). A tension against a slide of any size and a resultant outside a face: the tension. A
+    /// face outside against a slide: the face. Two slides with μ = 0.5: the larger excess of the
+    /// tangential force over μN (9 − 5 = 4 N against 3 − 0.5 = 2.5 N). Two equal tensions: the
+    /// first name.
+    #[test]
+    fn the_gravest_failure_is_reported_whatever_the_order() {
+        let model = Model::from_spec(&serial_chain(3)).unwrap();
+        let names: Vec<String> = model.interfaces.iter().map(|i| i.name.clone()).collect();
+        let tolerance = 1e-3;
+        // (normal, tangential, least edge force) of three contacts, and what must be reported.
+        type Contacts = [(f64, f64, f64); 3];
+        let cases: [(Contacts, (usize, &str, f64)); 5] = [
+            (
+                [(-5.0, 0.0, 1.0), (-8.0, 0.0, 1.0), (10.0, 0.0, 1.0)],
+                (1, "tension", -8.0),
+            ),
+            (
+                [(10.0, 90.0, 1.0), (10.0, 0.0, -50.0), (-2.0, 0.0, 1.0)],
+                (2, "tension", -2.0),
+            ),
+            (
+                [(10.0, 90.0, 1.0), (10.0, 0.0, -0.5), (10.0, 0.0, 1.0)],
+                (1, "outside_face", -0.5),
+            ),
+            (
+                [(1.0, 3.0, 1.0), (10.0, 9.0, 1.0), (10.0, 0.0, 1.0)],
+                (1, "sliding", 10.0),
+            ),
+            (
+                [(-4.0, 0.0, 1.0), (10.0, 0.0, 1.0), (-4.0, 0.0, 1.0)],
+                (0, "tension", -4.0),
+            ),
+        ];
+        let orders = [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ];
+        for (contacts, (expected, kind, normal)) in cases {
+            for order in orders {
+                // Interface i of the model carries contact order[i].
+                let forces: Vec<Option<ContactForce>> = order
+                    .iter()
+                    .map(|&c| force(contacts[c].0, contacts[c].1))
+                    .collect();
+                let edges: Vec<SeatEdges> = order
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &c)| SeatEdges {
+                        interface: i,
+                        slot: i,
+                        near: contacts[c].2,
+                        far: 2.0,
+                        seated_index: i,
+                        arm: 0.1,
+                    })
+                    .collect();
+                let v = judge(&model, &forces, &edges, &[], 0.0, Some(0.5), tolerance)
+                    .expect("a violation");
+                // The name that contact `expected` has in this order; equal tensions go to the
+                // first name among those that carry them.
+                let carriers: Vec<&String> = order
+                    .iter()
+                    .zip(&names)
+                    .filter(|&(&c, _)| contacts[c] == contacts[expected])
+                    .map(|(_, name)| name)
+                    .collect();
+                let first = carriers.iter().min().unwrap();
+                assert_eq!(&&v.interface, first, "{kind} in order {order:?}");
+                assert_eq!(v.kind, kind, "order {order:?}");
+                assert_eq!(v.normal, normal, "order {order:?}");
             }
         }
-        if let Some(mu) = friction
-            && f.tangential > mu * normal.max(0.0) + tolerance
-        {
-            return Some(violation(i, "sliding", normal, f));
-        }
     }
-    None
 }
