@@ -740,7 +740,9 @@ mod tests {
     /// twist relative to it) against the same release in absolute coordinates written here (the
     /// lower block's angle and the upper block's own twist (ω, v_G), G the upper block's twist
     /// at P less the lower block's): the same change of the bodies' motion, so the same gap's
-    /// acceleration and normal force, to round-off.
+    /// acceleration and normal force, to round-off. The wrench the face carries is written here
+    /// too, from the upper block's centre-of-mass acceleration by the classical kinematics of two
+    /// turning bodies (and checked against the engine's `body_forces`); only q̈ is the engine's.
     #[test]
     fn the_released_gap_does_not_depend_on_the_coordinates_it_is_read_in() {
         let spec = StructureSpec {
@@ -812,10 +814,24 @@ mod tests {
             g[(i, 0)] = -vp[i];
             g[(3 + i, 0)] = -u1[i];
         }
-        // The wrench on b at P from its motion in the chain: f = m(a − g_eff) and the moment.
-        let f = forces[b];
-        let omega = u1 * qdot[0] + u2 * qdot[1];
-        let alpha = u1 * d.qddot[0] + u2 * d.qddot[1] + (u1 * qdot[0]).cross(&u2) * qdot[1];
+        // The wrench on b at P from its motion in the chain, f = m(a_c − g_eff) and the moment,
+        // with a_c by the classical kinematics of the two turning bodies (not the engine's
+        // spatial algebra): the upper joint's pivot O₂ is fixed in a, which turns about O₁.
+        let (o1, o2) = (kin.pivot[0], kin.pivot[1]);
+        let (omega_a, alpha_a) = (u1 * qdot[0], u1 * d.qddot[0]);
+        let omega = omega_a + u2 * qdot[1];
+        let alpha = alpha_a + u2 * d.qddot[1] + omega_a.cross(&u2) * qdot[1];
+        let turning = |w: &Vector3<f64>, dw: &Vector3<f64>, r: Vector3<f64>| {
+            dw.cross(&r) + w.cross(&w.cross(&r))
+        };
+        let a_o2 = turning(&omega_a, &alpha_a, o2 - o1);
+        let a_c = a_o2 + turning(&omega, &alpha, kin.com[b] - o2);
+        let f = mb * (a_c - Vector3::new(0.0, 0.0, -model.gravity));
+        assert!(
+            (f - forces[b]).norm() <= 1e-9 * f.norm(),
+            "{f} vs {}",
+            forces[b]
+        );
         let m = (kin.com[b] - p).cross(&f) + ib * alpha + omega.cross(&(ib * omega));
         let wrench = DVector::from_vec(vec![f.x, f.y, f.z, m.x, m.y, m.z]);
         let change = -(mass.cholesky().unwrap().solve(&g.transpose()) * wrench);
