@@ -109,6 +109,28 @@ pub struct Violation {
     pub hop: Option<Box<crate::simulation::Hop>>,
 }
 
+impl Violation {
+    /// Whether this violation is graver than `other` (two found at one instant): a tension
+    /// (flight) before a resultant outside a face, that before a slide, and those before the
+    /// kinds the simulation records itself (`lift_off`, `impulse_tension`); within a kind the
+    /// most negative force (for a slide, the largest friction demand |F_t|/N); then the
+    /// interface name that sorts first. The order of the interfaces in the model file plays no
+    /// part.
+    pub fn graver_than(&self, other: &Violation) -> bool {
+        let key = |v: &Violation| match v.kind.as_str() {
+            "tension" => (0, v.normal),
+            "outside_face" => (1, v.normal),
+            "sliding" => (2, -v.friction_demand),
+            _ => (3, 0.0),
+        };
+        let ((rank, severity), (other_rank, other_severity)) = (key(self), key(other));
+        rank.cmp(&other_rank)
+            .then(severity.total_cmp(&other_severity))
+            .then_with(|| self.interface.cmp(&other.interface))
+            .is_lt()
+    }
+}
+
 fn top(v: &Vector6<f64>) -> Vector3<f64> {
     Vector3::new(v[0], v[1], v[2])
 }
@@ -500,10 +522,10 @@ pub fn self_stress_normals(
 /// at its first sample beyond with 1 ms samples, −5e-3 W with 10 ms).
 pub const TENSION_TOLERANCE: f64 = 1e-3;
 
-/// The gravest violation among the given contact forces and seated edges at time t (`judge`):
-/// tension, then a resultant outside the face, then sliding when μ is given, the most negative
-/// force first within a kind, whatever the order of the interfaces. A tension smaller than
-/// `tolerance` (N) is round-off, not flight.
+/// The gravest violation among the given contact forces and seated edges at time t (`judge`,
+/// [`Violation::graver_than`]): tension, then a resultant outside the face, then sliding when μ
+/// is given, whatever the order of the interfaces. A tension smaller than `tolerance` (N) is
+/// round-off, not flight.
 ///
 /// With `self_stress` ([`self_stress_normals`]) a tension counts only if no distribution of the
 /// hyperstatic forces is compressive: the nearest change ν of the least-norm one with every
@@ -695,10 +717,9 @@ fn judge_distribution(
 /// interface's normal force, then (far, near) of each edge split: a distribution other than the
 /// given one), from the given forces otherwise. Each contact's own failure is its tension, else
 /// a resultant outside its face, else sliding (the given tangential force against μ times the
-/// normal force read). Of the contacts that fail, a tension comes before a resultant outside a
-/// face and that before a slide; within one kind the most negative force (for a slide, the
-/// largest tangential force beyond μN) and then the interface's name decide, so that the contact
-/// reported does not depend on the order in which the file lists the interfaces.
+/// normal force read); of the contacts that fail, the gravest by [`Violation::graver_than`], so
+/// that the contact reported does not depend on the order in which the file lists the
+/// interfaces.
 pub(crate) fn judge(
     model: &Model,
     forces: &[Option<ContactForce>],
@@ -709,8 +730,7 @@ pub(crate) fn judge(
     tolerance: f64,
 ) -> Option<Violation> {
     let value = |i: usize, given: f64| values.get(i).copied().unwrap_or(given);
-    // (kind's rank, severity: lower is graver; interface, kind, reported normal force)
-    let mut gravest: Option<((u8, f64), usize, &str, f64)> = None;
+    let mut gravest: Option<Violation> = None;
     for (i, f) in forces.iter().enumerate() {
         let Some(f) = f else { continue };
         let normal = value(i, f.normal);
@@ -724,39 +744,28 @@ pub(crate) fn judge(
                 far.min(near)
             })
             .fold(f64::INFINITY, f64::min);
-        let outside = (outside < -tolerance).then_some(outside);
-        let excess = friction.map(|mu| f.tangential - mu * normal.max(0.0));
-        let failure = if normal < -tolerance {
-            Some(((0, normal), "tension", normal))
-        } else if let Some(least) = outside {
-            Some(((1, least), "outside_face", least))
+        let (kind, reported) = if normal < -tolerance {
+            ("tension", normal)
+        } else if outside < -tolerance {
+            ("outside_face", outside)
+        } else if friction.is_some_and(|mu| f.tangential > mu * normal.max(0.0) + tolerance) {
+            ("sliding", normal)
         } else {
-            excess
-                .filter(|&x| x > tolerance)
-                .map(|excess| ((2, -excess), "sliding", normal))
-        };
-        let Some((key, kind, reported)) = failure else {
             continue;
         };
-        let graver = gravest.as_ref().is_none_or(|(best, j, ..)| {
-            key.0
-                .cmp(&best.0)
-                .then(key.1.total_cmp(&best.1))
-                .then_with(|| model.interfaces[i].name.cmp(&model.interfaces[*j].name))
-                .is_lt()
-        });
-        if graver {
-            gravest = Some((key, i, kind, reported));
+        let v = Violation {
+            t,
+            interface: model.interfaces[i].name.clone(),
+            kind: kind.into(),
+            normal: reported,
+            friction_demand: f.friction_demand(),
+            hop: None,
+        };
+        if gravest.as_ref().is_none_or(|g| v.graver_than(g)) {
+            gravest = Some(v);
         }
     }
-    gravest.map(|(_, i, kind, normal)| Violation {
-        t,
-        interface: model.interfaces[i].name.clone(),
-        kind: kind.into(),
-        normal,
-        friction_demand: forces[i].map_or(f64::INFINITY, |f| f.friction_demand()),
-        hop: None,
-    })
+    gravest
 }
 
 #[cfg(test)]
@@ -776,9 +785,8 @@ mod tests {
     /// of the chain's three interfaces j0, j1, j2, each failing set is judged in every one of its
     /// orders (the forces permuted with the names). Two tensions: the more negative (−8 N against
     /// −5 N). A tension against a slide of any size and a resultant outside a face: the tension. A
-    /// face outside against a slide: the face. Two slides with μ = 0.5: the larger excess of the
-    /// tangential force over μN (9 − 5 = 4 N against 3 − 0.5 = 2.5 N). Two equal tensions: the
-    /// first name.
+    /// face outside against a slide: the face. Two slides with μ = 0.5: the larger friction
+    /// demand |F_t|/N (3/1 against 9/10). Two equal tensions: the name that sorts first.
     #[test]
     fn the_gravest_failure_is_reported_whatever_the_order() {
         let model = Model::from_spec(&serial_chain(3)).unwrap();
@@ -801,7 +809,7 @@ mod tests {
             ),
             (
                 [(1.0, 3.0, 1.0), (10.0, 9.0, 1.0), (10.0, 0.0, 1.0)],
-                (1, "sliding", 10.0),
+                (0, "sliding", 1.0),
             ),
             (
                 [(-4.0, 0.0, 1.0), (10.0, 0.0, 1.0), (-4.0, 0.0, 1.0)],

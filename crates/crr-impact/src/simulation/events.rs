@@ -58,8 +58,8 @@ pub(super) struct SegmentEvents<'b> {
     /// pull: the face lifts off and every body it carries loses its only support (a flight).
     pub(super) pressing: Vec<usize>,
     /// The dynamics the pivots' forces are computed with (the current pivots and seats, solved
-    /// by M: the subtree forces need the bias accelerations); present when `pressing` is not
-    /// empty.
+    /// as the run's own are; the subtree forces read the bias accelerations, which every solve
+    /// fills); present when `pressing` is not empty.
     pub(super) pressing_trial: Option<Box<Dynamics>>,
 }
 
