@@ -135,16 +135,17 @@ impl ArticulatedBody {
             data.bias_acceleration[k] = ap + c;
             self.axis[k] = s;
             self.velocity_product[k] = c;
-            let mut inertia = Matrix6::zeros();
+            // Summed in place (the same operations as into a zero matrix moved there after).
+            let inertia = &mut self.inertia[k];
+            inertia.fill(0.0);
             let mut momentum = Vector6::zeros();
             for &b in &self.bodies[self.body_start[k]..self.body_start[k + 1]] {
                 let body = &model.bodies[b];
                 let i_w = world_inertia(body, &data.rot_ops[k]);
                 let i_b = body_spatial_inertia(body.mass, &data.com[b], &i_w);
                 momentum += i_b * v;
-                add_assign(&mut inertia, &i_b);
+                add_assign(inertia, &i_b);
             }
-            self.inertia[k] = inertia;
             self.bias_force[k] = cross_force(&v, &momentum);
         }
         // Pass 2 (inwards): articulated inertias and bias forces. The parent receives

@@ -70,7 +70,7 @@ use thiserror::Error;
 use crr_kinematics::short_copy::copy_short;
 
 use dense::dense_eval;
-pub use dense::{DenseComponent, DenseStep};
+pub use dense::{DenseComponent, DenseStep, StepEnds};
 use events::{ZERO_START_PROBE, crosses};
 use stages::call_rhs;
 use tableau::*;
@@ -348,6 +348,9 @@ pub struct Solver {
     k: Vec<f64>,
     /// Dense-output coefficients of the last computed step, `ncoef × dim`.
     dense: Vec<f64>,
+    /// The size of the last finished step whose dense output still lacks DOP853's extra stages
+    /// ([`Solver::complete_dense`]); None when complete (or when no step is pending).
+    dense_pending: Option<f64>,
     /// Proposed next step size; 0 if unknown.
     h_next: f64,
     facold: f64,
@@ -392,6 +395,7 @@ impl Solver {
             y_event: vec![0.0; dim],
             k: vec![0.0; stages * dim],
             dense: vec![0.0; ncoef * dim],
+            dense_pending: None,
             h_next: 0.0,
             facold: 1e-4,
             last_rejected: false,
@@ -478,10 +482,6 @@ impl Solver {
         self.stats
     }
 
-    fn ncoef(&self) -> usize {
-        self.dense.len() / self.dim.max(1)
-    }
-
     /// Integrates from the current state until `t_end` (landed on exactly)
     /// or until the first event, whichever comes first. `on_step` is called
     /// for every accepted step with its dense output (for an event, the
@@ -501,6 +501,28 @@ impl Solver {
         t_end: f64,
         events: &mut impl EventFunctions,
         on_step: &mut impl FnMut(&DenseStep),
+    ) -> Result<Stop, SolveError> {
+        self.advance_lazily(sys, t_end, events, &mut |_| true, &mut |_, dense| {
+            if let Some(step) = dense {
+                on_step(step);
+            }
+        })
+    }
+
+    /// [`Self::advance`], with each step's dense output computed only where it is read:
+    /// `wants_dense` is asked with the exact states at the ends of every accepted step (for an
+    /// event, of the partial step ending at it), and `on_step` then receives those ends and the
+    /// dense output where it was wanted (None otherwise). The integration is the same to the
+    /// last bit; DOP853 saves its three extra stages per step (a fifth of its right-hand sides)
+    /// on the steps nobody interpolates. Event location computes the dense output it needs
+    /// itself.
+    pub fn advance_lazily(
+        &mut self,
+        sys: &mut impl OdeSystem,
+        t_end: f64,
+        events: &mut impl EventFunctions,
+        wants_dense: &mut impl FnMut(&StepEnds) -> bool,
+        on_step: &mut impl FnMut(&StepEnds, Option<&DenseStep>),
     ) -> Result<Stop, SolveError> {
         assert_eq!(sys.dim(), self.dim, "advance: system dimension mismatch");
         if t_end < self.t || t_end.is_nan() {
@@ -566,7 +588,7 @@ impl Solver {
             self.finish_step(sys, h, t1)?;
 
             let found = if ne > 0 {
-                self.first_event(events, t1, h)
+                self.first_event(sys, events, t1, h)?
             } else {
                 None
             };
@@ -578,9 +600,9 @@ impl Solver {
                         continue;
                     }
                     let h_land = t_star - self.t;
-                    self.emit(on_step, h_land, t_star);
+                    self.emit(sys, (wants_dense, on_step), h_land, t_star)?;
                 } else {
-                    self.emit(on_step, h, t1);
+                    self.emit(sys, (wants_dense, on_step), h, t1)?;
                 }
                 self.commit(t_star);
                 self.project(sys)?;
@@ -589,7 +611,7 @@ impl Solver {
                 return Ok(Stop::Event { index, t: t_star });
             }
 
-            self.emit(on_step, h, t1);
+            self.emit(sys, (wants_dense, on_step), h, t1)?;
             self.commit(t1);
             let projected = self.project(sys)?;
             if ne > 0 {
@@ -675,16 +697,18 @@ impl Solver {
     /// probe at `ZERO_START_PROBE`·h) and its end.
     fn first_event(
         &mut self,
+        sys: &mut impl OdeSystem,
         events: &mut impl EventFunctions,
         t1: f64,
         h: f64,
-    ) -> Option<(usize, f64)> {
+    ) -> Result<Option<(usize, f64)>, SolveError> {
         let ne = events.count();
         let mut found: Option<(usize, f64)> = None;
         events.eval(t1, &self.y_new, &mut self.g_new);
         let any_zero = self.zero_start.iter().any(|&z| z);
         let t_probe = self.t + ZERO_START_PROBE * h;
         if any_zero {
+            self.complete_dense(sys)?;
             dense_eval(&self.dense, self.dim, self.t, h, t_probe, &mut self.y_tmp);
             events.eval(t_probe, &self.y_tmp, &mut self.g_ref);
         }
@@ -706,6 +730,7 @@ impl Solver {
                 Some((_, tf)) => tf.min(t1),
                 None => t1,
             };
+            self.complete_dense(sys)?;
             let root = self.locate(events, i, ta, ga, t1, gb, tb, h);
             if let Some(tr) = root
                 && found.is_none_or(|(_, tf)| tr < tf)
@@ -713,7 +738,7 @@ impl Solver {
                 found = Some((i, tr));
             }
         }
-        found
+        Ok(found)
     }
 
     /// Lands on the event time t* with a genuine step from the step start. The root was located
@@ -772,15 +797,43 @@ impl Solver {
         }
     }
 
-    fn emit(&self, on_step: &mut impl FnMut(&DenseStep), h: f64, t1: f64) {
+    /// Hands the step just finished (before its commit: `y` is its start, `y_new` its end) to
+    /// `on_step`, with its dense output completed first where `wants_dense` asks for it.
+    fn emit(
+        &mut self,
+        sys: &mut impl OdeSystem,
+        (wants_dense, on_step): (
+            &mut impl FnMut(&StepEnds) -> bool,
+            &mut impl FnMut(&StepEnds, Option<&DenseStep>),
+        ),
+        h: f64,
+        t1: f64,
+    ) -> Result<(), SolveError> {
+        let t0 = self.t;
+        let wanted = wants_dense(&StepEnds {
+            t0,
+            t1,
+            y0: &self.y,
+            y1: &self.y_new,
+        });
+        if wanted {
+            self.complete_dense(sys)?;
+        }
+        let ends = StepEnds {
+            t0,
+            t1,
+            y0: &self.y,
+            y1: &self.y_new,
+        };
         let view = DenseStep {
-            t0: self.t,
+            t0,
             t1,
             h,
             dim: self.dim,
             coef: &self.dense,
         };
-        on_step(&view);
+        on_step(&ends, wanted.then_some(&view));
+        Ok(())
     }
 
     /// Accepts `y_new` at `t1`, with the FSAL stage as the new derivative.
@@ -810,6 +863,9 @@ impl Solver {
         std::mem::swap(&mut self.y, &mut self.y_new);
         self.t = t1;
         self.f_valid = true;
+        // The stages of the step are gone with its start: its dense output can no longer be
+        // completed (nothing reads it after the commit).
+        self.dense_pending = None;
     }
 
     /// RMS of `a − b` in units of the tolerance `atol + rtol·max(|a|, |b|)`, the norm of the

@@ -3,7 +3,7 @@
 
 use crr_dynamics::integrator::{
     DenseStep, Direction, EventFunctions, Method, NoEvents, OdeSystem, Options, RhsError,
-    SolveError, Solver, Stop,
+    SolveError, Solver, StepEnds, Stop,
 };
 use std::f64::consts::PI;
 
@@ -538,6 +538,98 @@ fn rocking_block_first_impact_matches_quadrature() {
     // Energy: θ'² = 2p²(cos(α-θ0) - cos α) at θ = 0.
     let v_exact = -(2.0 * p * p * ((alpha - theta0).cos() - alpha.cos())).sqrt();
     assert!((s.y()[1] - v_exact).abs() < 1e-10);
+}
+
+/// Each step's record: its end time, its end state, and (where its dense output was read) the
+/// interpolant at three fractions of the step, all as bits.
+type StepRecord = (u64, Vec<u64>, Option<Vec<u64>>);
+
+/// Reads three points of a step's interpolant (both states' components), as bits.
+fn dense_readings(d: &DenseStep) -> Vec<u64> {
+    let mut buf = [0.0; 2];
+    let mut out = Vec::new();
+    for f in [0.25, 0.5, 0.9] {
+        d.eval(d.t0() + f * (d.t1() - d.t0()), &mut buf);
+        out.extend(buf.iter().map(|x| x.to_bits()));
+    }
+    out
+}
+
+/// The lazy dense output changes nothing but the work: on the rocking block to its first impact
+/// (an event located inside a step) and then on free flight of the oscillator, DOP853 with the
+/// dense output read on every third step only gives the same steps, the same end states, the
+/// same event time and the same interpolant on the steps read, to the last bit, as the solver
+/// that computes it on every step; and each step not read and not holding an event saves
+/// DOP853's three extra stages exactly (its dense output needs stages 14–16 of Hairer's 16,
+/// which the error-controlled step does not).
+#[test]
+fn the_lazy_dense_output_changes_no_bit_and_saves_three_stages_per_unread_step() {
+    let (p, alpha) = (2.0, 0.2);
+    let run = |lazy: bool| {
+        let mut s = block_solver();
+        s.reset(0.0, &[alpha / 2.0, 0.0]);
+        let mut ev = Zero {
+            component: 0,
+            dir: Direction::Falling,
+        };
+        let mut steps: Vec<StepRecord> = Vec::new();
+        let mut count = 0usize;
+        let mut wants = |_: &StepEnds| {
+            count += 1;
+            !lazy || count.is_multiple_of(3)
+        };
+        let mut record = |ends: &StepEnds, d: Option<&DenseStep>| {
+            steps.push((
+                ends.t1.to_bits(),
+                ends.y1.iter().map(|x| x.to_bits()).collect(),
+                d.map(dense_readings),
+            ));
+        };
+        let block = &mut Block { p, alpha };
+        let stop = s
+            .advance_lazily(block, 10.0, &mut ev, &mut wants, &mut record)
+            .unwrap();
+        let Stop::Event { t: t_impact, .. } = stop else {
+            panic!("{stop:?}")
+        };
+        // Free flight after it: no events, 3 s of the oscillator from the same start.
+        let mut free = Solver::new(Method::Dop853, Options::default(), 2).unwrap();
+        free.reset(0.0, &[1.0, 0.0]);
+        free.advance_lazily(&mut Oscillator, 3.0, &mut NoEvents, &mut wants, &mut record)
+            .unwrap();
+        let free_y: Vec<u64> = free.y().iter().map(|x| x.to_bits()).collect();
+        (t_impact.to_bits(), steps, free_y, s.stats(), free.stats())
+    };
+    let (t_every, steps_every, y_every, block_every, free_every) = run(false);
+    let (t_lazy, steps_lazy, y_lazy, block_lazy, free_lazy) = run(true);
+    assert_eq!(t_every, t_lazy, "the impact's time");
+    assert_eq!(y_every, y_lazy, "the free flight's end state");
+    assert_eq!(steps_every.len(), steps_lazy.len());
+    let mut read = 0;
+    for (every, lazy) in steps_every.iter().zip(&steps_lazy) {
+        assert_eq!((every.0, &every.1), (lazy.0, &lazy.1), "a step's end");
+        if let Some(readings) = &lazy.2 {
+            assert_eq!(Some(readings), every.2.as_ref(), "a step's interpolant");
+            read += 1;
+        }
+    }
+    assert!(
+        read >= 3 && read < steps_lazy.len() / 2,
+        "{read} steps read"
+    );
+    // Free flight: no event, so every unread step saved exactly three evaluations.
+    let unread = free_lazy.accepted
+        - steps_lazy
+            .iter()
+            .rev()
+            .take(free_lazy.accepted)
+            .filter(|s| s.2.is_some())
+            .count();
+    assert_eq!(free_every.accepted, free_lazy.accepted);
+    assert_eq!(free_every.rhs_evals - free_lazy.rhs_evals, 3 * unread);
+    // The block: the step holding the impact computes its interpolant to locate it.
+    assert_eq!(block_every.accepted, block_lazy.accepted);
+    assert!(block_lazy.rhs_evals < block_every.rhs_evals);
 }
 
 #[test]

@@ -4,6 +4,21 @@
 //! that they agree to the last bit (DOP853's 8 coefficient rows, Dopri5's 5, a cubic Hermite
 //! for RK4).
 
+/// The exact states at the ends of an accepted step `[t0, t1]` (the integrator's own values,
+/// not read from the interpolant), given to the step's observer before its dense output is
+/// computed ([`crate::integrator::Solver::advance_lazily`]).
+#[derive(Debug, Clone, Copy)]
+pub struct StepEnds<'a> {
+    /// Start of the step.
+    pub t0: f64,
+    /// End of the step.
+    pub t1: f64,
+    /// The state at `t0`.
+    pub y0: &'a [f64],
+    /// The state at `t1`.
+    pub y1: &'a [f64],
+}
+
 /// Dense output of one step `[t0, t1]`, valid for `t0 ≤ t ≤ t1`.
 #[derive(Debug, Clone, Copy)]
 pub struct DenseStep<'a> {

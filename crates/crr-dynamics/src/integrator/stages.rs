@@ -146,6 +146,8 @@ impl Solver {
         h: f64,
         t1: f64,
     ) -> Result<f64, SolveError> {
+        // A new step overwrites the stages a pending dense output would need.
+        self.dense_pending = None;
         let Self {
             method,
             opts,
@@ -235,27 +237,28 @@ impl Solver {
     }
 
     /// After a step accepted into `y_new`: computes the FSAL stage (where
-    /// not yet done) and the dense-output coefficients.
+    /// not yet done) and the dense-output coefficients, except DOP853's last
+    /// four rows, which need three more stages: those wait for
+    /// [`Self::complete_dense`] (a step whose interpolant nobody reads costs
+    /// no more than its error-controlled stages and its FSAL stage).
     pub(super) fn finish_step(
         &mut self,
         sys: &mut impl OdeSystem,
         h: f64,
         t1: f64,
     ) -> Result<(), SolveError> {
-        let ncoef = self.ncoef();
         let Self {
             method,
             dim,
-            t,
             y,
             y_new,
-            y_tmp,
             k,
             dense,
             stats,
+            dense_pending,
             ..
         } = self;
-        let (d, t) = (*dim, *t);
+        let d = *dim;
         let fsal = match *method {
             Method::Dop853 => DOP853_FSAL,
             Method::Dopri5 => DOPRI5_FSAL,
@@ -263,13 +266,6 @@ impl Solver {
         };
         if !matches!(method, Method::Dopri5) {
             call_rhs(sys, stats, t1, y_new, &mut k[fsal * d..(fsal + 1) * d])?;
-        }
-        if let Method::Dop853 = method {
-            for s in DOP853_FSAL + 1..DOP853_STAGES {
-                stage_input(y, k, d, h, DOP853_A[s], y_tmp);
-                let (_, ks) = k.split_at_mut(s * d);
-                call_rhs(sys, stats, t + DOP853_C[s] * h, y_tmp, &mut ks[..d])?;
-            }
         }
         for i in 0..d {
             let ydiff = y_new[i] - y[i];
@@ -280,20 +276,7 @@ impl Solver {
             dense[3 * d + i] = ydiff - h * k[fsal * d + i] - bspl;
         }
         match *method {
-            Method::Dop853 => {
-                let rows = &mut dense[4 * d..8 * d];
-                match d {
-                    4 => stage_sums_fixed::<4, 4>(k, &DOP853_D, rows),
-                    6 => stage_sums_fixed::<6, 4>(k, &DOP853_D, rows),
-                    8 => stage_sums_fixed::<8, 4>(k, &DOP853_D, rows),
-                    _ => {
-                        for (row, out) in DOP853_D.iter().zip(rows.chunks_exact_mut(d)) {
-                            stage_sum(k, d, row, out);
-                        }
-                    }
-                }
-                rows.iter_mut().for_each(|x| *x *= h);
-            }
+            Method::Dop853 => *dense_pending = Some(h),
             Method::Dopri5 => {
                 for i in 0..d {
                     let mut s = 0.0;
@@ -305,7 +288,45 @@ impl Solver {
             }
             Method::Rk4 { .. } => {}
         }
-        debug_assert_eq!(dense.len(), ncoef * d);
+        Ok(())
+    }
+
+    /// Completes the dense output of the step just finished (not yet committed: `y` is still its
+    /// start): DOP853's three extra stages and its last four coefficient rows, the same
+    /// operations in the same order as when they were computed with the step. Nothing to do for
+    /// the other methods, or when already done.
+    pub(super) fn complete_dense(&mut self, sys: &mut impl OdeSystem) -> Result<(), SolveError> {
+        let Some(h) = self.dense_pending.take() else {
+            return Ok(());
+        };
+        let Self {
+            dim,
+            t,
+            y,
+            y_tmp,
+            k,
+            dense,
+            stats,
+            ..
+        } = self;
+        let (d, t) = (*dim, *t);
+        for s in DOP853_FSAL + 1..DOP853_STAGES {
+            stage_input(y, k, d, h, DOP853_A[s], y_tmp);
+            let (_, ks) = k.split_at_mut(s * d);
+            call_rhs(sys, stats, t + DOP853_C[s] * h, y_tmp, &mut ks[..d])?;
+        }
+        let rows = &mut dense[4 * d..8 * d];
+        match d {
+            4 => stage_sums_fixed::<4, 4>(k, &DOP853_D, rows),
+            6 => stage_sums_fixed::<6, 4>(k, &DOP853_D, rows),
+            8 => stage_sums_fixed::<8, 4>(k, &DOP853_D, rows),
+            _ => {
+                for (row, out) in DOP853_D.iter().zip(rows.chunks_exact_mut(d)) {
+                    stage_sum(k, d, row, out);
+                }
+            }
+        }
+        rows.iter_mut().for_each(|x| *x *= h);
         Ok(())
     }
 }

@@ -27,7 +27,7 @@ use serde::Serialize;
 use crr_dynamics::eom::{Dynamics, GeneralizedForce, slot_row};
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::integrator::{
-    DenseStep, Direction, EventFunctions, Method, Options, SolveError, Solver, Stop,
+    DenseStep, Direction, EventFunctions, Method, Options, SolveError, Solver, StepEnds, Stop,
 };
 use crr_dynamics::roots::sign_change;
 use crr_dynamics::{ConstrainedSystem, InitialState};
@@ -1342,7 +1342,7 @@ impl<'a> Simulation<'a> {
         // Dense-output sampling and peak detection, on copies so that the system can borrow the
         // dynamics.
         let dt = self.params.output_interval;
-        let mut next_sample = self.next_sample;
+        let next_sample = self.next_sample;
         let mut pending = std::mem::take(&mut self.spare.pending);
         pending.clear();
         let stride = 2 * n + 3;
@@ -1354,7 +1354,28 @@ impl<'a> Simulation<'a> {
         let mut buf = std::mem::take(&mut seg.y);
         buf.clear();
         buf.resize(2 * n + 2, 0.0);
-        let mut on_step = |step: &DenseStep| {
+        // The dense output is computed only for the steps that read it: a hop being measured, a
+        // sample inside the step, or a rate changing sign across it (a peak). Both closures
+        // read the next sample's index, which the second advances.
+        let next_sample = std::cell::Cell::new(next_sample);
+        let duration = self.params.duration;
+        let sample_in = |t1: f64| {
+            let next = next_sample.get() as f64 * dt;
+            next <= t1 + 1e-12 * dt && next <= duration + 1e-12 * dt
+        };
+        // A peak: q̇ₖ nonzero at both ends of the step, of opposite signs (the step's own states;
+        // where the dense output is computed, its values at the ends decide, as they always did).
+        let turns = |ends: &StepEnds, k: usize| {
+            let (a, b) = (ends.y0[n + k], ends.y1[n + k]);
+            a != 0.0 && b != 0.0 && a.signum() != b.signum()
+        };
+        let mut wants_dense = |ends: &StepEnds| {
+            hop_logging || sample_in(ends.t1) || rocking_coords.iter().any(|&k| turns(ends, k))
+        };
+        let mut on_step = |_: &StepEnds, step: Option<&DenseStep>| {
+            let Some(step) = step else {
+                return;
+            };
             // The states where an open hop's face is read: eight per step (module `hops`).
             if hop_logging {
                 for i in 1..=hops::READINGS_PER_STEP {
@@ -1369,14 +1390,13 @@ impl<'a> Simulation<'a> {
                     extend_short(&mut hop_log, &buf[..2 * n]);
                 }
             }
-            while (next_sample as f64) * dt <= step.t1() + 1e-12 * dt
-                && (next_sample as f64) * dt <= self.params.duration + 1e-12 * dt
-            {
-                let ts = (next_sample as f64 * dt).min(step.t1());
+            while sample_in(step.t1()) {
+                let next = next_sample.get();
+                let ts = (next as f64 * dt).min(step.t1());
                 step.eval(ts, &mut buf);
-                pending.push(next_sample as f64 * dt);
+                pending.push(next as f64 * dt);
                 extend_short(&mut pending, &buf);
-                next_sample += 1;
+                next_sample.set(next + 1);
             }
             for &k in &rocking_coords {
                 let rate = step.component(n + k);
@@ -1400,9 +1420,13 @@ impl<'a> Simulation<'a> {
         if let Some(r) = self.regularised.as_mut() {
             sys.extra = Some(r);
         }
-        let stop = self
-            .solver
-            .advance(&mut sys, t_stop, &mut events, &mut on_step);
+        let stop = self.solver.advance_lazily(
+            &mut sys,
+            t_stop,
+            &mut events,
+            &mut wants_dense,
+            &mut on_step,
+        );
         self.spare.system = sys.into_buffers();
         let (collapse_index, first_zone_index) =
             (events.collapse_index(), events.first_zone_index());
@@ -1445,7 +1469,7 @@ impl<'a> Simulation<'a> {
             self.spare.pressing = pressing_trial;
         }
         self.spare.rest = rest;
-        self.next_sample = next_sample;
+        self.next_sample = next_sample.get();
         // In the file's coordinates (a coordinate of a re-rooted chain that closes a loop of
         // the file has no peak to report).
         let file_dof = self.original.dof();
