@@ -53,8 +53,9 @@
 //!
 //! # Modules
 //!
-//! This file holds the types, the options and [`Solver::advance`] (the step loop with its
-//! error control, breakpoints and event handling); `stages` computes one step (stage inputs,
+//! This file holds the types, the options and [`Solver::advance_lazily`] (the step loop with
+//! its error control, breakpoints and event handling; [`Solver::advance`] computes every
+//! step's dense output); `stages` computes one step (stage inputs,
 //! right-hand sides, error estimate, dense coefficients, the initial step size), `dense` reads
 //! a step's interpolant ([`DenseStep`]), `events` locates a root inside a step, and `tableau`
 //! holds the methods' coefficients.
@@ -515,7 +516,10 @@ impl Solver {
     /// dense output where it was wanted (None otherwise). The integration is the same to the
     /// last bit; DOP853 saves its three extra stages per step (a fifth of its right-hand sides)
     /// on the steps nobody interpolates. Event location computes the dense output it needs
-    /// itself.
+    /// itself. The integration is the same operations in the same order for a right-hand
+    /// side that is a function of (t, y) alone; one that keeps state across calls (a cache)
+    /// sees fewer calls. A right-hand side that fails at an extra stage of a step nobody reads
+    /// is not evaluated there, so that step does not stop the run.
     pub fn advance_lazily(
         &mut self,
         sys: &mut impl OdeSystem,

@@ -67,7 +67,14 @@ pub fn integrate_smooth(
             for k in 1..=n_samples {
                 while solver.t() < (k as f64 * dt).min(t_end) {
                     let target = stops(solver.t(), k);
-                    solver.advance(&mut sys, target, &mut NoEvents, &mut |_| {})?;
+                    // Samples at step ends only: no step's interpolant is read.
+                    solver.advance_lazily(
+                        &mut sys,
+                        target,
+                        &mut NoEvents,
+                        &mut |_| false,
+                        &mut |_, _| {},
+                    )?;
                 }
                 let (n, y) = (model.dof(), solver.y());
                 out.push(Sample {
@@ -94,7 +101,13 @@ pub fn integrate_smooth(
                 while k <= n_samples && !repartition {
                     while solver.t() < (k as f64 * dt).min(t_end) {
                         let target = stops(solver.t(), k);
-                        solver.advance(&mut sys, target, &mut NoEvents, &mut |_| {})?;
+                        solver.advance_lazily(
+                            &mut sys,
+                            target,
+                            &mut NoEvents,
+                            &mut |_| false,
+                            &mut |_, _| {},
+                        )?;
                     }
                     let y = solver.y().to_vec();
                     sys.expand(&y).map_err(|source| SolveError::Rhs {
