@@ -513,9 +513,8 @@ impl Solver {
     /// [`Self::advance`], with each step's dense output computed only where it is read:
     /// `wants_dense` is asked with the exact states at the ends of every accepted step (for an
     /// event, of the partial step ending at it), and `on_step` then receives those ends and the
-    /// dense output where it was wanted (None otherwise). The integration is the same to the
-    /// last bit; DOP853 saves its three extra stages per step (a fifth of its right-hand sides)
-    /// on the steps nobody interpolates. Event location computes the dense output it needs
+    /// dense output where it was wanted (None otherwise). DOP853 saves its three extra stages
+    /// per step (a fifth of its right-hand sides) on the steps nobody interpolates. Event location computes the dense output it needs
     /// itself. The integration is the same operations in the same order for a right-hand
     /// side that is a function of (t, y) alone; one that keeps state across calls (a cache)
     /// sees fewer calls. A right-hand side that fails at an extra stage of a step nobody reads
@@ -813,31 +812,29 @@ impl Solver {
         h: f64,
         t1: f64,
     ) -> Result<(), SolveError> {
-        let t0 = self.t;
-        let wanted = wants_dense(&StepEnds {
-            t0,
-            t1,
-            y0: &self.y,
-            y1: &self.y_new,
-        });
+        let wanted = wants_dense(&self.step_ends(t1));
         if wanted {
             self.complete_dense(sys)?;
         }
-        let ends = StepEnds {
-            t0,
-            t1,
-            y0: &self.y,
-            y1: &self.y_new,
-        };
         let view = DenseStep {
-            t0,
+            t0: self.t,
             t1,
             h,
             dim: self.dim,
             coef: &self.dense,
         };
-        on_step(&ends, wanted.then_some(&view));
+        on_step(&self.step_ends(t1), wanted.then_some(&view));
         Ok(())
+    }
+
+    /// The step just finished, from its start to `t1` (before its commit).
+    fn step_ends(&self, t1: f64) -> StepEnds<'_> {
+        StepEnds {
+            t0: self.t,
+            t1,
+            y0: &self.y,
+            y1: &self.y_new,
+        }
     }
 
     /// Accepts `y_new` at `t1`, with the FSAL stage as the new derivative.

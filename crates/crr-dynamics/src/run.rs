@@ -9,7 +9,7 @@ use crr_kinematics::Model;
 use crate::closed_chain::{InitialState, REPARTITION_THRESHOLD, partition, partition_condition};
 use crate::eom::Dynamics;
 use crate::ground_motion::GroundMotion;
-use crate::integrator::{Method, NoEvents, Options, SolveError, Solver};
+use crate::integrator::{Method, NoEvents, OdeSystem, Options, SolveError, Solver};
 use crate::system::{ConstrainedSystem, ReducedSystem};
 
 /// Which form of the equations to integrate.
@@ -67,14 +67,7 @@ pub fn integrate_smooth(
             for k in 1..=n_samples {
                 while solver.t() < (k as f64 * dt).min(t_end) {
                     let target = stops(solver.t(), k);
-                    // Samples at step ends only: no step's interpolant is read.
-                    solver.advance_lazily(
-                        &mut sys,
-                        target,
-                        &mut NoEvents,
-                        &mut |_| false,
-                        &mut |_, _| {},
-                    )?;
+                    advance_unread(&mut solver, &mut sys, target)?;
                 }
                 let (n, y) = (model.dof(), solver.y());
                 out.push(Sample {
@@ -101,13 +94,7 @@ pub fn integrate_smooth(
                 while k <= n_samples && !repartition {
                     while solver.t() < (k as f64 * dt).min(t_end) {
                         let target = stops(solver.t(), k);
-                        solver.advance_lazily(
-                            &mut sys,
-                            target,
-                            &mut NoEvents,
-                            &mut |_| false,
-                            &mut |_, _| {},
-                        )?;
+                        advance_unread(&mut solver, &mut sys, target)?;
                     }
                     let y = solver.y().to_vec();
                     sys.expand(&y).map_err(|source| SolveError::Rhs {
@@ -134,4 +121,15 @@ pub fn integrate_smooth(
         }
     }
     Ok(out)
+}
+
+/// Advances `solver` to `target` without events, reading no step's interpolant (the samples are
+/// taken at step ends, `target` a breakpoint): DOP853's extra stages are never computed.
+fn advance_unread(
+    solver: &mut Solver,
+    sys: &mut impl OdeSystem,
+    target: f64,
+) -> Result<(), SolveError> {
+    solver.advance_lazily(sys, target, &mut NoEvents, &mut |_| false, &mut |_, _| {})?;
+    Ok(())
 }

@@ -136,8 +136,8 @@ impl OdeSystem for ConstrainedSystem<'_> {
         }
         let n = self.model.dof();
         // Without loops only the seated coordinates are set, to exactly 0: where each q and q̇
-        // already is +0.0 bit for bit (the articulated-body solve gives a locked coordinate
-        // q̈ = 0.0, so the integrator keeps it there) nothing moves, and f(t, y) and the events
+        // already is +0.0 bit for bit (either forward solve gives a seated coordinate q̈ = 0.0,
+        // so the integrator keeps it there) nothing moves, and f(t, y) and the events
         // at the step end stay valid (reporting a move re-evaluated both at every such step).
         if self.model.constraint_rows == 0
             && seated_tree
