@@ -11,6 +11,10 @@
 //! - `wall_pulse`: how a run with faces that lift off grows: planar running-bond walls of n × n
 //!   blocks (1.0 × 0.5 m, 0.5 m deep) under a one-sine pulse of 1.2 λ g (0.5 s), 3 s, with the
 //!   fitted exponent printed;
+//! - `long_run`: how a run grows with its duration: Housner's block from rest under a sine of
+//!   4 m/s² and 2 Hz (four impacts a second), 1 000 to 16 000 s sampled every 0.5 s, with the
+//!   exponent of cost ∝ duration^p printed (1 for a cost linear in the steps, impacts and
+//!   samples);
 //! - `many_bodies`: how a run grows with the number of bodies: a stack of n drums standing
 //!   seated for 0.5 s, and n free-standing blocks of distinct sizes under one sine pulse for 1 s.
 //!
@@ -633,6 +637,68 @@ fn wall_pulse_growth(c: &mut Criterion) {
     group.finish();
 }
 
+/// A run's cost as its duration grows: Housner's block (b = 0.2, h = 1 m) from rest under a
+/// steady sine of 4 m/s² at 2 Hz along x, which rocks it in a steady cycle with four impacts a
+/// second, for 1 000, 4 000 and 16 000 s with a sample every 0.5 s. Each duration is run once
+/// outside criterion and its wall time per simulated second printed, with the exponent p of
+/// cost ∝ duration^p (1 where nothing a step does grows with the history: 2 when every sample
+/// added up the energy lost at all the impacts before it). 1 000 and 4 000 s are timed by
+/// criterion.
+fn long_run_growth(c: &mut Criterion) {
+    use crr_dynamics::ground_motion::SineSpec;
+    let mut group = c.benchmark_group("long_run");
+    group
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(200))
+        .measurement_time(Duration::from_secs(5));
+    let model = Model::from_spec(&single_block(0.2, 1.0, 2500.0)).expect("valid block");
+    let sine = ComponentSpec::new(SignalSpec::Sine(SineSpec {
+        amplitude: 4.0,
+        period: None,
+        frequency: Some(2.0),
+        phase: 0.0,
+        cycles: None,
+        start: 0.0,
+    }));
+    let ground = GroundMotion::none()
+        .with_component(Axis::X, &sine, Path::new("."))
+        .expect("the sine");
+    let init = at_rest(&model);
+    let mut points = Vec::new();
+    for duration in [1_000.0, 4_000.0, 16_000.0] {
+        let params = Parameters {
+            duration,
+            output_interval: 0.5,
+            ..Parameters::default()
+        };
+        let start = std::time::Instant::now();
+        let traj = run(&model, &ground, &init, params.clone());
+        let seconds = start.elapsed().as_secs_f64();
+        check(&format!("long_run/{duration}"), &traj, Some(false));
+        eprintln!(
+            "long_run/{duration}: {} impacts, {} steps, {seconds:.2} s, {:.1} µs per simulated second",
+            traj.impacts.len(),
+            traj.solver_stats.steps,
+            seconds / duration * 1e6
+        );
+        points.push((duration.ln(), seconds.ln()));
+        if duration <= 4_000.0 {
+            group.bench_function(BenchmarkId::from_parameter(duration), |b| {
+                b.iter(|| black_box(run(&model, &ground, black_box(&init), params.clone())));
+            });
+        }
+    }
+    if let ([first, ..], [.., last]) = (points.as_slice(), points.as_slice()) {
+        eprintln!(
+            "long_run: cost ∝ duration^{:.2} from {} to {} s",
+            (last.1 - first.1) / (last.0 - first.0),
+            first.0.exp().round(),
+            last.0.exp().round()
+        );
+    }
+    group.finish();
+}
+
 // The Poincaré section and study benches share this binary (one LTO link fewer each in CI).
 #[path = "groups/poincare.rs"]
 mod poincare_group;
@@ -648,6 +714,7 @@ criterion_group!(
     many_bodies,
     colonnade_row_growth,
     wall_pulse_growth,
+    long_run_growth,
     poincare_group::section_200_periods,
     study_group::bench_study
 );

@@ -264,6 +264,7 @@ impl Simulation<'_> {
         {
             *s = self.open.original_slot(*s);
         }
+        self.lost_at_impacts += record.energy_lost;
         self.impacts.push(record);
         // Faces kept on their pivots after a contradicted lift-off are offered it again.
         self.spare.rest.held_faces.clear();
