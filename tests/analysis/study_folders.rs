@@ -127,6 +127,34 @@ fn rows_that_are_not_the_studys_are_refused_with_their_line() {
 }
 
 #[test]
+fn a_shard_s_folder_is_refused_to_another_shard_and_left_as_it_was() {
+    let dir = scratch("study_folder_other_shard");
+    let study = map(&dir, 3.0);
+    let s = study.to_str().unwrap();
+    let one = dir.join("one");
+    run_shard(s, "1/2", &one);
+    let rows = read(&one.join("cases.csv"));
+    // Shard 1/2 holds c000000, c000002 and c000004 (index mod 2 = 0); shard 2/2 the others.
+    assert_eq!(rows.lines().count(), 4, "{rows}");
+    refused(
+        &[
+            "study",
+            s,
+            "--quiet",
+            "--shard",
+            "2/2",
+            "--out",
+            one.to_str().unwrap(),
+        ],
+        "case c000000 is not one of this study's cases for shard 2/2",
+    );
+    assert_eq!(read(&one.join("cases.csv")), rows, "the rows are left");
+    // The shard's own resume finds every case done.
+    run_shard(s, "1/2", &one);
+    assert_eq!(read(&one.join("cases.csv")), rows);
+}
+
+#[test]
 fn a_merge_needs_every_shard_finished_and_of_one_study() {
     let dir = scratch("study_folder_merge");
     let study = map(&dir, 3.0);

@@ -533,7 +533,9 @@ pub fn run_study(
         .iter()
         .filter(|c| opts.shard.contains(c.index))
         .collect();
-    if let Some(id) = done.keys().find(|id| !mine.iter().any(|c| &c.id == *id)) {
+    // A set: a study of a million cases resumed half way compares each row once.
+    let mine_ids: std::collections::BTreeSet<&str> = mine.iter().map(|c| c.id.as_str()).collect();
+    if let Some(id) = done.keys().find(|id| !mine_ids.contains(id.as_str())) {
         return Err(Error::Argument(format!(
             "{}: case {id} is not one of this study's cases for shard {}/{}; use another --out \
              folder",

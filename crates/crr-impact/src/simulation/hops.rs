@@ -165,6 +165,10 @@ pub(super) struct Hops {
     /// starts from, whose pulls that segment measures.
     pub(super) after_impact: bool,
     slots: Vec<usize>,
+    /// The violation [`Simulation::attach_hop`] last looked for (its time and interface, all
+    /// its test reads) and how many hops of `done` it had looked at: a hop that did not cover
+    /// it then never will, so each look reads only the hops ended since, not every hop of the run.
+    attach_looked: Option<(f64, String, usize)>,
 }
 
 impl Hops {
@@ -658,9 +662,17 @@ impl Simulation<'_> {
         if v.kind != "tension" || v.hop.is_some() {
             return;
         }
-        if let Some(h) = self
-            .hops
-            .done
+        let looked_at = self.hops.done.len();
+        let from = match &mut self.hops.attach_looked {
+            Some((t, interface, count)) if *t == v.t && *interface == v.interface => {
+                std::mem::replace(count, looked_at)
+            }
+            other => {
+                *other = Some((v.t, v.interface.clone(), looked_at));
+                0
+            }
+        };
+        if let Some(h) = self.hops.done[from..]
             .iter()
             .rev()
             .find(|h| h.interface == v.interface && h.start <= v.t && v.t <= h.end)
