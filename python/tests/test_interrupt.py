@@ -7,11 +7,12 @@ signal comes from a timer thread (``_thread.interrupt_main``, what Ctrl-C does t
 thread). The assertion on the delay is only that the run stopped instead of going on, and a
 loaded machine may be slow to schedule the waiting thread.
 
-Python handles Ctrl-C only where SIGINT was not ignored when it started: a process that a
-non-interactive shell starts in the background (``cmd &`` in a script, ``nohup``, some CI runners)
-inherits SIGINT ignored, and then ``interrupt_main`` does nothing (the run would go on for
-minutes, ``/proc/<pid>/status`` showing SIGINT in ``SigIgn``). Each test therefore installs
-Python's own handler, as an interactive Python has it, and puts back what it found."""
+Python handles Ctrl-C only where SIGINT was not ignored when it started: a process that a shell
+without job control starts in the background (``cmd &`` in a script, as some CI runners do)
+inherits SIGINT ignored, and then ``interrupt_main`` does nothing (``/proc/<pid>/status`` shows
+SIGINT in ``SigIgn``; the first test would wait for the run's own end, at its impact limit, and
+fail). Each test therefore installs Python's own handler, as a Python started with SIGINT at its
+default has it, and puts back what it found."""
 
 from __future__ import annotations
 

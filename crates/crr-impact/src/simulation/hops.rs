@@ -165,9 +165,10 @@ pub(super) struct Hops {
     /// starts from, whose pulls that segment measures.
     pub(super) after_impact: bool,
     slots: Vec<usize>,
-    /// The violation [`Simulation::attach_hop`] last looked for (its time and interface, all
-    /// its test reads) and how many hops of `done` it had looked at: a hop that did not cover
-    /// it then never will, so each look reads only the hops ended since, not every hop of the run.
+    /// The violation [`Simulation::attach_hop`] last looked for without finding its hop (its
+    /// time and interface, all its test reads) and how many hops of `done` it had looked at: a
+    /// hop that did not cover it then never will, so each look reads only the hops ended since,
+    /// not every hop of the run.
     attach_looked: Option<(f64, String, usize)>,
 }
 
@@ -678,6 +679,9 @@ impl Simulation<'_> {
             .find(|h| h.interface == v.interface && h.start <= v.t && v.t <= h.end)
         {
             v.hop = Some(Box::new(h.clone()));
+            // A violation that replaces this one at the same instant and face looks from the
+            // start again: this hop covers it too.
+            self.hops.attach_looked = None;
         }
     }
 

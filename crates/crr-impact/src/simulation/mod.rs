@@ -487,7 +487,9 @@ pub struct Simulation<'a> {
     dissipated_at_impacts: f64,
     /// Σ of the impacts' `energy_lost`, summed as each impact is appended ([`Self::push_impact`])
     /// in the order `Iterator::sum` adds them (from −0.0), so that a sample does not add up the
-    /// whole list again: a long run's cost stays linear in its impacts.
+    /// whole list again: a long run's cost stays linear in its impacts. Every impact appended
+    /// counts, also those a caller has since removed from `impacts` (a Poincaré section clears
+    /// the list as it goes).
     lost_at_impacts: f64,
     /// Σ|ΔT + ΔU| of the snaps booked in `dissipated_at_impacts` ([`Trajectory::energy_at_snaps`]).
     energy_at_snaps: f64,
@@ -1045,7 +1047,8 @@ impl<'a> Simulation<'a> {
         self.energy_at_snaps += change.abs();
     }
 
-    /// Σ of the impacts' `energy_lost` so far (J).
+    /// Σ of the `energy_lost` of every impact appended so far (J), also those a caller has
+    /// since removed from `impacts`.
     pub(super) fn lost_at_impacts(&self) -> f64 {
         self.lost_at_impacts
     }
@@ -2142,8 +2145,9 @@ mod lost_at_impacts_tests {
                     impacts += 1;
                     let listed: f64 = sim.impacts.iter().map(|i| i.energy_lost).sum();
                     assert_eq!(sim.lost_at_impacts().to_bits(), listed.to_bits());
-                    // The kinetic energy before an impact is about ½ I_O θ̇² ≈ 10² J here, and
-                    // each term carries the rates' round-off (1e-12 relative).
+                    // Each term is about ½ I_O θ̇² ≈ 10² J and carries the rates' round-off
+                    // (about 1e-15 relative); 1e-9 of the running total leaves room for the
+                    // sum's own rounding over the run's impacts, far below a missed impact.
                     let scale = 1e-9 * housner.abs().max(1.0);
                     assert!(
                         (sim.lost_at_impacts() - housner).abs() <= scale,
