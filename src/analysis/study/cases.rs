@@ -453,19 +453,31 @@ impl Study {
     fn record_cases(&mut self, measure: IntensityMeasure, levels: &[f64]) {
         let study = self;
         study.intensity = measure;
+        // Each record's intensity, once: it depends on the record alone, not on the variant or
+        // the level (an Sa integrates the record's oscillator, which a study of thousands of
+        // cases would otherwise repeat for every case). None where the record could not be read
+        // or its Sa is not defined.
+        let intensity: Vec<Option<f64>> = study
+            .records
+            .iter()
+            .map(|r| {
+                let rec = r.record.as_ref().ok()?;
+                Some(match measure {
+                    IntensityMeasure::Factor => 1.0,
+                    IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
+                    IntensityMeasure::Pgv => peak_ground_velocity(rec),
+                    IntensityMeasure::Sa { period, damping } => {
+                        spectral_acceleration(rec, period, damping)? / STANDARD_GRAVITY
+                    }
+                })
+            })
+            .collect();
         for v in 0..study.variants.len() {
-            for k in 0..study.records.len() {
+            for (k, im) in intensity.iter().enumerate() {
                 for &level in levels {
-                    let factor = study.records[k].record.as_ref().ok().and_then(|rec| {
-                        let im = match measure {
-                            IntensityMeasure::Factor => return Some(level),
-                            IntensityMeasure::Pga => rec.peak() / STANDARD_GRAVITY,
-                            IntensityMeasure::Pgv => peak_ground_velocity(rec),
-                            IntensityMeasure::Sa { period, damping } => {
-                                spectral_acceleration(rec, period, damping)? / STANDARD_GRAVITY
-                            }
-                        };
-                        (im > 0.0).then(|| level / im)
+                    let factor = im.and_then(|im| match measure {
+                        IntensityMeasure::Factor => Some(level),
+                        _ => (im > 0.0).then(|| level / im),
                     });
                     study.push(
                         v,
