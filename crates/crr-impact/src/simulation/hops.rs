@@ -744,6 +744,109 @@ impl Simulation<'_> {
 }
 
 #[cfg(test)]
+mod attach_tests {
+    //! `attach_hop` remembers how far it has looked: after any sequence of hops ending and
+    //! first violations replacing one another it attaches what a look through every hop of the
+    //! run, newest first, finds.
+    use super::*;
+    use crr_dynamics::InitialSpec;
+    use crr_kinematics::fixtures::single_block;
+
+    fn hop(interface: &str, start: f64, end: f64) -> Hop {
+        Hop {
+            interface: interface.into(),
+            start,
+            pull_end: Some(end),
+            end,
+            largest_pull: 1.0,
+            separation: start * 1e-6,
+            departure: end * 1e-6,
+            closed: true,
+            opens: true,
+        }
+    }
+
+    fn tension(interface: &str, t: f64, normal: f64) -> crate::monitor::Violation {
+        crate::monitor::Violation {
+            t,
+            interface: interface.into(),
+            kind: "tension".into(),
+            normal,
+            friction_demand: 0.0,
+            hop: None,
+        }
+    }
+
+    /// The newest hop of `done` at the violation's face whose episode holds its instant.
+    fn covering(done: &[Hop], v: &crate::monitor::Violation) -> Option<Hop> {
+        done.iter()
+            .rev()
+            .find(|h| h.interface == v.interface && h.start <= v.t && v.t <= h.end)
+            .cloned()
+    }
+
+    #[test]
+    fn the_hop_attached_is_the_one_a_look_through_every_hop_finds() {
+        let model = Model::from_spec(&single_block(0.2, 1.0, 2500.0)).unwrap();
+        let initial = crr_dynamics::solve_initial(&model, &InitialSpec::default()).unwrap();
+        let ground = GroundMotion::none();
+        let mut sim = Simulation::new(&model, &ground, &initial, Parameters::default()).unwrap();
+        let snaps = SnapsAndLosses::default();
+        enum Step {
+            Ends(Hop),
+            Violation(crate::monitor::Violation),
+        }
+        let steps = [
+            Step::Violation(tension("base", 1.0, -5.0)),
+            Step::Ends(hop("other", 0.9, 1.1)),
+            Step::Ends(hop("base", 0.2, 0.5)),
+            // Covers t = 1.0: attached.
+            Step::Ends(hop("base", 0.95, 1.05)),
+            // A graver tension at the same instant and face replaces the first: covered by the
+            // same hop, which ended before it was recorded.
+            Step::Violation(tension("base", 1.0, -9.0)),
+            Step::Ends(hop("base", 1.2, 1.3)),
+            // An earlier tension: only the hop that ended long ago covers it.
+            Step::Violation(tension("base", 0.3, -1.0)),
+            Step::Ends(hop("base", 1.4, 1.5)),
+            // Earlier still, at a face no hop has covered yet; then one that does ends.
+            Step::Violation(tension("other", 0.1, -2.0)),
+            Step::Ends(hop("base", 0.0, 0.2)),
+            Step::Ends(hop("other", 0.05, 0.15)),
+            Step::Ends(hop("other", 0.08, 0.12)),
+        ];
+        // The reference: a look through every hop of the run, newest first, at each call, as
+        // before; a hop once attached stays with its violation.
+        let mut reference: Option<Hop> = None;
+        let key = |h: &Hop| (h.interface.clone(), h.start, h.end);
+        let mut attached = 0;
+        for (i, step) in steps.into_iter().enumerate() {
+            match step {
+                Step::Ends(h) => sim.hops.done.push(h),
+                Step::Violation(v) => {
+                    let normal = v.normal;
+                    sim.record_violation(v, snaps);
+                    let first = sim.violation.as_ref().unwrap();
+                    assert_eq!(first.normal, normal, "step {i}: the first violation now");
+                    reference = None;
+                }
+            }
+            sim.attach_hop();
+            let v = sim.violation.as_ref().unwrap();
+            if reference.is_none() {
+                reference = covering(&sim.hops.done, v);
+            }
+            let got = v.hop.as_deref().map(key);
+            assert_eq!(got, reference.as_ref().map(key), "step {i}: {v:?}");
+            attached += usize::from(got.is_some());
+        }
+        // Steps 3 to 7 (t = 1.0, then 0.3) and 10 to 11 (the first hop at `other` that covers
+        // t = 0.1 stays when a later one covers it too).
+        assert_eq!(attached, 7);
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crr_dynamics::eom::ForwardSolver;
