@@ -493,9 +493,7 @@ fn colonnade_row_growth(c: &mut Criterion) {
     use crr_dynamics::ground_motion::{RecordFormat, RecordSpec};
     // The untimed runs (about 30 s) only when this group is asked for: criterion's filter is
     // the first argument that is not an option.
-    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
-    if filter.is_some_and(|f| !"colonnade_row".contains(f.as_str()) && !f.contains("colonnade_row"))
-    {
+    if !asked_for("colonnade_row") {
         return;
     }
     let mut group = c.benchmark_group("colonnade_row");
@@ -547,6 +545,14 @@ fn colonnade_row_growth(c: &mut Criterion) {
     group.finish();
 }
 
+/// Whether the command line's filter (its first argument not starting with '-', if any) asks
+/// for `group`: the growth groups run their sizes once outside criterion (seconds each), which a
+/// filter naming another bench must not pay for.
+fn asked_for(group: &str) -> bool {
+    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    filter.is_none_or(|f| group.contains(f.as_str()) || f.contains(group))
+}
+
 /// Prints the exponent p of cost per step ∝ DOF^p fitted (least squares in log–log) over the
 /// sizes' points (ln DOF, ln seconds per step), and between the two largest alone: the exponent
 /// the largest sizes tend to.
@@ -583,8 +589,7 @@ fn print_growth(group: &str, points: &[(f64, f64)]) {
 /// (about 1.6 and 3.2 s a run).
 fn wall_pulse_growth(c: &mut Criterion) {
     use crr_impact::statics::{StaticsOptions, collapse_multiplier};
-    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
-    if filter.is_some_and(|f| !"wall_pulse".contains(f.as_str()) && !f.contains("wall_pulse")) {
+    if !asked_for("wall_pulse") {
         return;
     }
     let mut group = c.benchmark_group("wall_pulse");
@@ -646,8 +651,7 @@ fn wall_pulse_growth(c: &mut Criterion) {
 /// before it). 1 000 and 4 000 s are also timed by criterion.
 fn long_run_growth(c: &mut Criterion) {
     use crr_dynamics::ground_motion::SineSpec;
-    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
-    if filter.is_some_and(|f| !"long_run".contains(f.as_str()) && !f.contains("long_run")) {
+    if !asked_for("long_run") {
         return;
     }
     let mut group = c.benchmark_group("long_run");

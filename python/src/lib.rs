@@ -548,7 +548,7 @@ fn limit_samples(
 /// stops after its current step) and, once the work has returned, comes back as the
 /// `KeyboardInterrupt` with what the work returned. The result comes through a channel, so the
 /// wait ends the moment it is sent (a wake-up by `unpark` before the thread had finished made
-/// the waiter sleep another slice: 4.5 ms a call on average for a run of a millisecond).
+/// the waiter sleep another slice: docs/performance.md, "Python's wait for a run").
 fn interruptible<T: Send>(
     py: Python<'_>,
     cancel: &crr::Cancel,
@@ -584,11 +584,12 @@ fn interruptible<T: Send>(
         };
         // A Ctrl-C that came with the result still interrupts, and keeps the result.
         check(&mut interrupt);
-        let panicked = worker.join().is_err();
+        // Joined here, so that a panic comes back as no result (not as the scope's own panic).
+        let _ = worker.join();
         match (interrupt, result) {
-            (None, Some(result)) if !panicked => Ok(result),
             (Some(e), result) => Err((e, result)),
-            _ => Err((PyRuntimeError::new_err("the run's thread panicked"), None)),
+            (None, Some(result)) => Ok(result),
+            (None, None) => Err((PyRuntimeError::new_err("the run's thread panicked"), None)),
         }
     })
 }

@@ -514,8 +514,9 @@ impl Solver {
     /// `wants_dense` is asked with the exact states at the ends of every accepted step (for an
     /// event, of the partial step ending at it), and `on_step` then receives those ends and the
     /// dense output where it was wanted (None otherwise). DOP853 saves its three extra stages
-    /// per step (a fifth of its right-hand sides) on the steps nobody interpolates. Event location computes the dense output it needs
-    /// itself. The integration is the same operations in the same order for a right-hand
+    /// per step (a fifth of its right-hand sides) on the steps nobody interpolates. Event
+    /// location computes the dense output it needs itself. The integration is the same
+    /// operations in the same order for a right-hand
     /// side that is a function of (t, y) alone; one that keeps state across calls (a cache)
     /// sees fewer calls. A right-hand side that fails at an extra stage of a step nobody reads
     /// is not evaluated there, so that step does not stop the run.

@@ -455,8 +455,8 @@ impl Study {
         study.intensity = measure;
         // Each record's intensity, once: it depends on the record alone, not on the variant or
         // the level (an Sa integrates the record's oscillator, which a study of thousands of
-        // cases would otherwise repeat for every case). None where the record could not be read
-        // or its Sa is not defined.
+        // cases would otherwise repeat for every case); with `factors` it is 1, the level being
+        // the factor. None where the record could not be read or its Sa is not defined.
         let intensity: Vec<Option<f64>> = study
             .records
             .iter()
@@ -475,10 +475,8 @@ impl Study {
         for v in 0..study.variants.len() {
             for (k, im) in intensity.iter().enumerate() {
                 for &level in levels {
-                    let factor = im.and_then(|im| match measure {
-                        IntensityMeasure::Factor => Some(level),
-                        _ => (im > 0.0).then(|| level / im),
-                    });
+                    // level / 1 is the level itself, to the bit.
+                    let factor = im.and_then(|im| (im > 0.0).then(|| level / im));
                     study.push(
                         v,
                         Motion::Record {
