@@ -122,3 +122,80 @@ fn pulses_too_short_to_open_a_block_leave_it_at_rest() {
         assert!(peak < 1e-6, "{tag}: peak {peak}");
     }
 }
+
+/// A light body toppling on a heavy support: a finial (0.2 × 0.2 × 0.5 m, 50 kg) on a pier
+/// (2 × 2 × 1.5 m, 14 400 kg) under a one-sine pulse of 10 m/s², 0.6 s. The finial alone can
+/// lower the structure's U by about m g (R + h) ≈ 255 J, less than the threshold 1e-3 W L
+/// (286 J): the falling criterion never fires. Its joint turned to π/2 lays it on its side on
+/// the pier's top, and beyond it would pass through the pier: until 2026-12-02 it did, swinging
+/// to 6.2 rad with no collapse reported (found by an independent review). The collapse is now
+/// reported there, naming the finial, at the state where it lies on its side: its centre at the
+/// pivot's height plus its half-width, 1.6 m instead of 1.75 m, U = −m g × 0.15 m (by hand).
+#[test]
+fn a_light_body_toppling_on_a_heavy_support_collapses_where_it_lies_on_its_side() {
+    let text = r#"name = "finial_on_pier"
+gravity = 9.81
+
+[[body]]
+name = "pier"
+density = 2400.0
+box = { center = [0.0, 0.0, 0.75], size = [2.0, 2.0, 1.5] }
+
+[[body]]
+name = "finial"
+density = 2500.0
+box = { center = [0.0, 0.0, 1.75], size = [0.2, 0.2, 0.5] }
+
+[[interface]]
+name = "base"
+parent = "ground"
+child = "pier"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [1.0, 0.0, 0.0]
+pivot_negative = [-1.0, 0.0, 0.0]
+
+[[interface]]
+name = "joint"
+parent = "pier"
+child = "finial"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [0.1, 0.0, 1.5]
+pivot_negative = [-0.1, 0.0, 1.5]
+
+[ground_motion]
+x = { one_sine_pulse = { amplitude = 10.0, period = 0.6 } }
+"#;
+    let (model, traj) = common::run_model_text("finial_on_pier", text, Some(6.0));
+    let c = traj.collapse.as_ref().expect("the finial topples");
+    assert_eq!(c.body, "finial");
+    let last = traj.samples.last().unwrap();
+    assert_eq!(last.t, c.t);
+    // The pier stays seated: its multiplier, b/h = 1 / 0.7535 of the pier with the finial, is
+    // above the pulse's 10 / 9.81 = 1.02. The finial's joint on its side, to the event's
+    // location.
+    let joint = model.coords.iter().position(|k| k.name == "joint").unwrap();
+    let base = model.coords.iter().position(|k| k.name == "base").unwrap();
+    assert_eq!(last.q[base], 0.0);
+    assert!(
+        (last.q[joint].abs() - std::f64::consts::FRAC_PI_2).abs() < 1e-9,
+        "joint at {} rad",
+        last.q[joint]
+    );
+    // Lying on its side: U − U(rest) = m g (1.6 − 1.75) with m = 0.2 × 0.2 × 0.5 × 2500 kg.
+    let lying = 0.2 * 0.2 * 0.5 * 2500.0 * 9.81 * (1.6 - 1.75);
+    assert!(
+        (last.potential - lying).abs() < 1e-6,
+        "U = {} J, lying on its side {lying} J",
+        last.potential
+    );
+    // Above the structure's own threshold: the falling criterion could not have fired.
+    assert!(last.potential > threshold(&model));
+    // Every sample before it keeps the finial on the pier's side of its support's plane.
+    for s in traj.samples.iter() {
+        assert!(
+            s.q[joint].abs() <= std::f64::consts::FRAC_PI_2 + 1e-9,
+            "at {} s",
+            s.t
+        );
+    }
+}

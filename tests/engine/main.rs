@@ -20,6 +20,7 @@ mod out_of_plane;
 mod streaming;
 mod temple;
 mod twist_closure;
+mod uplift_at_a_jump;
 mod uplift_at_multiplier;
 mod uplift_fast_signals;
 mod uplift_filter_in_loops;

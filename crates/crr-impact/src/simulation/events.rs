@@ -132,15 +132,23 @@ impl SegmentEvents<'_> {
         );
     }
 
-    /// The collapse function: U above its threshold, positive while standing (needs
-    /// [`Self::load_state`]).
+    /// The collapse function, positive while standing (needs [`Self::load_state`]): the lesser
+    /// of U above its threshold and of π/2 less every rocking angle on its pivot's side. A
+    /// rocking joint turned to π/2 has laid its body on its support's plane and beyond it
+    /// would put the body through its support (the initial states refused): that body has
+    /// toppled, however light it is against the structure (whose U may not reach its threshold).
     fn collapse_value(&self) -> f64 {
         if self.rocking.is_empty() {
-            1.0
-        } else {
-            (potential_energy(self.model, &self.kin) - self.u_rest) / self.energy_scale
-                + self.collapse_drop
+            return 1.0;
         }
+        let falling = (potential_energy(self.model, &self.kin) - self.u_rest) / self.energy_scale
+            + self.collapse_drop;
+        let toppling = self
+            .rocking
+            .iter()
+            .map(|&(s, side)| std::f64::consts::FRAC_PI_2 - side.sign() * self.angles[s])
+            .fold(f64::INFINITY, f64::min);
+        falling.min(toppling)
     }
 
     /// The uplift function: +1 when the seated state cannot hold at t, −1 while it holds.

@@ -940,6 +940,11 @@ impl<'a> Simulation<'a> {
             loop_residual: LoopResidual::default(),
             hops: hops::Hops::default(),
         };
+        // A seated structure that cannot hold at t = 0 uplifts at once, before the first
+        // sample: the monitor judges the contacts the motion starts on (a load that starts
+        // above the threshold, as a one-cosine pulse does, would find the seated structure
+        // pulling). The release leaves q and q̇ as they are.
+        sim.release_if_opening()?;
         let y = std::mem::take(&mut sim.y);
         let first = sim.sample_at(0.0, &y);
         sim.y = y;
@@ -957,8 +962,6 @@ impl<'a> Simulation<'a> {
             sim.finished = true;
             return Ok(sim);
         }
-        // A seated structure that cannot hold at t = 0 uplifts at once.
-        sim.release_if_opening()?;
         Ok(sim)
     }
 
@@ -1670,8 +1673,12 @@ impl<'a> Simulation<'a> {
                     self.impact(slot).map(StopReason::Impact)
                 } else if index == collapse_index {
                     let (q, qdot) = (self.chain_q(), self.chain_qdot());
-                    if q.dot(&qdot) > 0.0 {
-                        let c = self.collapse_record();
+                    let toppled = self.toppled_body(&q);
+                    if toppled.is_some() || q.dot(&qdot) > 0.0 {
+                        let c = match toppled {
+                            Some(body) => Collapse { t: self.t, body },
+                            None => self.collapse_record(),
+                        };
                         self.collapse = Some(c.clone());
                         self.finished = true;
                         self.record_current_sample(self.t);
@@ -1696,6 +1703,33 @@ impl<'a> Simulation<'a> {
                 }
             }
         }
+    }
+
+    /// The body of a rocking joint turned to π/2 on its pivot's side at `q` (within 1e-9 rad,
+    /// the collapse event's location): it lies on its support's plane, toppled (the collapse
+    /// function, `events`). None when no joint is there.
+    fn toppled_body(&mut self, q: &DVector<f64>) -> Option<String> {
+        let model = Arc::clone(&self.model);
+        let mut angles = vec![0.0; model.slot_count];
+        slot_angles(
+            &model,
+            &mut self.out_kin,
+            q,
+            &self.dynamics.pivots,
+            &mut angles,
+        );
+        let seated = &self.seated;
+        (0..model.slot_count)
+            .filter(|&s| !seated[s])
+            .find(|&s| {
+                self.dynamics.pivots.sides[s].sign() * angles[s]
+                    >= std::f64::consts::FRAC_PI_2 - 1e-9
+            })
+            .map(|s| {
+                model.bodies[model.interfaces[slot_interface(&model, s)].child]
+                    .name
+                    .clone()
+            })
     }
 
     fn collapse_record(&mut self) -> Collapse {

@@ -1616,17 +1616,25 @@ impl Simulation<'_> {
                         lo = mid;
                     }
                 }
-                found = Some(hi);
+                found = Some((lo, hi));
                 break;
             }
             t0 = t1;
         }
         self.spare.trial = Some(trial);
         self.spare.rest = rest;
-        let t_end = found.unwrap_or(t_stop);
+        let t_end = found.map_or(t_stop, |(_, hi)| hi);
         let dt = self.params.output_interval;
         let y = self.y.clone();
-        while (self.next_sample as f64) * dt <= t_end + 1e-12 * dt
+        // The samples at rest: up to the last instant known to hold where the structure
+        // uplifts. A sample in the uplift's bracket is left to the motion that follows: the
+        // load there may already be past the threshold (a pulse that starts at a sample's
+        // instant), where the seated structure would be judged pulling.
+        let at_rest = |ts: f64| match found {
+            Some((lo, _)) => ts <= lo,
+            None => ts <= t_end + 1e-12 * dt,
+        };
+        while at_rest((self.next_sample as f64) * dt)
             && (self.next_sample as f64) * dt <= self.params.duration + 1e-12 * dt
         {
             let s = self.sample_at(self.next_sample as f64 * dt, &y);

@@ -1,0 +1,109 @@
+//! A load that starts above the uplift threshold: a one-cosine pulse jumps from 0 to its
+//! amplitude at its start. A block whose threshold g tan α lies below that amplitude leaves rest
+//! at the jump itself, and the first sample of its motion must judge the contacts it moves on,
+//! not the seated block under the jumped load: until 2026-12-02 the sample at the jump was taken
+//! before the release, and the monitor reported the seated base pulling (`outside_face`, at
+//! t = 0 or at the pulse's start), marking every such run as outside the model (found by an
+//! independent review: 6 of 8 cases of a one-cosine pulse study).
+use crate::common;
+
+/// Housner's block of the bundled `single_block.toml` (0.4 × 2 m, b/h = 0.2) under a
+/// one-cosine pulse of `amplitude` (m/s²), period 0.8 s, from `start`.
+fn block_under_cosine_pulse(amplitude: f64, start: f64) -> String {
+    format!(
+        r#"name = "block_under_cosine_pulse"
+gravity = 9.81
+
+[[body]]
+name = "block"
+density = 2500.0
+box = {{ center = [0.0, 0.0, 1.0], size = [0.4, 0.4, 2.0] }}
+
+[[interface]]
+name = "base"
+parent = "ground"
+child = "block"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [0.2, 0.0, 0.0]
+pivot_negative = [-0.2, 0.0, 0.0]
+
+[ground_motion]
+x = {{ one_cosine_pulse = {{ amplitude = {amplitude}, period = 0.8, start = {start} }} }}
+
+[analysis]
+duration = 1.0
+"#
+    )
+}
+
+/// The first time θ returns to 0 after leaving rest at `start`, by a classical fourth-order
+/// Runge–Kutta integration (step 1e-5 s, the crossing by linear interpolation) of the rocking
+/// block's equation of motion (Housner 1963, Makris & Zhang): on its negative pivot,
+/// θ̈ = −p² [sin(−α − θ) + (a_g/g) cos(−α − θ)], p² = 3g/(4R), with a_g the one-cosine pulse.
+fn first_return_by_rk4(amplitude: f64, start: f64) -> f64 {
+    let (g, b, h) = (9.81_f64, 0.2_f64, 1.0_f64);
+    let (r, alpha) = (b.hypot(h), (b / h).atan());
+    let p2 = 3.0 * g / (4.0 * r);
+    let a_g = |t: f64| {
+        let s = t - start;
+        if (0.0..=0.8).contains(&s) {
+            amplitude * (2.0 * std::f64::consts::PI * s / 0.8).cos()
+        } else {
+            0.0
+        }
+    };
+    let f = |t: f64, y: [f64; 2]| {
+        let phi = -alpha - y[0];
+        [y[1], -p2 * (phi.sin() + a_g(t) / g * phi.cos())]
+    };
+    let step = 1e-5;
+    let (mut t, mut y) = (start, [0.0_f64, 0.0]);
+    loop {
+        let k1 = f(t, y);
+        let k2 = f(
+            t + step / 2.0,
+            [y[0] + step / 2.0 * k1[0], y[1] + step / 2.0 * k1[1]],
+        );
+        let k3 = f(
+            t + step / 2.0,
+            [y[0] + step / 2.0 * k2[0], y[1] + step / 2.0 * k2[1]],
+        );
+        let k4 = f(t + step, [y[0] + step * k3[0], y[1] + step * k3[1]]);
+        let next = [
+            y[0] + step / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+            y[1] + step / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+        ];
+        if t > start + 10.0 * step && next[0] >= 0.0 {
+            return t + step * y[0] / (y[0] - next[0]);
+        }
+        (t, y) = (t + step, next);
+        assert!(t < start + 5.0, "no return within 5 s");
+    }
+}
+
+#[test]
+fn a_pulse_that_starts_above_the_threshold_uplifts_at_its_start_with_no_violation() {
+    // Threshold g tan α = 9.81 × 0.2 = 1.962 m/s², below the amplitude 3 m/s²: the block
+    // leaves rest at the jump, at t = 0 and, for the pulse started at the sample instant 0.2 s,
+    // there.
+    for start in [0.0, 0.2] {
+        let tag = format!("cosine_pulse_from_{start}");
+        let (_, traj) =
+            common::run_model_text(&tag, &block_under_cosine_pulse(3.0, start), Some(1.0));
+        assert_eq!(traj.uplift_time, Some(start), "{tag}");
+        assert!(
+            traj.violation.is_none(),
+            "{tag}: a violation at a jump the block leaves rest at: {:?}",
+            traj.violation
+        );
+        // The motion that follows is the rocking block's own: its first impact where the
+        // independent integration of Housner's equation brings θ back to 0 (its step's error
+        // and the linear crossing: well below 1e-6 s).
+        let first = traj.impacts.first().expect("the block lands").t;
+        let expected = first_return_by_rk4(3.0, start);
+        assert!(
+            (first - expected).abs() < 1e-6,
+            "{tag}: first impact at {first} s, Housner's equation {expected} s"
+        );
+    }
+}
