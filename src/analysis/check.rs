@@ -68,7 +68,9 @@ pub struct MechanismReport {
     pub p_squared_linearised: f64,
     /// r = θ̇⁺/θ̇⁻ of the momentum law at θ = 0 for the mechanism velocity, pivots flipped.
     pub r: f64,
-    /// T⁺/T⁻ of that impact.
+    /// T⁺/T⁻ of that impact: 0 where r < 0 (a squat block, sin²α > 2/3 for Housner's): the law
+    /// would turn the mechanism on into its seat, so the impact seats it and the rocking ends
+    /// there, as `crr simulate` does.
     pub energy_ratio: f64,
     /// max |q̇⁺ − r q̇⁻| / max |q̇⁻|: how far the velocity after the impact is from a multiple of
     /// the velocity before (0 for a symmetric mechanism).
@@ -221,7 +223,7 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
         p_squared: eq.p_squared,
         p_squared_linearised: eq.p_squared_linearised,
         r,
-        energy_ratio: res.energy_ratio(),
+        energy_ratio: if r < 0.0 { 0.0 } else { res.energy_ratio() },
         mode_change,
         lagrangian,
         frequencies,
@@ -499,6 +501,9 @@ pub fn to_text(r: &CheckReport) -> String {
             "  r (momentum law) = {:.6}, T⁺/T⁻ = {:.6}, mode change {:.1e}\n",
             k.r, k.energy_ratio, k.mode_change
         );
+        if k.r < 0.0 {
+            s += "  r < 0: the law would turn the mechanism on into its seat, so its first impact seats it and the rocking ends there (T⁺ = 0)\n";
+        }
         let l = &k.lagrangian;
         s += "one-DOF Lagrangian (eq 4): L/M(0) = ½(1 ± νθ + ξθ²)θ̇² ∓ ηθ + ½χθ² (NOTATION.md)\n";
         s += &format!(

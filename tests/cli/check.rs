@@ -86,3 +86,80 @@ fn text_output_has_the_table() {
     assert!(s.contains("activation multiplier λ = 0.200000"));
     assert!(s.contains("F_H Housner (Hz)"));
 }
+
+/// A squat block, b/h = 2 (a slab 2 m wide and 1 m high): sin²α = 0.8 > 2/3, so Housner's
+/// r = 1 − 1.5 sin²α = −0.2 is negative. The momentum law would send the block on about its
+/// new corner into the ground, so its first impact seats it: `crr check` reports T⁺/T⁻ = 0 (not
+/// r² = 0.04) and says why, and `crr simulate` of the slab released from 0.01 rad loses at its
+/// one impact all the energy it fell with, m g R (cos(α − θ₀) − cos α) by hand (found by an
+/// independent review: the report said 0.04).
+#[test]
+fn a_squat_block_s_negative_r_seats_it_at_its_first_impact() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("squat_block");
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("squat_block.toml");
+    std::fs::write(
+        &model,
+        r#"name = "squat_block"
+gravity = 9.81
+
+[[body]]
+name = "block"
+density = 2500.0
+box = { center = [0.0, 0.0, 0.5], size = [2.0, 0.4, 1.0] }
+
+[[interface]]
+name = "base"
+parent = "ground"
+child = "block"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [1.0, 0.0, 0.0]
+pivot_negative = [-1.0, 0.0, 0.0]
+
+[initial]
+angles = { base = 0.01 }
+
+[analysis]
+duration = 3.0
+"#,
+    )
+    .unwrap();
+    let r = check(model.to_str().unwrap());
+    let (b, h, g, theta0): (f64, f64, f64, f64) = (1.0, 0.5, 9.81, 0.01);
+    let alpha = (b / h).atan();
+    let m = &r["mechanism"];
+    assert!((m["r"].as_f64().unwrap() - (1.0 - 1.5 * alpha.sin().powi(2))).abs() < 1e-12);
+    assert!((m["r"].as_f64().unwrap() + 0.2).abs() < 1e-12);
+    assert_eq!(m["energy_ratio"].as_f64().unwrap(), 0.0);
+    let text = Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args(["check", model.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(text.contains("T⁺/T⁻ = 0.000000"), "{text}");
+    assert!(text.contains("r < 0"), "{text}");
+    let out = dir.join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args([
+            "simulate",
+            model.to_str().unwrap(),
+            "--force",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let impacts = std::fs::read_to_string(out.join("impacts.csv")).unwrap();
+    let rows: Vec<&str> = impacts.lines().skip(1).collect();
+    assert_eq!(rows.len(), 1, "one impact, then at rest: {impacts}");
+    let lost: f64 = rows[0].split(',').nth(4).unwrap().parse().unwrap();
+    let mass = 2.0 * 0.4 * 1.0 * 2500.0;
+    let radius = b.hypot(h);
+    let fallen = mass * g * radius * ((alpha - theta0).cos() - alpha.cos());
+    assert!(
+        (lost - fallen).abs() < 1e-6 * fallen,
+        "lost {lost} J, fell with {fallen} J"
+    );
+}
