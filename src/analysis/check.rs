@@ -306,6 +306,7 @@ pub fn check_with(
         static_multipliers_note: statics_note,
         warnings: crate::analysis::static_multiplier::gravity_along_axis_warning(model)
             .into_iter()
+            .chain(crate::analysis::contact_geometry::contact_geometry_warnings(model))
             .collect(),
     }
 }

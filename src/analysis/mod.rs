@@ -5,6 +5,7 @@
 
 pub mod assemble;
 pub mod check;
+pub mod contact_geometry;
 pub mod inspect;
 pub mod levels;
 pub mod poincare;

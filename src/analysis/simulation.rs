@@ -827,6 +827,7 @@ fn warnings(
     if let Some(tilt) = crate::analysis::static_multiplier::gravity_along_axis_warning(&p.model) {
         out.push(tilt);
     }
+    out.extend(crate::analysis::contact_geometry::contact_geometry_warnings(&p.model));
     let analysis = p.file.analysis.clone().unwrap_or_default();
     if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)
         && analysis.rtol > crr_dynamics::analysis::RTOL_WARNING

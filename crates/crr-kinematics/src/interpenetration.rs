@@ -136,6 +136,13 @@ fn triangles(s: &Surface) -> impl Iterator<Item = [Vector3<f64>; 3]> + '_ {
     })
 }
 
+/// The distance (m) from `p` to the closed surface `s`: the least over its faces' triangles.
+pub fn distance_to_surface(s: &Surface, p: &Vector3<f64>) -> f64 {
+    triangles(s)
+        .map(|t| distance_to_triangle(p, &t))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The winding number of the closed surface `s` about `p` (1 inside, 0 outside): the solid
 /// angles of its triangles seen from p (Van Oosterom & Strackee 1983) over 4π.
 fn winding_number(s: &Surface, p: &Vector3<f64>) -> f64 {
@@ -252,5 +259,20 @@ mod tests {
         assert!((d([0.5, -1.0, 0.0]) - 1.0).abs() < 1e-15);
         assert!((d([2.0, 0.0, 0.0]) - 1.0).abs() < 1e-15);
         assert!((d([1.0, 1.0, 0.0]) - 0.5f64.sqrt()).abs() < 1e-15);
+    }
+
+    /// The distance to a cube of side 2 centred at the origin, by hand: 0 on a face, an edge or
+    /// a corner; a point inside, its distance to the nearest face; outside beside a face, the
+    /// excess of its coordinate; beyond a corner, the length of the excess vector.
+    #[test]
+    fn distance_to_a_cube_s_surface() {
+        let a = cube([0.0, 0.0, 0.0], 2.0);
+        let d = |p: [f64; 3]| distance_to_surface(&a, &Vector3::from(p));
+        assert!(d([1.0, 0.3, -0.2]).abs() < 1e-15);
+        assert!(d([1.0, 1.0, 0.5]).abs() < 1e-15);
+        assert!(d([1.0, -1.0, 1.0]).abs() < 1e-15);
+        assert!((d([0.2, 0.5, -0.1]) - 0.5).abs() < 1e-15);
+        assert!((d([3.0, 0.5, 0.0]) - 2.0).abs() < 1e-15);
+        assert!((d([2.0, 2.0, 3.0]) - 6.0f64.sqrt()).abs() < 1e-15);
     }
 }
