@@ -1270,7 +1270,7 @@ impl<'a> Simulation<'a> {
         // after the contact program found it lifting (a flight): there the flight is now.
         let pressing = self.pressing_faces_now();
         if let Some(k) = self.held_face_pulling(&pressing) {
-            return Err(self.flight_of(k));
+            return self.fall_or_flight(k);
         }
         self.hops_at_segment_start(&pressing);
         let mut hop_log = std::mem::take(&mut self.hops.log);
@@ -1513,7 +1513,7 @@ impl<'a> Simulation<'a> {
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());
         if let Some(k) = pulling {
-            return Err(self.flight_of(k));
+            return self.fall_or_flight(k);
         }
         if let Some((face, point)) = landing {
             let mut landings = vec![(face, point)];
@@ -1544,6 +1544,51 @@ impl<'a> Simulation<'a> {
             first_zone_index,
             rocking_len,
         )
+    }
+
+    /// The bodies carried by tree slot k lose their only support now (its pivot would pull,
+    /// [`pressing_faces`]): a collapse where they have already fallen past their point of no
+    /// return ([`Self::fallen_in_flight`]), otherwise a flight, an error of the run.
+    fn fall_or_flight(&mut self, k: usize) -> Result<StopReason, SimulationError> {
+        match self.fallen_in_flight(k) {
+            Some(c) => {
+                self.collapse = Some(c.clone());
+                self.finished = true;
+                self.record_current_sample(self.t);
+                Ok(StopReason::Collapse(c))
+            }
+            None => Err(self.flight_of(k)),
+        }
+    }
+
+    /// The collapse of the bodies carried by tree slot k when they leave their support past
+    /// their point of no return: their centre of mass below its rest height by `collapse_drop`
+    /// of the model size (their potential energy below rest by collapse_drop·W_k·L, the
+    /// collapse criterion on them alone) while the joint turns away from its seat. A body
+    /// toppling off a support loses its contact on the way down (its centre's acceleration
+    /// towards the pivot outgrows gravity): that flight is the end of a fall, reported as a
+    /// collapse naming the joint's body (a finial on a pier flies at 1.2 to 1.5 rad, where it
+    /// has dropped by a quarter of its height). None for bodies above their rest height (a
+    /// block leaving its corner under a fast signal).
+    fn fallen_in_flight(&mut self, k: usize) -> Option<Collapse> {
+        let model = Arc::clone(&self.model);
+        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        let (mass, drop) = (0..model.bodies.len())
+            .filter(|&b| model.carries(k, Some(model.body_coord[b])))
+            .fold((0.0, 0.0), |(m, d), b| {
+                let body = &model.bodies[b];
+                (
+                    m + body.mass,
+                    d + body.mass * (self.out_kin.com[b].z - body.com.z),
+                )
+            });
+        let turning_away = self.dynamics.pivots.sides[k].sign() * qdot[k] > 0.0;
+        let child = model.interfaces[model.coords[k].interface].child;
+        (turning_away && drop < -self.params.collapse_drop * mass * model.size).then(|| Collapse {
+            t: self.t,
+            body: model.bodies[child].name.clone(),
+        })
     }
 
     /// The flight of the bodies carried by tree slot k, whose pivot would pull now
