@@ -68,9 +68,7 @@ pub struct MechanismReport {
     pub p_squared_linearised: f64,
     /// r = θ̇⁺/θ̇⁻ of the momentum law at θ = 0 for the mechanism velocity, pivots flipped.
     pub r: f64,
-    /// T⁺/T⁻ of that impact: 0 where r < 0 (a squat block, sin²α > 2/3 for Housner's): the law
-    /// would turn the mechanism on into its seat, so the impact seats it and the rocking ends
-    /// there, as `crr simulate` does.
+    /// T⁺/T⁻ of that impact: 0 where the mechanism seats at it ([`seats_at_impact`]).
     pub energy_ratio: f64,
     /// max |q̇⁺ − r q̇⁻| / max |q̇⁻|: how far the velocity after the impact is from a multiple of
     /// the velocity before (0 for a symmetric mechanism).
@@ -223,7 +221,11 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
         p_squared: eq.p_squared,
         p_squared_linearised: eq.p_squared_linearised,
         r,
-        energy_ratio: if r < 0.0 { 0.0 } else { res.energy_ratio() },
+        energy_ratio: if seats_at_impact(r, mode_change) {
+            0.0
+        } else {
+            res.energy_ratio()
+        },
         mode_change,
         lagrangian,
         frequencies,
@@ -502,7 +504,7 @@ pub fn to_text(r: &CheckReport) -> String {
             "  r (momentum law) = {:.6}, T⁺/T⁻ = {:.6}, mode change {:.1e}\n",
             k.r, k.energy_ratio, k.mode_change
         );
-        if k.r < 0.0 {
+        if seats_at_impact(k.r, k.mode_change) {
             s += "  r < 0: the law would turn the mechanism on into its seat, so its first impact seats it and the rocking ends there (T⁺ = 0)\n";
         }
         let l = &k.lagrangian;
@@ -529,4 +531,13 @@ pub fn to_text(r: &CheckReport) -> String {
         }
     }
     s
+}
+
+/// Whether the momentum law's impact seats the one-DOF mechanism: r < 0 (a squat block,
+/// sin²α > 2/3 for Housner's) with the velocity after it a multiple of the one before (mode
+/// change below 1e-9): every joint's rate after it would turn into its seat, so the impact seats
+/// the mechanism and the rocking ends there, as `crr simulate` does. Where the mode changes,
+/// other joints may keep rocking, and T⁺/T⁻ is the law's.
+pub fn seats_at_impact(r: f64, mode_change: f64) -> bool {
+    r < 0.0 && mode_change <= 1e-9
 }

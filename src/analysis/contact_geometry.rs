@@ -5,10 +5,12 @@
 //! own contacts, and these checks give a hand-written file the same scrutiny, as warnings of
 //! `crr check` and `crr simulate` (a model may place a pivot off its bodies on purpose).
 //!
-//! A hinge's pivot is a line: the point of it nearest each body's centre of mass must lie on
-//! that body's surface (the line along an edge of a block touches the block there, whatever
-//! point of the line the file gives). A rocking base's corners must each lie on both surfaces.
-//! The ground has no surface: only the child is checked on it. Bodies' surfaces are those of
+//! A hinge's pivot is a line: the point the file gives, or the point of the line nearest the
+//! body's centre of mass, must lie on that body's surface (a line along an edge of a block
+//! touches the block at its point nearest the centre, whatever point of the line the file
+//! gives; the point given serves an edge that does not span the centre). A pin (one pivot
+//! line, a joint that is not a contact) is not checked. A rocking base's corners must each lie
+//! on both surfaces. The ground has no surface: only the child is checked on it. Bodies' surfaces are those of
 //! their shapes at rest (an annular sector's arcs as chords), and a point counts as on a
 //! surface within [`ON_SURFACE`] of the model size.
 
@@ -45,7 +47,13 @@ pub fn contact_geometry_warnings(model: &Model) -> Vec<String> {
                 let surface = surfaces[b].as_ref()?;
                 pivot_points(&iface.kind, &model.bodies[b].com)
                     .into_iter()
-                    .map(|p| (distance_to_surface(surface, &p), p, b))
+                    .map(|candidates| {
+                        candidates
+                            .into_iter()
+                            .map(|p| (distance_to_surface(surface, &p), p, b))
+                            .min_by(|x, y| x.0.total_cmp(&y.0))
+                            .expect("a pivot has a point")
+                    })
                     .max_by(|x, y| x.0.total_cmp(&y.0))
             })
             .max_by(|x, y| x.0.total_cmp(&y.0));
@@ -80,18 +88,24 @@ pub fn contact_geometry_warnings(model: &Model) -> Vec<String> {
     out
 }
 
-/// The points of an interface's pivots to find on a body whose centre of mass is `com`: each
-/// hinge pivot line's point nearest the centre, or a rocking base's corners.
-fn pivot_points(kind: &InterfaceKind, com: &Vector3<f64>) -> Vec<Vector3<f64>> {
+/// The pivots of an interface to find on a body whose centre of mass is `com`, each as the
+/// points of which one must lie on the body: a hinge pivot line's point given and its point
+/// nearest the centre (none for a pin), or each of a rocking base's corners.
+fn pivot_points(kind: &InterfaceKind, com: &Vector3<f64>) -> Vec<Vec<Vector3<f64>>> {
     match kind {
         InterfaceKind::Hinge {
             axis,
             pivot_positive,
             pivot_negative,
-        } => [pivot_positive, pivot_negative]
-            .into_iter()
-            .map(|p| p + axis * axis.dot(&(com - p)))
-            .collect(),
-        InterfaceKind::RockingBase { corners, .. } => corners.to_vec(),
+        } => {
+            if (pivot_positive - pivot_negative).cross(axis).norm() == 0.0 {
+                return Vec::new();
+            }
+            [pivot_positive, pivot_negative]
+                .into_iter()
+                .map(|p| vec![*p, p + axis * axis.dot(&(com - p))])
+                .collect()
+        }
+        InterfaceKind::RockingBase { corners, .. } => corners.iter().map(|c| vec![*c]).collect(),
     }
 }

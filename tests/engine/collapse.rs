@@ -1,6 +1,7 @@
 //! Collapse is reported whenever a structure is past its point of no return, from any initial
-//! state, and never for one whose potential energy has not dropped past the threshold
-//! (docs/simulation.md, "Collapse"). Initial states a rocking joint cannot have (turned beyond
+//! state, and never for one whose potential energy has not dropped past the threshold, unless
+//! one of its bodies topples (a rocking contact turned to π/2) or falls off its support past its
+//! own point of no return (docs/simulation.md, "Collapse"). Initial states a rocking joint cannot have (turned beyond
 //! ±π/2, non-finite) are refused with a message naming the joint.
 
 use crate::common;

@@ -96,6 +96,23 @@ fn a_pulse_that_starts_above_the_threshold_uplifts_at_its_start_with_no_violatio
             "{tag}: a violation at a jump the block leaves rest at: {:?}",
             traj.violation
         );
+        // The samples in order (an impact's instant twice, before and after it), the jump's
+        // instant once: the samples at rest end before the uplift's bracket, and the motion
+        // takes the jump's own instant.
+        let times: Vec<f64> = traj.samples.iter().map(|s| s.t).collect();
+        assert!(
+            times.windows(2).all(|w| w[0] <= w[1]),
+            "{tag}: sample times out of order"
+        );
+        let at_jump = times.iter().filter(|&&t| (t - start).abs() < 1e-9).count();
+        assert_eq!(
+            at_jump, 1,
+            "{tag}: the jump's instant sampled {at_jump} times"
+        );
+        assert!(
+            (times[1] - 0.01).abs() < 1e-12,
+            "{tag}: the grid of 0.01 s kept"
+        );
         // The motion that follows is the rocking block's own: its first impact where the
         // independent integration of Housner's equation brings θ back to 0 (its step's error
         // and the linear crossing: well below 1e-6 s).

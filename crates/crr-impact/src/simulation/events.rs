@@ -19,6 +19,9 @@ pub(super) struct SegmentEvents<'b> {
     pub(super) ground: &'b GroundMotion,
     /// Rocking slots watched for a zero crossing, with their sides.
     pub(super) rocking: Vec<(usize, Side)>,
+    /// Per slot, whether it is a rocking contact (two distinct pivots), not a pin
+    /// ([`super::slots::is_contact`]): the toppling event watches these.
+    pub(super) contacts: &'b [bool],
     /// Per rocking slot, its seat: where its impact is (sign(side)·φ at the seat), 0 except for an
     /// angle that starts the segment a little on the wrong side of its pivot ([`rocking_seats`]).
     pub(super) seats: Vec<f64>,
@@ -67,11 +70,14 @@ impl SegmentEvents<'_> {
     pub(super) fn collapse_index(&self) -> usize {
         self.rocking.len()
     }
-    pub(super) fn uplift_index(&self) -> usize {
+    pub(super) fn toppling_index(&self) -> usize {
         self.rocking.len() + 1
     }
+    pub(super) fn uplift_index(&self) -> usize {
+        self.rocking.len() + 2
+    }
     pub(super) fn first_zone_index(&self) -> usize {
-        self.rocking.len() + 1 + usize::from(self.uplift.is_some())
+        self.rocking.len() + 2 + usize::from(self.uplift.is_some())
     }
     pub(super) fn first_gap_index(&self) -> usize {
         self.first_zone_index() + 2 * self.zones.len()
@@ -132,23 +138,31 @@ impl SegmentEvents<'_> {
         );
     }
 
-    /// The collapse function, positive while standing (needs [`Self::load_state`]): the lesser
-    /// of U above its threshold and of π/2 less every rocking angle on its pivot's side. A
-    /// rocking joint turned to π/2 has laid its body on its support's plane and beyond it
-    /// would put the body through its support (the initial states refused): that body has
-    /// toppled, however light it is against the structure (whose U may not reach its threshold).
+    /// The collapse function: U above its threshold, positive while standing (needs
+    /// [`Self::load_state`]).
     fn collapse_value(&self) -> f64 {
         if self.rocking.is_empty() {
-            return 1.0;
+            1.0
+        } else {
+            (potential_energy(self.model, &self.kin) - self.u_rest) / self.energy_scale
+                + self.collapse_drop
         }
-        let falling = (potential_energy(self.model, &self.kin) - self.u_rest) / self.energy_scale
-            + self.collapse_drop;
-        let toppling = self
-            .rocking
+    }
+
+    /// The toppling function: π/2 less the largest rocking contact's angle on its pivot's side,
+    /// positive while every body stands on its support (needs [`Self::load_state`]). A rocking
+    /// joint turned to π/2 has laid its body on its support's plane, and beyond it the body
+    /// would pass through its support (the initial states refused): that body has toppled,
+    /// however light it is against the structure (whose U may not reach its threshold). A pin
+    /// (one pivot line) is no contact: it turns through π/2 as a pendulum does. Its own event,
+    /// not folded into the collapse function's: that one may stay below 0 after a crossing
+    /// with the rotations shrinking, and a lesser of the two could then never fall through 0.
+    fn toppling_value(&self) -> f64 {
+        self.rocking
             .iter()
+            .filter(|&&(s, _)| self.contacts[s])
             .map(|&(s, side)| std::f64::consts::FRAC_PI_2 - side.sign() * self.angles[s])
-            .fold(f64::INFINITY, f64::min);
-        falling.min(toppling)
+            .fold(1.0, f64::min)
     }
 
     /// The uplift function: +1 when the seated state cannot hold at t, −1 while it holds.
@@ -179,6 +193,7 @@ impl SegmentEvents<'_> {
             g[i] = side.sign() * self.angles[s] - self.seats[i] + ROCKING_EVENT_MARGIN;
         }
         g[self.collapse_index()] = self.collapse_value();
+        g[self.toppling_index()] = self.toppling_value();
         let z0 = self.first_zone_index();
         for j in 0..2 * self.zones.len() {
             g[z0 + j] = self.zone_value(j);
@@ -242,6 +257,8 @@ impl EventFunctions for SegmentEvents<'_> {
             side.sign() * self.angles[s] - self.seats[i] + ROCKING_EVENT_MARGIN
         } else if i == self.collapse_index() {
             self.collapse_value()
+        } else if i == self.toppling_index() {
+            self.toppling_value()
         } else if self.uplift.is_some() && i == self.uplift_index() {
             self.uplift_value(t)
         } else if i < self.first_gap_index() {
@@ -264,9 +281,14 @@ impl EventFunctions for SegmentEvents<'_> {
     }
 
     fn direction(&self, i: usize) -> Direction {
-        // Impacts (sign(side)·φ + margin), collapse (U past its threshold), the open faces'
-        // gaps and the pivots' normal forces fall through 0.
-        if i < self.rocking.len() || i == self.collapse_index() || i >= self.first_gap_index() {
+        // Impacts (sign(side)·φ + margin), collapse (U past its threshold), toppling (a
+        // contact's angle past π/2), the open faces' gaps and the pivots' normal forces fall
+        // through 0.
+        if i < self.rocking.len()
+            || i == self.collapse_index()
+            || i == self.toppling_index()
+            || i >= self.first_gap_index()
+        {
             Direction::Falling
         } else if self.uplift.is_some() && i == self.uplift_index() {
             Direction::Rising

@@ -12,7 +12,10 @@
 //! - **collapse**: the potential energy falls below its value at rest by more than
 //!   [`Parameters::collapse_drop`]·W·L (W the weight, L the model size) while the rotations grow
 //!   (q·q̇ > 0): the structure is past its point of no return (for a block, beyond θ = 2α); the run
-//!   stops with the time and the body whose centre has dropped most.
+//!   stops with the time and the body whose centre has dropped most. Also a collapse, naming
+//!   the body: a rocking contact turned to π/2 (a body laid on its support's plane, its own
+//!   event), and the flight of bodies already fallen past their point of no return on their
+//!   support (`Simulation::fallen_in_flight`).
 //!
 //! **Seating** (the Zeno limit of free rocking, infinitely many impacts in finite time): after an
 //! impact, an interface whose rate is below [`Parameters::seat_rate`], or that impacted less than
@@ -230,7 +233,9 @@ pub struct Peak {
 pub struct Collapse {
     /// Time (s).
     pub t: f64,
-    /// The body whose centre has dropped most below its rest height.
+    /// The body whose centre has dropped most below its rest height; for a body that toppled
+    /// (a contact turned to π/2) or fell off its support (a flight past its point of no return),
+    /// that body.
     pub body: String,
 }
 
@@ -479,6 +484,9 @@ pub struct Simulation<'a> {
     spare: Workspaces,
     /// The model's connected parts (the uplift test batches its releases over them).
     parts: crr_kinematics::Parts,
+    /// Per slot of the chain integrated, whether it is a rocking contact, not a pin
+    /// ([`slots::contact_slots`]).
+    contact_slots: Vec<bool>,
     /// State [q, q̇, W, D] at the current time.
     y: Vec<f64>,
     t: f64,
@@ -911,6 +919,7 @@ impl<'a> Simulation<'a> {
             out_kin: Data::new(model),
             spare: Workspaces::new(model, trial, &initial.pivots),
             parts: model.parts(),
+            contact_slots: slots::contact_slots(model),
             y,
             t: 0.0,
             seated,
@@ -940,20 +949,27 @@ impl<'a> Simulation<'a> {
             loop_residual: LoopResidual::default(),
             hops: hops::Hops::default(),
         };
-        // A seated structure that cannot hold at t = 0 uplifts at once, before the first
-        // sample: the monitor judges the contacts the motion starts on (a load that starts
-        // above the threshold, as a one-cosine pulse does, would find the seated structure
-        // pulling). The release leaves q and q̇ as they are.
-        sim.release_if_opening()?;
-        let y = std::mem::take(&mut sim.y);
-        let first = sim.sample_at(0.0, &y);
-        sim.y = y;
-        sim.energy_start = first.kinetic + first.potential;
         // Released beyond the point of no return (its potential energy already below the rest
         // level by the collapse margin, e.g. a block tilted past 2α): collapsed at t = 0. The
         // event only sees U falling through the threshold, which such a start never does.
         let energy_scale = model.total_mass() * model.gravity * model.size;
-        let collapsed = first.potential < -sim.params.collapse_drop * energy_scale;
+        let q0 = sim.chain_q();
+        forward_kinematics(model, &mut sim.out_kin, &q0, &sim.dynamics.pivots);
+        let u0 = potential_energy(model, &sim.out_kin) - sim.u_rest;
+        let collapsed = u0 < -sim.params.collapse_drop * energy_scale;
+        // A seated structure that cannot hold at t = 0 uplifts at once, before the first
+        // sample: the monitor judges the contacts the motion starts on (a load that starts
+        // above the threshold, as a one-cosine pulse does, would find the seated structure
+        // pulling).
+        if !collapsed {
+            sim.release_if_opening()?;
+        }
+        let y = std::mem::take(&mut sim.y);
+        let first = sim.sample_at(0.0, &y);
+        sim.y = y;
+        // The energy the run starts with, before the release: a release that snaps a loop
+        // closed (a twisting seat's flip) books its change of T + U as dissipated.
+        sim.energy_start = first.kinetic + first.potential - first.work_in + first.dissipated;
         sim.record_sample(first);
         sim.next_sample = 1;
         if collapsed {
@@ -1329,6 +1345,7 @@ impl<'a> Simulation<'a> {
             trial: self.take_trial(),
             rest: std::mem::take(&mut self.spare.rest),
             slot_part: &self.parts.of_slot,
+            contacts: &self.contact_slots,
             q: std::mem::take(&mut seg.q),
             qdot: std::mem::take(&mut seg.qdot),
             u_rest: self.u_rest,
@@ -1551,20 +1568,25 @@ impl<'a> Simulation<'a> {
     /// return ([`Self::fallen_in_flight`]), otherwise a flight, an error of the run.
     fn fall_or_flight(&mut self, k: usize) -> Result<StopReason, SimulationError> {
         match self.fallen_in_flight(k) {
-            Some(c) => {
-                self.collapse = Some(c.clone());
-                self.finished = true;
-                self.record_current_sample(self.t);
-                Ok(StopReason::Collapse(c))
-            }
+            Some(c) => Ok(self.finish_with_collapse(c)),
             None => Err(self.flight_of(k)),
         }
+    }
+
+    /// Ends the run with the collapse `c`, its state the last sample.
+    fn finish_with_collapse(&mut self, c: Collapse) -> StopReason {
+        self.collapse = Some(c.clone());
+        self.finished = true;
+        self.record_final_sample();
+        StopReason::Collapse(c)
     }
 
     /// The collapse of the bodies carried by tree slot k when they leave their support past
     /// their point of no return: their centre of mass below its rest height by `collapse_drop`
     /// of the model size (their potential energy below rest by collapse_drop·W_k·L, the
-    /// collapse criterion on them alone) while the joint turns away from its seat. A body
+    /// collapse criterion on them alone) while the joint turns away from its seat, measured
+    /// with their support at rest (every coordinate that does not carry them at 0: a support
+    /// tilted by its own rocking lowers or raises them without their falling). A body
     /// toppling off a support loses its contact on the way down (its centre's acceleration
     /// towards the pivot outgrows gravity): that flight is the end of a fall, reported as a
     /// collapse naming the joint's body (a finial on a pier flies at 1.2 to 1.5 rad, where it
@@ -1572,7 +1594,12 @@ impl<'a> Simulation<'a> {
     /// block leaving its corner under a fast signal).
     fn fallen_in_flight(&mut self, k: usize) -> Option<Collapse> {
         let model = Arc::clone(&self.model);
-        let (q, qdot) = (self.chain_q(), self.chain_qdot());
+        let (mut q, qdot) = (self.chain_q(), self.chain_qdot());
+        for j in 0..model.dof() {
+            if !model.carries(k, Some(j)) {
+                q[j] = 0.0;
+            }
+        }
         forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
         let (mass, drop) = (0..model.bodies.len())
             .filter(|&b| model.carries(k, Some(model.body_coord[b])))
@@ -1716,18 +1743,21 @@ impl<'a> Simulation<'a> {
                 if let Some(slot) = event_slot {
                     debug_assert!(index < rocking_len);
                     self.impact(slot).map(StopReason::Impact)
+                } else if index == collapse_index + 1 {
+                    // The toppling event (`events`): a rocking contact turned to π/2.
+                    let q = self.chain_q();
+                    match self.toppled_body(&q) {
+                        Some(body) => Ok(self.finish_with_collapse(Collapse { t: self.t, body })),
+                        None => {
+                            self.reset_solver();
+                            Ok(StopReason::Breakpoint(self.t))
+                        }
+                    }
                 } else if index == collapse_index {
                     let (q, qdot) = (self.chain_q(), self.chain_qdot());
-                    let toppled = self.toppled_body(&q);
-                    if toppled.is_some() || q.dot(&qdot) > 0.0 {
-                        let c = match toppled {
-                            Some(body) => Collapse { t: self.t, body },
-                            None => self.collapse_record(),
-                        };
-                        self.collapse = Some(c.clone());
-                        self.finished = true;
-                        self.record_current_sample(self.t);
-                        Ok(StopReason::Collapse(c))
+                    if q.dot(&qdot) > 0.0 {
+                        let c = self.collapse_record();
+                        Ok(self.finish_with_collapse(c))
                     } else {
                         self.reset_solver();
                         Ok(StopReason::Breakpoint(self.t))
@@ -1750,9 +1780,11 @@ impl<'a> Simulation<'a> {
         }
     }
 
-    /// The body of a rocking joint turned to π/2 on its pivot's side at `q` (within 1e-9 rad,
-    /// the collapse event's location): it lies on its support's plane, toppled (the collapse
-    /// function, `events`). None when no joint is there.
+    /// The body of a rocking contact turned to π/2 on its pivot's side at `q` (within 1e-9
+    /// rad, the toppling event's location): it lies on its support's plane, toppled (the
+    /// toppling function, `events`): the interface's child, or on a chain grown again around
+    /// open faces, where the interface was turned round, the file's child, its parent here.
+    /// None when no contact is there.
     fn toppled_body(&mut self, q: &DVector<f64>) -> Option<String> {
         let model = Arc::clone(&self.model);
         let mut angles = vec![0.0; model.slot_count];
@@ -1763,18 +1795,20 @@ impl<'a> Simulation<'a> {
             &self.dynamics.pivots,
             &mut angles,
         );
-        let seated = &self.seated;
-        (0..model.slot_count)
-            .filter(|&s| !seated[s])
+        let (seated, contacts) = (&self.seated, &self.contact_slots);
+        let s = (0..model.slot_count)
+            .filter(|&s| !seated[s] && contacts[s])
             .find(|&s| {
                 self.dynamics.pivots.sides[s].sign() * angles[s]
                     >= std::f64::consts::FRAC_PI_2 - 1e-9
-            })
-            .map(|s| {
-                model.bodies[model.interfaces[slot_interface(&model, s)].child]
-                    .name
-                    .clone()
-            })
+            })?;
+        let i = slot_interface(&model, s);
+        let iface = &model.interfaces[i];
+        let body = match iface.parent {
+            crr_kinematics::Parent::Body(b) if self.open.turned(i) => b,
+            _ => iface.child,
+        };
+        Some(model.bodies[body].name.clone())
     }
 
     fn collapse_record(&mut self) -> Collapse {

@@ -242,6 +242,12 @@ impl OpenLoops {
         self.to_active[s]
     }
 
+    /// Whether the chain's interface `i` is the file's turned round (its parent here is the
+    /// file's child).
+    pub(super) fn turned(&self, i: usize) -> bool {
+        self.turned.get(i).copied().unwrap_or(false)
+    }
+
     /// The file's slot of the chain's slot `s`.
     pub(super) fn original_slot(&self, s: usize) -> usize {
         self.to_original[s]
@@ -485,6 +491,7 @@ impl Simulation<'_> {
         self.spare.rest.audit = audit;
         self.dynamics = dynamics;
         self.regularised = Regularised::of(&chain);
+        self.contact_slots = super::slots::contact_slots(&chain);
         self.parts = chain.parts();
         self.seated = seated;
         self.last_impact = last_impact;

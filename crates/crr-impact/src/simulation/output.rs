@@ -12,8 +12,8 @@ pub(super) struct Taken {
     t: f64,
     pub(super) kinetic: f64,
     pub(super) potential: f64,
-    work_in: f64,
-    dissipated: f64,
+    pub(super) work_in: f64,
+    pub(super) dissipated: f64,
 }
 
 impl Simulation<'_> {

@@ -31,6 +31,13 @@ pub fn check_initial_state(model: &Model, initial: &InitialState) -> Result<(), 
     Ok(())
 }
 
+/// Per slot of `model`, whether its interface is a rocking contact ([`is_contact`]).
+pub(super) fn contact_slots(model: &Model) -> Vec<bool> {
+    (0..model.slot_count)
+        .map(|s| is_contact(&model.interfaces[slot_interface(model, s)].kind))
+        .collect()
+}
+
 /// A joint with two distinct pivots (a rocking contact), as opposed to a plain hinge.
 pub(super) fn is_contact(kind: &InterfaceKind) -> bool {
     match kind {
