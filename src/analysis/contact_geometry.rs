@@ -9,14 +9,14 @@
 //! body's centre of mass, must lie on that body's surface (a line along an edge of a block
 //! touches the block at its point nearest the centre, whatever point of the line the file
 //! gives; the point given serves an edge that does not span the centre). A pin (one pivot
-//! line, a joint that is not a contact) is not checked. A rocking base's corners must each lie
-//! on both surfaces. The ground has no surface: only the child is checked on it. Bodies' surfaces are those of
-//! their shapes at rest (an annular sector's arcs as chords), and a point counts as on a
-//! surface within [`ON_SURFACE`] of the model size.
+//! line, a joint that is not a contact: [`ContactFace::is_pin`]) is not checked. A rocking
+//! base's corners must each lie on both surfaces. The ground has no surface: only the child is
+//! checked on it. Bodies' surfaces are those of their shapes at rest (an annular sector's arcs
+//! as chords), and a point counts as on a surface within [`ON_SURFACE`] of the model size.
 
 use crr_kinematics::interpenetration::{distance_to_surface, interpenetration};
 use crr_kinematics::shapes::Surface;
-use crr_kinematics::{InterfaceKind, Model, Parent};
+use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent};
 use nalgebra::Vector3;
 
 /// How far (a fraction of the model size) a pivot may lie from a body's surface, and two bodies
@@ -34,7 +34,10 @@ pub fn contact_geometry_warnings(model: &Model) -> Vec<String> {
         .map(|b| b.shape.surface().ok())
         .collect();
     let mut out = Vec::new();
-    for iface in &model.interfaces {
+    for (index, iface) in model.interfaces.iter().enumerate() {
+        if ContactFace::is_pin(model, index) {
+            continue;
+        }
         let child = Some(iface.child);
         let parent = match iface.parent {
             Parent::Body(b) => Some(b),
@@ -90,22 +93,17 @@ pub fn contact_geometry_warnings(model: &Model) -> Vec<String> {
 
 /// The pivots of an interface to find on a body whose centre of mass is `com`, each as the
 /// points of which one must lie on the body: a hinge pivot line's point given and its point
-/// nearest the centre (none for a pin), or each of a rocking base's corners.
+/// nearest the centre, or each of a rocking base's corners.
 fn pivot_points(kind: &InterfaceKind, com: &Vector3<f64>) -> Vec<Vec<Vector3<f64>>> {
     match kind {
         InterfaceKind::Hinge {
             axis,
             pivot_positive,
             pivot_negative,
-        } => {
-            if (pivot_positive - pivot_negative).cross(axis).norm() == 0.0 {
-                return Vec::new();
-            }
-            [pivot_positive, pivot_negative]
-                .into_iter()
-                .map(|p| vec![*p, p + axis * axis.dot(&(com - p))])
-                .collect()
-        }
+        } => [pivot_positive, pivot_negative]
+            .into_iter()
+            .map(|p| vec![*p, p + axis * axis.dot(&(com - p))])
+            .collect(),
         InterfaceKind::RockingBase { corners, .. } => corners.iter().map(|c| vec![*c]).collect(),
     }
 }

@@ -125,15 +125,15 @@ pub fn most_compressive_impulses(
     momentum_change: &[(Vector3<f64>, Vector3<f64>)],
     set_by_law: &[usize],
 ) -> Option<MostCompressive> {
-    compressive_impulses_at_least(model, dynamics, momentum_change, set_by_law, f64::INFINITY)
+    compressive_impulses_at_least(model, dynamics, momentum_change, set_by_law, None)
 }
 
 /// [`most_compressive_impulses`], answered without its program where a cheaper distribution
 /// already presses enough: the least-norm distribution of the same impulses over the same
 /// touching points (one least-squares solve, the correction that carries distributions, from no
 /// impulse) is one of the program's feasible points, so s* is at least its least normal impulse.
-/// Where that impulse is at least `enough` (N s), the answer is that distribution: its least
-/// normal impulse capped at 0 as `min_normal` (a lower bound of s*, within `enough` of it),
+/// Where that impulse is at least `floor` (N s; None: the program always), the answer is that
+/// distribution: its least normal impulse capped at 0 as `min_normal` (a lower bound of s*),
 /// `limiting` None (no program, no dual price), its `normals`. Otherwise, the program's answer.
 ///
 /// The impulses of impacts and landings are mostly carried by faces that press everywhere, and
@@ -145,7 +145,7 @@ pub fn compressive_impulses_at_least(
     dynamics: &Dynamics,
     momentum_change: &[(Vector3<f64>, Vector3<f64>)],
     set_by_law: &[usize],
-    enough: f64,
+    floor: Option<f64>,
 ) -> Option<MostCompressive> {
     let program = FaceProgram::build_setting(model, dynamics, set_by_law, FaceAxes::Parent);
     // Impulses in W·√(L/g), the structure's weight over its time unit, so that the program's
@@ -159,10 +159,11 @@ pub fn compressive_impulses_at_least(
             loads[6 * b + 3 + i] = angular[i] / (unit * model.size);
         }
     }
-    let least_norm = (enough < f64::INFINITY)
-        .then(|| program.least_norm(&loads, &mut LeastNorm::default()))
-        .flatten()
-        .filter(|x| program.smallest(x) * unit >= enough);
+    let least_norm = floor.and_then(|floor| {
+        program
+            .least_norm(&loads, &mut LeastNorm::default())
+            .filter(|x| program.smallest(x) * unit >= floor)
+    });
     let mut answer = match least_norm {
         Some(x) => program.answer(&x, None),
         None => {

@@ -124,9 +124,9 @@ pub(super) fn least_normal_impulse(
     set_by_law: &[usize],
 ) -> Option<LeastNormal> {
     let changes = momentum_changes(model, d, q, (pivots_before, qdot_minus), qdot_after);
-    let enough = -0.5 * tension_tolerance(model);
+    let floor = Some(-0.5 * tension_tolerance(model));
     crate::face_forces::least_normal_impulse_on_tree(model, d, &changes, set_by_law).or_else(|| {
-        crate::face_forces::compressive_impulses_at_least(model, d, &changes, set_by_law, enough)
+        crate::face_forces::compressive_impulses_at_least(model, d, &changes, set_by_law, floor)
             .map(|least| LeastNormal {
                 min_normal: least.min_normal,
                 limiting: least.limiting,
@@ -289,7 +289,7 @@ mod tests {
             let lp = most_compressive_impulses(&model, &d, &changes, &[]).expect("the LP solves");
             for (i, floor) in [0.5, 2.0].into_iter().enumerate() {
                 let enough = -floor * tolerance;
-                let quick = compressive_impulses_at_least(&model, &d, &changes, &[], enough)
+                let quick = compressive_impulses_at_least(&model, &d, &changes, &[], Some(enough))
                     .expect("an answer");
                 if quick == lp {
                     programs += 1;

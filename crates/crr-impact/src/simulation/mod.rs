@@ -1461,8 +1461,11 @@ impl<'a> Simulation<'a> {
             &mut on_step,
         );
         self.spare.system = sys.into_buffers();
-        let (collapse_index, first_zone_index) =
-            (events.collapse_index(), events.first_zone_index());
+        let (collapse_index, toppling_index, first_zone_index) = (
+            events.collapse_index(),
+            events.toppling_index(),
+            events.first_zone_index(),
+        );
         let rocking_len = events.rocking.len();
         let event_slot = match &stop {
             Ok(Stop::Event { index, .. }) => events.rocking.get(*index).map(|r| r.0),
@@ -1558,6 +1561,7 @@ impl<'a> Simulation<'a> {
             stop,
             event_slot,
             collapse_index,
+            toppling_index,
             first_zone_index,
             rocking_len,
         )
@@ -1589,8 +1593,8 @@ impl<'a> Simulation<'a> {
     /// tilted by its own rocking lowers or raises them without their falling). A body
     /// toppling off a support loses its contact on the way down (its centre's acceleration
     /// towards the pivot outgrows gravity): that flight is the end of a fall, reported as a
-    /// collapse naming the joint's body (a finial on a pier flies at 1.2 to 1.5 rad, where it
-    /// has dropped by a quarter of its height). None for bodies above their rest height (a
+    /// collapse naming the joint's body (a 0.5 m finial on a pier flies at 1.2 to 1.5 rad, its
+    /// centre 0.07 to 0.14 m below its rest height). None for bodies above their rest height (a
     /// block leaving its corner under a fast signal).
     fn fallen_in_flight(&mut self, k: usize) -> Option<Collapse> {
         let model = Arc::clone(&self.model);
@@ -1725,6 +1729,7 @@ impl<'a> Simulation<'a> {
         stop: Stop,
         event_slot: Option<usize>,
         collapse_index: usize,
+        toppling_index: usize,
         first_zone_index: usize,
         rocking_len: usize,
     ) -> Result<StopReason, SimulationError> {
@@ -1743,7 +1748,7 @@ impl<'a> Simulation<'a> {
                 if let Some(slot) = event_slot {
                     debug_assert!(index < rocking_len);
                     self.impact(slot).map(StopReason::Impact)
-                } else if index == collapse_index + 1 {
+                } else if index == toppling_index {
                     // The toppling event (`events`): a rocking contact turned to π/2.
                     let q = self.chain_q();
                     match self.toppled_body(&q) {
@@ -1781,10 +1786,11 @@ impl<'a> Simulation<'a> {
     }
 
     /// The body of a rocking contact turned to π/2 on its pivot's side at `q` (within 1e-9
-    /// rad, the toppling event's location): it lies on its support's plane, toppled (the
-    /// toppling function, `events`): the interface's child, or on a chain grown again around
-    /// open faces, where the interface was turned round, the file's child, its parent here.
-    /// None when no contact is there.
+    /// rad, the toppling event's location; of several, the farthest turned, so that the body
+    /// named does not depend on the order of the slots): it lies on its support's plane,
+    /// toppled (the toppling function, `events`): the interface's child, or on a chain grown
+    /// again around open faces, where the interface was turned round, the file's child, its
+    /// parent here. None when no contact is there.
     fn toppled_body(&mut self, q: &DVector<f64>) -> Option<String> {
         let model = Arc::clone(&self.model);
         let mut angles = vec![0.0; model.slot_count];
@@ -1796,12 +1802,11 @@ impl<'a> Simulation<'a> {
             &mut angles,
         );
         let (seated, contacts) = (&self.seated, &self.contact_slots);
+        let past_seat = |s: usize| self.dynamics.pivots.sides[s].sign() * angles[s];
         let s = (0..model.slot_count)
             .filter(|&s| !seated[s] && contacts[s])
-            .find(|&s| {
-                self.dynamics.pivots.sides[s].sign() * angles[s]
-                    >= std::f64::consts::FRAC_PI_2 - 1e-9
-            })?;
+            .filter(|&s| past_seat(s) >= std::f64::consts::FRAC_PI_2 - 1e-9)
+            .max_by(|&a, &b| past_seat(a).total_cmp(&past_seat(b)))?;
         let i = slot_interface(&model, s);
         let iface = &model.interfaces[i];
         let body = match iface.parent {
