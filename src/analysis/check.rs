@@ -425,6 +425,11 @@ pub fn to_text(r: &CheckReport) -> String {
                             lifting.join(", ")
                         );
                     }
+                    if let Some(convex) = m.convex_lambda {
+                        s += &format!(
+                            "    found by the search for joints that open and slide (without them λ = {convex:.6}): the structure does not hold beyond this λ, but the search is not exhaustive and a lower mechanism may exist (docs/simulation.md, \"Joints that open may slide\")\n"
+                        );
+                    }
                     let sliding = with(crr_impact::statics::Motion::Slides);
                     if !sliding.is_empty() {
                         s += &format!(
@@ -483,6 +488,15 @@ pub fn to_text(r: &CheckReport) -> String {
             s += &format!(" {name} {code}");
         }
         s += "\n";
+        if k.alpha_eq < -1e-9 {
+            // Its weight opens it: nothing holds it at rest, nothing to activate, and no rocking
+            // about a seat to give frequencies for.
+            s += &format!(
+                "the mechanism falls under its own weight (U′(0) = {:.6e} N m < 0 as it opens, α_eq = {:.6} rad): it has no activation multiplier, equivalent block or free-rocking frequencies (the static multiplier above says what load would hold it)\n",
+                k.potential_slope, k.alpha_eq
+            );
+            return s;
+        }
         s += &format!(
             "activation multiplier λ = {:.6} (ground acceleration {:.4} m/s² along {}({:.3}, {:.3}, {:.3}))\n",
             k.lambda,

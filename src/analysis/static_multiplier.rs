@@ -72,6 +72,11 @@ pub struct StaticMultiplier {
     /// those whatever they are, so λ relies on a capacity the model gives it without geometry
     /// (the out-of-plane width of the joint). Empty where some distribution spares them all.
     pub hinges_out_of_plane: Vec<String>,
+    /// The convex program's λ, where `lambda` lies below it: `lambda` is then the search's
+    /// answer for joints that open and slide, an admissible mechanism (the structure does not
+    /// hold beyond it) from a search that is not exhaustive, so a lower one may exist. `None`
+    /// where `lambda` is the convex program's own answer (exact for joints that do not slide).
+    pub convex_lambda: Option<f64>,
 }
 
 impl StaticMultiplier {
@@ -125,6 +130,7 @@ pub fn static_multiplier_with(
             required_friction: None,
             out_of_plane: along_axis,
             hinges_out_of_plane: Vec::new(),
+            convex_lambda: None,
         });
     }
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
@@ -286,5 +292,9 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         required_friction: friction,
         out_of_plane: out_of_plane(model, &Vector3::from(collapse.direction)),
         hinges_out_of_plane: Vec::new(),
+        convex_lambda: collapse
+            .from_sliding_search()
+            .then_some(collapse.convex_lambda)
+            .flatten(),
     }
 }

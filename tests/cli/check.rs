@@ -233,3 +233,71 @@ fn pivots_off_their_bodies_and_overlapping_blocks_are_reported() {
         }
     }
 }
+
+/// A reader that closes the pipe early (`crr check --json … | head -1`) ends the program quietly
+/// with 141 (128 + SIGPIPE, what a shell reports for a tool the signal ends), not with a panic
+/// and a backtrace (an independent review).
+#[test]
+fn a_reader_that_closes_the_pipe_ends_the_program_quietly() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args(["check", "examples/models/temple.toml", "--json"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("crr runs");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().expect("its output"))
+        .read_line(&mut first)
+        .expect("a first line");
+    // The reader is dropped here: the pipe is closed with the report still to come.
+    assert_eq!(first.trim(), "{");
+    let out = child.wait_with_output().expect("crr ends");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.code(), Some(141), "{stderr}");
+}
+
+/// A structure that falls under its own weight (a leaning prism, its centre of mass 0.3 m
+/// beyond its base's edge over a height of 1 m, by its trapezoid's centroid) has no activation
+/// multiplier, equivalent block or free-rocking frequencies: the report says so instead of
+/// printing them for a negative α_eq (an independent review).
+#[test]
+fn a_structure_that_falls_under_its_own_weight_has_no_free_rocking_report() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("models");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("leaning_prism.toml");
+    std::fs::write(
+        &path,
+        r#"name = "lean"
+[[body]]
+name = "block"
+density = 2000.0
+prism = { polygon = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [1.2, -0.2, 2.0], [0.8, -0.2, 2.0]], extrude = [0.0, 0.4, 0.0] }
+[[interface]]
+name = "base"
+parent = "ground"
+child = "block"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [0.2, 0.0, 0.0]
+pivot_negative = [-0.2, 0.0, 0.0]
+"#,
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_crr"))
+        .args(["check", path.to_str().unwrap()])
+        .output()
+        .expect("crr runs");
+    let text = String::from_utf8_lossy(&o.stdout);
+    // The centroid of the parallelogram lies at x = 0.5 over its base [−0.2, 0.2]: 0.3 m beyond
+    // the + edge, 1 m up, so it would need 0.3 g along +x to stand.
+    assert!(
+        text.contains("does not hold at rest") && text.contains("0.300000 g"),
+        "{text}"
+    );
+    assert!(text.contains("falls under its own weight"), "{text}");
+    assert!(!text.contains("free-rocking frequency"), "{text}");
+    assert!(!text.contains("activation multiplier λ"), "{text}");
+}

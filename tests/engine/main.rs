@@ -8,6 +8,7 @@ mod common;
 mod arch_3d;
 mod certificate_audit;
 mod collapse;
+mod far_from_origin;
 mod impact_laws_on_chains;
 mod impulse_tension;
 mod initial_state_paths;

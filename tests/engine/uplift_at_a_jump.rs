@@ -124,3 +124,82 @@ fn a_pulse_that_starts_above_the_threshold_uplifts_at_its_start_with_no_violatio
         );
     }
 }
+
+/// The bundled drum column (eight drums and a capital, `examples/models/drum_column.toml`),
+/// tilted 0.005 rad on its base and let go, under a rectangular pulse of 12 m/s² from 0.15 s to
+/// 0.45 s, sampled every `output_interval` s, for 1 s.
+fn drum_column_under_rectangular_pulse(output_interval: f64) -> String {
+    let bundled = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models/drum_column.toml"),
+    )
+    .expect("the bundled drum column");
+    let structure = &bundled[..bundled.find("[ground_motion]").expect("its ground motion")];
+    format!(
+        r#"{structure}[ground_motion]
+x = {{ rectangular_pulse = {{ amplitude = 12.0, duration = 0.3, start = 0.15 }} }}
+
+[initial]
+angles = {{ bed_1 = 0.005 }}
+
+[analysis]
+duration = 1.0
+output_interval = {output_interval}
+"#
+    )
+}
+
+/// The same jump in motion: the column rocks on its base with its beds seated when the pulse
+/// starts at a sample instant (0.15 s) and, on a drum bed, pushes the chain past its threshold
+/// there; it ends at another (0.15 + 0.3 s, an ulp below 0.45 in floating point). Until
+/// 2026-12-02 the samples at those instants were taken before the engine's release, under the
+/// load after the jump, and the monitor reported a seated bed's resultant outside its face at
+/// 0.15 s (`outside_face`, the run marked outside the model), and with that mended, at 0.45 s.
+/// The sample grid decides nothing in the physics: sampled every 0.01 s (both jumps on sample
+/// instants) or every 0.007 s (neither), the run is the same (its impacts at the same instants,
+/// to 1e-9 s) and neither finds a hypothesis failing.
+#[test]
+fn a_jump_in_motion_at_a_sample_instant_is_judged_after_the_release() {
+    let runs: Vec<_> = [0.01, 0.007]
+        .into_iter()
+        .map(|dt| {
+            let tag = format!("drum_column_jump_sampled_{dt}");
+            let (_, traj) =
+                common::run_model_text(&tag, &drum_column_under_rectangular_pulse(dt), None);
+            assert!(
+                traj.violation.is_none(),
+                "{tag}: a hypothesis failing where the load jumps: {:?}",
+                traj.violation
+            );
+            let times: Vec<f64> = traj.samples.iter().map(|s| s.t).collect();
+            assert!(
+                times.windows(2).all(|w| w[0] <= w[1]),
+                "{tag}: sample times out of order"
+            );
+            traj
+        })
+        .collect();
+    let (on_grid, off_grid) = (&runs[0], &runs[1]);
+    assert!(
+        on_grid.impacts.len() > 10,
+        "the column rocks: {} impacts",
+        on_grid.impacts.len()
+    );
+    assert_eq!(on_grid.impacts.len(), off_grid.impacts.len());
+    for (a, b) in on_grid.impacts.iter().zip(&off_grid.impacts) {
+        assert!(
+            (a.t - b.t).abs() < 1e-9,
+            "impact at {} s sampled every 0.01 s, {} s every 0.007 s",
+            a.t,
+            b.t
+        );
+    }
+    // The samples at the jumps: once each on the 0.01 s grid.
+    for jump in [0.15, 0.45] {
+        let at_jump = on_grid
+            .samples
+            .iter()
+            .filter(|s| (s.t - jump).abs() < 1e-9)
+            .count();
+        assert_eq!(at_jump, 1, "the instant {jump} s sampled {at_jump} times");
+    }
+}

@@ -937,3 +937,258 @@ fn the_wall_assembled_from_its_stones_matches_the_block_lp() {
         assert_close(&format!("assembled wall, dx = {dx:+}"), got, expected, RTOL);
     }
 }
+
+// ------------------------------------------------------------------------------------------------
+// A corner wedge that slides off its other support, by virtual work
+// ------------------------------------------------------------------------------------------------
+
+/// A planar wall of `courses` of height `h` (depth 0.5 m), course c cut at the lengths
+/// `cuts[c]` from x = 0 (each course spans the sum), mirrored about x = 0 when `mirror`: its
+/// blocks (name, [x₀, x₁], [z₀, z₁]) and the model whose every bed-joint overlap is a hinge about
+/// +y, `{above}_on_{below}`, as in [`running_bond_wall`].
+fn cut_wall(cuts: &[&[f64]], h: f64, mirror: bool) -> (Vec<WallBlock>, StructureSpec) {
+    use crr::kinematics::fixtures::{MASONRY_DENSITY, box_body, hinge};
+    let mut blocks = Vec::new();
+    for (c, course) in cuts.iter().enumerate() {
+        let mut x = 0.0;
+        for (i, &len) in course.iter().enumerate() {
+            let (x0, x1) = if mirror { (-x - len, -x) } else { (x, x + len) };
+            blocks.push(WallBlock {
+                name: format!("c{c}_b{i}"),
+                x: [x0, x1],
+                z: [c as f64 * h, (c + 1) as f64 * h],
+            });
+            x += len;
+        }
+    }
+    let body = blocks
+        .iter()
+        .map(|b| {
+            box_body(
+                &b.name,
+                MASONRY_DENSITY,
+                [(b.x[0] + b.x[1]) / 2.0, 0.0, (b.z[0] + b.z[1]) / 2.0],
+                [b.x[1] - b.x[0], 0.5, h],
+            )
+        })
+        .collect();
+    let mut interface = Vec::new();
+    for above in &blocks {
+        let supports: Vec<(&str, [f64; 2])> = if above.z[0] == 0.0 {
+            vec![("ground", above.x)]
+        } else {
+            blocks
+                .iter()
+                .filter(|b| (b.z[1] - above.z[0]).abs() < 1e-12)
+                .map(|b| {
+                    (
+                        b.name.as_str(),
+                        [b.x[0].max(above.x[0]), b.x[1].min(above.x[1])],
+                    )
+                })
+                .filter(|(_, x)| x[1] - x[0] > 1e-9)
+                .collect()
+        };
+        for (below, x) in supports {
+            let z = above.z[0];
+            interface.push(hinge(
+                &format!("{}_on_{below}", above.name),
+                below,
+                &above.name,
+                [0.0, 1.0, 0.0],
+                [x[1], 0.0, z],
+                [x[0], 0.0, z],
+            ));
+        }
+    }
+    let spec = StructureSpec {
+        name: "cut_wall".into(),
+        gravity: 9.81,
+        body,
+        interface,
+        symmetry: Vec::new(),
+    };
+    (blocks, spec)
+}
+
+/// A block of [`cut_wall`].
+struct WallBlock {
+    name: String,
+    x: [f64; 2],
+    z: [f64; 2],
+}
+
+/// A planar rigid motion: the velocity (v_x, v_z) of the point (x, z) for a rotation at rate ω
+/// (positive turning +x into +z's place, i.e. counter-clockwise seen from −y) about (p_x, p_z)
+/// plus a translation (u_x, u_z).
+#[derive(Clone, Copy)]
+struct PlanarMotion {
+    about: [f64; 2],
+    omega: f64,
+    translation: [f64; 2],
+}
+
+impl PlanarMotion {
+    const REST: PlanarMotion = PlanarMotion {
+        about: [0.0, 0.0],
+        omega: 0.0,
+        translation: [0.0, 0.0],
+    };
+    fn velocity(&self, x: f64, z: f64) -> [f64; 2] {
+        [
+            self.translation[0] - self.omega * (z - self.about[1]),
+            self.translation[1] + self.omega * (x - self.about[0]),
+        ]
+    }
+}
+
+/// The kinematic theorem on a wall of boxes of one density: λ = (power of the weights against
+/// the motion) / (power of the inertial load −λ g d_x x̂), the boxes' areas as their weights and
+/// their centres' velocities, for the motion `motion` of each block (none: at rest). The motion
+/// must be admissible, which is checked here at both ends of every bed-joint overlap: the gap
+/// rate (the upper block's vertical velocity less the lower's) is ≥ 0, and the joint slips
+/// (relative horizontal velocity) only where it opens at both ends (a compressed joint cannot
+/// slide; a joint that opens carries nothing and may).
+fn wedge_multiplier(blocks: &[WallBlock], motion: &[PlanarMotion], dx: f64) -> f64 {
+    let tol = 1e-12;
+    let at = |i: Option<usize>, x: f64, z: f64| i.map_or([0.0, 0.0], |i| motion[i].velocity(x, z));
+    for (a, above) in blocks.iter().enumerate() {
+        let supports: Vec<(Option<usize>, [f64; 2])> = if above.z[0] == 0.0 {
+            vec![(None, above.x)]
+        } else {
+            blocks
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| (b.z[1] - above.z[0]).abs() < 1e-12)
+                .map(|(j, b)| (Some(j), [b.x[0].max(above.x[0]), b.x[1].min(above.x[1])]))
+                .filter(|(_, x)| x[1] - x[0] > 1e-9)
+                .collect()
+        };
+        for (below, x) in supports {
+            let z = above.z[0];
+            let rel: Vec<[f64; 2]> = x
+                .iter()
+                .map(|&xe| {
+                    let (u, l) = (at(Some(a), xe, z), at(below, xe, z));
+                    [u[0] - l[0], u[1] - l[1]]
+                })
+                .collect();
+            let opens = rel.iter().all(|r| r[1] > tol);
+            for r in &rel {
+                assert!(r[1] >= -tol, "{} interpenetrates its support", above.name);
+                assert!(
+                    opens || r[0].abs() <= tol,
+                    "{} slides on a support it presses",
+                    above.name
+                );
+            }
+        }
+    }
+    let (mut gravity, mut load) = (0.0, 0.0);
+    for (b, m) in blocks.iter().zip(motion) {
+        let area = (b.x[1] - b.x[0]) * (b.z[1] - b.z[0]);
+        let v = m.velocity((b.x[0] + b.x[1]) / 2.0, (b.z[0] + b.z[1]) / 2.0);
+        gravity += area * v[1];
+        load += area * (-dx * v[0]);
+    }
+    assert!(load > 0.0, "the load does no work on the mechanism");
+    gravity / load
+}
+
+/// A corner wedge that the search for sliding lift-offs missed until 2026-12-02 (an independent
+/// review: 32 of the 250 directions of 125 three-course walls answered above their wedge). Three
+/// courses 0.5 m high and 1 m long cut [0.2 | 0.8], [0.8 | 0.2], [0.35 | 0.65], loaded along +x
+/// (the inertial load towards −x). The end block c0_b0 turns about its outer foot (0, 0); the
+/// blocks c1_b0, c2_b0, c2_b1 translate together by (−0.5, 0.2) per unit of its rotation (c1_b0
+/// hinges on c0_b0's inner top corner and leaves c0_b1 sliding, opened by 0.2 at every point);
+/// c1_b1 turns about its left foot (0.8, 0.5), c2_b1 hinged on its right top corner. Virtual
+/// work (areas as weights): against gravity 0.1·0.1 + 0.9·0.2 + 0.1·0.1 = 0.2, by the load
+/// 0.1·0.25 + 0.9·0.5 + 0.1·0.25 = 0.5: λ = 2/5, an upper bound of the true multiplier (an
+/// admissible motion). The engine's answer must not exceed it and, having found the wedge,
+/// equals it (1e-7); the convex program alone (no joint that opens may slide) gives 0.577778.
+/// The mirrored wall gives the same along −x.
+#[test]
+fn a_corner_wedge_that_slides_off_its_other_support_is_found() {
+    let cuts: [&[f64]; 3] = [&[0.2, 0.8], &[0.8, 0.2], &[0.35, 0.65]];
+    for mirror in [false, true] {
+        let (blocks, spec) = cut_wall(&cuts, 0.5, mirror);
+        let s = if mirror { -1.0 } else { 1.0 };
+        // The motion above, mirrored with the wall (x → −x turns rotations round).
+        let wedge = |about: [f64; 2], omega: f64, translation: [f64; 2]| PlanarMotion {
+            about: [s * about[0], about[1]],
+            omega: s * omega,
+            translation: [s * translation[0], translation[1]],
+        };
+        let turning = wedge([0.0, 0.0], 1.0, [0.0, 0.0]);
+        let sliding = wedge([0.0, 0.0], 0.0, [-0.5, 0.2]);
+        let rocking = wedge([0.8, 0.5], 1.0, [0.0, 0.0]);
+        let motion: Vec<PlanarMotion> = blocks
+            .iter()
+            .map(|b| match b.name.as_str() {
+                "c0_b0" => turning,
+                "c1_b0" | "c2_b0" | "c2_b1" => sliding,
+                "c1_b1" => rocking,
+                _ => PlanarMotion::REST,
+            })
+            .collect();
+        let dx = s;
+        let by_hand = wedge_multiplier(&blocks, &motion, dx);
+        assert!(
+            (by_hand - 0.4).abs() < 1e-12,
+            "virtual work gives {by_hand}"
+        );
+        let found = engine_default(&spec, dx).expect("the wall has a multiplier");
+        let convex = engine(&spec, dx).expect("the wall has a multiplier");
+        println!("mirror {mirror}: engine {found:.12}, convex {convex:.12}, wedge {by_hand}");
+        assert!(
+            found <= by_hand * (1.0 + 1e-9),
+            "{found} above the wedge {by_hand}"
+        );
+        assert_close("corner wedge", Some(found), by_hand, RTOL);
+        assert!(convex > by_hand * 1.4, "the convex program's {convex}");
+    }
+}
+
+/// An arch of 200 voussoirs near its minimum thickness (t/R = 0.108, radii 0.946 and 1.054),
+/// assembled from its stones as a user writes them (`crr assemble --all-contacts --planar` of
+/// annular sectors): the multiplier along ±x equals Heyman's thrust-line program's (1e-7), and
+/// the friction it needs is found. Until 2026-12-02 `crr check` gave no multiplier at all here
+/// (an independent review): the program asking whether the arch stands without friction, which
+/// it does not, stopped the solver with a `NumericalError` at the statics' own tolerances
+/// instead of an infeasibility; the statics now retry with other settings before giving up.
+#[test]
+fn an_arch_of_200_voussoirs_near_its_minimum_thickness_has_its_multiplier() {
+    use crr::analysis::assemble::{assemble, read_assembly};
+    use crr::kinematics::assembly::ContactSet;
+    let (n, r_in, r_out) = (200, 0.946, 1.054);
+    let mut text = String::from("name = \"arch\"\ngravity = 9.81\n");
+    for k in 0..n {
+        let (from, to) = (
+            k as f64 * std::f64::consts::PI / n as f64,
+            (k + 1) as f64 * std::f64::consts::PI / n as f64,
+        );
+        text += &format!(
+            "\n[[body]]\nname = \"v{}\"\ndensity = 2000.0\nannular_sector = {{ center = [0.0, 0.0, 0.0], axis = [0.0, -1.0, 0.0], start = [1.0, 0.0, 0.0], inner_radius = {r_in}, outer_radius = {r_out}, thickness = 1.0, from_angle = {from}, to_angle = {to} }}\n",
+            k + 1
+        );
+    }
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("assemblies");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("arch_200_voussoirs.toml");
+    std::fs::write(&path, text).unwrap();
+    let file = read_assembly(&path).unwrap();
+    let assembled = assemble(&path, &file, true, ContactSet::All, 1e-6).unwrap();
+    for dx in [1.0, -1.0] {
+        let expected = arch_lambda(n, r_in, r_out, dx).expect("the thrust line stands");
+        let report = static_multiplier(&assembled.model, Vector3::new(dx, 0.0, 0.0))
+            .unwrap_or_else(|e| panic!("dx = {dx:+}: {e}"));
+        assert_close(
+            &format!("200 voussoirs, dx = {dx:+}"),
+            report.lambda,
+            expected,
+            RTOL,
+        );
+        let mu = report.required_friction.expect("a friction for λ");
+        assert!(mu > 0.0 && mu.is_finite(), "μ = {mu}");
+    }
+}

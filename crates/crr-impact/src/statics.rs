@@ -80,6 +80,46 @@ impl Default for StaticsOptions {
 /// Friction coefficients of the probes that look for sliding lift-offs (largest first).
 const PROBE_FRICTION: [f64; 4] = [2.0, 1.0, 0.5, 0.25];
 
+/// The search for sliding lift-offs tries pairs of the probes' interfaces where no set and no
+/// single interface lowers λ, up to this many interfaces (at most 66 programs a round).
+const PAIRS_UP_TO: usize = 12;
+
+/// The interior-point solver's settings, tried in turn until one gives a verdict (solved or
+/// infeasible): the program's own (gaps and feasibility to 1e-12), then, where the solver stalls
+/// in round-off (`NumericalError`), more iterations and refinement steps with tolerances of
+/// 1e-10, then 1e-11 without equilibration. The friction the multiplier of an arch of 200
+/// voussoirs near its minimum thickness needs asks whether it stands without friction; the
+/// program's own settings stopped there with a `NumericalError` and `crr check` gave no
+/// multiplier at all; the third settings find it infeasible, as it is (an independent review).
+/// Tolerances of 1e-10 lie far below the 1e-7 the multipliers are checked to.
+struct SolverAttempt {
+    tolerance: f64,
+    max_iter: u32,
+    refinement_steps: u32,
+    equilibrate: bool,
+}
+
+const SOLVER_ATTEMPTS: [SolverAttempt; 3] = [
+    SolverAttempt {
+        tolerance: 1e-12,
+        max_iter: 400,
+        refinement_steps: 10,
+        equilibrate: true,
+    },
+    SolverAttempt {
+        tolerance: 1e-10,
+        max_iter: 1000,
+        refinement_steps: 50,
+        equilibrate: true,
+    },
+    SolverAttempt {
+        tolerance: 1e-11,
+        max_iter: 1000,
+        refinement_steps: 50,
+        equilibrate: false,
+    },
+];
+
 /// Most rounds of the search for sliding lift-offs (each frees at least one interface).
 const LIFT_OFF_ROUNDS: usize = 8;
 
@@ -173,6 +213,22 @@ pub struct Collapse {
     /// Virtual velocities of the bodies in the mechanism, scaled so that the largest of |v| and
     /// size·|ω| over the bodies is 1 (all zero when it holds).
     pub bodies: Vec<BodyMotion>,
+    /// The convex program's λ (no joint freed to slide where it opens). Where `lambda` lies
+    /// below it, `lambda` is the search's answer for joints that open and slide: an admissible
+    /// mechanism with an equilibrium at its λ, so the structure does not hold beyond it, but
+    /// the search is not exhaustive and a lower one may exist ([`collapse_multiplier`]).
+    pub convex_lambda: Option<f64>,
+}
+
+impl Collapse {
+    /// Whether λ comes from the search for joints that open and slide (below the convex answer).
+    pub fn from_sliding_search(&self) -> bool {
+        match (self.lambda, self.convex_lambda) {
+            (Some(l), Some(c)) => l < c,
+            (Some(_), None) => true,
+            _ => false,
+        }
+    }
 }
 
 impl Collapse {
@@ -342,7 +398,9 @@ fn solve_program(
 /// μ = 2, 1, 0.5, 0.25 find candidates: the interfaces that separate and slide in a probe's
 /// mechanism are freed (normal forces only) and the program without sliding is solved again. A
 /// candidate is kept when its λ is lower and its mechanism is physical: every freed interface
-/// either separates at all its points or does not slide (a compressed joint cannot slide). Rounds
+/// either separates at all its points or does not slide (a compressed joint cannot slide). Each
+/// probe's interfaces are tried freed together, each of the probes' interfaces alone and, where
+/// none of those lowers λ, each pair of them; the lowest physical candidate is kept. Rounds
 /// repeat until no probe lowers λ. Every answer kept is an admissible mechanism with an
 /// equilibrium at its λ (an upper bound of the true multiplier, never above the convex one); the
 /// search is not proved to find the lowest.
@@ -357,7 +415,59 @@ fn sliding_lift_offs(
     let Some(mut best_lambda) = convex.lambda else {
         return Ok(convex);
     };
+    let convex_lambda = convex.lambda;
     let mut best = convex;
+    for _ in 0..LIFT_OFF_ROUNDS {
+        let probes = lowering_probes(model, faces, d, options, free, best_lambda);
+        if probes.is_empty() {
+            break;
+        }
+        // The interfaces that separate and slide in some probe's mechanism, in the file's order.
+        let mut opened: Vec<usize> = probes.iter().flatten().copied().collect();
+        opened.sort_unstable();
+        opened.dedup();
+        // Each probe's interfaces freed together, then each interface alone, then (where
+        // neither lowers λ) each pair: freed together they can fail the physical test (one of
+        // them compressed and sliding) where one or two of them are a mechanism, a corner wedge
+        // of a wall whose block leaves its other support sideways while the probe's mechanism
+        // also opened a joint that must stay closed (an independent review found three-course
+        // walls answered up to 44 % above their wedge's multiplier that way).
+        let mut sets: Vec<Vec<usize>> = probes.into_iter().filter(|p| p.len() > 1).collect();
+        sets.extend(opened.iter().map(|&i| vec![i]));
+        let mut found = lowest_physical(model, faces, d, options, free, best_lambda, &sets);
+        if found.is_none() && opened.len() <= PAIRS_UP_TO {
+            let pairs: Vec<Vec<usize>> = (0..opened.len())
+                .flat_map(|a| (a + 1..opened.len()).map(move |b| (a, b)))
+                .map(|(a, b)| vec![opened[a], opened[b]])
+                .collect();
+            found = lowest_physical(model, faces, d, options, free, best_lambda, &pairs);
+        }
+        let Some((lambda, candidate, trial)) = found else {
+            break;
+        };
+        best_lambda = lambda;
+        best = Collapse {
+            convex_lambda,
+            ..candidate
+        };
+        *free = trial;
+    }
+    Ok(best)
+}
+
+/// The probes with friction that lower λ below `best_lambda`, each as the interfaces its
+/// mechanism separates at all their points while sliding (not yet freed, not pins; empty sets
+/// left out). λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a
+/// smaller one, with the same freed interfaces, so where the smallest probe does not lower λ,
+/// none does, and one program answers for the four.
+fn lowering_probes(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    free: &[bool],
+    best_lambda: f64,
+) -> Vec<Vec<usize>> {
     let probe_options = |mu: f64| StaticsOptions {
         friction: Friction::Pyramid(mu),
         sliding_lift_off: false,
@@ -365,72 +475,80 @@ fn sliding_lift_offs(
     };
     // (Written as the negation of "holds as high": a NaN λ counts as lowering, as it always has,
     // and goes on to the candidate's own program.)
-    let lowers = |probe: &Collapse, best_lambda: f64| {
-        !probe.lambda.is_none_or(|l| l >= best_lambda * (1.0 - 1e-6))
-    };
+    let lowers = |probe: &Collapse| !probe.lambda.is_none_or(|l| l >= best_lambda * (1.0 - 1e-6));
     let smallest_mu = PROBE_FRICTION.iter().copied().fold(f64::INFINITY, f64::min);
-    for _ in 0..LIFT_OFF_ROUNDS {
-        let mut improved = false;
-        // λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a smaller
-        // one, with the same freed interfaces. So where the smallest probe does not lower λ,
-        // no probe does, and one program answers for the four.
-        let mut smallest = Some(solve_program(
-            model,
-            faces,
-            d,
-            &probe_options(smallest_mu),
-            free,
-        ));
-        if let Some(Ok(probe)) = &smallest
-            && !lowers(probe, best_lambda)
-        {
-            break;
+    let mut smallest = Some(solve_program(
+        model,
+        faces,
+        d,
+        &probe_options(smallest_mu),
+        free,
+    ));
+    if let Some(Ok(probe)) = &smallest
+        && !lowers(probe)
+    {
+        return Vec::new();
+    }
+    let mut sets = Vec::new();
+    for mu in PROBE_FRICTION {
+        let probe = match smallest.take_if(|_| mu == smallest_mu) {
+            Some(probe) => probe,
+            None => solve_program(model, faces, d, &probe_options(mu), free),
+        };
+        let Ok(probe) = probe else {
+            continue;
+        };
+        if !lowers(&probe) {
+            continue;
         }
-        for mu in PROBE_FRICTION {
-            let probe = match smallest.take_if(|_| mu == smallest_mu) {
-                Some(probe) => probe,
-                None => solve_program(model, faces, d, &probe_options(mu), free),
-            };
-            let Ok(probe) = probe else {
-                continue;
-            };
-            if !lowers(&probe, best_lambda) {
-                continue;
-            }
-            let mut trial = free.clone();
-            let mut added = false;
-            for i in &probe.interfaces {
-                if i.gap_rates.iter().all(|&g| g > MECHANISM_TOLERANCE)
+        let opened: Vec<usize> = probe
+            .interfaces
+            .iter()
+            .filter(|i| {
+                i.gap_rates.iter().all(|&g| g > MECHANISM_TOLERANCE)
                     && i.slip_rate > MECHANISM_TOLERANCE
-                    && !trial[i.interface]
+                    && !free[i.interface]
                     && !faces[i.interface].pin
-                {
-                    trial[i.interface] = true;
-                    added = true;
-                }
-            }
-            if !added {
-                continue;
-            }
-            let Ok(candidate) = solve_program(model, faces, d, options, &trial) else {
-                continue;
-            };
-            let Some(lambda) = candidate.lambda else {
-                continue;
-            };
-            if lambda < best_lambda * (1.0 - 1e-9) && physical(&candidate, &trial) {
-                best_lambda = lambda;
-                best = candidate;
-                *free = trial;
-                improved = true;
-                break;
-            }
-        }
-        if !improved {
-            break;
+            })
+            .map(|i| i.interface)
+            .collect();
+        if !opened.is_empty() {
+            sets.push(opened);
         }
     }
-    Ok(best)
+    sets
+}
+
+/// Of the interface sets `sets`, each freed in addition to `free`, the one whose program
+/// without sliding gives the lowest λ below `best_lambda` with a physical mechanism: that λ, its
+/// collapse and the freed interfaces. None where no set lowers λ physically.
+fn lowest_physical(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    free: &[bool],
+    best_lambda: f64,
+    sets: &[Vec<usize>],
+) -> Option<(f64, Collapse, Vec<bool>)> {
+    let mut found: Option<(f64, Collapse, Vec<bool>)> = None;
+    for set in sets {
+        let mut trial = free.to_vec();
+        for &i in set {
+            trial[i] = true;
+        }
+        let Ok(candidate) = solve_program(model, faces, d, options, &trial) else {
+            continue;
+        };
+        let Some(lambda) = candidate.lambda else {
+            continue;
+        };
+        let lowest = found.as_ref().map_or(best_lambda, |f| f.0);
+        if lambda < lowest * (1.0 - 1e-9) && physical(&candidate, &trial) {
+            found = Some((lambda, candidate, trial));
+        }
+    }
+    found
 }
 
 /// Whether every freed interface of a mechanism separates at all its points or does not slide.
@@ -757,26 +875,34 @@ impl Program {
         b: &[f64],
         cones: &[SupportedConeT<f64>],
     ) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
-        let settings = DefaultSettingsBuilder::default()
-            .verbose(false)
-            .tol_gap_abs(1e-12)
-            .tol_gap_rel(1e-12)
-            .tol_feas(1e-12)
-            .tol_ktratio(1e-10)
-            .max_iter(400)
-            .build()
-            .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
-        let mut solver = DefaultSolver::new(p, q, a, b, cones, settings)
-            .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
-        solver.solve();
-        let solution = solver.solution;
-        match solution.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(solution),
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                Err(StaticsError::DoesNotHold(String::new()))
+        let mut failed = None;
+        for attempt in &SOLVER_ATTEMPTS {
+            let settings = DefaultSettingsBuilder::default()
+                .verbose(false)
+                .tol_gap_abs(attempt.tolerance)
+                .tol_gap_rel(attempt.tolerance)
+                .tol_feas(attempt.tolerance)
+                .tol_ktratio(1e-10_f64.max(attempt.tolerance))
+                .max_iter(attempt.max_iter)
+                .iterative_refinement_max_iter(attempt.refinement_steps)
+                .equilibrate_enable(attempt.equilibrate)
+                .build()
+                .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
+            let mut solver = DefaultSolver::new(p, q, a, b, cones, settings)
+                .map_err(|e| StaticsError::Solver(format!("{e:?}")))?;
+            solver.solve();
+            let solution = solver.solution;
+            match solution.status {
+                SolverStatus::Solved | SolverStatus::AlmostSolved => return Ok(solution),
+                SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                    return Err(StaticsError::DoesNotHold(String::new()));
+                }
+                other => {
+                    failed.get_or_insert(format!("{other:?}"));
+                }
             }
-            other => Err(StaticsError::Solver(format!("{other:?}"))),
         }
+        Err(StaticsError::Solver(failed.unwrap_or_default()))
     }
 
     fn collapse(
@@ -787,7 +913,9 @@ impl Program {
         options: &StaticsOptions,
         solution: &clarabel::solver::DefaultSolution<f64>,
     ) -> Collapse {
-        let lambda = solution.x[0];
+        // A structure balanced exactly on an edge has λ = 0 within the solver's round-off
+        // (answers below −1e-9 are refused as not holding): no "λ = −0.000000".
+        let lambda = solution.x[0].max(0.0);
         let holds = lambda >= options.lambda_max * (1.0 - 1e-9);
         let size = model.size;
         // Virtual velocities: the duals of the equilibrium rows (forces → v, moments → size·ω).
@@ -904,6 +1032,7 @@ impl Program {
         Collapse {
             direction: [d.x + 0.0, d.y + 0.0, d.z + 0.0],
             lambda: (!holds).then_some(lambda),
+            convex_lambda: (!holds).then_some(lambda),
             interfaces,
             bodies: bodies
                 .iter()

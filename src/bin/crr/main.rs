@@ -57,6 +57,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    quiet_on_broken_pipe();
     let result = match Cli::parse().command {
         Command::Inspect(a) => inspect::run(a),
         Command::Simulate(a) => simulate::run(a),
@@ -68,4 +69,24 @@ fn main() -> ExitCode {
         Command::Assemble(a) => assemble::run(a),
     };
     failure::exit_code(result)
+}
+
+/// A standard output closed by its reader (`crr check --json | head`) ends the program quietly
+/// with 141 (128 + SIGPIPE, what a shell reports for a tool that the signal ends), as other
+/// command-line tools do, instead of with `print!`'s panic and a backtrace. Files are written
+/// before their summaries are printed, so nothing computed is lost.
+fn quiet_on_broken_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if message.starts_with("failed printing to stdout") && message.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default(info);
+    }));
 }

@@ -508,6 +508,11 @@ pub struct Simulation<'a> {
     u_rest: f64,
     energy_start: f64,
     next_sample: usize,
+    /// The instant of the last uplift event whose samples were deferred to the motion after its
+    /// release (−∞ before any): such a sample, at its grid instant up to the event's bracket
+    /// before it, is judged under the load the release was decided with (at a jump, the load
+    /// after it; [`Self::sample_under_load_at`]).
+    deferred_to: f64,
     finished: bool,
     /// Running over every sample recorded (also those drained): peak |q| per coordinate, the
     /// largest |T + U − W + D − E(0)|, the time of the last sample.
@@ -678,6 +683,12 @@ pub const UNDECIDED_GAP: f64 = 1e-11;
 /// energy has dropped by half its weight times its size has fallen.
 pub const COLLAPSE_DROP_MAX: f64 = 0.5;
 
+/// The width of an event's located bracket at time `t` (s): the root finder's tolerance
+/// 1e-13 max(|t|, 1) and its round-off 4 ε |t| (`crr_dynamics::integrator`, Brent's method).
+fn event_bracket(t: f64) -> f64 {
+    1e-13 * t.abs().max(1.0) + 4.0 * f64::EPSILON * t.abs()
+}
+
 /// Settings that would change the physics rather than the numerics are refused, with the reason:
 /// a seat rate or impact interval as large as the motion's own scales seats joints that rock
 /// (turning a collapse into survival), a collapse drop beyond a fall lets a block pass through the
@@ -709,8 +720,36 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
             params.collapse_drop
         )));
     }
+    // The mass matrix and the generalized forces are sums of spatial quantities about the world
+    // origin (a body's inertia there, I_c − m [c]×², less its share about its centre): a body
+    // at a distance D from it carries D²/L² times its own inertia, and round-off takes ε D²/L²
+    // of M(q). Placed in survey coordinates (5e5 m away, 2.5e5 times its size) a single block's
+    // rocking lost its energy balance and a stack stalled the integrator (an independent
+    // review); at 1e4 sizes the loss reaches 2e-8 of M, beyond the integrator's tolerance.
+    let farthest = model
+        .bodies
+        .iter()
+        .map(|b| b.com.norm())
+        .fold(0.0, f64::max);
+    if farthest > FARTHEST_FROM_ORIGIN * model.size {
+        let body = model
+            .bodies
+            .iter()
+            .max_by(|a, b| a.com.norm().total_cmp(&b.com.norm()))
+            .map_or("", |b| b.name.as_str());
+        return Err(SimulationError::Parameter(format!(
+            "body \"{body}\" lies {farthest:.4e} m from the world origin, {:.3e} times the model's size              L = {:.4} m (at most {FARTHEST_FROM_ORIGIN:e}): its inertia about the origin would lose              {:.1e} of itself to round-off and the dynamics would depend on where the model sits;              translate the model near the origin (e.g. put a ground pivot there)",
+            farthest / model.size,
+            model.size,
+            f64::EPSILON * (farthest / model.size).powi(2)
+        )));
+    }
     Ok(())
 }
+
+/// The farthest a body's centre may lie from the world origin, in model sizes
+/// ([`check_physical_bounds`]): the dynamics' round-off grows as the square of that distance.
+pub const FARTHEST_FROM_ORIGIN: f64 = 1e4;
 
 /// Sets the tree coordinates `seated(k)` of q and q̇ to exactly 0 and closes the loops again by
 /// the least change of the other coordinates, positions then velocities (Φ = 0, Φ_q q̇ = 0):
@@ -929,6 +968,7 @@ impl<'a> Simulation<'a> {
             energy_at_snaps: 0.0,
             snaps_at_violation: None,
             undecided: UndecidedRow::default(),
+            deferred_to: f64::NEG_INFINITY,
             u_rest,
             energy_start: 0.0,
             next_sample: 0,
@@ -1373,7 +1413,9 @@ impl<'a> Simulation<'a> {
         let next_sample = self.next_sample;
         let mut pending = std::mem::take(&mut self.spare.pending);
         pending.clear();
-        let stride = 2 * n + 3;
+        // Each pending sample: its grid instant, the instant of its state (the step's end where
+        // the grid instant lies past it within round-off), then q, q̇, W and D.
+        let stride = 2 * n + 4;
         let mut peaks = std::mem::take(&mut seg.peaks);
         peaks.clear();
         let mut rocking_coords = std::mem::take(&mut seg.rocking_coords);
@@ -1428,6 +1470,7 @@ impl<'a> Simulation<'a> {
                 let ts = (next as f64 * dt).min(step.t1());
                 step.eval(ts, &mut buf);
                 pending.push(next as f64 * dt);
+                pending.push(ts);
                 extend_short(&mut pending, &buf);
                 next_sample.set(next + 1);
             }
@@ -1467,6 +1510,16 @@ impl<'a> Simulation<'a> {
             events.first_zone_index(),
         );
         let rocking_len = events.rocking.len();
+        // An uplift event: the seated chain cannot hold from here (a load that jumps past its
+        // threshold jumps at the event's instant).
+        let uplift_at = match &stop {
+            Ok(Stop::Event { index, .. })
+                if events.uplift.is_some() && *index == events.uplift_index() =>
+            {
+                Some(self.solver.t())
+            }
+            _ => None,
+        };
         let event_slot = match &stop {
             Ok(Stop::Event { index, .. }) => events.rocking.get(*index).map(|r| r.0),
             _ => None,
@@ -1523,9 +1576,26 @@ impl<'a> Simulation<'a> {
         // are that pull's (module `hops`).
         self.hops.log = hop_log;
         self.hops_read_log();
-        for sample in pending.chunks_exact(stride) {
-            let s = self.sample_at(sample[0], &sample[1..]);
+        // A sample at an uplift event's instant (within its location's bracket) belongs to the
+        // motion after the release, as at rest (`rest_until_uplift`): taken here, it would
+        // judge the seated chain under a load that may already be past the threshold (a pulse
+        // that starts at a sample's instant) and report the joints that open as pulling.
+        let deferred = uplift_at.map_or(0, |te| {
+            pending
+                .chunks_exact(stride)
+                .filter(|sample| sample[0] >= te - event_bracket(te))
+                .count()
+        });
+        let taken = pending.len() / stride - deferred;
+        for sample in pending.chunks_exact(stride).take(taken) {
+            let s = self.sample_under_load_at(sample[0], sample[1], &sample[2..]);
             self.record_sample(s);
+        }
+        self.next_sample -= deferred;
+        if deferred > 0
+            && let Some(te) = uplift_at
+        {
+            self.deferred_to = te;
         }
         self.spare.pending = pending;
         self.attach_hop();

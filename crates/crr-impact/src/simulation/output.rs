@@ -21,6 +21,17 @@ impl Simulation<'_> {
     /// (the monitor), leaves its q, q̇ and slot states in the workspace and returns its scalars,
     /// for [`Self::record_sample`].
     pub(super) fn sample_at(&mut self, t: f64, y: &[f64]) -> Taken {
+        self.sample_under_load_at(t, t, y)
+    }
+
+    /// [`Self::sample_at`] for a sample recorded at `t` whose state is the one at `t_state`, and
+    /// whose contacts are judged under the ground acceleration there: a sample instant up to
+    /// round-off past a step that ends at a breakpoint is the step's end state, and at a jump
+    /// (a pulse that ends at a sample instant, its end computed as start + duration one ulp
+    /// before it) the load at the grid instant would be the one after the jump, on a chain
+    /// decided under the one before. A sample deferred past an uplift event is judged under the
+    /// load the release was decided with (`deferred_to`; later samples are past it).
+    pub(super) fn sample_under_load_at(&mut self, t: f64, t_state: f64, y: &[f64]) -> Taken {
         let n = self.model.dof();
         let (mut q, mut qdot) = (
             std::mem::take(&mut self.spare.sample_q),
@@ -38,13 +49,22 @@ impl Simulation<'_> {
         // The monitor's solve leaves the kinematics of this state in its workspace: the energies
         // read them when it ran (the same q and pivots), else the output workspace's.
         let mut monitor_kin = false;
+        let t_load = t_state.max(self.deferred_to);
         if self.violation.is_none() {
             let d = &mut self.spare.monitor;
             d.pivots.clone_from(&self.dynamics.pivots);
             d.seated.clone_from(&self.dynamics.seated);
             let work = &mut self.spare.forces;
-            if crate::monitor::contact_forces_into(&self.model, d, self.ground, t, &q, &qdot, work)
-                .is_ok()
+            if crate::monitor::contact_forces_into(
+                &self.model,
+                d,
+                self.ground,
+                t_load,
+                &q,
+                &qdot,
+                work,
+            )
+            .is_ok()
             {
                 let (forces, edges) = (&work.forces, &work.edges);
                 monitor_kin = true;
@@ -69,7 +89,7 @@ impl Simulation<'_> {
                         d,
                         work,
                         (&q, &qdot),
-                        crr_dynamics::eom::effective_gravity(&self.model, self.ground, t),
+                        crr_dynamics::eom::effective_gravity(&self.model, self.ground, t_load),
                         t,
                         self.params.friction,
                         tol,

@@ -1637,7 +1637,10 @@ impl Simulation<'_> {
         while at_rest((self.next_sample as f64) * dt)
             && (self.next_sample as f64) * dt <= self.params.duration + 1e-12 * dt
         {
-            let s = self.sample_at(self.next_sample as f64 * dt, &y);
+            // A grid instant up to round-off past the segment's end (a breakpoint, where the
+            // load may jump) is judged under the load at that end.
+            let ts = self.next_sample as f64 * dt;
+            let s = self.sample_under_load_at(ts, ts.min(t_end), &y);
             self.record_sample(s);
             self.next_sample += 1;
         }
