@@ -223,15 +223,9 @@ pub struct Collapse {
 impl Collapse {
     /// Whether λ comes from the search for joints that open and slide (below the convex answer).
     pub fn from_sliding_search(&self) -> bool {
-        match (self.lambda, self.convex_lambda) {
-            (Some(l), Some(c)) => l < c,
-            (Some(_), None) => true,
-            _ => false,
-        }
+        matches!((self.lambda, self.convex_lambda), (Some(l), Some(c)) if l < c)
     }
-}
 
-impl Collapse {
     /// The interfaces that lift off in the mechanism.
     pub fn lifting_off(&self) -> impl Iterator<Item = &InterfaceCollapse> {
         self.interfaces

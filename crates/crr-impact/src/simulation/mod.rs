@@ -729,19 +729,20 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
     let farthest = model
         .bodies
         .iter()
-        .map(|b| b.com.norm())
-        .fold(0.0, f64::max);
-    if farthest > FARTHEST_FROM_ORIGIN * model.size {
-        let body = model
-            .bodies
-            .iter()
-            .max_by(|a, b| a.com.norm().total_cmp(&b.com.norm()))
-            .map_or("", |b| b.name.as_str());
+        .max_by(|a, b| a.com.norm().total_cmp(&b.com.norm()));
+    if let Some(body) = farthest
+        && body.com.norm() > FARTHEST_FROM_ORIGIN * model.size
+    {
+        let ratio = body.com.norm() / model.size;
         return Err(SimulationError::Parameter(format!(
-            "body \"{body}\" lies {farthest:.4e} m from the world origin, {:.3e} times the model's size              L = {:.4} m (at most {FARTHEST_FROM_ORIGIN:e}): its inertia about the origin would lose              {:.1e} of itself to round-off and the dynamics would depend on where the model sits;              translate the model near the origin (e.g. put a ground pivot there)",
-            farthest / model.size,
+            "body \"{}\" lies {:.4e} m from the world origin, {ratio:.3e} times the model's size \
+             L = {:.4} m (at most {FARTHEST_FROM_ORIGIN:e}): its inertia about the origin would lose \
+             {:.1e} of itself to round-off and the dynamics would depend on where the model sits; \
+             translate the model near the origin (e.g. put a ground pivot there)",
+            body.name,
+            body.com.norm(),
             model.size,
-            f64::EPSILON * (farthest / model.size).powi(2)
+            f64::EPSILON * ratio * ratio
         )));
     }
     Ok(())
