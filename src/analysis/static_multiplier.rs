@@ -183,10 +183,13 @@ pub fn parse_direction(text: &str) -> Result<Vector3<f64>, String> {
             .parse::<f64>()
             .map_err(|_| format!("'{}' in '{text}' is not a number", p.trim()))?;
     }
-    if !(d.iter().all(|x| x.is_finite()) && d.norm() > 0.0) {
+    // Only the direction counts: scaled by its largest component, a vector of tiny or huge
+    // components (1e-300, 1e300) is one, whose norm alone would underflow or overflow.
+    let largest = d.amax();
+    if !(largest.is_finite() && largest > 0.0) {
         return Err(format!("'{text}' is not a non-zero finite vector"));
     }
-    Ok(d)
+    Ok(d / largest)
 }
 
 /// The four horizontal directions ±x, ±y.

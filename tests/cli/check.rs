@@ -294,3 +294,38 @@ pivot_negative = [-0.2, 0.0, 0.0]
     assert!(!text.contains("free-rocking frequency"), "{text}");
     assert!(!text.contains("activation multiplier λ"), "{text}");
 }
+
+/// A direction is a direction whatever its scale: components of 1e-300 (whose norm underflows
+/// to 0) or 1e300 (whose norm overflows) give the same report as the unit vector. The single
+/// block's multiplier along x is its b/h = 0.2 (Housner). Along d = (1, 0, 1)/√2 the effective
+/// gravity is (−λg/√2, 0, −g − λg/√2), and the block tips when its horizontal part reaches b/h
+/// of its vertical one: (λ/√2)/(1 + λ/√2) = 0.2, λ = 0.25 √2 = 0.353553.
+#[test]
+fn directions_of_any_scale_give_the_same_multiplier() {
+    let report = |direction: &str| {
+        let o = Command::new(env!("CARGO_BIN_EXE_crr"))
+            .args([
+                "check",
+                "examples/models/single_block.toml",
+                "--direction",
+                direction,
+            ])
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .expect("crr runs");
+        let text = String::from_utf8_lossy(&o.stdout).into_owned();
+        assert!(o.status.success(), "{direction}: {text}");
+        text.lines()
+            .find(|l| l.trim_start().starts_with("d = "))
+            .unwrap_or_else(|| panic!("{direction}: {text}"))
+            .to_string()
+    };
+    let x = report("+x");
+    assert!(x.contains("λ = 0.200000"), "{x}");
+    assert_eq!(report("1e-300,0,0"), x);
+    assert_eq!(report("1e300,0,0"), x);
+    let diagonal = report("1,0,1");
+    assert!(diagonal.contains("λ = 0.353553"), "{diagonal}");
+    assert_eq!(report("1e-300,0,1e-300"), diagonal);
+    assert_eq!(report("1e300,0,1e300"), diagonal);
+}

@@ -39,6 +39,48 @@ fn record_headers_cannot_ask_for_absurd_allocations() {
     }
 }
 
+/// A time step in the wrong unit (or absurd): the samples' span overflows (a record error naming
+/// the file), or the run it sets would last 3e300 s (refused before anything runs, naming the
+/// duration; the bundled block's time scale √(L/g) is 0.33 s, its limit 1e7 of that).
+#[test]
+fn records_whose_time_step_is_absurd_are_refused() {
+    let dir = scratch("dt");
+    for (dt, needle) in [
+        ("1e308", "span more than any time"),
+        ("1e300", "duration = 3e300 s is more than 1e7 times"),
+        ("1e3", "duration = 3e3 s"),
+    ] {
+        let at2 = dir.join(format!("dt_{dt}.AT2"));
+        std::fs::write(
+            &at2,
+            format!("TEST\nTEST\nACCELERATION IN G\nNPTS= 4, DT= {dt} SEC\n 0.0 0.1 0.2 0.0\n"),
+        )
+        .unwrap();
+        let out = dir.join(format!("out_{dt}"));
+        let args = [
+            "simulate",
+            "examples/models/single_block.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--record",
+            at2.to_str().unwrap(),
+            "--format",
+            "peer-at2",
+        ];
+        if dt == "1e3" {
+            // 3 000 s of record is a long run, not an absurd one: it is not refused for its
+            // length (here it is stopped by --duration before it starts costing).
+            let mut short = args.to_vec();
+            short.extend(["--duration", "0.5", "--quiet"]);
+            let o = crr(&short);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            continue;
+        }
+        refused(&args, needle);
+        assert!(!out.join("history.csv").exists(), "{dt}: nothing written");
+    }
+}
+
 #[test]
 fn plot_refuses_empty_and_non_finite_histories() {
     let dir = scratch("plot");

@@ -9,6 +9,7 @@ mod arch_3d;
 mod certificate_audit;
 mod collapse;
 mod far_from_origin;
+mod free_fall;
 mod impact_laws_on_chains;
 mod impulse_tension;
 mod initial_state_paths;

@@ -234,11 +234,15 @@ impl Collapse {
     }
 }
 
-/// `direction` made unit; an error for a zero or non-finite one.
+/// `direction` made unit; an error for a zero or non-finite one. Scaled by its largest component
+/// first, so that a direction of tiny or huge components (1e-300, 1e300) is a direction: its
+/// norm alone would underflow to 0 or overflow.
 fn unit_direction(direction: Vector3<f64>) -> Result<Vector3<f64>, StaticsError> {
-    let norm = direction.norm();
-    if norm.is_finite() && norm > 0.0 {
-        Ok(direction / norm)
+    let largest = direction.amax();
+    let scaled = direction / largest;
+    let norm = scaled.norm();
+    if largest.is_finite() && largest > 0.0 && norm.is_finite() {
+        Ok(scaled / norm)
     } else {
         Err(StaticsError::Direction(
             direction.x,

@@ -48,6 +48,13 @@ impl Record {
                 "time step must be positive and finite, got {dt}"
             )));
         }
+        let span = accel.len().saturating_sub(1) as f64 * dt;
+        if !span.is_finite() {
+            return Err(invalid(format!(
+                "{} samples at a time step of {dt:e} s span {span} s",
+                accel.len()
+            )));
+        }
         Self::build(Times::Uniform { dt }, accel)
     }
 
@@ -443,6 +450,11 @@ fn at2_header(lines: &[&str], source: &str) -> Result<(usize, usize, f64), Groun
             }
             if !(dt.is_finite() && dt > 0.0) {
                 return Err(err(format!("DT must be positive, got {dt}")));
+            }
+            if !((npts - 1) as f64 * dt).is_finite() {
+                return Err(err(format!(
+                    "NPTS = {npts} samples at DT = {dt:e} s span more than any time"
+                )));
             }
             return Ok((idx, npts, dt));
         }

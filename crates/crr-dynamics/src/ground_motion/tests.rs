@@ -154,6 +154,17 @@ fn at2_bad_dt_is_an_error_with_line() {
     assert_eq!(msg, "x.AT2:4: DT must be positive, got 0");
 }
 
+/// Four samples 1e308 s apart span 3e308 s, beyond the largest float: refused at the header's
+/// line (and by `Record::uniform` for records built in memory).
+#[test]
+fn at2_whose_samples_span_beyond_any_time_is_an_error() {
+    let msg = err_string(parse_at2("a\nb\nc\nNPTS= 4, DT= 1e308\n1 2 3 4\n", "x.AT2"));
+    assert_eq!(
+        msg,
+        "x.AT2:4: NPTS = 4 samples at DT = 1e308 s span more than any time"
+    );
+}
+
 #[test]
 fn fortran_numbers() {
     assert_eq!(parse_fortran_float(".1234E-02"), Some(0.1234e-2));
@@ -327,6 +338,9 @@ fn record_constructor_errors() {
     assert!(Record::uniform(0.0, vec![1.0, 2.0]).is_err());
     assert!(Record::uniform(0.1, vec![1.0]).is_err());
     assert!(Record::uniform(0.1, vec![1.0, f64::NAN]).is_err());
+    // Three samples 1e308 s apart end at 2e308 s: no time.
+    assert!(Record::uniform(1e308, vec![1.0, 2.0, 3.0]).is_err());
+    assert!(Record::uniform(1e308, vec![1.0, 2.0]).is_ok());
     assert!(Record::from_samples(vec![0.0, 0.0], vec![1.0, 2.0]).is_err());
     assert!(Record::from_samples(vec![0.0, 1.0], vec![1.0]).is_err());
     assert!(GroundMotion::from_record(Axis::X, small_record(), f64::INFINITY).is_err());

@@ -720,6 +720,16 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
             params.collapse_drop
         )));
     }
+    if params.duration.is_nan() || params.duration > LONGEST_DURATION * time_scale {
+        return Err(SimulationError::Parameter(format!(
+            "duration = {:e} s is more than {LONGEST_DURATION:e} times the structure's time scale \
+             √(L/g) = {time_scale:.4} s (the ground motion's end, where [analysis] gives no \
+             duration): an instant t is located to 1e-13 t, beyond that coarser than the \
+             impacts' own spacing near rest (min_impact_interval, default 1e-6 s); a record \
+             whose time step or times are in the wrong unit gives such a duration",
+            params.duration
+        )));
+    }
     // The mass matrix and the generalized forces are sums of spatial quantities about the world
     // origin (a body's inertia there, I_c − m [c]×², less its share about its centre): a body
     // at a distance D from it carries D²/L² times its own inertia, and round-off takes ε D²/L²
@@ -747,6 +757,13 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
     }
     Ok(())
 }
+
+/// The longest run, in the structure's time scale √(L/g) ([`check_physical_bounds`]): events
+/// are located to 1e-13 of their instant (the event bracket), 1e-6 √(L/g) at this bound, the
+/// spacing of the impacts of a joint coming to rest (`min_impact_interval`). Rocking dies out
+/// within some hundreds of time units; a run of a million (the Python interrupt test's 1e6 s of a
+/// 2 m block) is far inside it.
+pub const LONGEST_DURATION: f64 = 1e7;
 
 /// The farthest a body's centre may lie from the world origin, in model sizes
 /// ([`check_physical_bounds`]): the dynamics' round-off grows as the square of that distance.

@@ -68,6 +68,42 @@ pub(super) fn opening_mode_in(
     qdot: &DVector<f64>,
 ) -> Option<Vec<(usize, Side)>> {
     let rate_scale = (model.gravity / model.size).sqrt();
+    let thrown = if qdot.amax() <= 1e-12 * rate_scale {
+        free_fall(model, ground, t)
+    } else {
+        None
+    };
+    // A load along the ground's normal that pulls every body off it: a flight, whatever the
+    // chain could release (every rocking from rest pulls at its pivot too, below).
+    if let Some((faces, true)) = thrown {
+        rest.lift_off = Some(faces);
+        return Some(Vec::new());
+    }
+    let decided = opening_mode_decided(model, ground, template, trial, rest, slot_part, t, q, qdot);
+    // Another load that pulls every body off the ground, where nothing opens: a flight.
+    if decided.is_none()
+        && let Some((faces, _)) = thrown
+    {
+        rest.lift_off = Some(faces);
+        return Some(Vec::new());
+    }
+    decided
+}
+
+/// [`opening_mode_in`] but for a structure thrown off the ground.
+#[allow(clippy::too_many_arguments)]
+fn opening_mode_decided(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    trial: &mut Dynamics,
+    rest: &mut RestCache,
+    slot_part: &[usize],
+    t: f64,
+    q: &DVector<f64>,
+    qdot: &DVector<f64>,
+) -> Option<Vec<(usize, Side)>> {
+    let rate_scale = (model.gravity / model.size).sqrt();
     // On open chains the single releases are exact: every mechanism of a tree of one-support
     // joints is a positive combination of single-joint openings, and a ratio of two linear
     // forms (the loads' and the weight's power) is least at an extreme ray; a block cannot lift
@@ -139,6 +175,47 @@ pub(super) fn opening_mode_in(
         model, ground, &start, trial, rest, slot_part, t, q, qdot, true,
     )
     .or(Some(sides))
+}
+
+/// The interfaces on the ground (their names) where the effective gravity g_eff(t) pulls a
+/// structure at rest off the ground, and whether g_eff lies along the ground's normal (its part
+/// across it within 1e-9 g): every face on the ground has the same normal n (into the bodies;
+/// the ground does not turn), g_eff · n > 1e-9 g, and none of them is a pin (which holds any
+/// force). None otherwise.
+///
+/// Why this is a flight: held as it is, the structure needs from the ground the force −M g_eff,
+/// whose part along n, −M g_eff · n, is the sum of the faces' normal forces: one of them pulls.
+/// The motion in which every body falls freely (each with g_eff relative to the ground, no
+/// contact force anywhere, the contacts between bodies at rest relative to each other, every
+/// point on the ground moving off its face) meets every contact condition: the bodies leave the
+/// ground, outside the model. On a horizontal ground, a vertical ground acceleration below −g.
+/// Where g_eff lies along n, rocking from rest pulls at its pivot as well: a body of mass m
+/// turning about a pivot, its centre at r from it, has the normal force
+/// m (a_c − g_eff) · n = m |g_eff| (m wᵀI_P⁻¹w/|g_eff|² − 1) with w = r × g_eff, and
+/// I_P ⪰ m(|r|² − r rᵀ) on w ⊥ r bounds it by m |g_eff| (sin²θ − 1) ≤ 0 (θ between r and
+/// g_eff). Across n the CRR model's no-slip contacts may keep a pivot pressing (a body leaning
+/// far under a large horizontal part), so there the flight is taken only where the decision
+/// opens nothing.
+fn free_fall(model: &Model, ground: &GroundMotion, t: f64) -> Option<(Vec<String>, bool)> {
+    let g_eff = crr_dynamics::eom::effective_gravity(model, ground, t);
+    let mut faces = Vec::new();
+    let mut normal: Option<Vector3<f64>> = None;
+    for (index, iface) in model.interfaces.iter().enumerate() {
+        if !matches!(iface.parent, crr_kinematics::Parent::Ground) {
+            continue;
+        }
+        let face = ContactFace::of_interface(model, index);
+        let common = *normal.get_or_insert(face.normal);
+        if face.pin
+            || (face.normal - common).norm() > 1e-9
+            || g_eff.dot(&face.normal) <= 1e-9 * model.gravity
+        {
+            return None;
+        }
+        faces.push(iface.name.clone());
+    }
+    let along = normal.is_some_and(|n| (g_eff - n * g_eff.dot(&n)).norm() <= 1e-9 * model.gravity);
+    (!faces.is_empty()).then_some((faces, along))
 }
 
 /// The local test of [`opening_mode_in`]: single releases, the active set, and Gauss' principle
