@@ -19,6 +19,7 @@ mod mirror_invariance;
 mod opening_program;
 mod order_invariance;
 mod out_of_plane;
+mod stack_planar_and_3d;
 mod streaming;
 mod temple;
 mod twist_closure;

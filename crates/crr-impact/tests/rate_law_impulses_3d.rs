@@ -27,12 +27,14 @@
 //! equal the samples' (measured 1e-14 relative, asserted 1e-12), and the law leaves the angular
 //! momentum about the edge line unchanged (1e-13 N m s against |ΔH| of order 100), as it must: the edge's impulses have no moment about it.
 //!
-//! Where s* is below −1e-3 W·√(L/g) the run records an `impulse_tension` at the impact's instant
-//! on `base` with s* as its `normal` (to 1e-8 of W·√(L/g), as in `rate_law_impulses.rs`); where
-//! s* pushes, nothing is recorded. The lower block is light (240 kg/m³): being held, its mass
+//! The engine measures a contact's impulse per edge (`face_forces::touching_points_per_edge`):
+//! a corner's times the two corners of the base's edge, 2 s*, what a planar hinge's pivot line
+//! would carry. Where 2 s* is below −1e-3 W·√(L/g) the run records an `impulse_tension` at the
+//! impact's instant on `base` with 2 s* as its `normal` (to 1e-8 of W·√(L/g), as in
+//! `rate_law_impulses.rs`); where s* pushes, nothing is recorded. The lower block is light (240 kg/m³): being held, its mass
 //! enters no impulse, only the tolerance's unit W·√(L/g) (about 5 400 N s). The laws chosen give
-//! both answers: r = 0.3, 0.6 and the Dirac law with r^C = 0.35 pull by 95, 47 and 86 N s; r = 1
-//! pushes with 4.5 N s. This does not tell the edge from the whole base apart (the upper block's
+//! both answers: r = 0.3, 0.6 and the Dirac law with r^C = 0.35 pull by 95, 47 and 86 N s at a
+//! corner (189, 94 and 172 N s per edge); r = 1 pushes with 4.5 N s. This does not tell the edge from the whole base apart (the upper block's
 //! change of momentum alone sets the ground's impulse here); it checks the rate laws' impulses on
 //! a 3D rocking base against a derivation of its own.
 use std::collections::BTreeMap;
@@ -241,7 +243,8 @@ fn a_rate_law_impact_on_a_base_rocking_on_its_other_tilt_is_checked_at_the_held_
             "{law:?}: ΔH about the edge {}",
             hand.about_edge
         );
-        let least = hand.least;
+        // Per edge: the two corners of the seated base's edge each carrying s*.
+        let least = 2.0 * hand.least;
         println!("{law:?}: ψ₂ = {psi2:.5} rad, least ground impulse {least:.3} N s");
         // Each verdict at least three tolerances (1e-3 W·√(L/g)) from the threshold, or a push.
         assert!(

@@ -52,7 +52,8 @@ pub struct LeastNormal {
     pub limiting: Option<usize>,
 }
 
-/// s*, the largest smallest normal impulse (N s, at most 0) of the most compressive
+/// s*, the largest smallest normal impulse (N s, at most 0, each point's measured per edge,
+/// [`super::touching_points_per_edge`]) of the most compressive
 /// distribution that changes each body's momentum by `momentum_change[b]` = (m_b Δċ_b, I_b Δω_b)
 /// on the touching points of the state in `dynamics`, the slots `set_by_law` touching on both
 /// pivots with impulses of either sign, when the interfaces form a tree (see the module's
@@ -89,6 +90,10 @@ pub fn least_normal_impulse_on_tree(
         let Some(s) = interface_least_normal(&columns, at, model.size, unit)? else {
             continue;
         };
+        // Per edge, as the global program measures impulses: for one face the best of the
+        // weighted least is the weight times the best of the least.
+        let points = columns.iter().filter(|u| u.unilateral).count();
+        let s = s * super::touching_points_per_edge(&model.interfaces[index].kind, points);
         if least.is_none_or(|(m, _)| s < m) {
             least = Some((s, index));
         }

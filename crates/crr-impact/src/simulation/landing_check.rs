@@ -30,7 +30,10 @@ use crate::face_forces::LeastNormal;
 
 /// The least tension of a landing's impulse that is recorded, in W·√(L/g) (W the structure's
 /// weight, L its size): the monitor's 1e-3 W on the contact forces, over the structure's time
-/// unit. Below it the impulse's tension is of the order of the programs' tolerances.
+/// unit. Below it the impulse's tension is of the order of the programs' tolerances. Compared
+/// with a touching point's impulse measured per edge
+/// ([`crate::face_forces::touching_points_per_edge`]), so that a face is judged the same written
+/// as pivot lines or as corners.
 pub const IMPULSE_TENSION_TOLERANCE: f64 = 1e-3;
 
 impl Simulation<'_> {
