@@ -130,3 +130,86 @@ fn a_ground_falling_slower_than_g_leaves_every_structure_at_rest() {
         assert!(last.q.iter().all(|&x| x == 0.0), "{name}: {:?}", last.q);
     }
 }
+
+/// The bundled block (half-width b = 0.2 m, half-height h = 1 m) at rest under g_eff =
+/// (−γ g, 0, ε g), rocking about the −x edge that the horizontal part pushes it over: the
+/// pivot's normal force over m g. About the pivot P, r = (b, 0, h) to the centre; the torque of
+/// m g_eff about y is m g (−γ h − ε b), I_P = (4/3) m (b² + h²), α = torque / I_P about y, the
+/// centre accelerates by α ŷ × r = α (h, 0, −b), and the ground's force is m (a_c − g_eff).
+fn pivot_normal_by_hand(gamma: f64, epsilon: f64) -> f64 {
+    let (b, h) = (0.2, 1.0);
+    let alpha = (-gamma * h - epsilon * b) / (4.0 / 3.0 * (b * b + h * h));
+    -alpha * b - epsilon
+}
+
+/// With a horizontal part as well, the motion decides: the block released onto its pivot pulls
+/// there under a small one (a flight at once: every body, t = 0), and presses under a large one
+/// (it rocks, thrown off later, when its pivot's force falls to zero). By hand at t = 0:
+/// N = −0.0096 m g under (γ, ε) = (0.001, 0.01), +0.0624 m g under (0.5, 0.01).
+#[test]
+fn with_a_horizontal_part_the_motion_decides_whether_the_ground_presses() {
+    for (gamma, flies_at_once) in [(0.001, true), (0.5, false)] {
+        let normal = pivot_normal_by_hand(gamma, 0.01);
+        assert_eq!(
+            normal < 0.0,
+            flies_at_once,
+            "γ = {gamma}: N = {normal} m g by hand"
+        );
+        let text = at_rest_under(
+            "single_block",
+            &format!("constant = {{ value = {} }}", -1.01 * G),
+            1.0,
+        )
+        .replace(
+            "[ground_motion]\n",
+            &format!(
+                "[ground_motion]\nx = {{ constant = {{ value = {} }} }}\n",
+                gamma * G
+            ),
+        );
+        let path = common::write_model(&format!("thrown_across_{gamma}"), &text);
+        let model = crr::ModelInput::read(&path).unwrap();
+        let run = crr::run(&model, &crr::RunOptions::default()).unwrap();
+        let Some(crr::impact::SimulationError::LiftOff { t, in_flight, .. }) = &run.failure else {
+            panic!("γ = {gamma}: {:?}, not a flight", run.failure);
+        };
+        assert_eq!(in_flight, &["block"], "γ = {gamma}");
+        if flies_at_once {
+            assert_eq!(*t, 0.0, "γ = {gamma}");
+        } else {
+            assert_eq!(
+                run.trajectory.uplift_time,
+                Some(0.0),
+                "γ = {gamma}: it rocks at once"
+            );
+            assert!(
+                *t > 0.1,
+                "γ = {gamma}: thrown off at {t} s, while its pivot pressed"
+            );
+        }
+    }
+}
+
+/// A block let go from a tilt (nothing seated, every rate 0) under −1.01 g: its pivot pulls
+/// (the bound of `free_fall`'s docs), a flight at t = 0; it used to rock about it.
+#[test]
+fn a_block_let_go_from_a_tilt_under_a_ground_falling_faster_than_g_flies_at_once() {
+    let text = format!(
+        "{}\n[initial]\nangles = {{ base = 0.1 }}\n",
+        at_rest_under(
+            "single_block",
+            &format!("constant = {{ value = {} }}", -1.01 * G),
+            1.0
+        )
+    );
+    let path = common::write_model("thrown_from_a_tilt", &text);
+    let model = crr::ModelInput::read(&path).unwrap();
+    let run = crr::run(&model, &crr::RunOptions::default()).unwrap();
+    let Some(crr::impact::SimulationError::LiftOff { t, in_flight, .. }) = &run.failure else {
+        panic!("{:?}, not a flight", run.failure);
+    };
+    assert_eq!(
+        (*t, in_flight.as_slice()),
+        (0.0, ["block".to_string()].as_slice())
+    );
+}

@@ -68,26 +68,68 @@ pub(super) fn opening_mode_in(
     qdot: &DVector<f64>,
 ) -> Option<Vec<(usize, Side)>> {
     let rate_scale = (model.gravity / model.size).sqrt();
-    let thrown = if qdot.amax() <= 1e-12 * rate_scale {
-        free_fall(model, ground, t)
-    } else {
-        None
-    };
+    let at_rest = qdot.amax() <= 1e-12 * rate_scale;
     // A load along the ground's normal that pulls every body off it: a flight, whatever the
-    // chain could release (every rocking from rest pulls at its pivot too, below).
-    if let Some((faces, true)) = thrown {
-        rest.lift_off = Some(faces);
+    // chain could release (every motion from rest pulls at the ground too, `free_fall`).
+    if at_rest && let Some(thrown) = free_fall(model, ground, t).filter(|f| f.along) {
+        rest.lift_off = Some(thrown.faces);
+        rest.thrown_off = true;
         return Some(Vec::new());
     }
     let decided = opening_mode_decided(model, ground, template, trial, rest, slot_part, t, q, qdot);
-    // Another load that pulls every body off the ground, where nothing opens: a flight.
-    if decided.is_none()
-        && let Some((faces, _)) = thrown
+    // Another load that pulls every body off the ground, where the motion decided (the
+    // current one when nothing opens) pulls at the ground as well: a flight.
+    if at_rest
+        && let Some(faces) = thrown_off(
+            model,
+            ground,
+            template,
+            decided.as_deref().unwrap_or(&[]),
+            (t, q, qdot),
+        )
     {
         rest.lift_off = Some(faces);
+        rest.thrown_off = true;
         return Some(Vec::new());
     }
     decided
+}
+
+/// The interfaces on the ground (their names) where the structure at rest in `template`, with
+/// the releases `mode` made, is thrown off the ground: [`free_fall`] finds g_eff pulling every
+/// body off it, and the ground's total force along its normal n in that motion,
+/// M (a_cm − g_eff) · n (the bodies' momentum rates less their loads: every contact between
+/// bodies cancels), pulls beyond 1e-9 W. Then no motion the model offers keeps the ground's
+/// contacts pressing, and free fall meets every contact condition. Along n every motion pulls
+/// there ([`free_fall`]); across it a body leaning far may press, which this asks of the motion
+/// itself. None otherwise, or where the motion cannot be solved (the decision stands).
+pub(super) fn thrown_off(
+    model: &Model,
+    ground: &GroundMotion,
+    template: &Dynamics,
+    mode: &[(usize, Side)],
+    (t, q, qdot): (f64, &DVector<f64>, &DVector<f64>),
+) -> Option<Vec<String>> {
+    let thrown = free_fall(model, ground, t)?;
+    if thrown.along {
+        return Some(thrown.faces);
+    }
+    let mut d = template.clone();
+    for &(k, side) in mode {
+        d.pivots.sides[k] = side;
+        d.seated.retain(|&s| s != k);
+    }
+    d.accelerations(model, ground, t, q, qdot).ok()?;
+    crr_kinematics::jacobians(model, &mut d.kin);
+    // At rest the bodies' centres accelerate by J_c q̈ (no velocity terms).
+    let a = &d.kin.com_jacobian * &d.qddot;
+    let mut momentum_rate = Vector3::zeros();
+    for (b, body) in model.bodies.iter().enumerate() {
+        momentum_rate += body.mass * a.fixed_rows::<3>(3 * b);
+    }
+    let mass = model.total_mass();
+    let normal_force = (momentum_rate - mass * d.effective_gravity()).dot(&thrown.normal);
+    (normal_force < -1e-9 * mass * model.gravity).then_some(thrown.faces)
 }
 
 /// [`opening_mode_in`] but for a structure thrown off the ground.
@@ -177,26 +219,29 @@ fn opening_mode_decided(
     .or(Some(sides))
 }
 
-/// The interfaces on the ground (their names) where the effective gravity g_eff(t) pulls a
-/// structure at rest off the ground, and whether g_eff lies along the ground's normal (its part
-/// across it within 1e-9 g): every face on the ground has the same normal n (into the bodies;
-/// the ground does not turn), g_eff · n > 1e-9 g, and none of them is a pin (which holds any
-/// force). None otherwise.
+/// The faces on the ground where the effective gravity g_eff(t) pulls a structure at rest off
+/// the ground: every face on the ground has the same normal n (into the bodies; the ground does
+/// not turn), g_eff · n > 1e-9 g, and none of them is a pin (which holds any force). None
+/// otherwise.
 ///
-/// Why this is a flight: held as it is, the structure needs from the ground the force −M g_eff,
-/// whose part along n, −M g_eff · n, is the sum of the faces' normal forces: one of them pulls.
-/// The motion in which every body falls freely (each with g_eff relative to the ground, no
-/// contact force anywhere, the contacts between bodies at rest relative to each other, every
-/// point on the ground moving off its face) meets every contact condition: the bodies leave the
-/// ground, outside the model. On a horizontal ground, a vertical ground acceleration below −g.
-/// Where g_eff lies along n, rocking from rest pulls at its pivot as well: a body of mass m
-/// turning about a pivot, its centre at r from it, has the normal force
-/// m (a_c − g_eff) · n = m |g_eff| (m wᵀI_P⁻¹w/|g_eff|² − 1) with w = r × g_eff, and
-/// I_P ⪰ m(|r|² − r rᵀ) on w ⊥ r bounds it by m |g_eff| (sin²θ − 1) ≤ 0 (θ between r and
-/// g_eff). Across n the CRR model's no-slip contacts may keep a pivot pressing (a body leaning
-/// far under a large horizontal part), so there the flight is taken only where the decision
-/// opens nothing.
-fn free_fall(model: &Model, ground: &GroundMotion, t: f64) -> Option<(Vec<String>, bool)> {
+/// Held as it is, the structure needs from the ground the force −M g_eff, whose part along n,
+/// −M g_eff · n, is the sum of the faces' normal forces: one of them pulls. The motion in which
+/// every body falls freely (each with g_eff relative to the ground, no contact force anywhere,
+/// the contacts between bodies at rest relative to each other, every point on the ground moving
+/// off its face) meets every contact condition: the bodies leave the ground, outside the model.
+/// On a horizontal ground, a vertical ground acceleration below −g.
+///
+/// Where g_eff lies along n ([`Thrown::along`]), every motion of the model from rest pulls at
+/// the ground too. At q̇ = 0 the constrained accelerations are the M-orthogonal projection of
+/// free fall's q̈_f (every body accelerating with g_eff) onto the motions the contacts allow, so
+/// q̈ᵀMq̈_f = q̈ᵀMq̈ ≤ q̈_fᵀMq̈_f, that is M a_cm · g_eff ≤ M |g_eff|²: with g_eff = ε n the
+/// ground's total normal force M (a_cm − g_eff) · n = M (a_cm · g_eff − ε²)/ε is at most 0,
+/// whatever opens. (For one body turning about a pivot, its centre at r from it, it is
+/// m ε (m wᵀI_P⁻¹w/ε² − 1) with w = r × g_eff, and I_P ⪰ m(|r|²I − r rᵀ) bounds it by
+/// m ε (sin²θ − 1), θ between r and g_eff.) Across n the model's no-slip contacts may keep the
+/// ground pressing (a body leaning far under a large horizontal part): [`thrown_off`] asks the
+/// motion decided.
+fn free_fall(model: &Model, ground: &GroundMotion, t: f64) -> Option<Thrown> {
     let g_eff = crr_dynamics::eom::effective_gravity(model, ground, t);
     let mut faces = Vec::new();
     let mut normal: Option<Vector3<f64>> = None;
@@ -214,8 +259,23 @@ fn free_fall(model: &Model, ground: &GroundMotion, t: f64) -> Option<(Vec<String
         }
         faces.push(iface.name.clone());
     }
-    let along = normal.is_some_and(|n| (g_eff - n * g_eff.dot(&n)).norm() <= 1e-9 * model.gravity);
-    (!faces.is_empty()).then_some((faces, along))
+    let normal = normal?;
+    let along = (g_eff - normal * g_eff.dot(&normal)).norm() <= 1e-9 * g_eff.dot(&normal);
+    Some(Thrown {
+        faces,
+        normal,
+        along,
+    })
+}
+
+/// A structure thrown off the ground ([`free_fall`]).
+struct Thrown {
+    /// The interfaces on the ground.
+    faces: Vec<String>,
+    /// Their common normal n (into the bodies).
+    normal: Vector3<f64>,
+    /// Whether g_eff lies along n (its part across n within 1e-9 of its part along it).
+    along: bool,
 }
 
 /// The local test of [`opening_mode_in`]: single releases, the active set, and Gauss' principle
@@ -1301,11 +1361,33 @@ impl Simulation<'_> {
     /// One round of [`Self::release_if_opening`].
     fn release_once(&mut self) -> Result<Option<Vec<(usize, Side)>>, SimulationError> {
         if self.dynamics.seated.is_empty() {
+            // Nothing to release; but a structure at rest on its pivots alone (let go from a
+            // tilt) may be thrown off the ground, its motion pulling there (`thrown_off`).
+            let (q, qdot) = (self.chain_q(), self.chain_qdot());
+            let rate_scale = (self.model.gravity / self.model.size).sqrt();
+            if qdot.amax() <= 1e-12 * rate_scale
+                && let Some(interfaces) = thrown_off(
+                    &self.model,
+                    self.ground,
+                    &self.dynamics,
+                    &[],
+                    (self.t, &q, &qdot),
+                )
+            {
+                let in_flight = bodies_without_support(&self.model, &interfaces);
+                return Err(SimulationError::LiftOff {
+                    t: self.t,
+                    reason: super::flight_words(&in_flight),
+                    in_flight,
+                    interfaces,
+                });
+            }
             return Ok(None);
         }
         let (q, qdot) = (self.chain_q(), self.chain_qdot());
         let mut trial = self.take_trial();
         self.spare.rest.lift_off = None;
+        self.spare.rest.thrown_off = false;
         let mode = opening_mode_in(
             &self.model,
             self.ground,
@@ -1321,6 +1403,8 @@ impl Simulation<'_> {
         let mut mode = mode;
         if let Some(interfaces) = self.spare.rest.lift_off.take() {
             let in_flight = bodies_without_support(&self.model, &interfaces);
+            // Thrown off the ground: every body flies, no face is held for a pivot event.
+            let thrown = std::mem::take(&mut self.spare.rest.thrown_off);
             // The proposal's other joints and sides, by the file's slots (the chain changes).
             let proposal: Vec<(usize, Side)> = mode
                 .iter()
@@ -1368,7 +1452,7 @@ impl Simulation<'_> {
                     }
                     FaceRelease::Unsolved => None,
                 }
-            } else if let Some(carrying) = self.early_flight(&interfaces, &in_flight) {
+            } else if !thrown && let Some(carrying) = self.early_flight(&interfaces, &in_flight) {
                 // The faces carrying the bodies in flight, whose pivots' normal forces the
                 // chain's exact solve still finds pressing, stay on their pivots: their events
                 // locate the flight where those forces reach zero. With other faces lifting

@@ -38,6 +38,9 @@ pub(super) struct RestCache {
     /// Set by the uplift test when the load exceeds the collapse multiplier in a mechanism where
     /// blocks lift off a support (outside the CRR chain): those interfaces' names.
     pub(super) lift_off: Option<Vec<String>>,
+    /// Set with `lift_off` when it is a structure thrown off the ground (a flight of every body,
+    /// `seating::thrown_off`): no face of it may be held for a pivot event.
+    pub(super) thrown_off: bool,
     /// Faces (interfaces of the chain) the contact program keeps on their pivots, their lifts
     /// left out, until the next impact, landing or change of chain (a release of another joint
     /// does not clear them): faces rocking on one pivot whose lift-off the chain without them
