@@ -545,7 +545,7 @@ fn limit_samples(
 
 /// Runs `work` on a thread of its own, without the GIL, while this thread waits for its result
 /// in slices of [`POLL`] and checks for signals between them: Ctrl-C sets `cancel` (the work
-/// stops after its current step) and, once the work has returned, comes back as the
+/// stops within one integration step) and, once the work has returned, comes back as the
 /// `KeyboardInterrupt` with what the work returned. The result comes through a channel, so the
 /// wait ends the moment it is sent (a wake-up by `unpark` before the thread had finished made
 /// the waiter sleep another slice: docs/performance.md, "Python's wait for a run").

@@ -279,7 +279,7 @@ pub fn run_section(
         Flow::Continue
     };
     let (trajectory, error) =
-        match simulate_observed(model, &ground, initial, &params, false, &mut observe) {
+        match simulate_observed(model, &ground, initial, &params, false, None, &mut observe) {
             Ok(run) => run,
             Err(e) => {
                 section.error = Some(e.to_string());

@@ -73,8 +73,8 @@ pub struct RunOptions {
     pub duration: Option<f64>,
     /// Print the percentage done on stderr while running.
     pub progress: bool,
-    /// A flag the run polls after every step: once set, it stops with
-    /// [`SimulationError::Cancelled`] and keeps what it computed.
+    /// A flag the run polls inside and after every step: once set, it stops with
+    /// [`SimulationError::Cancelled`] within one integration step and keeps what it computed.
     pub cancel: Option<Cancel>,
     /// Most output samples a run keeps in memory (not streamed): the run stops with
     /// [`SimulationError::TooManySamples`] after the step that passes it (a step records at
@@ -93,7 +93,8 @@ impl Cancel {
         Self::default()
     }
 
-    /// Asks every run holding this flag to stop after its current step.
+    /// Asks every run holding this flag to stop: within one integration step of its
+    /// current step ([`Simulation::set_interrupt`]), at a state of the motion.
     pub fn cancel(&self) {
         self.0.store(true, Ordering::Relaxed);
     }
@@ -469,8 +470,8 @@ pub enum Flow {
 /// a collapse or an error: the one loop every run goes through (`crr::run`, `crr simulate`, the
 /// cases of a study). The samples are drained into `sink` after every step when `stream` (a sink
 /// error stops the run), else kept in the trajectory; a percentage goes to stderr when
-/// `progress`; a set `cancel` flag stops the run after the step in which it was set
-/// ([`SimulationError::Cancelled`]), and so do more than `max_samples` samples kept in memory
+/// `progress`; a set `cancel` flag stops the run within one integration step of the request,
+/// inside the current step where it is long ([`SimulationError::Cancelled`]), and so do more than `max_samples` samples kept in memory
 /// ([`SimulationError::TooManySamples`]). An error before the first step is `Err`; one later comes
 /// back with the trajectory computed until then.
 #[allow(clippy::too_many_arguments)]
@@ -515,23 +516,26 @@ pub fn simulate(
             ))),
         }
     };
-    simulate_observed(model, ground, initial, params, progress, &mut drain)
+    simulate_observed(model, ground, initial, params, progress, cancel, &mut drain)
 }
 
 /// [`simulate`] with an observer called after every step with the simulation and the step's
 /// result: it may drain the samples, read the impacts, and stop the run ([`Flow`]) — Poincaré
 /// sections keep their points and stop after enough crossings this way. The run ends at its
 /// duration, a collapse, an error, or when the observer says so; an observer's error comes
-/// first.
+/// first. A set `cancel` also stops a step from inside, within one integration step of the
+/// request ([`Simulation::set_interrupt`]), with [`SimulationError::Cancelled`].
 pub fn simulate_observed(
     model: &Model,
     ground: &GroundMotion,
     initial: &InitialState,
     params: &Parameters,
     progress: bool,
+    cancel: Option<&Cancel>,
     observe: &mut dyn FnMut(&mut Simulation, &Result<StopReason, SimulationError>) -> Flow,
 ) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
     let mut sim = Simulation::new(model, ground, initial, params.clone())?;
+    sim.set_interrupt(cancel.map(|c| Arc::clone(&c.0)));
     let total = params.duration;
     let mut shown = -1i64;
     let error = loop {

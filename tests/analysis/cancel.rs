@@ -1,7 +1,8 @@
 //! Stopping a run early, keeping what it computed. Its cancellation flag (`RunOptions::cancel`):
-//! set before the run, the run stops after its first step; set from another thread while it runs,
-//! it stops soon after; a study stops and resumes. Its sample limit (`RunOptions::max_samples`)
-//! stops it after the step that passes the limit. In every case the run is partial
+//! set before the run, the run stops within its first step, after one integration step (or one
+//! interval of the uplift test's grid at rest) at a state of the motion; set from another thread
+//! while it runs, it stops soon after; a study stops and resumes. Its sample limit
+//! (`RunOptions::max_samples`) stops it after the step that passes the limit. In every case the run is partial
 //! (`"completed": false`) and keeps every sample and impact computed until then, identical to
 //! those of the run not stopped.
 
@@ -51,6 +52,69 @@ fn a_flag_set_before_the_run_stops_it_after_one_step() {
     for (x, y) in before.iter().zip(b.iter()) {
         assert_eq!((x.t, x.q, x.qdot), (y.t, y.q, y.qdot));
     }
+}
+
+/// The flag is read inside a step too. The bundled block released at θ₀ = 0.1 rad rocks freely
+/// about its +x edge: its first step would run to the first impact (about 0.5 s: θ = α − (α − θ₀)
+/// cosh pt in the linear range). Under a flag already set it stops after one integration step,
+/// long before, at a state of the motion: Housner's energy integral,
+/// θ̇² = 2p² (cos(α − θ₀) − cos(α − θ)) with p² = 3g/4R for a box about its edge (I_O = 4mR²/3),
+/// holds at the last sample to the integrator's tolerance.
+#[test]
+fn a_flag_stops_a_rocking_step_at_a_state_of_the_motion() {
+    let model = crr::ModelInput::read(common::bundled_path("single_block")).unwrap();
+    let cancel = Cancel::new();
+    cancel.cancel();
+    let run = crr::run(&model, &options(20.0, &cancel)).unwrap();
+    let Some(SimulationError::Cancelled { t }) = run.failure else {
+        panic!("{:?}", run.failure);
+    };
+    assert!(t > 0.0 && t < 0.4, "stopped at {t}");
+    assert!(run.trajectory.impacts.is_empty());
+    let last = run.trajectory.samples.iter().next_back().unwrap();
+    assert_eq!(last.t, t);
+    let (b, h, g, theta0) = (0.2f64, 1.0f64, 9.81, 0.1);
+    let (alpha, r) = (b.atan2(h), b.hypot(h));
+    let p2 = 0.75 * g / r;
+    let (theta, rate) = (last.q[0], last.qdot[0]);
+    assert!(
+        theta > 0.0 && theta < theta0 && rate < 0.0,
+        "{theta} {rate}"
+    );
+    let expected = 2.0 * p2 * ((alpha - theta0).cos() - (alpha - theta).cos());
+    // rtol 1e-10 per step on q̇ ~ 0.1 rad/s: q̇² to far better than 1e-9 p².
+    assert!(
+        (rate * rate - expected).abs() <= 1e-9 * p2,
+        "θ̇² = {} against {expected}",
+        rate * rate
+    );
+}
+
+/// At rest under a ground motion below its uplift threshold (a sine of 0.5 m/s² against
+/// g tan α = 1.96 m/s²), with a sample every 0.5 s, the block's first step is the whole run of
+/// 1 000 s at rest (one segment, the uplift test on its grid). A flag already set stops it after
+/// one interval of that grid instead, every sample until then at rest.
+#[test]
+fn a_flag_stops_a_long_rest_within_one_interval_of_the_uplift_grid() {
+    let text = common::bundled_text("single_block").replace("angles = { base = 0.1 }", "")
+        + "\n[ground_motion]\nx = { sine = { amplitude = 0.5, frequency = 2.0 } }\n\n[analysis]\noutput_interval = 0.5\n";
+    let model = crr::ModelInput::parse("resting.toml", &text, false).unwrap();
+    let cancel = Cancel::new();
+    cancel.cancel();
+    let run = crr::run(&model, &options(1000.0, &cancel)).unwrap();
+    let Some(SimulationError::Cancelled { t }) = run.failure else {
+        panic!("{:?}", run.failure);
+    };
+    // The uplift test's grid under a 2 Hz sine is far finer than a second.
+    assert!(t > 0.0 && t < 1.0, "stopped at {t}");
+    assert_eq!(run.trajectory.end_time, t);
+    for s in run.trajectory.samples.iter() {
+        assert_eq!((s.q[0], s.qdot[0]), (0.0, 0.0), "at {}", s.t);
+    }
+    // Not stopped, the same block stays at rest through a step that reaches the run's end.
+    let full = crr::run(&model, &options(30.0, &Cancel::new())).unwrap();
+    assert!(full.completed());
+    assert!(full.trajectory.samples.iter().all(|s| s.q[0] == 0.0));
 }
 
 /// The bundled block rocking under a sine (a sample every 0.5 s): some 9 000 simulated seconds

@@ -1,4 +1,4 @@
-//! SIGINT (Ctrl-C) and SIGTERM stop `crr simulate` after its current step: it writes the results
+//! SIGINT (Ctrl-C) and SIGTERM stop `crr simulate` within one integration step: it writes the results
 //! computed until then into the folder, says in summary.json and on stderr that the run was
 //! interrupted and is partial, and exits with 1 (a simulation stopped part-way).
 

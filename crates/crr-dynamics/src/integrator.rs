@@ -65,6 +65,9 @@ mod events;
 mod stages;
 mod tableau;
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -318,6 +321,13 @@ pub enum SolveError {
     /// Invalid [`Options`] or method parameters.
     #[error("invalid integrator options: {0}")]
     InvalidOptions(String),
+    /// The interrupt flag ([`Solver::set_interrupt`]) was set: the advance stopped after an
+    /// accepted step, the solver's state `(t, y(t))` is that step's end.
+    #[error("interrupted at t = {t}")]
+    Interrupted {
+        /// Time reached: the end of the last accepted step.
+        t: f64,
+    },
 }
 
 /// Largest distance (RMS, in tolerances `atol + rtol·|y|`) between the dense output of a step at
@@ -364,6 +374,8 @@ pub struct Solver {
     zero_start: Vec<bool>,
     /// Event fired last (index, time).
     fired: Option<(usize, f64)>,
+    /// Read after every accepted step that does not end the advance ([`Solver::set_interrupt`]).
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 impl Solver {
@@ -407,7 +419,30 @@ impl Solver {
             g_tmp: Vec::new(),
             zero_start: Vec::new(),
             fired: None,
+            interrupt: None,
         })
+    }
+
+    /// A flag read after every accepted step: once set, [`Self::advance`] (and
+    /// [`Self::advance_lazily`]) stop with [`SolveError::Interrupted`] at the end of that step, a
+    /// state as good as any other step end. Each advance still takes at least one step, so that a
+    /// caller that goes on after an interrupt makes progress. A long advance (a quiet stretch of
+    /// many steps, a stalled one of many short steps) is then stopped within one step of the
+    /// request instead of at its end.
+    pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
+        self.interrupt = flag;
+    }
+
+    /// The flag of [`Self::set_interrupt`].
+    pub fn interrupt(&self) -> Option<&Arc<AtomicBool>> {
+        self.interrupt.as_ref()
+    }
+
+    /// Whether the flag of [`Self::set_interrupt`] is set.
+    pub fn interrupted(&self) -> bool {
+        self.interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
     }
 
     /// Forgets which event fired last. Call it when the next `advance` uses a different set of
@@ -632,6 +667,9 @@ impl Solver {
             h = h_new;
             if last {
                 return Ok(Stop::Reached);
+            }
+            if self.interrupted() {
+                return Err(SolveError::Interrupted { t: self.t });
             }
         }
     }

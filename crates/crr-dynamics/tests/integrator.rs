@@ -6,6 +6,8 @@ use crr_dynamics::integrator::{
     SolveError, Solver, StepEnds, Stop,
 };
 use std::f64::consts::PI;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 // ------------------------------------------------------------------ systems
 
@@ -854,6 +856,85 @@ fn max_steps_is_an_error() {
         matches!(err, SolveError::TooManySteps { max_steps: 10, t } if t > 0.0 && t < 1.0),
         "{err:?}"
     );
+}
+
+/// The oscillator, raising a flag when a stage reaches `at` (as another thread would).
+struct FlagAt {
+    at: f64,
+    flag: Arc<AtomicBool>,
+}
+impl OdeSystem for FlagAt {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
+        if t >= self.at {
+            self.flag.store(true, Ordering::Relaxed);
+        }
+        Oscillator.rhs(t, y, dydt)
+    }
+}
+
+/// An interrupt stops an advance at the end of the accepted step in which it is seen, a state of
+/// the solution (cos t, −sin t) to the tolerances; cleared, the advance goes on to the end as
+/// the uninterrupted one does.
+#[test]
+fn an_interrupt_stops_an_advance_at_an_accepted_step() {
+    let opts = Options {
+        h_max: 0.1,
+        ..Options::default()
+    };
+    let flag = Arc::new(AtomicBool::new(false));
+    let mut s = Solver::new(Method::Dop853, opts, 2).unwrap();
+    s.set_interrupt(Some(Arc::clone(&flag)));
+    s.reset(0.0, &[1.0, 0.0]);
+    let mut sys = FlagAt {
+        at: 3.0,
+        flag: Arc::clone(&flag),
+    };
+    let err = s
+        .advance(&mut sys, 10.0, &mut NoEvents, &mut ignore)
+        .unwrap_err();
+    let SolveError::Interrupted { t } = err else {
+        panic!("{err:?}")
+    };
+    // The flag rises in a step whose stages reach 3 (steps ≤ h_max = 0.1); the interrupt is
+    // read at the end of that step, or of the shorter retry of a rejected one.
+    assert!((2.9..=3.1).contains(&t), "interrupted at {t}");
+    assert_eq!(s.t(), t);
+    // The global error of DOP853 at rtol 1e-10 over 3 s stays far below 1e-8.
+    assert!((s.y()[0] - t.cos()).abs() < 1e-8 && (s.y()[1] + t.sin()).abs() < 1e-8);
+    flag.store(false, Ordering::Relaxed);
+    sys.at = f64::INFINITY;
+    let stop = s
+        .advance(&mut sys, 10.0, &mut NoEvents, &mut ignore)
+        .unwrap();
+    assert_eq!(stop, Stop::Reached);
+    assert!((s.y()[0] - 10f64.cos()).abs() < 1e-8 && (s.y()[1] + 10f64.sin()).abs() < 1e-8);
+}
+
+/// A flag already set still lets each advance take one accepted step, so that a caller that
+/// goes on advancing makes progress.
+#[test]
+fn an_advance_under_a_set_interrupt_takes_one_step() {
+    let opts = Options {
+        h_max: 0.1,
+        ..Options::default()
+    };
+    let mut s = Solver::new(Method::Dopri5, opts, 2).unwrap();
+    s.set_interrupt(Some(Arc::new(AtomicBool::new(true))));
+    s.reset(0.0, &[1.0, 0.0]);
+    let mut t_prev = 0.0;
+    for _ in 0..3 {
+        let accepted = s.stats().accepted;
+        let err = s
+            .advance(&mut Oscillator, 10.0, &mut NoEvents, &mut ignore)
+            .unwrap_err();
+        assert_eq!(err, SolveError::Interrupted { t: s.t() });
+        assert_eq!(s.stats().accepted, accepted + 1);
+        assert!(s.t() > t_prev && s.t() <= t_prev + 0.1);
+        t_prev = s.t();
+    }
 }
 
 /// y' = y², y(0) = 1: y = 1/(1-t) blows up at t = 1.

@@ -3,8 +3,8 @@
 
 use crr::Cancel;
 
-/// A flag set by the first SIGINT (Ctrl-C) or SIGTERM: the run stops after its current step and
-/// writes what it computed. A second signal ends the process at once (exit 130), for a run that
+/// A flag set by the first SIGINT (Ctrl-C) or SIGTERM: the run stops within one integration step
+/// (`crr::Cancel`) and writes what it computed. A second signal ends the process at once (exit 130), for a run that
 /// does not come back.
 pub(crate) fn interrupt_flag() -> Cancel {
     let cancel = Cancel::new();

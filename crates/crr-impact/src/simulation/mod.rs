@@ -23,6 +23,7 @@
 //! (its rate set to 0, the other generalized momenta kept); the run continues seated until uplift.
 
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use nalgebra::DVector;
 use serde::Serialize;
@@ -1144,6 +1145,18 @@ impl<'a> Simulation<'a> {
             .extend((0..self.model.slot_count).filter(|&s| seated[s]));
     }
 
+    /// A flag the run reads inside its steps: once set, [`Self::step`] stops with
+    /// [`SimulationError::Cancelled`] within one integration step (or, at rest, one grid
+    /// interval of the uplift test) of the request, at a state of the motion (the end of an
+    /// accepted step, or an instant known to hold at rest), with the samples up to there
+    /// recorded. Each step still advances at least once, so a caller that reads the flag
+    /// between steps too stops after the first. Without it a step runs to its event, breakpoint
+    /// or end, which may take long (a quiet stretch of a large structure, a stalled step of
+    /// many short steps).
+    pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
+        self.solver.set_interrupt(flag);
+    }
+
     fn reset_solver(&mut self) {
         self.solver.reset(self.t, &self.y);
         // Every segment rebuilds its event list: an index from the last one means nothing now.
@@ -1617,6 +1630,12 @@ impl<'a> Simulation<'a> {
         }
         self.spare.pending = pending;
         self.attach_hop();
+        if let Err(SolveError::Interrupted { t }) = stop {
+            // The end of an accepted step, its samples recorded above: the run stops there.
+            self.t = t;
+            copy_short(&mut self.y, self.solver.y());
+            return Err(SimulationError::Cancelled { t });
+        }
         let stop = stop?;
         self.t = self.solver.t();
         copy_short(&mut self.y, self.solver.y());

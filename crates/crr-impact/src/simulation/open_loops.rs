@@ -502,7 +502,9 @@ impl Simulation<'_> {
         let n = self.model.dof();
         if n != n_old {
             self.y = vec![0.0; 2 * n + 2];
+            let interrupt = self.solver.interrupt().cloned();
             self.solver = Solver::new(self.params.method, self.params.options, 2 * n + 2)?;
+            self.solver.set_interrupt(interrupt);
         }
         self.y[..n].copy_from_slice(q.as_slice());
         self.y[n..2 * n].copy_from_slice(qdot.as_slice());

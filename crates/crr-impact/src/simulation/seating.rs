@@ -1760,7 +1760,14 @@ impl Simulation<'_> {
         };
         let mut found = None;
         let mut t0 = self.t;
+        // An interrupt read after each grid interval (the first always runs) ends the rest at
+        // the last instant known to hold.
+        let mut interrupted_at = None;
         while t0 < t_stop {
+            if t0 > self.t && self.solver.interrupted() {
+                interrupted_at = Some(t0);
+                break;
+            }
             let whole = ground.duration() <= t0 || ground.is_affine_on(t0, t_stop);
             let t1 = if whole {
                 t_stop
@@ -1784,7 +1791,7 @@ impl Simulation<'_> {
         }
         self.spare.trial = Some(trial);
         self.spare.rest = rest;
-        let t_end = found.map_or(t_stop, |(_, hi)| hi);
+        let t_end = interrupted_at.unwrap_or(found.map_or(t_stop, |(_, hi)| hi));
         let dt = self.params.output_interval;
         let y = self.y.clone();
         // The samples at rest: up to the last instant known to hold where the structure
@@ -1807,6 +1814,9 @@ impl Simulation<'_> {
         }
         self.t = t_end;
         self.reset_solver();
+        if let Some(t) = interrupted_at {
+            return Err(SimulationError::Cancelled { t });
+        }
         if found.is_some()
             && let Some(mode) = self.release_at_uplift_event()?
         {
