@@ -706,18 +706,23 @@ fn hop_words(h: &crr_impact::simulation::Hop, tolerance: f64) -> String {
 
 /// The warning for a planar model (every interface a hinge about one common axis a,
 /// [`Model::planar_axis`]) under a ground motion with a part along a: its hinges carry that part
-/// bilaterally, so the run answers for the in-plane part only. The part's peak is bounded by
-/// Σₖ |aₖ| PGAₖ over the components (exact where a is a coordinate axis, as in every planar
-/// model the project bundles). None when the model is not planar or nothing acts along a.
+/// bilaterally, so the run answers for the in-plane part only. Where one component acts along a
+/// (a coordinate axis, as in every planar model the project bundles) the part's peak is that
+/// component's |aₖ| PGAₖ, quoted as the peak; where several do, their peaks need not coincide and
+/// Σₖ |aₖ| PGAₖ is quoted as a bound. None when the model is not planar or nothing acts along a.
 fn out_of_plane_ground_motion(model: &Model, ground: &GroundMotion) -> Option<String> {
     let axis = model.planar_axis()?;
     let pga = ground.pga();
-    let along = axis.abs().dot(&pga);
+    let parts = axis.abs().component_mul(&pga);
+    let along = parts.sum();
     // Below 1e-12 g the part is round-off of a turned axis.
-    (along > 1e-12 * model.gravity).then(|| {
+    let negligible = 1e-12 * model.gravity;
+    (along > negligible).then(|| {
+        let acting = parts.iter().filter(|&&p| p > negligible).count();
+        let peak = if acting == 1 { "peak" } else { "peak at most" };
         format!(
             "the ground motion has a part along the hinges' common axis ({:.3}, {:.3}, {:.3}) \
-             (peak up to {:.3e} m/s², {:.3} g): the hinges of a planar model carry it \
+             ({peak} {:.3e} m/s², {:.3} g): the hinges of a planar model carry it \
              bilaterally, so this run answers for the motion in the plane normal to that axis \
              only; out-of-plane rocking, overturning or sliding is outside the model",
             axis.x,

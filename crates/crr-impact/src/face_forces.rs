@@ -59,7 +59,10 @@ pub const PROXIMAL: f64 = 1e-7;
 #[derive(Clone, Debug, PartialEq)]
 pub struct MostCompressive {
     /// s*, the largest smallest normal force at a touching point that any distribution in
-    /// equilibrium reaches (N); 0 when a compressive distribution exists.
+    /// equilibrium reaches (N; an impulse in N s for [`most_compressive_impulses`]), each point's
+    /// measured per edge ([`touching_points_per_edge`]: a hinge's pivot line as it is, a corner
+    /// of a rocking base times the corners it shares an edge with); 0 when a compressive
+    /// distribution exists.
     pub min_normal: f64,
     /// The interface whose point holds s* with the largest dual price (the contact that limits
     /// it; the lowest index among equals), None when no point is unilateral.
@@ -102,7 +105,7 @@ pub fn most_compressive(
     dynamics: &Dynamics,
     work: &ForceWork,
 ) -> Option<MostCompressive> {
-    let program = FaceProgram::build(model, dynamics);
+    let program = FaceProgram::build(model, dynamics).per_edge();
     let loads = program.loads(model, dynamics, work)?;
     let (x, z) = program.solve(&loads, 0.0)?;
     Some(program.answer(&x, Some(&z)))
@@ -647,7 +650,7 @@ impl RestFaces {
         }
         let program = match self.entry.take() {
             Some(entry) => entry.program,
-            None => FaceProgram::build(model, dynamics),
+            None => FaceProgram::build(model, dynamics).per_edge(),
         };
         let loads = program.loads(model, dynamics, work)?;
         // In motion: the last distribution plus the least-norm change that restores the

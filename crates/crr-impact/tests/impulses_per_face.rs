@@ -20,7 +20,13 @@
 
 use crr_dynamics::eom::Dynamics;
 use crr_dynamics::ground_motion::GroundMotion;
-use crr_impact::face_forces::{compressive_impulses_at_least, least_normal_impulse_on_tree};
+use std::path::Path;
+
+use crr_dynamics::ground_motion::{Axis, ComponentSpec, ConstantSpec, SignalSpec};
+use crr_impact::face_forces::{
+    compressive_impulses_at_least, least_normal_impulse_on_tree, most_compressive,
+};
+use crr_impact::monitor::{ForceWork, TENSION_TOLERANCE, check_distribution, contact_forces_into};
 use crr_kinematics::fixtures::{box_body, hinge, rocking_base};
 use crr_kinematics::spec::{DEFAULT_GRAVITY, StructureSpec};
 use crr_kinematics::{ActivePivots, Model, Side};
@@ -137,4 +143,91 @@ fn a_face_s_pull_is_the_same_written_as_pivot_lines_or_as_corners() {
         }
     }
     assert!(pulled >= 3, "the cases pull ({pulled} of them)");
+}
+
+/// A constant ground acceleration a_x (m/s²).
+fn constant_x(a_x: f64) -> GroundMotion {
+    GroundMotion::none()
+        .with_component(
+            Axis::X,
+            &ComponentSpec::new(SignalSpec::Constant(ConstantSpec { value: a_x })),
+            Path::new("."),
+        )
+        .unwrap()
+}
+
+/// The forces the monitor judges are measured per edge as the impulses are: the stack at rest
+/// under a constant a_x, each block carrying m (a_x, 0, g) from its supports (its weight and its
+/// inertial load), gives its faces a force along z and a moment about y fixed by statics, the
+/// pivot lines' forces λ± = (F_z ∓ M_y/b)/2 as for impulses. The face program's least force
+/// (`most_compressive`) must be min(λ±) over both faces, whether the faces are lines or corners
+/// (1e-6 W: the proximal term). And the monitor must judge both forms alike at an a_x where the
+/// base's pulling edge carries −8e-4 W, beyond the −5e-4 W (tolerance/2) its program allows, and
+/// at one where it carries −3e-4 W, within it: measured point by point, the 3D corners carried
+/// −4e-4 W each and passed.
+#[test]
+fn a_face_s_pull_at_rest_is_the_same_written_as_pivot_lines_or_as_corners() {
+    let (m_lower, m_upper) = (2400.0 * 0.6 * 0.6 * 1.5, 2400.0 * 0.4 * 0.4 * 1.6);
+    let weight = (m_lower + m_upper) * DEFAULT_GRAVITY;
+    // The least pivot-line force of both faces under a_x, by hand.
+    let by_hand = |a_x: f64| {
+        let load = |m: f64| Vector3::new(m * a_x, 0.0, m * DEFAULT_GRAVITY);
+        let (c_lower, c_upper) = (Vector3::new(0.0, 0.0, 0.75), Vector3::new(0.0, 0.0, 2.3));
+        let (f_upper, m_upper_o) = (load(m_upper), c_upper.cross(&load(m_upper)));
+        let f_all = f_upper + load(m_lower);
+        let m_all = m_upper_o + c_lower.cross(&load(m_lower));
+        let (b1, b2) = line_impulses(f_all, m_all, 0.3, 0.0);
+        let (j1, j2) = line_impulses(f_upper, m_upper_o, 0.2, 1.5);
+        b1.min(b2).min(j1).min(j2)
+    };
+    // The base's least force F_z/2 − |M_y|/(2b) is linear in a_x: the a_x giving it `target` W.
+    let base_pulling = |target: f64| {
+        let moment_per_ax = m_lower * 0.75 + m_upper * 2.3;
+        (weight / 2.0 - target * weight) * 2.0 * 0.3 / moment_per_ax
+    };
+    let tolerance = TENSION_TOLERANCE * weight;
+    for (a_x, judged) in [
+        (0.5, None),
+        (2.0, None),
+        (base_pulling(-3e-4), Some(false)),
+        (base_pulling(-8e-4), Some(true)),
+        (3.0, Some(true)),
+        (-2.4, Some(true)),
+    ] {
+        let expected = by_hand(a_x);
+        if let Some(pulls) = judged {
+            assert_eq!(
+                expected < -0.5 * tolerance,
+                pulls,
+                "a_x = {a_x}: {expected} N"
+            );
+        }
+        for planar in [true, false] {
+            let model = stack(planar);
+            let ground = constant_x(a_x);
+            let mut d = Dynamics::new(&model, ActivePivots::uniform(&model, Side::Positive));
+            d.seated = (0..model.slot_count).collect();
+            let zero = DVector::zeros(model.dof());
+            let mut work = ForceWork::default();
+            contact_forces_into(&model, &mut d, &ground, 0.0, &zero, &zero, &mut work).unwrap();
+            let program = most_compressive(&model, &d, &work)
+                .expect("the program solves")
+                .min_normal;
+            assert!(
+                (program - expected.min(0.0)).abs() <= 1e-6 * weight,
+                "a_x = {a_x}, planar {planar}: {program} N against {expected} N by hand"
+            );
+            if let Some(pulls) = judged {
+                let violation = check_distribution(&model, &d, &work, 0.0, None, tolerance);
+                assert_eq!(
+                    violation.is_some(),
+                    pulls,
+                    "a_x = {a_x}, planar {planar}: {violation:?}"
+                );
+                if let Some(v) = violation {
+                    assert_eq!(v.interface, "base");
+                }
+            }
+        }
+    }
 }
