@@ -647,6 +647,39 @@ fn too_many_coordinates(name: &str, n: usize, at_least: &str) -> ModelError {
 }
 
 impl Model {
+    /// The same structure moved by `d` (m): every body's centre and shape, every pivot line's
+    /// point and every corner plus d; axes, normals, mass properties about the centres, the
+    /// tree, the loops and the size as they are. Gravity and the ground's motion are the same
+    /// everywhere, so the moved structure has the same motion in its angles, the same energies
+    /// relative to rest and the same contact forces. (The dynamics sums spatial quantities about
+    /// the world origin, whose round-off grows as the square of a body's distance from it: a
+    /// structure given far from the origin is computed moved near it.)
+    pub fn translated(&self, d: &Vector3<f64>) -> Model {
+        let mut moved = self.clone();
+        for body in &mut moved.bodies {
+            body.com += d;
+            body.shape = body.shape.translated(d);
+        }
+        for interface in &mut moved.interfaces {
+            match &mut interface.kind {
+                InterfaceKind::Hinge {
+                    pivot_positive,
+                    pivot_negative,
+                    ..
+                } => {
+                    *pivot_positive += d;
+                    *pivot_negative += d;
+                }
+                InterfaceKind::RockingBase { corners, .. } => {
+                    for c in corners.iter_mut() {
+                        *c += d;
+                    }
+                }
+            }
+        }
+        moved
+    }
+
     /// Validates a description and builds the model: mass properties, interface geometry, the
     /// spanning tree from the ground (coordinates in breadth-first order, interfaces in file order)
     /// and the loop closures.

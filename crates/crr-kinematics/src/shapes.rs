@@ -647,6 +647,32 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// The same shape moved by `d` (m): every point given plus d, every direction, size and
+    /// angle as it is.
+    pub fn translated(&self, d: &Vector3<f64>) -> Shape {
+        let moved = |p: &[f64; 3]| [p[0] + d.x, p[1] + d.y, p[2] + d.z];
+        match self {
+            Shape::Box(s) => Shape::Box(BoxShape {
+                center: moved(&s.center),
+                ..s.clone()
+            }),
+            Shape::Polyhedron(s) => Shape::Polyhedron(PolyhedronShape {
+                vertices: s.vertices.iter().map(moved).collect(),
+            }),
+            Shape::Prism(s) => Shape::Prism(PrismShape {
+                polygon: s.polygon.iter().map(moved).collect(),
+                ..s.clone()
+            }),
+            Shape::AnnularSector(s) => Shape::AnnularSector(AnnularSectorShape {
+                center: moved(&s.center),
+                ..s.clone()
+            }),
+            Shape::Compound(parts) => {
+                Shape::Compound(parts.iter().map(|p| p.translated(d)).collect())
+            }
+        }
+    }
+
     /// Exact mass properties (unit density), validating the input.
     pub fn mass_properties(&self) -> Result<MassProperties, ShapeError> {
         match self {

@@ -25,7 +25,7 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use nalgebra::DVector;
+use nalgebra::{DVector, Vector3};
 use serde::Serialize;
 
 use crr_dynamics::eom::{Dynamics, GeneralizedForce, slot_row};
@@ -460,8 +460,9 @@ pub struct Simulation<'a> {
     /// lifted off ([`Model::with_open_interfaces`]), its tree grown again where one of
     /// them was in it.
     model: Arc<Model>,
-    /// The file's model: the outputs' slots (samples, impacts) are numbered as its slots.
-    original: &'a Model,
+    /// The file's model, moved near the origin where it lies far from it ([`near_origin`]): the
+    /// outputs' slots (samples, impacts) are numbered as its slots.
+    original: Arc<Model>,
     /// The faces open: which interfaces of `original` are open, the slots' maps between the
     /// two models and the open faces watched for a corner touching again.
     open: OpenLoops,
@@ -731,12 +732,9 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
             params.duration
         )));
     }
-    // The mass matrix and the generalized forces are sums of spatial quantities about the world
-    // origin (a body's inertia there, I_c − m [c]×², less its share about its centre): a body
-    // at a distance D from it carries D²/L² times its own inertia, and round-off takes ε D²/L²
-    // of M(q). Placed in survey coordinates (5e5 m away, 2.5e5 times its size) a single block's
-    // rocking lost its energy balance and a stack stalled the integrator (an independent
-    // review); at 1e4 sizes the loss reaches 2e-8 of M, beyond the integrator's tolerance.
+    // The simulation computes a structure far from the origin moved near it (`near_origin`); its
+    // input coordinates themselves resolve its geometry to ε D only, 2e-7 of its size at the
+    // bound (the geometry's own tolerance is 1e-6 of the size).
     let farthest = model
         .bodies
         .iter()
@@ -747,13 +745,12 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
         let ratio = body.com.norm() / model.size;
         return Err(SimulationError::Parameter(format!(
             "body \"{}\" lies {:.4e} m from the world origin, {ratio:.3e} times the model's size \
-             L = {:.4} m (at most {FARTHEST_FROM_ORIGIN:e}): its inertia about the origin would lose \
-             {:.1e} of itself to round-off and the dynamics would depend on where the model sits; \
-             translate the model near the origin (e.g. put a ground pivot there)",
+             L = {:.4} m (at most {FARTHEST_FROM_ORIGIN:e}): its coordinates resolve its geometry \
+             to {:.1e} of its size only; translate the model nearer the origin",
             body.name,
             body.com.norm(),
             model.size,
-            f64::EPSILON * ratio * ratio
+            f64::EPSILON * ratio
         )));
     }
     Ok(())
@@ -767,8 +764,34 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
 pub const LONGEST_DURATION: f64 = 1e7;
 
 /// The farthest a body's centre may lie from the world origin, in model sizes
-/// ([`check_physical_bounds`]): the dynamics' round-off grows as the square of that distance.
-pub const FARTHEST_FROM_ORIGIN: f64 = 1e4;
+/// ([`check_physical_bounds`]): beyond, the coordinates of the input resolve the geometry to less
+/// than ε × 1e9 ≈ 2e-7 of the model's size, near its geometric tolerance (1e-6 of the size).
+pub const FARTHEST_FROM_ORIGIN: f64 = 1e9;
+
+/// Farther than this many model sizes from the world origin, a structure is simulated moved so
+/// that its bodies' mean centre is at the origin ([`Model::translated`]): the dynamics sums
+/// spatial quantities about the origin (a body's inertia there, I_c − m \[c\]×², less its share
+/// about its centre), so a body at D carries D²/L² times its own inertia and round-off takes
+/// ε D²/L² of M(q). Placed in survey coordinates (5e5 m away, 2.5e5 times its size), a single
+/// block's rocking lost its energy balance and a stack stalled the integrator (an independent
+/// review), before such models were moved. Within 10 sizes (every bundled model) the model is
+/// used as given.
+pub const MOVED_BEYOND: f64 = 10.0;
+
+/// `model`, moved so that its bodies' mean centre is at the origin when a body's centre lies
+/// farther than [`MOVED_BEYOND`] model sizes from it; otherwise as it is. Angles, energies
+/// relative to rest, contact forces and every output of a run are the same for both.
+fn near_origin(model: &Model) -> Model {
+    let far = model
+        .bodies
+        .iter()
+        .any(|b| b.com.norm() > MOVED_BEYOND * model.size);
+    if !far || model.bodies.is_empty() {
+        return model.clone();
+    }
+    let mean = model.bodies.iter().map(|b| b.com).sum::<Vector3<f64>>() / model.bodies.len() as f64;
+    model.translated(&-mean)
+}
 
 /// Sets the tree coordinates `seated(k)` of q and q̇ to exactly 0 and closes the loops again by
 /// the least change of the other coordinates, positions then velocities (Φ = 0, Φ_q q̇ = 0):
@@ -924,6 +947,8 @@ impl<'a> Simulation<'a> {
             }
         }
         check_physical_bounds(model, &params)?;
+        let placed = Arc::new(near_origin(model));
+        let model = &*placed;
         let n = model.dof();
         let mut pivots = initial.pivots.clone();
         let mut kin = Data::new(model);
@@ -962,8 +987,8 @@ impl<'a> Simulation<'a> {
         let sample_room = regular_samples + regular_samples / 4;
         let impact_room = params.max_impacts.min(INITIAL_IMPACT_ROOM);
         let mut sim = Self {
-            model: Arc::new(model.clone()),
-            original: model,
+            model: Arc::clone(&placed),
+            original: Arc::clone(&placed),
             open: OpenLoops::none(model),
             file_q: vec![0.0; model.dof()],
             file_qdot: vec![0.0; model.dof()],

@@ -293,7 +293,7 @@ impl Simulation<'_> {
             .filter_map(|name| self.original.interface_index(name))
             .collect();
         open.extend(&opening);
-        let built = match OpenLoops::with(self.original, &open, &[]) {
+        let built = match OpenLoops::with(&self.original, &open, &[]) {
             Ok(built) => built,
             Err(e) => return FaceRelease::Impossible(e.to_string()),
         };
@@ -567,7 +567,7 @@ impl Simulation<'_> {
     ) -> Result<usize, SimulationError> {
         self.check_impact_room()?;
         let t = self.t;
-        let original = self.original;
+        let original = Arc::clone(&self.original);
         let landing: Vec<usize> = landings
             .iter()
             .map(|&(face, _)| self.open.faces[face].interface)
@@ -599,7 +599,7 @@ impl Simulation<'_> {
                     .is_none_or(|i| !matches!(i.role, crr_kinematics::Role::Tree { .. }))
             })
             .collect();
-        let built = OpenLoops::with(original, &open, &outside_tree).map_err(|e| {
+        let built = OpenLoops::with(&original, &open, &outside_tree).map_err(|e| {
             SimulationError::Invariant(format!("cannot close the landing face's loop: {e}"))
         })?;
         self.switch_chain(built, &closing)?;
@@ -850,7 +850,7 @@ impl Simulation<'_> {
     /// coordinates ([`file_coordinates`]).
     pub(super) fn file_coordinates(&mut self, q: &DVector<f64>, qdot: &DVector<f64>) {
         file_coordinates(
-            self.original,
+            &self.original,
             &self.model,
             &self.open,
             &mut self.out_kin,
@@ -868,7 +868,7 @@ impl Simulation<'_> {
         if !self.open.faces.is_empty() {
             forward_kinematics(&self.model, &mut self.out_kin, q, &self.dynamics.pivots);
             face_openings(
-                self.original,
+                &self.original,
                 &self.model,
                 &self.out_kin,
                 &self.open,
@@ -889,7 +889,7 @@ impl Simulation<'_> {
                 &self.chain_q(),
                 &self.dynamics.pivots,
             );
-            face_openings(self.original, &self.model, &kin, &self.open, &mut out);
+            face_openings(&self.original, &self.model, &kin, &self.open, &mut out);
         }
         out
     }
@@ -904,7 +904,7 @@ impl Simulation<'_> {
         let (mut fq, mut fqdot) = (vec![0.0; n], vec![0.0; n]);
         let mut kin = Data::new(&self.model);
         file_coordinates(
-            self.original,
+            &self.original,
             &self.model,
             &self.open,
             &mut kin,
