@@ -423,7 +423,8 @@ impl Solver {
         })
     }
 
-    /// A flag read after every accepted step: once set, [`Self::advance`] (and
+    /// A flag read after every accepted step that does not end the advance (one that reaches
+    /// `t_end` or an event returns as usual): once set, [`Self::advance`] (and
     /// [`Self::advance_lazily`]) stop with [`SolveError::Interrupted`] at the end of that step, a
     /// state as good as any other step end. Each advance still takes at least one step, so that a
     /// caller that goes on after an interrupt makes progress. A long advance (a quiet stretch of

@@ -22,9 +22,10 @@
 //! forces. A plain hinge (one pivot line) is a pin: its force is free.
 //!
 //! **Program.** max s subject to every body's equilibrium Σ f = Fᵦ, Σ (p − c_b) × f + couples = Mᵦ,
-//! fₙ ≥ s at every unilateral point, s ≤ 0 (with a small proximal term on the forces,
-//! [`PROXIMAL`]). Its optimum s* is the largest smallest normal force
-//! any distribution reaches: s* = 0 when a compressive one exists, and s* < 0 is the least tension
+//! w fₙ ≥ s at every unilateral point, s ≤ 0 (with a small proximal term on the forces,
+//! [`PROXIMAL`]); w is 1, or for the monitor's and the impulses' programs the point's face's
+//! [`touching_points_per_edge`], which measures each point's force per edge. Its optimum s* is
+//! the largest smallest (weighted) normal force any distribution reaches: s* = 0 when a compressive one exists, and s* < 0 is the least tension
 //! the motion needs somewhere. One linear program with one global answer, whatever the order of
 //! the bodies, interfaces and corners; solved by `clarabel`'s interior point, on the sparse
 //! equilibrium of the bodies (six rows each, a few columns per contact point) rather than on the
@@ -320,15 +321,15 @@ impl FaceProgram {
         Some(b)
     }
 
-    /// max s subject to the equilibrium rows with right-hand side `loads`, fₙ ≥ s at every
-    /// unilateral point and s ≤ `cap` (W), with the proximal term: the primal x (column 0 is s,
+    /// max s subject to the equilibrium rows with right-hand side `loads`, w fₙ ≥ s at every
+    /// unilateral point (w its weight, [`Self::per_edge`]) and s ≤ `cap` (W), with the proximal term: the primal x (column 0 is s,
     /// forces in W) and the duals z of the inequality rows (one per unilateral point, then the
     /// cap's).
     fn solve(&self, loads: &[f64], cap: f64) -> Option<(Vec<f64>, Vec<f64>)> {
         let equilibrium = 6 * self.bodies;
         let (mut ri, mut ci, mut vi) = self.triplets();
         let mut b = loads.to_vec();
-        // fₙ ≥ s at every unilateral point (s − fₙ ≤ 0), and s ≤ cap.
+        // w fₙ ≥ s at every unilateral point (s − w fₙ ≤ 0), and s ≤ cap.
         let mut row = equilibrium;
         for (&c, &w) in self.unilateral.iter().zip(&self.unilateral_weight) {
             ri.extend([row, row]);
@@ -610,8 +611,8 @@ const CARRIED_RESIDUAL: f64 = 1e-9;
 impl RestFaces {
     /// [`most_compressive`] at a state with effective gravity `g_eff` (m/s²), position `q` and
     /// rates `qdot`: the last distribution carried to the new state answers when its smallest
-    /// point force is at least `floor` (N; then `limiting` is None and `min_normal` is that force
-    /// capped at 0); otherwise the program is solved with s ≤ `cap` (N), and its answer kept for
+    /// point force, measured per edge, is at least `floor` (N; then `limiting` is None and
+    /// `min_normal` is that force capped at 0); otherwise the program is solved with s ≤ `cap` (N), and its answer kept for
     /// the next samples.
     #[allow(clippy::too_many_arguments)]
     pub fn most_compressive(
@@ -961,7 +962,12 @@ fn interface_columns(
 /// corners on that edge share, and measured point by point the 3D form of a stack pulled half as
 /// hard as its planar twin at the same impact (an independent review found a 3D stack held
 /// through a 17.7 N s pull on one edge that the planar stack released: its corners took 8.9 N s
-/// each, under the 10 N s tolerance). The planar measure is the point's own.
+/// each, under the 10 N s tolerance). The planar measure is the point's own. A base rocking on
+/// an edge (two corners) weighs each corner by 2: the edge's share as above, while a moment
+/// across that edge (out of the rocking plane) loads its two corners apart, and each is then
+/// judged at twice its own force, more strictly than the seat's edge split of the
+/// tree-coordinate family judges it (that family asks the program only where its own split
+/// pulls beyond the tolerance).
 pub fn touching_points_per_edge(kind: &InterfaceKind, points: usize) -> f64 {
     match kind {
         InterfaceKind::Hinge { .. } => 1.0,

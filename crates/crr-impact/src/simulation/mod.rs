@@ -1174,7 +1174,7 @@ impl<'a> Simulation<'a> {
     /// [`SimulationError::Cancelled`] within one integration step (or, at rest, one grid
     /// interval of the uplift test) of the request, at a state of the motion (the end of an
     /// accepted step, or an instant known to hold at rest), with the samples up to there
-    /// recorded. Each step still advances at least once, so a caller that reads the flag
+    /// recorded and a last one at that instant ([`Self::record_final_sample`]). Each step still advances at least once, so a caller that reads the flag
     /// between steps too stops after the first. Without it a step runs to its event, breakpoint
     /// or end, which may take long (a quiet stretch of a large structure, a stalled step of
     /// many short steps).
@@ -1659,6 +1659,7 @@ impl<'a> Simulation<'a> {
             // The end of an accepted step, its samples recorded above: the run stops there.
             self.t = t;
             copy_short(&mut self.y, self.solver.y());
+            self.record_final_sample();
             return Err(SimulationError::Cancelled { t });
         }
         let stop = stop?;

@@ -1815,6 +1815,7 @@ impl Simulation<'_> {
         self.t = t_end;
         self.reset_solver();
         if let Some(t) = interrupted_at {
+            self.record_final_sample();
             return Err(SimulationError::Cancelled { t });
         }
         if found.is_some()
