@@ -159,14 +159,27 @@ pub fn inspect(model: &Model, q: &DVector<f64>) -> InspectReport {
         *s = Side::of(*a, *s);
     }
     forward_kinematics(model, &mut data, q, &pivots);
-    mass_matrix(model, &mut data);
+    // M(q) and Q(q) sum spatial quantities about the origin: a model far from it has them
+    // computed moved near it, where they are the same up to the round-off the move avoids.
+    let moved = model.moved_near_origin();
+    let (dynamic, mut moved_data) = match &moved {
+        Some(m) => {
+            let mut d = Data::new(m);
+            forward_kinematics(m, &mut d, q, &pivots);
+            (m, Some(d))
+        }
+        None => (model, None),
+    };
+    let dynamic_data = moved_data.as_mut().unwrap_or(&mut data);
+    mass_matrix(dynamic, dynamic_data);
     let mut qg = DVector::zeros(model.dof());
     generalized_gravity(
-        model,
-        &mut data,
+        dynamic,
+        dynamic_data,
         &Vector3::new(0.0, 0.0, -model.gravity),
         &mut qg,
     );
+    let mass_matrix_rows = rows(&dynamic_data.mass_matrix);
     let has_closures = model.constraint_rows > 0;
     if has_closures {
         constraint_residual(model, &mut data, &pivots, q);
@@ -228,7 +241,7 @@ pub fn inspect(model: &Model, q: &DVector<f64>) -> InspectReport {
                 rotation: mat3(&body_rotation(model, &data, b)),
             })
             .collect(),
-        mass_matrix: rows(&data.mass_matrix),
+        mass_matrix: mass_matrix_rows,
         generalized_gravity: qg.iter().copied().collect(),
         potential_energy: potential_energy(model, &data),
         constraint_residual: has_closures.then(|| data.phi.iter().copied().collect()),

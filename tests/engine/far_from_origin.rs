@@ -188,3 +188,36 @@ fn a_model_beyond_what_its_coordinates_resolve_is_refused() {
         "{error}"
     );
 }
+
+/// `crr inspect` of a model far from the origin: its mass matrix M(q) and generalized gravity
+/// Q(q) are those of the model at the origin (computed moved near it), to 1e-9 relative: the
+/// file's points are rounded to ulp(4.5e6 m) ≈ 1e-9 m, 5e-10 of the block's size (3e-12 seen).
+/// Computed about the origin, at 4.5e6 m, 2.25e6 times the block's size, round-off would take
+/// ε (D/L)² ≈ 1e-3 of M. The bodies' centres are reported where the file puts them.
+#[test]
+fn inspect_reports_a_far_model_s_mass_matrix_as_at_the_origin() {
+    let load = |tag: &str, text: &str| crr::load_model(&common::write_model(tag, text)).unwrap().1;
+    let near = load("inspect_near", &block_at(0.0, 0.0, 0.0));
+    let far = load("inspect_far", &block_at(SURVEY[0], SURVEY[1], SURVEY[2]));
+    let q = nalgebra::DVector::from_vec(vec![0.1]);
+    let (a, b) = (
+        crr::analysis::inspect::inspect(&near, &q),
+        crr::analysis::inspect::inspect(&far, &q),
+    );
+    let (ma, mb) = (a.mass_matrix[0][0], b.mass_matrix[0][0]);
+    assert!(
+        (ma - mb).abs() <= 1e-9 * ma,
+        "M = {ma} at the origin, {mb} far away"
+    );
+    let (qa, qb) = (a.generalized_gravity[0], b.generalized_gravity[0]);
+    assert!(
+        (qa - qb).abs() <= 1e-9 * qa.abs(),
+        "Q = {qa} at the origin, {qb} far away"
+    );
+    // Housner's block about its edge: I_O = m (4/3) R² with R² = b² + h² (0.2, 1.0 m).
+    let m = 2500.0 * 0.4 * 0.4 * 2.0;
+    let i_o = m * 4.0 / 3.0 * (0.2f64.powi(2) + 1.0);
+    assert!((mb - i_o).abs() <= 1e-9 * i_o, "M = {mb}, I_O = {i_o}");
+    let centre = b.bodies[0].center;
+    assert!((centre[1] - SURVEY[1]).abs() < 1.0, "{centre:?}");
+}

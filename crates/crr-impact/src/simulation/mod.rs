@@ -25,7 +25,7 @@
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use nalgebra::{DVector, Vector3};
+use nalgebra::DVector;
 use serde::Serialize;
 
 use crr_dynamics::eom::{Dynamics, GeneralizedForce, slot_row};
@@ -460,7 +460,8 @@ pub struct Simulation<'a> {
     /// lifted off ([`Model::with_open_interfaces`]), its tree grown again where one of
     /// them was in it.
     model: Arc<Model>,
-    /// The file's model, moved near the origin where it lies far from it ([`near_origin`]): the
+    /// The file's model, moved near the origin where it lies far from it
+    /// ([`Model::moved_near_origin`]): the
     /// outputs' slots (samples, impacts) are numbered as its slots.
     original: Arc<Model>,
     /// The faces open: which interfaces of `original` are open, the slots' maps between the
@@ -732,7 +733,8 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
             params.duration
         )));
     }
-    // The simulation computes a structure far from the origin moved near it (`near_origin`); its
+    // The simulation computes a structure far from the origin moved near it
+    // (`Model::moved_near_origin`); its
     // input coordinates themselves resolve its geometry to ε D only, 2e-7 of its size at the
     // bound (the geometry's own tolerance is 1e-6 of the size).
     let farthest = model
@@ -757,8 +759,9 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
 }
 
 /// The longest run, in the structure's time scale √(L/g) ([`check_physical_bounds`]): events
-/// are located to 1e-13 of their instant (the event bracket), 1e-6 √(L/g) at this bound, the
-/// spacing of the impacts of a joint coming to rest (`min_impact_interval`). Rocking dies out
+/// are located to 1e-13 of their instant (the event bracket), 1e-6 √(L/g) at this bound, which
+/// for structures of a metre to ten (√(L/g) = 0.3 to 1 s) is the order of the default spacing of
+/// the impacts of a joint coming to rest (`min_impact_interval`, 1e-6 s). Rocking dies out
 /// within some hundreds of time units; a run of a million (the Python interrupt test's 1e6 s of a
 /// 2 m block) is far inside it.
 pub const LONGEST_DURATION: f64 = 1e7;
@@ -767,31 +770,6 @@ pub const LONGEST_DURATION: f64 = 1e7;
 /// ([`check_physical_bounds`]): beyond, the coordinates of the input resolve the geometry to less
 /// than ε × 1e9 ≈ 2e-7 of the model's size, near its geometric tolerance (1e-6 of the size).
 pub const FARTHEST_FROM_ORIGIN: f64 = 1e9;
-
-/// Farther than this many model sizes from the world origin, a structure is simulated moved so
-/// that its bodies' mean centre is at the origin ([`Model::translated`]): the dynamics sums
-/// spatial quantities about the origin (a body's inertia there, I_c − m \[c\]×², less its share
-/// about its centre), so a body at D carries D²/L² times its own inertia and round-off takes
-/// ε D²/L² of M(q). Placed in survey coordinates (5e5 m away, 2.5e5 times its size), a single
-/// block's rocking lost its energy balance and a stack stalled the integrator (an independent
-/// review), before such models were moved. Within 10 sizes (every bundled model) the model is
-/// used as given.
-pub const MOVED_BEYOND: f64 = 10.0;
-
-/// `model`, moved so that its bodies' mean centre is at the origin when a body's centre lies
-/// farther than [`MOVED_BEYOND`] model sizes from it; otherwise as it is. Angles, energies
-/// relative to rest, contact forces and every output of a run are the same for both.
-fn near_origin(model: &Model) -> Model {
-    let far = model
-        .bodies
-        .iter()
-        .any(|b| b.com.norm() > MOVED_BEYOND * model.size);
-    if !far || model.bodies.is_empty() {
-        return model.clone();
-    }
-    let mean = model.bodies.iter().map(|b| b.com).sum::<Vector3<f64>>() / model.bodies.len() as f64;
-    model.translated(&-mean)
-}
 
 /// Sets the tree coordinates `seated(k)` of q and q̇ to exactly 0 and closes the loops again by
 /// the least change of the other coordinates, positions then velocities (Φ = 0, Φ_q q̇ = 0):
@@ -947,7 +925,8 @@ impl<'a> Simulation<'a> {
             }
         }
         check_physical_bounds(model, &params)?;
-        let placed = Arc::new(near_origin(model));
+        // Far from the origin the dynamics would lose digits to round-off: moved near it.
+        let placed = Arc::new(model.moved_near_origin().unwrap_or_else(|| model.clone()));
         let model = &*placed;
         let n = model.dof();
         let mut pivots = initial.pivots.clone();
