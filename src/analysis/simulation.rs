@@ -471,8 +471,8 @@ pub enum Flow {
 /// cases of a study). The samples are drained into `sink` after every step when `stream` (a sink
 /// error stops the run), else kept in the trajectory; a percentage goes to stderr when
 /// `progress`; a set `cancel` flag stops the run within one integration step of the request,
-/// inside the current step where it is long ([`SimulationError::Cancelled`]), and so do more than `max_samples` samples kept in memory
-/// ([`SimulationError::TooManySamples`]). An error before the first step is `Err`; one later comes
+/// inside the current step where it is long ([`SimulationError::Cancelled`]), and so do more
+/// than `max_samples` samples kept in memory ([`SimulationError::TooManySamples`]). An error before the first step is `Err`; one later comes
 /// back with the trajectory computed until then.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(

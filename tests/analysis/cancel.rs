@@ -19,6 +19,14 @@ fn options(duration: f64, cancel: &Cancel) -> RunOptions {
     }
 }
 
+/// The instant at which `run` was cancelled (a run that was not is a failure of the test).
+fn cancelled_at(run: &crr::Run) -> f64 {
+    match run.failure {
+        Some(SimulationError::Cancelled { t }) => t,
+        _ => panic!("not cancelled: {:?}", run.failure),
+    }
+}
+
 #[test]
 fn a_flag_set_before_the_run_stops_it_after_one_step() {
     let model = crr::ModelInput::read(common::bundled_path("block_record")).unwrap();
@@ -26,9 +34,7 @@ fn a_flag_set_before_the_run_stops_it_after_one_step() {
     cancel.cancel();
     let run = crr::run(&model, &options(20.0, &cancel)).unwrap();
     assert!(!run.completed());
-    let Some(SimulationError::Cancelled { t }) = run.failure else {
-        panic!("{:?}", run.failure);
-    };
+    let t = cancelled_at(&run);
     assert!(t > 0.0 && t < 20.0, "stopped at {t}");
     assert_eq!(run.trajectory.end_time, t);
     assert!(
@@ -66,9 +72,7 @@ fn a_flag_stops_a_rocking_step_at_a_state_of_the_motion() {
     let cancel = Cancel::new();
     cancel.cancel();
     let run = crr::run(&model, &options(20.0, &cancel)).unwrap();
-    let Some(SimulationError::Cancelled { t }) = run.failure else {
-        panic!("{:?}", run.failure);
-    };
+    let t = cancelled_at(&run);
     assert!(t > 0.0 && t < 0.4, "stopped at {t}");
     assert!(run.trajectory.impacts.is_empty());
     let last = run.trajectory.samples.iter().next_back().unwrap();
@@ -102,9 +106,7 @@ fn a_flag_stops_a_long_rest_within_one_interval_of_the_uplift_grid() {
     let cancel = Cancel::new();
     cancel.cancel();
     let run = crr::run(&model, &options(1000.0, &cancel)).unwrap();
-    let Some(SimulationError::Cancelled { t }) = run.failure else {
-        panic!("{:?}", run.failure);
-    };
+    let t = cancelled_at(&run);
     // The uplift test's grid under a 2 Hz sine is far finer than a second.
     assert!(t > 0.0 && t < 1.0, "stopped at {t}");
     assert_eq!(run.trajectory.end_time, t);
@@ -136,9 +138,7 @@ fn a_flag_set_from_another_thread_stops_a_long_run() {
     });
     let run = crr::run(&model, &options(1e6, &cancel)).unwrap();
     timer.join().unwrap();
-    let Some(SimulationError::Cancelled { t }) = run.failure else {
-        panic!("{:?}", run.failure);
-    };
+    let t = cancelled_at(&run);
     assert!(t < 1e6);
     assert!(!run.trajectory.impacts.is_empty());
     assert_eq!(run.trajectory.end_time, t);

@@ -25,8 +25,8 @@
 //! w fₙ ≥ s at every unilateral point, s ≤ 0 (with a small proximal term on the forces,
 //! [`PROXIMAL`]); w is 1, or for the monitor's and the impulses' programs the point's face's
 //! [`touching_points_per_edge`], which measures each point's force per edge. Its optimum s* is
-//! the largest smallest (weighted) normal force any distribution reaches: s* = 0 when a compressive one exists, and s* < 0 is the least tension
-//! the motion needs somewhere. One linear program with one global answer, whatever the order of
+//! the largest smallest (weighted) normal force any distribution reaches: s* = 0 when a
+//! compressive one exists, and s* < 0 is the least tension the motion needs somewhere. One linear program with one global answer, whatever the order of
 //! the bodies, interfaces and corners; solved by `clarabel`'s interior point, on the sparse
 //! equilibrium of the bodies (six rows each, a few columns per contact point) rather than on the
 //! dense self-stress states of the tree coordinates.
@@ -322,9 +322,9 @@ impl FaceProgram {
     }
 
     /// max s subject to the equilibrium rows with right-hand side `loads`, w fₙ ≥ s at every
-    /// unilateral point (w its weight, [`Self::per_edge`]) and s ≤ `cap` (W), with the proximal term: the primal x (column 0 is s,
-    /// forces in W) and the duals z of the inequality rows (one per unilateral point, then the
-    /// cap's).
+    /// unilateral point (w its weight, [`Self::per_edge`]) and s ≤ `cap` (W), with the proximal
+    /// term: the primal x (column 0 is s, forces in W) and the duals z of the inequality rows
+    /// (one per unilateral point, then the cap's).
     fn solve(&self, loads: &[f64], cap: f64) -> Option<(Vec<f64>, Vec<f64>)> {
         let equilibrium = 6 * self.bodies;
         let (mut ri, mut ci, mut vi) = self.triplets();
@@ -612,8 +612,8 @@ impl RestFaces {
     /// [`most_compressive`] at a state with effective gravity `g_eff` (m/s²), position `q` and
     /// rates `qdot`: the last distribution carried to the new state answers when its smallest
     /// point force, measured per edge, is at least `floor` (N; then `limiting` is None and
-    /// `min_normal` is that force capped at 0); otherwise the program is solved with s ≤ `cap` (N), and its answer kept for
-    /// the next samples.
+    /// `min_normal` is that force capped at 0); otherwise the program is solved with s ≤ `cap`
+    /// (N), and its answer kept for the next samples.
     #[allow(clippy::too_many_arguments)]
     pub fn most_compressive(
         &mut self,

@@ -647,7 +647,7 @@ fn too_many_coordinates(name: &str, n: usize, at_least: &str) -> ModelError {
 }
 
 /// Farther than this many model sizes from the world origin, a structure is computed moved so
-/// that its bodies' mean centre is at the origin ([`Model::moved_near_origin`]): the dynamics
+/// that its bodies' mean centre is near the origin ([`Model::moved_near_origin`]): the dynamics
 /// sums spatial quantities about the origin (a body's inertia there, I_c − m \[c\]×², less its
 /// share about its centre), so a body at D carries D²/L² times its own inertia and round-off
 /// takes ε D²/L² of M(q). Placed in survey coordinates (5e5 m away, 2.5e5 times its size), a
@@ -690,10 +690,16 @@ impl Model {
         moved
     }
 
-    /// This model moved so that its bodies' mean centre is at the origin, when a body's centre
-    /// lies farther than [`MOVED_BEYOND`] model sizes from it; None otherwise (the model is used
-    /// as it is). Angles, the mass matrix M(q), the generalized forces, energies relative to rest
-    /// and contact forces are the same for both, up to the round-off the move avoids.
+    /// This model moved so that its bodies' mean centre is near the origin, when a body's
+    /// centre lies farther than [`MOVED_BEYOND`] model sizes from it; None otherwise (the model
+    /// is used as it is). Angles, the mass matrix M(q), the generalized forces, energies relative
+    /// to rest and contact forces are the same for both, up to the round-off the move avoids.
+    ///
+    /// The move is the mean centre rounded to a multiple of u, the power of two at or above the
+    /// model's size: every coordinate of the model is a multiple of its own ulp, which divides
+    /// u, so each moved coordinate is a multiple of it no larger than the coordinate and is
+    /// computed exactly. The moved model is the given one to the bit, and the order in which the
+    /// bodies are listed (which changes the mean by round-off) does not change the move.
     pub fn moved_near_origin(&self) -> Option<Model> {
         let far = self
             .bodies
@@ -704,7 +710,9 @@ impl Model {
         }
         let mean =
             self.bodies.iter().map(|b| b.com).sum::<Vector3<f64>>() / self.bodies.len() as f64;
-        Some(self.translated(&-mean))
+        let unit = self.size.log2().ceil().exp2();
+        let reference = (mean / unit).map(f64::round) * unit;
+        Some(self.translated(&-reference))
     }
 
     /// Validates a description and builds the model: mass properties, interface geometry, the

@@ -461,8 +461,8 @@ pub struct Simulation<'a> {
     /// them was in it.
     model: Arc<Model>,
     /// The file's model, moved near the origin where it lies far from it
-    /// ([`Model::moved_near_origin`]): the
-    /// outputs' slots (samples, impacts) are numbered as its slots.
+    /// ([`Model::moved_near_origin`]): the outputs' slots (samples, impacts) are numbered as its
+    /// slots.
     original: Arc<Model>,
     /// The faces open: which interfaces of `original` are open, the slots' maps between the
     /// two models and the open faces watched for a corner touching again.
@@ -734,9 +734,8 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
         )));
     }
     // The simulation computes a structure far from the origin moved near it
-    // (`Model::moved_near_origin`); its
-    // input coordinates themselves resolve its geometry to ε D only, 2e-7 of its size at the
-    // bound (the geometry's own tolerance is 1e-6 of the size).
+    // (`Model::moved_near_origin`); its input coordinates themselves resolve its geometry to
+    // ε D only, 2e-7 of its size at the bound (the geometry's own tolerance is 1e-6 of the size).
     let farthest = model
         .bodies
         .iter()
@@ -1153,10 +1152,10 @@ impl<'a> Simulation<'a> {
     /// [`SimulationError::Cancelled`] within one integration step (or, at rest, one grid
     /// interval of the uplift test) of the request, at a state of the motion (the end of an
     /// accepted step, or an instant known to hold at rest), with the samples up to there
-    /// recorded and a last one at that instant ([`Self::record_final_sample`]). Each step still advances at least once, so a caller that reads the flag
-    /// between steps too stops after the first. Without it a step runs to its event, breakpoint
-    /// or end, which may take long (a quiet stretch of a large structure, a stalled step of
-    /// many short steps).
+    /// recorded and a last one at that instant ([`Self::record_final_sample`]). Each step still
+    /// advances at least once, so a caller that reads the flag between steps too stops after the
+    /// first. Without it a step runs to its event, breakpoint or end, which may take long (a
+    /// quiet stretch of a large structure, a stalled step of many short steps).
     pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
         self.solver.set_interrupt(flag);
     }
