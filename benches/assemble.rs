@@ -13,7 +13,7 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 
-use crr::analysis::assemble::read_assembly;
+use crr::analysis::assemble::{AssemblyOptions, read_assembly};
 use crr::analysis::rigid_domains::mechanism_model;
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
 use crr::kinematics::Model;
@@ -24,7 +24,7 @@ use crr::output::assemble::write_merged_model;
 fn wall_of_200(c: &mut Criterion) {
     let bodies = running_bond_wall(20, 10, 0.6, 0.25, 0.3).body;
     let assemble = || {
-        let contacts = detect_contacts(&bodies, 1e-6, ContactSet::Beds).unwrap();
+        let contacts = detect_contacts(&bodies, 1e-6, ContactSet::Beds, 0.0).unwrap();
         let spec = structure_of(
             "wall",
             9.81,
@@ -79,7 +79,18 @@ fn wall_of_200(c: &mut Criterion) {
     std::fs::write(&path, text).unwrap();
     let file = read_assembly(&path).unwrap();
     let directions = [Vector3::x(), -Vector3::x()];
-    let mechanism = || mechanism_model(&path, &file, true, &directions, 1e-6).unwrap();
+    let mechanism = || {
+        mechanism_model(
+            &path,
+            &file,
+            &directions,
+            &AssemblyOptions {
+                planar: true,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    };
     let m = mechanism();
     let merged_path = dir.join("wall_200_domains.toml");
     write_merged_model(&m, &merged_path, true).unwrap();

@@ -17,6 +17,33 @@ use crate::input::obj::obj_bodies;
 /// The default contact tolerance (m): two faces closer than this touch.
 pub const DEFAULT_TOLERANCE: f64 = 1e-6;
 
+/// How an assembly becomes a model: which contacts are interfaces, of which kind, and the
+/// geometry's tolerance and ground.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AssemblyOptions {
+    /// A planar layout in the x–z plane: hinges about y instead of rocking bases.
+    pub planar: bool,
+    /// Which contacts become interfaces: the beds, or every contact.
+    pub contacts: ContactSet,
+    /// Faces closer than this touch (m).
+    pub tolerance: f64,
+    /// The height of the ground (m): a site elevation where the blocks' coordinates are a
+    /// survey's (the ground is the plane z = 0 by default).
+    pub ground_level: f64,
+}
+
+impl Default for AssemblyOptions {
+    /// Rocking bases on the bed contacts, the default tolerance, the ground at z = 0.
+    fn default() -> Self {
+        Self {
+            planar: false,
+            contacts: ContactSet::Beds,
+            tolerance: DEFAULT_TOLERANCE,
+            ground_level: 0.0,
+        }
+    }
+}
+
 /// Reads an assembly file: a model file (TOML, or JSON when it ends in .json) with bodies (its
 /// `[[body]]` tables, then the blocks of its `[[obj]]` files) and no interfaces.
 pub fn read_assembly(path: &Path) -> Result<ModelFile, Error> {
@@ -67,18 +94,23 @@ pub struct Assembled {
     pub folder: std::path::PathBuf,
 }
 
-/// Finds the contacts of the assembly `file` (read from `path`) and builds the model whose
-/// interfaces are the contacts of `set` (every bed, or every contact): rocking bases, or hinges
-/// about y with `planar`.
+/// Finds the contacts of the assembly `file` (read from `path`) on the ground of `options` and
+/// builds the model whose interfaces are its contacts (every bed, or every contact): rocking
+/// bases, or hinges about y when planar.
 pub fn assemble(
     path: &Path,
     file: &ModelFile,
-    planar: bool,
-    set: ContactSet,
-    tolerance: f64,
+    options: &AssemblyOptions,
 ) -> Result<Assembled, Error> {
+    let &AssemblyOptions {
+        planar,
+        contacts: set,
+        tolerance,
+        ground_level,
+    } = options;
     let here = |e: &dyn std::fmt::Display| Error::Argument(format!("{}: {e}", path.display()));
-    let contacts = detect_contacts(&file.body, tolerance, set).map_err(|e| here(&e))?;
+    let contacts =
+        detect_contacts(&file.body, tolerance, set, ground_level).map_err(|e| here(&e))?;
     let style = if planar {
         InterfaceStyle::PlanarHinge
     } else {

@@ -37,7 +37,7 @@ use crr_kinematics::spec::{BlockSpec, BodySpec, SymmetrySpec};
 use crr_kinematics::{ActivePivots, Model, Parent, Side, StructureSpec};
 
 use crate::Error;
-use crate::analysis::assemble::{Assembled, assemble};
+use crate::analysis::assemble::{Assembled, AssemblyOptions, assemble};
 use crate::input::model_file::ModelFile;
 
 /// The collapse along one direction of the assembly of every contact.
@@ -80,20 +80,25 @@ pub struct MechanismModel {
 }
 
 /// The limit analysis of the assembly `file` (read from `path`) along `directions` and its
-/// merged model (hinges about y with `planar`, else rocking bases).
+/// merged model (hinges about y with `options.planar`, else rocking bases; every contact an
+/// interface, whatever `options.contacts`).
 pub fn mechanism_model(
     path: &Path,
     file: &ModelFile,
-    planar: bool,
     directions: &[Vector3<f64>],
-    tolerance: f64,
+    options: &AssemblyOptions,
 ) -> Result<MechanismModel, Error> {
+    let (planar, tolerance) = (options.planar, options.tolerance);
     // The assembly's [[symmetry]] tables name coordinates of the merged model, not of this one.
     let blocks_only = ModelFile {
         symmetry: Vec::new(),
         ..file.clone()
     };
-    let all = assemble(path, &blocks_only, planar, ContactSet::All, tolerance)?;
+    let every_contact = AssemblyOptions {
+        contacts: ContactSet::All,
+        ..*options
+    };
+    let all = assemble(path, &blocks_only, &every_contact)?;
     // One limit analysis per direction, each on its own thread (independent programs; the
     // answers are collected in the directions' order, so the result does not depend on timing).
     let collapses = std::thread::scope(|scope| {

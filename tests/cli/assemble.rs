@@ -8,9 +8,8 @@ use std::collections::BTreeSet;
 
 use nalgebra::Vector3;
 
-use crr::analysis::assemble::{DEFAULT_TOLERANCE, assemble, read_assembly};
+use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
-use crr::kinematics::assembly::ContactSet;
 use crr::kinematics::spec::PivotSpec;
 
 use crate::common;
@@ -62,7 +61,15 @@ fn joints(spec_interfaces: &[crr::kinematics::spec::InterfaceSpec]) -> BTreeSet<
 fn the_wall_assembled_from_its_blocks_is_the_hand_written_wall() {
     let path = assembly_of("wall", "wall_assembly");
     let file = read_assembly(&path).unwrap();
-    let planar = assemble(&path, &file, true, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
+    let planar = assemble(
+        &path,
+        &file,
+        &AssemblyOptions {
+            planar: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let (hand, _) = crr::load_model(&common::bundled_path("wall")).unwrap();
     assert_eq!(joints(&planar.file.interface), joints(&hand.interface));
     // 4 courses of 3 blocks (half blocks at the ends of the odd ones): 3 on the ground, and the
@@ -82,7 +89,7 @@ fn the_wall_assembled_from_its_blocks_is_the_hand_written_wall() {
     let seven_elevenths = 7.0 / 11.0;
     for m in [
         &planar.model,
-        &assemble(&path, &file, false, ContactSet::Beds, DEFAULT_TOLERANCE)
+        &assemble(&path, &file, &AssemblyOptions::default())
             .unwrap()
             .model,
     ] {
@@ -107,7 +114,7 @@ fn a_panel_cut_into_courses_rocks_whole_on_its_base_edge() {
     }
     let path = common::write_model("panel_assembly", &text);
     let file = read_assembly(&path).unwrap();
-    let bases = assemble(&path, &file, false, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
+    let bases = assemble(&path, &file, &AssemblyOptions::default()).unwrap();
     assert_eq!(bases.model.dof(), 10);
     assert!(bases.model.closures.is_empty());
     for (d, expected) in [
@@ -119,7 +126,15 @@ fn a_panel_cut_into_courses_rocks_whole_on_its_base_edge() {
         let l = lambda(&bases.model, d);
         assert!((l - expected).abs() < 1e-9, "{d:?}: {l}");
     }
-    let hinges = assemble(&path, &file, true, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
+    let hinges = assemble(
+        &path,
+        &file,
+        &AssemblyOptions {
+            planar: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert!((lambda(&hinges.model, Vector3::x()) - 0.16).abs() < 1e-9);
     // The model file written loads back into the same model.
     let out = common::scratch("panel_model").join("panel.toml");
@@ -214,6 +229,139 @@ fn overlapping_blocks_and_a_block_below_the_ground_are_refused_naming_them() {
     );
 }
 
+/// The text of an assembly of boxes with every box centre moved by `d` (Rust's shortest
+/// round-trip formatting: the file holds the moved centres to their last bit).
+fn boxes_moved(text: &str, d: [f64; 3]) -> String {
+    let key = "center = [";
+    text.lines()
+        .map(|line| match line.find(key) {
+            Some(i) => {
+                let from = i + key.len();
+                let to = from + line[from..].find(']').expect("a closing bracket");
+                let c: Vec<f64> = line[from..to]
+                    .split(',')
+                    .map(|x| x.trim().parse().expect("a number"))
+                    .collect();
+                format!(
+                    "{}{:?}, {:?}, {:?}{}\n",
+                    &line[..from],
+                    c[0] + d[0],
+                    c[1] + d[1],
+                    c[2] + d[2],
+                    &line[to..]
+                )
+            }
+            None => format!("{line}\n"),
+        })
+        .collect()
+}
+
+/// A site elevation is the ground's level. The bundled wall's blocks written in a survey's
+/// coordinates (5e5 m east, 4.5e6 m north, 350 m up):
+/// - on the default ground (z = 0) nothing rests: refused, naming the first block and where the
+///   lowest stands, with the option that fixes it;
+/// - with `--ground-level 350` the command line writes the model, and the library gives the
+///   same bed joints as at the origin (parents, children, pivot lines moved by the offset, to
+///   1e-9 m: the survey coordinates hold the points to ulp(4.5e6) ≈ 1e-9 m) and the wall's
+///   multiplier 7/11 of the corner wedge's virtual work along ±x, to 1e-9;
+/// - a block sunk 0.05 m below the level is refused with that depth.
+#[test]
+fn a_wall_in_survey_coordinates_stands_on_the_ground_level_given() {
+    const SURVEY: [f64; 3] = [5e5, 4.5e6, 350.0];
+    let head = {
+        let text = common::bundled_text("wall");
+        text[..text.find("[[interface]]").unwrap()].to_string()
+    };
+    let path = common::write_model("wall_survey_assembly", &boxes_moved(&head, SURVEY));
+    let o = common::crr(&["assemble", path.to_str().unwrap(), "--planar"]);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("rests on nothing")
+            && err.contains("the lowest stands at z = 350.000000 m")
+            && err.contains("--ground-level 350`"),
+        "{err}"
+    );
+
+    let model = common::scratch("wall_survey_model").join("model.toml");
+    let o = common::crr(&[
+        "assemble",
+        path.to_str().unwrap(),
+        "--planar",
+        "--ground-level",
+        "350",
+        "--out",
+        model.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let planar = AssemblyOptions {
+        planar: true,
+        ..Default::default()
+    };
+    let origin_path = assembly_of("wall", "wall_origin_assembly");
+    let at_origin = assemble(&origin_path, &read_assembly(&origin_path).unwrap(), &planar).unwrap();
+    assert!(
+        text.contains(&format!("({} interfaces,", at_origin.file.interface.len())),
+        "{text}"
+    );
+
+    let survey = assemble(
+        &path,
+        &read_assembly(&path).unwrap(),
+        &AssemblyOptions {
+            ground_level: 350.0,
+            ..planar
+        },
+    )
+    .unwrap();
+    assert_eq!(survey.file.interface.len(), at_origin.file.interface.len());
+    let line = |p: &Option<PivotSpec>| match p.as_ref().expect("a pivot") {
+        PivotSpec::Point(a) => [*a, *a],
+        PivotSpec::Segment(ends) => *ends,
+    };
+    for (far, near) in survey.file.interface.iter().zip(&at_origin.file.interface) {
+        assert_eq!(
+            (&far.name, &far.parent, &far.child),
+            (&near.name, &near.parent, &near.child)
+        );
+        for (a, b) in [
+            (line(&far.pivot_positive), line(&near.pivot_positive)),
+            (line(&far.pivot_negative), line(&near.pivot_negative)),
+        ] {
+            for (pa, pb) in a.iter().zip(&b) {
+                for k in 0..3 {
+                    assert!(
+                        (pa[k] - SURVEY[k] - pb[k]).abs() < 1e-9,
+                        "{}: {pa:?} against {pb:?}",
+                        far.name
+                    );
+                }
+            }
+        }
+    }
+    for d in [Vector3::x(), -Vector3::x()] {
+        let l = lambda(&survey.model, d);
+        assert!((l - 7.0 / 11.0).abs() < 1e-9, "{l}");
+    }
+
+    let sunk = boxes_moved(&head, [SURVEY[0], SURVEY[1], SURVEY[2] - 0.05]);
+    let path = common::write_model("wall_survey_sunk", &sunk);
+    let o = common::crr(&[
+        "assemble",
+        path.to_str().unwrap(),
+        "--planar",
+        "--ground-level",
+        "350",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("reaches 0.050000 m below the ground (z = 350 m)"),
+        "{err}"
+    );
+}
+
 /// The trilithon bundled as three stones (`examples/assemblies/trilithon.toml`) gives, with
 /// `--planar`, the hand-written trilithon's four joints (`examples/models/trilithon.toml`: the same
 /// parents, children and pivot lines) and its multiplier b/h = 0.5/4 = 0.125 along ±x.
@@ -222,7 +370,15 @@ fn the_trilithon_of_stones_is_the_hand_written_trilithon() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/trilithon.toml");
     let file = read_assembly(&path).unwrap();
-    let planar = assemble(&path, &file, true, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
+    let planar = assemble(
+        &path,
+        &file,
+        &AssemblyOptions {
+            planar: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let (hand, _) = crr::load_model(&common::bundled_path("trilithon")).unwrap();
     assert_eq!(joints(&planar.file.interface), joints(&hand.interface));
     for d in [Vector3::x(), -Vector3::x()] {
@@ -365,7 +521,7 @@ fn blocks_from_an_obj_file() {
         let file = read_assembly(&path).unwrap();
         let names: Vec<&str> = file.body.iter().map(|b| b.name.as_str()).collect();
         assert_eq!(names, ["lower", "upper"], "{tag}");
-        let a = assemble(&path, &file, false, ContactSet::Beds, DEFAULT_TOLERANCE).unwrap();
+        let a = assemble(&path, &file, &AssemblyOptions::default()).unwrap();
         let mass = a.model.total_mass();
         assert!(
             (mass - 2.0 * 0.16 * 2000.0).abs() < 1e-9 * mass,

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
 
-use crr::analysis::assemble::{DEFAULT_TOLERANCE, read_assembly};
+use crr::analysis::assemble::{AssemblyOptions, read_assembly};
 use crr::analysis::rigid_domains::{MechanismModel, mechanism_model};
 use crr::impact::SlotState;
 use crr::impact::statics::{StaticsOptions, collapse_multiplier};
@@ -27,7 +27,16 @@ fn bundled_assembly(name: &str) -> PathBuf {
 
 fn mechanism(path: &Path, planar: bool, directions: &[Vector3<f64>]) -> MechanismModel {
     let file = read_assembly(path).unwrap();
-    mechanism_model(path, &file, planar, directions, DEFAULT_TOLERANCE).unwrap()
+    mechanism_model(
+        path,
+        &file,
+        directions,
+        &AssemblyOptions {
+            planar,
+            ..Default::default()
+        },
+    )
+    .unwrap()
 }
 
 fn lambda(model: &Model, d: Vector3<f64>) -> Option<f64> {
@@ -383,9 +392,17 @@ fn symmetry_rows_of_the_assembly_give_dof3_of_the_merged_model() {
     }
     let path = with("equal", "nope");
     let file = read_assembly(&path).unwrap();
-    let e = mechanism_model(&path, &file, true, &along_x(), DEFAULT_TOLERANCE)
-        .unwrap_err()
-        .to_string();
+    let e = mechanism_model(
+        &path,
+        &file,
+        &along_x(),
+        &AssemblyOptions {
+            planar: true,
+            ..Default::default()
+        },
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("no coordinate named \"nope\""), "{e}");
 }
 

@@ -34,7 +34,7 @@ fn a_loose_tolerance_is_an_error_not_a_false_collapse() {
 /// error beyond 1e-5 rad.
 #[test]
 fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
-    use crr::analysis::assemble::{DEFAULT_TOLERANCE, assemble, read_assembly};
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
     use crr::impact::SlotState;
     use crr::kinematics::assembly::ContactSet;
     let source =
@@ -49,7 +49,16 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
             );
         let path = common::write_model(&format!("arch_stones_x{scale}"), &text);
         let file = read_assembly(&path).unwrap();
-        let assembled = assemble(&path, &file, true, ContactSet::All, DEFAULT_TOLERANCE).unwrap();
+        let assembled = assemble(
+            &path,
+            &file,
+            &AssemblyOptions {
+                planar: true,
+                contacts: ContactSet::All,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         let model_path = common::write_model(
             &format!("arch_stones_x{scale}_model"),
             &crr::output::assemble::model_toml(&assembled, &assembled.file),

@@ -169,14 +169,23 @@ fn walls_release_their_wedges_loops_above_their_multiplier() {
 /// multiplier is the one the model of every stone has (`tests/cli/mechanism.rs`).
 #[test]
 fn models_of_rigid_domains_leave_rest_at_their_multiplier() {
-    use crr::analysis::assemble::{DEFAULT_TOLERANCE, read_assembly};
+    use crr::analysis::assemble::{AssemblyOptions, read_assembly};
     use crr::analysis::rigid_domains::mechanism_model;
     for (name, lambda) in [("facade", 1.25), ("arch", 0.365716)] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("examples/assemblies/{name}.toml"));
         let file = read_assembly(&path).unwrap();
         let directions = [Vector3::x(), -Vector3::x()];
-        let m = mechanism_model(&path, &file, true, &directions, DEFAULT_TOLERANCE).unwrap();
+        let m = mechanism_model(
+            &path,
+            &file,
+            &directions,
+            &AssemblyOptions {
+                planar: true,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         assert!(
             m.merged
                 .model

@@ -845,7 +845,7 @@ fn arch_hinges(n: usize, r_in: f64, r_out: f64, dx: f64) -> Vec<usize> {
 /// touches the intrados or the extrados, the other joints staying closed.
 #[test]
 fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
-    use crr::analysis::assemble::{assemble, read_assembly};
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
     use crr::impact::statics::Motion;
     use crr::kinematics::assembly::ContactSet;
     let (n, r_in, r_out) = (9, 2.0, 2.5);
@@ -853,7 +853,16 @@ fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/arch.toml");
     let file = read_assembly(&path).unwrap();
     for planar in [true, false] {
-        let assembled = assemble(&path, &file, planar, ContactSet::All, 1e-6).unwrap();
+        let assembled = assemble(
+            &path,
+            &file,
+            &AssemblyOptions {
+                planar,
+                contacts: ContactSet::All,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         let model = &assembled.model;
         assert_eq!(model.interfaces.len(), n + 1);
         for dx in [1.0, -1.0] {
@@ -919,12 +928,19 @@ fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
 /// ±x (1e-7).
 #[test]
 fn the_wall_assembled_from_its_stones_matches_the_block_lp() {
-    use crr::analysis::assemble::{assemble, read_assembly};
-    use crr::kinematics::assembly::ContactSet;
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/wall.toml");
     let file = read_assembly(&path).unwrap();
-    let assembled = assemble(&path, &file, true, ContactSet::Beds, 1e-6).unwrap();
+    let assembled = assemble(
+        &path,
+        &file,
+        &AssemblyOptions {
+            planar: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let options = StaticsOptions {
         sliding_lift_off: false,
         ..StaticsOptions::default()
@@ -1158,7 +1174,7 @@ fn a_corner_wedge_that_slides_off_its_other_support_is_found() {
 /// instead of an infeasibility; the statics now retry with other settings before giving up.
 #[test]
 fn an_arch_of_200_voussoirs_near_its_minimum_thickness_has_its_multiplier() {
-    use crr::analysis::assemble::{assemble, read_assembly};
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
     use crr::kinematics::assembly::ContactSet;
     let (n, r_in, r_out) = (200, 0.946, 1.054);
     let mut text = String::from("name = \"arch\"\ngravity = 9.81\n");
@@ -1177,7 +1193,16 @@ fn an_arch_of_200_voussoirs_near_its_minimum_thickness_has_its_multiplier() {
     let path = dir.join("arch_200_voussoirs.toml");
     std::fs::write(&path, text).unwrap();
     let file = read_assembly(&path).unwrap();
-    let assembled = assemble(&path, &file, true, ContactSet::All, 1e-6).unwrap();
+    let assembled = assemble(
+        &path,
+        &file,
+        &AssemblyOptions {
+            planar: true,
+            contacts: ContactSet::All,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     for dx in [1.0, -1.0] {
         let expected = arch_lambda(n, r_in, r_out, dx).expect("the thrust line stands");
         let report = static_multiplier(&assembled.model, Vector3::new(dx, 0.0, 0.0))

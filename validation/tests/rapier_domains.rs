@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Vector3;
 
-use crr::analysis::assemble::{DEFAULT_TOLERANCE, read_assembly};
+use crr::analysis::assemble::{AssemblyOptions, read_assembly};
 use crr::analysis::rigid_domains::mechanism_model;
 use crr::analysis::simulation::{Prepared, prepare};
 use crr::dynamics::InitialSpec;
@@ -68,7 +68,16 @@ fn a_block_cut_in_courses_rocks_as_one_domain_in_crr_and_in_rapier() {
     std::fs::write(&assembly, text).unwrap();
     let file = read_assembly(&assembly).unwrap();
     let directions = [Vector3::x(), -Vector3::x()];
-    let mut m = mechanism_model(&assembly, &file, true, &directions, DEFAULT_TOLERANCE).unwrap();
+    let mut m = mechanism_model(
+        &assembly,
+        &file,
+        &directions,
+        &AssemblyOptions {
+            planar: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     for c in &m.collapses {
         assert!((c.lambda.unwrap() - 0.2).abs() < 1e-9, "{c:?}");
     }

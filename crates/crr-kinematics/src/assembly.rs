@@ -4,8 +4,9 @@
 //!
 //! Two faces touch when they face each other (outward normals opposite, to 1e-9) in one plane
 //! (their distance at most the tolerance); the contact face is the overlap of the two convex
-//! polygons (clipped in the plane, Sutherland–Hodgman). The ground is the plane z = 0: a face
-//! lying on it with its outward normal down rests on the ground whole. A contact whose normal
+//! polygons (clipped in the plane, Sutherland–Hodgman). The ground is the horizontal plane at the
+//! ground level (z = 0 unless a site elevation is given): a face lying on it with its outward
+//! normal down rests on the ground whole. A contact whose normal
 //! leans less than 45° from the vertical is a **bed** (the lower body supports the upper one: a
 //! rocking interface); a steeper one is a **side** contact (a head joint, a block against a
 //! neighbour), reported but not made an interface, since a CRR interface is a support rocking
@@ -201,19 +202,27 @@ pub enum ContactSet {
     All,
 }
 
-/// The contact faces of `bodies` resting on the ground (z = 0) and on each other: faces facing
-/// each other in one plane (distance at most `tolerance`, m) whose overlap has an area above
-/// tolerance × the model size. Every body must be supported through the contacts of `set`
-/// (else it floats: an error naming it), and two bodies may touch on one face only.
+/// The contact faces of `bodies` resting on the ground (the plane z = `ground_level`, m) and on
+/// each other: faces facing each other in one plane (distance at most `tolerance`, m) whose
+/// overlap has an area above tolerance × the model size. Every body must be supported through
+/// the contacts of `set` (else it floats: an error naming it, and where the blocks' lowest point
+/// is when none reaches the ground), and two bodies may touch on one face only.
 pub fn detect_contacts(
     bodies: &[BodySpec],
     tolerance: f64,
     set: ContactSet,
+    ground_level: f64,
 ) -> Result<Vec<ContactFace>, AssemblyError> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(error(
             "tolerance",
             format!("must be a positive length (m), got {tolerance}"),
+        ));
+    }
+    if !ground_level.is_finite() {
+        return Err(error(
+            "ground level",
+            format!("must be a finite height (m), got {ground_level}"),
         ));
     }
     let surfaces = bodies
@@ -236,14 +245,18 @@ pub fn detect_contacts(
     let size = boxes
         .iter()
         .fold(0.0f64, |m, (lo, hi)| m.max((hi - lo).norm()));
-    refuse_overlaps(bodies, &surfaces, &boxes, tolerance)?;
+    refuse_overlaps(bodies, &surfaces, &boxes, tolerance, ground_level)?;
     let min_area = tolerance * size;
     let facing = 1.0 - 1e-9;
     let mut contacts = Vec::new();
-    // On the ground: a face on z = 0 whose outward normal is −z rests whole.
+    // On the ground: a face on the ground level whose outward normal is −z rests whole.
     for (b, fs) in faces.iter().enumerate() {
         for f in fs {
-            if f.normal.z < -facing && f.polygon.iter().all(|v| v.z.abs() <= tolerance) {
+            if f.normal.z < -facing
+                && f.polygon
+                    .iter()
+                    .all(|v| (v.z - ground_level).abs() <= tolerance)
+            {
                 if !f.convex {
                     return Err(non_convex(&bodies[b].name));
                 }
@@ -305,6 +318,7 @@ pub fn detect_contacts(
         }
     }
     let counts = |c: &ContactFace| c.bed || set == ContactSet::All;
+    let hint = ground_hint(&boxes, ground_level, tolerance);
     for (k, c) in contacts.iter().enumerate() {
         let same_pair = |d: &ContactFace| {
             (d.lower == c.lower && d.upper == c.upper)
@@ -329,8 +343,9 @@ pub fn detect_contacts(
                     return Err(error(
                         format!("body \"{}\"", body.name),
                         format!(
-                            "rests on nothing: no face of it lies on the ground (z = 0) or on a \
-                             block below within the tolerance of {tolerance} m"
+                            "rests on nothing: no face of it lies on the ground (z = \
+                             {ground_level} m) or on a block below within the tolerance of \
+                             {tolerance} m{hint}"
                         ),
                     ));
                 }
@@ -343,13 +358,35 @@ pub fn detect_contacts(
                     format!("body \"{}\"", bodies[b].name),
                     format!(
                         "rests on nothing: no chain of contacts within the tolerance of \
-                         {tolerance} m reaches it from the ground (z = 0)"
+                         {tolerance} m reaches it from the ground (z = {ground_level} m){hint}"
                     ),
                 ));
             }
         }
     }
     Ok(contacts)
+}
+
+/// What a body resting on nothing is told when no block reaches down to the ground: where the
+/// lowest block stands (blocks in a survey's coordinates, on ground at a site elevation), and
+/// how to give that level. Empty when some block stands on the ground.
+fn ground_hint(
+    boxes: &[(Vector3<f64>, Vector3<f64>)],
+    ground_level: f64,
+    tolerance: f64,
+) -> String {
+    let lowest = boxes
+        .iter()
+        .map(|(lo, _)| lo.z)
+        .fold(f64::INFINITY, f64::min);
+    if lowest > ground_level + tolerance {
+        format!(
+            "; no block reaches down to the ground: the lowest stands at z = {lowest:.6} m, and \
+             where the ground is there, give its level (`crr assemble --ground-level {lowest}`)"
+        )
+    } else {
+        String::new()
+    }
 }
 
 /// The number of contacts between each body and the ground along the shortest chain of
@@ -389,14 +426,16 @@ fn refuse_overlaps(
     surfaces: &[Surface],
     boxes: &[(Vector3<f64>, Vector3<f64>)],
     tolerance: f64,
+    ground_level: f64,
 ) -> Result<(), AssemblyError> {
     for (b, (lo, _)) in boxes.iter().enumerate() {
-        if lo.z < -tolerance {
+        if lo.z < ground_level - tolerance {
             return Err(error(
                 format!("body \"{}\"", bodies[b].name),
                 format!(
-                    "reaches {:.6} m below the ground (z = 0): a block must stand on or above it",
-                    -lo.z
+                    "reaches {:.6} m below the ground (z = {ground_level} m): a block must stand \
+                     on or above it",
+                    ground_level - lo.z
                 ),
             ));
         }

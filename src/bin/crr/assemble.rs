@@ -1,10 +1,10 @@
 //! `crr assemble ASSEMBLY [--contacts] [--out MODEL.toml] [--all-contacts] [--planar]
-//! [--mechanism [--direction D]…] [--tolerance T] [--force]`.
+//! [--mechanism [--direction D]…] [--tolerance T] [--ground-level Z] [--force]`.
 
 use std::path::PathBuf;
 
 use crr::Error;
-use crr::analysis::assemble::{DEFAULT_TOLERANCE, assemble, read_assembly};
+use crr::analysis::assemble::{AssemblyOptions, DEFAULT_TOLERANCE, assemble, read_assembly};
 use crr::analysis::rigid_domains::mechanism_model;
 use crr::analysis::static_multiplier::parse_direction;
 use crr::input::model_file::ModelFile;
@@ -35,6 +35,15 @@ pub(crate) struct Args {
     /// Faces closer than this touch (m).
     #[arg(long, default_value_t = DEFAULT_TOLERANCE)]
     pub(crate) tolerance: f64,
+    /// The height of the ground (m), for blocks given in a survey's coordinates: faces on the
+    /// plane z = Z rest on the ground.
+    #[arg(
+        long,
+        value_name = "Z",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub(crate) ground_level: f64,
     /// The limit analysis of the assembly (every contact an interface) along each direction, and
     /// the model of its rigid domains: the interfaces that move in any mechanism are hinges, the
     /// blocks no mechanism separates one compound body.
@@ -59,12 +68,7 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
     if a.mechanism {
         return run_mechanism(&a, &file);
     }
-    let set = if a.all_contacts {
-        ContactSet::All
-    } else {
-        ContactSet::Beds
-    };
-    let assembled = assemble(&a.assembly, &file, a.planar, set, a.tolerance)?;
+    let assembled = assemble(&a.assembly, &file, &options(&a))?;
     if a.contacts || a.out.is_none() {
         print!("{}", contacts_text(&assembled));
     }
@@ -79,6 +83,20 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         );
     }
     Ok(())
+}
+
+/// The options of the arguments `a`.
+fn options(a: &Args) -> AssemblyOptions {
+    AssemblyOptions {
+        planar: a.planar,
+        contacts: if a.all_contacts {
+            ContactSet::All
+        } else {
+            ContactSet::Beds
+        },
+        tolerance: a.tolerance,
+        ground_level: a.ground_level,
+    }
 }
 
 /// `crr assemble --mechanism`: the report, and the merged model written with `--out`.
@@ -96,7 +114,7 @@ fn run_mechanism(a: &Args, file: &ModelFile) -> Result<(), Failure> {
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| Failure::Input(Error::Argument(format!("--direction: {e}"))))?
     };
-    let m = mechanism_model(&a.assembly, file, a.planar, &directions, a.tolerance)?;
+    let m = mechanism_model(&a.assembly, file, &directions, &options(a))?;
     if a.contacts {
         print!("{}", contacts_text(&m.all_contacts));
     }
