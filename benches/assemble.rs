@@ -84,10 +84,7 @@ fn wall_of_200(c: &mut Criterion) {
             &path,
             &file,
             &directions,
-            &AssemblyOptions {
-                planar: true,
-                ..Default::default()
-            },
+            &AssemblyOptions::default().in_plane(),
         )
         .unwrap()
     };

@@ -32,6 +32,24 @@ pub struct AssemblyOptions {
     pub ground_level: f64,
 }
 
+impl AssemblyOptions {
+    /// These options with a planar layout (`crr assemble --planar`): hinges about y.
+    pub fn in_plane(self) -> Self {
+        Self {
+            planar: true,
+            ..self
+        }
+    }
+
+    /// These options with every contact an interface (`crr assemble --all-contacts`).
+    pub fn with_all_contacts(self) -> Self {
+        Self {
+            contacts: ContactSet::All,
+            ..self
+        }
+    }
+}
+
 impl Default for AssemblyOptions {
     /// Rocking bases on the bed contacts, the default tolerance, the ground at z = 0.
     fn default() -> Self {

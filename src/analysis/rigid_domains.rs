@@ -94,11 +94,7 @@ pub fn mechanism_model(
         symmetry: Vec::new(),
         ..file.clone()
     };
-    let every_contact = AssemblyOptions {
-        contacts: ContactSet::All,
-        ..*options
-    };
-    let all = assemble(path, &blocks_only, &every_contact)?;
+    let all = assemble(path, &blocks_only, &options.with_all_contacts())?;
     // One limit analysis per direction, each on its own thread (independent programs; the
     // answers are collected in the directions' order, so the result does not depend on timing).
     let collapses = std::thread::scope(|scope| {

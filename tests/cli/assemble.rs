@@ -61,15 +61,7 @@ fn joints(spec_interfaces: &[crr::kinematics::spec::InterfaceSpec]) -> BTreeSet<
 fn the_wall_assembled_from_its_blocks_is_the_hand_written_wall() {
     let path = assembly_of("wall", "wall_assembly");
     let file = read_assembly(&path).unwrap();
-    let planar = assemble(
-        &path,
-        &file,
-        &AssemblyOptions {
-            planar: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let planar = assemble(&path, &file, &AssemblyOptions::default().in_plane()).unwrap();
     let (hand, _) = crr::load_model(&common::bundled_path("wall")).unwrap();
     assert_eq!(joints(&planar.file.interface), joints(&hand.interface));
     // 4 courses of 3 blocks (half blocks at the ends of the odd ones): 3 on the ground, and the
@@ -126,15 +118,7 @@ fn a_panel_cut_into_courses_rocks_whole_on_its_base_edge() {
         let l = lambda(&bases.model, d);
         assert!((l - expected).abs() < 1e-9, "{d:?}: {l}");
     }
-    let hinges = assemble(
-        &path,
-        &file,
-        &AssemblyOptions {
-            planar: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let hinges = assemble(&path, &file, &AssemblyOptions::default().in_plane()).unwrap();
     assert!((lambda(&hinges.model, Vector3::x()) - 0.16).abs() < 1e-9);
     // The model file written loads back into the same model.
     let out = common::scratch("panel_model").join("panel.toml");
@@ -272,8 +256,14 @@ fn a_wall_in_survey_coordinates_stands_on_the_ground_level_given() {
         let text = common::bundled_text("wall");
         text[..text.find("[[interface]]").unwrap()].to_string()
     };
+    // `crr assemble FILE --planar` with more arguments.
+    let planar_cli = |path: &std::path::Path, more: &[&str]| {
+        let mut args = vec!["assemble", path.to_str().unwrap(), "--planar"];
+        args.extend_from_slice(more);
+        common::crr(&args)
+    };
     let path = common::write_model("wall_survey_assembly", &boxes_moved(&head, SURVEY));
-    let o = common::crr(&["assemble", path.to_str().unwrap(), "--planar"]);
+    let o = planar_cli(&path, &[]);
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
@@ -284,21 +274,13 @@ fn a_wall_in_survey_coordinates_stands_on_the_ground_level_given() {
     );
 
     let model = common::scratch("wall_survey_model").join("model.toml");
-    let o = common::crr(&[
-        "assemble",
-        path.to_str().unwrap(),
-        "--planar",
-        "--ground-level",
-        "350",
-        "--out",
-        model.to_str().unwrap(),
-    ]);
+    let o = planar_cli(
+        &path,
+        &["--ground-level", "350", "--out", model.to_str().unwrap()],
+    );
     let text = String::from_utf8_lossy(&o.stdout).to_string();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let planar = AssemblyOptions {
-        planar: true,
-        ..Default::default()
-    };
+    let planar = AssemblyOptions::default().in_plane();
     let origin_path = assembly_of("wall", "wall_origin_assembly");
     let at_origin = assemble(&origin_path, &read_assembly(&origin_path).unwrap(), &planar).unwrap();
     assert!(
@@ -347,13 +329,7 @@ fn a_wall_in_survey_coordinates_stands_on_the_ground_level_given() {
 
     let sunk = boxes_moved(&head, [SURVEY[0], SURVEY[1], SURVEY[2] - 0.05]);
     let path = common::write_model("wall_survey_sunk", &sunk);
-    let o = common::crr(&[
-        "assemble",
-        path.to_str().unwrap(),
-        "--planar",
-        "--ground-level",
-        "350",
-    ]);
+    let o = planar_cli(&path, &["--ground-level", "350"]);
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
@@ -370,15 +346,7 @@ fn the_trilithon_of_stones_is_the_hand_written_trilithon() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/trilithon.toml");
     let file = read_assembly(&path).unwrap();
-    let planar = assemble(
-        &path,
-        &file,
-        &AssemblyOptions {
-            planar: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let planar = assemble(&path, &file, &AssemblyOptions::default().in_plane()).unwrap();
     let (hand, _) = crr::load_model(&common::bundled_path("trilithon")).unwrap();
     assert_eq!(joints(&planar.file.interface), joints(&hand.interface));
     for d in [Vector3::x(), -Vector3::x()] {

@@ -396,10 +396,7 @@ fn symmetry_rows_of_the_assembly_give_dof3_of_the_merged_model() {
         &path,
         &file,
         &along_x(),
-        &AssemblyOptions {
-            planar: true,
-            ..Default::default()
-        },
+        &AssemblyOptions::default().in_plane(),
     )
     .unwrap_err()
     .to_string();

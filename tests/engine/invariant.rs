@@ -36,7 +36,6 @@ fn a_loose_tolerance_is_an_error_not_a_false_collapse() {
 fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
     use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
     use crr::impact::SlotState;
-    use crr::kinematics::assembly::ContactSet;
     let source =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/arch.toml");
     for (scale, until) in [(1.8, 6.56), (3.0, 2.5)] {
@@ -52,11 +51,7 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
         let assembled = assemble(
             &path,
             &file,
-            &AssemblyOptions {
-                planar: true,
-                contacts: ContactSet::All,
-                ..Default::default()
-            },
+            &AssemblyOptions::default().in_plane().with_all_contacts(),
         )
         .unwrap();
         let model_path = common::write_model(

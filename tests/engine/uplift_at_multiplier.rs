@@ -180,10 +180,7 @@ fn models_of_rigid_domains_leave_rest_at_their_multiplier() {
             &path,
             &file,
             &directions,
-            &AssemblyOptions {
-                planar: true,
-                ..Default::default()
-            },
+            &AssemblyOptions::default().in_plane(),
         )
         .unwrap();
         assert!(

@@ -932,15 +932,7 @@ fn the_wall_assembled_from_its_stones_matches_the_block_lp() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/wall.toml");
     let file = read_assembly(&path).unwrap();
-    let assembled = assemble(
-        &path,
-        &file,
-        &AssemblyOptions {
-            planar: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let assembled = assemble(&path, &file, &AssemblyOptions::default().in_plane()).unwrap();
     let options = StaticsOptions {
         sliding_lift_off: false,
         ..StaticsOptions::default()
@@ -1175,7 +1167,6 @@ fn a_corner_wedge_that_slides_off_its_other_support_is_found() {
 #[test]
 fn an_arch_of_200_voussoirs_near_its_minimum_thickness_has_its_multiplier() {
     use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
-    use crr::kinematics::assembly::ContactSet;
     let (n, r_in, r_out) = (200, 0.946, 1.054);
     let mut text = String::from("name = \"arch\"\ngravity = 9.81\n");
     for k in 0..n {
@@ -1196,11 +1187,7 @@ fn an_arch_of_200_voussoirs_near_its_minimum_thickness_has_its_multiplier() {
     let assembled = assemble(
         &path,
         &file,
-        &AssemblyOptions {
-            planar: true,
-            contacts: ContactSet::All,
-            ..Default::default()
-        },
+        &AssemblyOptions::default().in_plane().with_all_contacts(),
     )
     .unwrap();
     for dx in [1.0, -1.0] {

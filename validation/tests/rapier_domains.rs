@@ -72,10 +72,7 @@ fn a_block_cut_in_courses_rocks_as_one_domain_in_crr_and_in_rapier() {
         &assembly,
         &file,
         &directions,
-        &AssemblyOptions {
-            planar: true,
-            ..Default::default()
-        },
+        &AssemblyOptions::default().in_plane(),
     )
     .unwrap();
     for c in &m.collapses {
