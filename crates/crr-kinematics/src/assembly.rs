@@ -434,7 +434,8 @@ fn refuse_overlaps(
                 format!("body \"{}\"", bodies[b].name),
                 format!(
                     "reaches {:.6} m below the ground (z = {ground_level} m): a block must stand \
-                     on or above it",
+                     on or above it (where the ground lies lower, give its level: `crr assemble \
+                     --ground-level Z`)",
                     ground_level - lo.z
                 ),
             ));
