@@ -225,10 +225,18 @@ pub fn detect_contacts(
             format!("must be a finite height (m), got {ground_level}"),
         ));
     }
-    let surfaces = bodies
+    let mut surfaces = bodies
         .iter()
         .map(body_surface)
         .collect::<Result<Vec<_>, _>>()?;
+    // Faces are compared near the origin: a plane's offset n·x taken at survey coordinates
+    // carries the normal's round-off times the distance (1e-9 × 4.5e6 m ≈ 5e-3 m, far beyond
+    // the tolerance). The contacts are moved back.
+    let reference = reference_near(&surfaces);
+    for v in surfaces.iter_mut().flat_map(|s| s.vertices.iter_mut()) {
+        *v -= reference;
+    }
+    let ground_near = ground_level - reference.z;
     let faces: Vec<Vec<Face>> = surfaces.iter().map(faces_of).collect();
     let boxes: Vec<(Vector3<f64>, Vector3<f64>)> = surfaces
         .iter()
@@ -245,7 +253,14 @@ pub fn detect_contacts(
     let size = boxes
         .iter()
         .fold(0.0f64, |m, (lo, hi)| m.max((hi - lo).norm()));
-    refuse_overlaps(bodies, &surfaces, &boxes, tolerance, ground_level)?;
+    refuse_overlaps(
+        bodies,
+        &surfaces,
+        &boxes,
+        tolerance,
+        ground_level,
+        &reference,
+    )?;
     let min_area = tolerance * size;
     let facing = 1.0 - 1e-9;
     let mut contacts = Vec::new();
@@ -255,7 +270,7 @@ pub fn detect_contacts(
             if f.normal.z < -facing
                 && f.polygon
                     .iter()
-                    .all(|v| (v.z - ground_level).abs() <= tolerance)
+                    .all(|v| (v.z - ground_near).abs() <= tolerance)
             {
                 if !f.convex {
                     return Err(non_convex(&bodies[b].name));
@@ -318,7 +333,12 @@ pub fn detect_contacts(
         }
     }
     let counts = |c: &ContactFace| c.bed || set == ContactSet::All;
-    let hint = ground_hint(&boxes, ground_level, tolerance);
+    let hint = ground_hint(&boxes, ground_near, reference.z, tolerance);
+    for c in &mut contacts {
+        for p in &mut c.corners {
+            *p += reference;
+        }
+    }
     for (k, c) in contacts.iter().enumerate() {
         let same_pair = |d: &ContactFace| {
             (d.lower == c.lower && d.upper == c.upper)
@@ -372,14 +392,16 @@ pub fn detect_contacts(
 /// how to give that level. Empty when some block stands on the ground.
 fn ground_hint(
     boxes: &[(Vector3<f64>, Vector3<f64>)],
-    ground_level: f64,
+    ground_near: f64,
+    reference_z: f64,
     tolerance: f64,
 ) -> String {
     let lowest = boxes
         .iter()
         .map(|(lo, _)| lo.z)
         .fold(f64::INFINITY, f64::min);
-    if lowest > ground_level + tolerance {
+    if lowest > ground_near + tolerance {
+        let lowest = lowest + reference_z;
         format!(
             "; no block reaches down to the ground: the lowest stands at z = {lowest:.6} m, and \
              where the ground is there, give its level (`crr assemble --ground-level {lowest}`)"
@@ -387,6 +409,34 @@ fn ground_hint(
     } else {
         String::new()
     }
+}
+
+/// The point the surfaces are moved to the origin from ([`detect_contacts`]): none (zero) for
+/// blocks within [`crate::MOVED_BEYOND`] sizes of the origin, so that their contacts are found
+/// from their coordinates as given; otherwise the mean of the vertices rounded to a multiple of
+/// the power of two at or above the size (as [`crate::Model::moved_near_origin`]), which moves
+/// every coordinate exactly.
+fn reference_near(surfaces: &[Surface]) -> Vector3<f64> {
+    let vertices = || surfaces.iter().flat_map(|s| s.vertices.iter());
+    let (lo, hi) = vertices().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), v| (lo.inf(v), hi.sup(v)),
+    );
+    let size = (hi - lo).norm();
+    let count = vertices().count();
+    if count == 0
+        || size.is_nan()
+        || size <= 0.0
+        || vertices().all(|v| v.norm() <= crate::MOVED_BEYOND * size)
+    {
+        return Vector3::zeros();
+    }
+    let mean = vertices().sum::<Vector3<f64>>() / count as f64;
+    let unit = size.log2().ceil().exp2();
+    (mean / unit).map(f64::round) * unit
 }
 
 /// The number of contacts between each body and the ground along the shortest chain of
@@ -420,23 +470,26 @@ fn ground_depths(bodies: usize, contacts: &[ContactFace]) -> Vec<Option<usize>> 
 }
 
 /// Blocks below the ground or inside one another are errors of the geometry: each is named, with
-/// the depth and a point of the overlap.
+/// the depth and a point of the overlap (`surfaces` and `boxes` are moved by −`reference`, the
+/// points reported moved back).
 fn refuse_overlaps(
     bodies: &[BodySpec],
     surfaces: &[Surface],
     boxes: &[(Vector3<f64>, Vector3<f64>)],
     tolerance: f64,
     ground_level: f64,
+    reference: &Vector3<f64>,
 ) -> Result<(), AssemblyError> {
+    let ground_near = ground_level - reference.z;
     for (b, (lo, _)) in boxes.iter().enumerate() {
-        if lo.z < ground_level - tolerance {
+        if lo.z < ground_near - tolerance {
             return Err(error(
                 format!("body \"{}\"", bodies[b].name),
                 format!(
                     "reaches {:.6} m below the ground (z = {ground_level} m): a block must stand \
                      on or above it (where the ground lies lower, give its level: `crr assemble \
                      --ground-level Z`)",
-                    ground_level - lo.z
+                    ground_near - lo.z
                 ),
             ));
         }
@@ -458,7 +511,10 @@ fn refuse_overlaps(
                         "overlap: they interpenetrate by {:.6} m, around ({:.4}, {:.4}, {:.4}) m; \
                          blocks in contact touch along faces (within the tolerance of {tolerance} \
                          m)",
-                        p.depth, p.point.x, p.point.y, p.point.z
+                        p.depth,
+                        p.point.x + reference.x,
+                        p.point.y + reference.y,
+                        p.point.z + reference.z
                     ),
                 ));
             }
