@@ -213,9 +213,10 @@ fn overlapping_blocks_and_a_block_below_the_ground_are_refused_naming_them() {
     );
 }
 
-/// The text of an assembly of boxes with every box centre moved by `d` (Rust's shortest
-/// round-trip formatting: the file holds the moved centres to their last bit).
-fn boxes_moved(text: &str, d: [f64; 3]) -> String {
+/// `text` with the value of every `center = [x, y, z]` replaced: `write(centre, rest)` gives the
+/// new text from the coordinates on, `rest` being what followed the closing bracket (numbers in
+/// Rust's shortest round-trip formatting hold the new centres to their last bit).
+fn rewrite_centres(text: &str, write: impl Fn([f64; 3], &str) -> String) -> String {
     let key = "center = [";
     text.lines()
         .map(|line| match line.find(key) {
@@ -227,17 +228,26 @@ fn boxes_moved(text: &str, d: [f64; 3]) -> String {
                     .map(|x| x.trim().parse().expect("a number"))
                     .collect();
                 format!(
-                    "{}{:?}, {:?}, {:?}{}\n",
+                    "{}{}\n",
                     &line[..from],
-                    c[0] + d[0],
-                    c[1] + d[1],
-                    c[2] + d[2],
-                    &line[to..]
+                    write([c[0], c[1], c[2]], &line[to..])
                 )
             }
             None => format!("{line}\n"),
         })
         .collect()
+}
+
+/// The text of an assembly of boxes with every box centre moved by `d`.
+fn boxes_moved(text: &str, d: [f64; 3]) -> String {
+    rewrite_centres(text, |c, rest| {
+        format!(
+            "{:?}, {:?}, {:?}{rest}",
+            c[0] + d[0],
+            c[1] + d[1],
+            c[2] + d[2]
+        )
+    })
 }
 
 /// A site elevation is the ground's level. The bundled wall's blocks written in a survey's
@@ -342,33 +352,17 @@ fn a_wall_in_survey_coordinates_stands_on_the_ground_level_given() {
 /// about the vertical through the origin (each centre turned, each box given that rotation) and
 /// then moved by `d`.
 fn boxes_turned(text: &str, angle: f64, d: [f64; 3]) -> String {
-    let key = "center = [";
     let (sin, cos) = angle.sin_cos();
-    text.lines()
-        .map(|line| match line.find(key) {
-            Some(i) => {
-                let from = i + key.len();
-                let to = from + line[from..].find(']').expect("a closing bracket");
-                let c: Vec<f64> = line[from..to]
-                    .split(',')
-                    .map(|x| x.trim().parse().expect("a number"))
-                    .collect();
-                let rest = line[to..]
-                    .trim_end()
-                    .strip_suffix('}')
-                    .expect("an inline table");
-                format!(
-                    "{}{:?}, {:?}, {:?}{}, rotation = [0.0, 0.0, {angle:?}] }}\n",
-                    &line[..from],
-                    cos * c[0] - sin * c[1] + d[0],
-                    sin * c[0] + cos * c[1] + d[1],
-                    c[2] + d[2],
-                    rest.trim_end()
-                )
-            }
-            None => format!("{line}\n"),
-        })
-        .collect()
+    rewrite_centres(text, |c, rest| {
+        let rest = rest.trim_end().strip_suffix('}').expect("an inline table");
+        format!(
+            "{:?}, {:?}, {:?}{}, rotation = [0.0, 0.0, {angle:?}] }}",
+            cos * c[0] - sin * c[1] + d[0],
+            sin * c[0] + cos * c[1] + d[1],
+            c[2] + d[2],
+            rest.trim_end()
+        )
+    })
 }
 
 /// Faces at a bearing are found in survey coordinates as at the origin: the bundled façade
