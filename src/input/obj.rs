@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+use crr_kinematics::exact_reference;
 use crr_kinematics::shapes::{PolyhedronShape, Shape};
 use crr_kinematics::spec::BodySpec;
 
@@ -221,7 +222,10 @@ impl Block {
     }
 
     /// Every vertex lies on the inner side of every face's plane (to 1e-9 of the block's size),
-    /// the faces oriented outward by the mesh's sign of volume.
+    /// the faces oriented outward by the mesh's sign of volume. Computed with the block moved
+    /// near the origin ([`exact_reference`], exact): a face's plane taken at 4.5e6 m would carry
+    /// its normal's round-off times that distance, about 1e-9 × 4.5e6 m, and a box turned to a
+    /// bearing in survey coordinates was refused as not convex (measured).
     fn check_convex(&self) -> Result<(), String> {
         let lo = self
             .vertices
@@ -232,16 +236,19 @@ impl Block {
             .iter()
             .fold(Vector3::repeat(f64::NEG_INFINITY), |a, v| a.sup(v));
         let size = (hi - lo).norm();
+        let mean = self.vertices.iter().sum::<Vector3<f64>>() / self.vertices.len() as f64;
+        let reference = exact_reference(&mean, size);
+        let near: Vec<Vector3<f64>> = self.vertices.iter().map(|v| v - reference).collect();
         let area_vector = |f: &[usize]| {
             (0..f.len()).fold(Vector3::zeros(), |s: Vector3<f64>, i| {
-                let (a, b) = (self.vertices[f[i]], self.vertices[f[(i + 1) % f.len()]]);
+                let (a, b) = (near[f[i]], near[f[(i + 1) % f.len()]]);
                 s + a.cross(&b) * 0.5
             })
         };
         let volume: f64 = self
             .faces
             .iter()
-            .map(|f| area_vector(f).dot(&self.vertices[f[0]]) / 3.0)
+            .map(|f| area_vector(f).dot(&near[f[0]]) / 3.0)
             .sum();
         if volume.abs() <= 1e-12 * size.powi(3) {
             return Err("the mesh encloses no volume".into());
@@ -251,11 +258,12 @@ impl Block {
             let Some(n) = (area_vector(f) * outward).try_normalize(0.0) else {
                 continue;
             };
-            let offset = n.dot(&self.vertices[f[0]]);
+            let offset = n.dot(&near[f[0]]);
             if let Some(v) = self
                 .vertices
                 .iter()
-                .find(|v| n.dot(v) - offset > 1e-9 * size)
+                .zip(&near)
+                .find_map(|(v, w)| (n.dot(w) - offset > 1e-9 * size).then_some(v))
             {
                 return Err(format!(
                     "the block is not convex: the vertex ({:.6}, {:.6}, {:.6}) m lies outside \

@@ -414,8 +414,8 @@ fn ground_hint(
 /// The point the surfaces are moved to the origin from ([`detect_contacts`]): none (zero) for
 /// blocks within [`crate::MOVED_BEYOND`] sizes of the origin, so that their contacts are found
 /// from their coordinates as given; otherwise the mean of the vertices rounded to a multiple of
-/// the power of two at or above the size (as [`crate::Model::moved_near_origin`]), which moves
-/// every coordinate exactly.
+/// the power of two at or above the size ([`crate::exact_reference`], as
+/// [`crate::Model::moved_near_origin`]), which moves every coordinate exactly.
 fn reference_near(surfaces: &[Surface]) -> Vector3<f64> {
     let vertices = || surfaces.iter().flat_map(|s| s.vertices.iter());
     let (lo, hi) = vertices().fold(
@@ -435,8 +435,7 @@ fn reference_near(surfaces: &[Surface]) -> Vector3<f64> {
         return Vector3::zeros();
     }
     let mean = vertices().sum::<Vector3<f64>>() / count as f64;
-    let unit = size.log2().ceil().exp2();
-    (mean / unit).map(f64::round) * unit
+    crate::exact_reference(&mean, size)
 }
 
 /// The number of contacts between each body and the ground along the shortest chain of

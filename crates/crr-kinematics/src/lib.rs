@@ -63,7 +63,7 @@ pub use kinematics::{body_point, body_points, body_rotation, forward_kinematics,
 pub use mass_matrix::{kinetic_energy, mass_matrix, mass_matrix_from_jacobians};
 pub use model::{
     Body, Closure, Coordinate, Interface, InterfaceKind, MAX_COORDINATES, MIN_DIRAC_WIDTH,
-    MOVED_BEYOND, Model, Parent, Parts, Role, Side,
+    MOVED_BEYOND, Model, Parent, Parts, Role, Side, exact_reference,
 };
 pub use pivots::ActivePivots;
 pub use potential::{generalized_gravity, potential_energy};

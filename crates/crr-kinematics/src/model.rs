@@ -656,6 +656,18 @@ fn too_many_coordinates(name: &str, n: usize, at_least: &str) -> ModelError {
 /// the model is used as given.
 pub const MOVED_BEYOND: f64 = 10.0;
 
+/// The point a structure of size `size` (m) whose points' mean is `mean` is moved to the origin
+/// from: `mean` rounded to a multiple of u, the power of two at or above `size`. A coordinate x
+/// with |x| ≥ u is a multiple of its own ulp, which divides u, and lies within size + u/2 ≤ 1.5 u
+/// of the point, so x minus the point is a multiple of ulp(x) below 2⁵³ ulp(x) and is computed
+/// exactly (smaller coordinates, of a structure near the origin, move to the round-off of u).
+/// The mean's own round-off (the order the points are listed in) changes the point only where
+/// the mean sits at a rounding boundary, and the moves are exact then too.
+pub fn exact_reference(mean: &Vector3<f64>, size: f64) -> Vector3<f64> {
+    let unit = size.log2().ceil().exp2();
+    (mean / unit).map(f64::round) * unit
+}
+
 impl Model {
     /// The same structure moved by `d` (m): every body's centre and shape, every pivot line's
     /// point and every corner plus d; axes, normals, mass properties about the centres, the
@@ -696,10 +708,9 @@ impl Model {
     /// to rest and contact forces are the same for both, up to the round-off the move avoids.
     ///
     /// The move is the mean centre rounded to a multiple of u, the power of two at or above the
-    /// model's size: every coordinate of the model is a multiple of its own ulp, which divides
-    /// u, so each moved coordinate is a multiple of it no larger than the coordinate and is
-    /// computed exactly. The moved model is the given one to the bit, and the order in which the
-    /// bodies are listed (which changes the mean by round-off) does not change the move.
+    /// model's size ([`exact_reference`]): each moved coordinate is computed exactly. The moved
+    /// model is the given one to the bit, and the order in which the bodies are listed (which
+    /// changes the mean by round-off) does not change the move.
     pub fn moved_near_origin(&self) -> Option<Model> {
         let far = self
             .bodies
@@ -710,9 +721,7 @@ impl Model {
         }
         let mean =
             self.bodies.iter().map(|b| b.com).sum::<Vector3<f64>>() / self.bodies.len() as f64;
-        let unit = self.size.log2().ceil().exp2();
-        let reference = (mean / unit).map(f64::round) * unit;
-        Some(self.translated(&-reference))
+        Some(self.translated(&-exact_reference(&mean, self.size)))
     }
 
     /// Validates a description and builds the model: mass properties, interface geometry, the
