@@ -110,6 +110,8 @@ pub struct Assembled {
     pub model: Model,
     /// The folder of the assembly file (its relative record paths start there).
     pub folder: std::path::PathBuf,
+    /// The height of the ground plane its contacts were found on (m; `--ground-level`).
+    pub ground_level: f64,
 }
 
 /// Finds the contacts of the assembly `file` (read from `path`) on the ground of `options` and
@@ -164,5 +166,6 @@ pub fn assemble(
         file: out,
         model,
         folder: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        ground_level,
     })
 }

@@ -311,5 +311,6 @@ fn merged_model(
         file,
         model,
         folder: all.folder.clone(),
+        ground_level: all.ground_level,
     })
 }

@@ -65,7 +65,20 @@ pub fn model_toml(a: &Assembled, file: &ModelFile) -> String {
         a.model.dof(),
         a.model.closures.len()
     );
-    header + &toml::to_string(file).expect("a model file serialises to TOML")
+    header + &ground_line(a) + &toml::to_string(file).expect("a model file serialises to TOML")
+}
+
+/// The header line that records a ground other than z = 0 (`--ground-level`): the model's
+/// ground hinges lie on it, and assembling the file again needs the same option.
+fn ground_line(a: &Assembled) -> String {
+    if a.ground_level == 0.0 {
+        String::new()
+    } else {
+        format!(
+            "# The ground is the plane z = {} m (`crr assemble --ground-level {}`).\n",
+            a.ground_level, a.ground_level
+        )
+    }
 }
 
 /// The merged model of `crr assemble --mechanism` as TOML, with a header naming the directions.
@@ -89,7 +102,7 @@ pub fn merged_model_toml(m: &MechanismModel, file: &ModelFile) -> String {
         a.model.closures.len(),
         m.mobility.dof2
     );
-    header + &toml::to_string(file).expect("a model file serialises to TOML")
+    header + &ground_line(a) + &toml::to_string(file).expect("a model file serialises to TOML")
 }
 
 /// The report of `crr assemble --mechanism`: per direction λ and the interfaces that move, the

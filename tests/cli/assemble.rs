@@ -297,6 +297,12 @@ fn a_wall_in_survey_coordinates_stands_on_the_ground_level_given() {
         text.contains(&format!("({} interfaces,", at_origin.file.interface.len())),
         "{text}"
     );
+    // The model written records the ground it stands on.
+    let written = std::fs::read_to_string(&model).unwrap();
+    assert!(
+        written.contains("# The ground is the plane z = 350 m (`crr assemble --ground-level 350`)"),
+        "{written}"
+    );
 
     let survey = assemble(
         &path,
