@@ -24,7 +24,7 @@ use crr::output::assemble::write_merged_model;
 fn wall_of_200(c: &mut Criterion) {
     let bodies = running_bond_wall(20, 10, 0.6, 0.25, 0.3).body;
     let assemble = || {
-        let contacts = detect_contacts(&bodies, 1e-6, ContactSet::Beds, 0.0).unwrap();
+        let contacts = detect_contacts(&bodies, 1e-6, ContactSet::Beds, 0.0, &[]).unwrap();
         let spec = structure_of(
             "wall",
             9.81,

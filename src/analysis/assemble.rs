@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use crr_kinematics::assembly::{
-    ContactFace, ContactSet, InterfaceStyle, detect_contacts, structure_of,
+    ContactFace, ContactSet, InterfaceStyle, detect_contacts, free_blocks, structure_of,
 };
 use crr_kinematics::{Model, StructureSpec};
 
@@ -94,6 +94,18 @@ pub fn read_assembly(path: &Path) -> Result<ModelFile, Error> {
     if file.body.is_empty() {
         return Err(here("the assembly has no [[body]]"));
     }
+    if let Some(name) = file.fixed.iter().find(|f| !names.contains(&f.as_str())) {
+        return Err(here(&format!(
+            "fixed: no block is named \"{name}\" (the blocks are the [[body]] tables and the \
+             objects of the [[obj]] files)"
+        )));
+    }
+    if file.fixed.len() == file.body.len() {
+        return Err(here(
+            "fixed: every block is fixed, so nothing can move (fixed names the blocks that are \
+             part of the ground)",
+        ));
+    }
     Ok(file)
 }
 
@@ -112,6 +124,8 @@ pub struct Assembled {
     pub folder: std::path::PathBuf,
     /// The height of the ground plane its contacts were found on (m; `--ground-level`).
     pub ground_level: f64,
+    /// The blocks that were part of the ground (the assembly's `fixed`), not in the model.
+    pub fixed: Vec<String>,
 }
 
 /// Finds the contacts of the assembly `file` (read from `path`) on the ground of `options` and
@@ -129,8 +143,15 @@ pub fn assemble(
         ground_level,
     } = options;
     let here = |e: &dyn std::fmt::Display| Error::Argument(format!("{}: {e}", path.display()));
-    let contacts =
-        detect_contacts(&file.body, tolerance, set, ground_level).map_err(|e| here(&e))?;
+    let fixed: Vec<bool> = file
+        .body
+        .iter()
+        .map(|b| file.fixed.contains(&b.name))
+        .collect();
+    let found =
+        detect_contacts(&file.body, tolerance, set, ground_level, &fixed).map_err(|e| here(&e))?;
+    // The fixed blocks are ground: the model is the free blocks.
+    let (free, contacts) = free_blocks(&file.body, &found, &fixed);
     let style = if planar {
         InterfaceStyle::PlanarHinge
     } else {
@@ -139,7 +160,7 @@ pub fn assemble(
     let spec: StructureSpec = structure_of(
         &file.name,
         file.gravity,
-        &file.body,
+        &free,
         &contacts,
         style,
         set,
@@ -154,6 +175,7 @@ pub fn assemble(
     let out = ModelFile {
         body: spec.body.clone(),
         interface: spec.interface.clone(),
+        fixed: Vec::new(),
         ..file.clone()
     };
     let model = Model::from_spec(&spec).map_err(|source| Error::Model {
@@ -167,5 +189,6 @@ pub fn assemble(
         model,
         folder: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         ground_level,
+        fixed: file.fixed.clone(),
     })
 }

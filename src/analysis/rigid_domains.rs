@@ -312,5 +312,6 @@ fn merged_model(
         model,
         folder: all.folder.clone(),
         ground_level: all.ground_level,
+        fixed: all.fixed.clone(),
     })
 }

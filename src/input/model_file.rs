@@ -48,6 +48,11 @@ pub struct ModelFile {
     /// Blocks from Wavefront OBJ files (assemblies only: `crr assemble` turns them into bodies).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub obj: Vec<crate::input::obj::ObjSpec>,
+    /// The blocks that are part of the ground (assemblies only): abutments, foundations, the
+    /// rock of a stepped site, by name. `crr assemble` makes the faces on them ground contacts
+    /// and leaves them out of the model.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed: Vec<String>,
 }
 
 impl ModelFile {
@@ -198,6 +203,13 @@ pub fn build_model(path: &Path, file: ModelFile) -> Result<(ModelFile, Model), E
         return Err(Error::Argument(format!(
             "{}: [[obj]] lists blocks of an assembly: turn it into a model with `crr assemble` \
              (docs/assembly.md)",
+            path.display()
+        )));
+    }
+    if !file.fixed.is_empty() {
+        return Err(Error::Argument(format!(
+            "{}: `fixed` names blocks of an assembly that are part of the ground: turn it into \
+             a model with `crr assemble` (docs/assembly.md)",
             path.display()
         )));
     }

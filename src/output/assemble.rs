@@ -68,17 +68,24 @@ pub fn model_toml(a: &Assembled, file: &ModelFile) -> String {
     header + &ground_line(a) + &toml::to_string(file).expect("a model file serialises to TOML")
 }
 
-/// The header line that records a ground other than z = 0 (`--ground-level`): the model's
-/// ground hinges lie on it, and assembling the file again needs the same option.
+/// The header lines that record a ground other than the plane z = 0 (`--ground-level`; the
+/// model's ground hinges lie on it, and assembling the file again needs the same option) and
+/// the fixed blocks that are part of it.
 fn ground_line(a: &Assembled) -> String {
-    if a.ground_level == 0.0 {
-        String::new()
-    } else {
-        format!(
+    let mut lines = String::new();
+    if a.ground_level != 0.0 {
+        lines += &format!(
             "# The ground is the plane z = {} m (`crr assemble --ground-level {}`).\n",
             a.ground_level, a.ground_level
-        )
+        );
     }
+    if !a.fixed.is_empty() {
+        lines += &format!(
+            "# Fixed blocks, part of the ground and not in the model: {}.\n",
+            a.fixed.join(", ")
+        );
+    }
+    lines
 }
 
 /// The merged model of `crr assemble --mechanism` as TOML, with a header naming the directions.

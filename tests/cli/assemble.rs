@@ -683,3 +683,159 @@ fn an_obj_column_in_survey_coordinates_assembles_as_at_the_origin() {
         }
     }
 }
+
+/// Blocks that are part of the ground (`fixed`): the bundled arch of 9 voussoirs
+/// (`examples/assemblies/arch.toml`) raised 1 m onto two fixed abutments (1 × 2 × 1 m boxes
+/// under its springings, wider than them) is the arch on the ground raised 1 m: the same 10
+/// joints (names, parents, children) with every corner 1 m higher to 1e-12 m, no abutment in the
+/// model, and the same multipliers along ±x (the ground's and the abutments' faces are one
+/// support; gravity and the load do not depend on the height) to 1e-9.
+#[test]
+fn an_arch_on_fixed_abutments_is_the_arch_on_the_ground_raised() {
+    let source =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/arch.toml");
+    let text = std::fs::read_to_string(source).unwrap();
+    let blocks = &text[..text.find("[ground_motion]").unwrap()];
+    let all = AssemblyOptions::default().with_all_contacts();
+    let on_ground_path = common::write_model("arch_on_ground", blocks);
+    let on_ground = assemble(
+        &on_ground_path,
+        &read_assembly(&on_ground_path).unwrap(),
+        &all,
+    )
+    .unwrap();
+    let raised = boxes_moved(blocks, [0.0, 0.0, 1.0])
+        + "fixed = [\"abutment_left\", \"abutment_right\"]\n"
+        + "[[body]]\nname = \"abutment_left\"\ndensity = 2200.0\n"
+        + "box = { center = [-2.25, 0.0, 0.5], size = [1.0, 2.0, 1.0] }\n"
+        + "[[body]]\nname = \"abutment_right\"\ndensity = 2200.0\n"
+        + "box = { center = [2.25, 0.0, 0.5], size = [1.0, 2.0, 1.0] }\n";
+    // `fixed` is a key of the file's top level: before the first table.
+    let raised = {
+        let at = raised.find("[[body]]").unwrap();
+        let (head, tail) = raised.split_at(at);
+        let fixed_line = "fixed = [\"abutment_left\", \"abutment_right\"]\n";
+        format!("{head}{fixed_line}{}", tail.replacen(fixed_line, "", 1))
+    };
+    let on_abutments_path = common::write_model("arch_on_abutments", &raised);
+    let on_abutments = assemble(
+        &on_abutments_path,
+        &read_assembly(&on_abutments_path).unwrap(),
+        &all,
+    )
+    .unwrap();
+    assert_eq!(on_abutments.file.body.len(), 9);
+    assert_eq!(on_abutments.file.interface.len(), 10);
+    assert_eq!(
+        on_abutments.file.interface.len(),
+        on_ground.file.interface.len()
+    );
+    for (a, g) in on_abutments
+        .file
+        .interface
+        .iter()
+        .zip(&on_ground.file.interface)
+    {
+        assert_eq!(
+            (&a.name, &a.parent, &a.child),
+            (&g.name, &g.parent, &g.child)
+        );
+        let (ca, cg) = (
+            &a.rocking_base.as_ref().unwrap().corners,
+            &g.rocking_base.as_ref().unwrap().corners,
+        );
+        assert_eq!(ca.len(), cg.len(), "{}", a.name);
+        for (p, q) in ca.iter().zip(cg) {
+            let moved = [q[0], q[1], q[2] + 1.0];
+            assert!(
+                (0..3).all(|k| (p[k] - moved[k]).abs() < 1e-12),
+                "{}: {p:?} against {q:?}",
+                a.name
+            );
+        }
+    }
+    for d in [Vector3::x(), -Vector3::x()] {
+        let (la, lg) = (lambda(&on_abutments.model, d), lambda(&on_ground.model, d));
+        assert!((la - lg).abs() < 1e-9 * lg, "{la} against {lg}");
+    }
+}
+
+/// A stepped site: a block 0.4 × 0.4 × 1 m on the ground (λ = b/h = 0.4) and a block
+/// 0.3 × 0.3 × 1.5 m on a fixed step 0.5 m high that reaches 0.3 m below the ground level
+/// (a foundation: fixed blocks may) rock on their own: the structure's multiplier is the
+/// tall block's b/h = 0.2 along ±x and ±y, its model has the two blocks and two ground joints,
+/// and the model written names the step. Refused, each naming the item: a fixed name that is no
+/// block; a free block carrying a fixed one; a model file with `fixed` given to `crr simulate`.
+#[test]
+fn blocks_on_a_fixed_step_rock_on_the_ground_it_makes() {
+    let body = |name: &str, centre: [f64; 3], size: [f64; 3]| {
+        format!(
+            "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
+             size = {size:?} }}\n"
+        )
+    };
+    let site = |fixed: &str, extra: &str| {
+        format!("name = \"stepped\"\nfixed = [{fixed}]\n")
+            + &body("low", [-1.0, 0.0, 0.5], [0.4, 0.4, 1.0])
+            + &body("step", [1.0, 0.0, 0.1], [1.0, 1.0, 0.8])
+            + &body("high", [1.0, 0.0, 1.25], [0.3, 0.3, 1.5])
+            + extra
+    };
+    let path = common::write_model("stepped_site", &site("\"step\"", ""));
+    let a = assemble(
+        &path,
+        &read_assembly(&path).unwrap(),
+        &AssemblyOptions::default(),
+    )
+    .unwrap();
+    let names: Vec<&str> = a.file.body.iter().map(|b| b.name.as_str()).collect();
+    assert_eq!(names, ["low", "high"]);
+    let joints: Vec<(&str, &str)> = a
+        .file
+        .interface
+        .iter()
+        .map(|i| (i.parent.as_str(), i.child.as_str()))
+        .collect();
+    assert_eq!(joints, [("ground", "low"), ("ground", "high")]);
+    for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
+        let l = lambda(&a.model, d);
+        assert!((l - 0.2).abs() < 1e-9, "{d:?}: {l}");
+    }
+    let model = common::scratch("stepped_site_model").join("model.toml");
+    let o = common::crr(&[
+        "assemble",
+        path.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let written = std::fs::read_to_string(&model).unwrap();
+    assert!(
+        written.contains("# Fixed blocks, part of the ground and not in the model: step."),
+        "{written}"
+    );
+    let o = common::crr(&["simulate", model.to_str().unwrap(), "--quiet", "--force"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let refused = |tag: &str, text: &str, command: &str| {
+        let path = common::write_model(tag, text);
+        let o = common::crr(&[command, path.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{tag}");
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let err = refused("stepped_unknown", &site("\"stair\"", ""), "assemble");
+    assert!(err.contains("fixed: no block is named \"stair\""), "{err}");
+    let lintel = body("lintel", [-1.0, 0.0, 1.1], [0.6, 0.6, 0.2]);
+    let err = refused(
+        "stepped_carried",
+        &site("\"step\", \"lintel\"", &lintel),
+        "assemble",
+    );
+    assert!(
+        err.contains("body \"low\": carries the fixed block \"lintel\""),
+        "{err}"
+    );
+    let err = refused("stepped_as_model", &site("\"step\"", ""), "simulate");
+    assert!(err.contains("`fixed` names blocks of an assembly"), "{err}");
+}

@@ -207,12 +207,20 @@ pub enum ContactSet {
 /// overlap has an area above tolerance × the model size. Every body must be supported through
 /// the contacts of `set` (else it floats: an error naming it, and where the blocks' lowest point
 /// is when none reaches the ground), and two bodies may touch on one face only.
+///
+/// The bodies marked in `fixed` (index by index; a shorter slice leaves the rest free) are part
+/// of the ground: abutments, foundations, the rock of a stepped site. They may reach below the
+/// ground level, they need no support, and a face of a free body on one of them rests on the
+/// ground (`lower` None, the normal out of the fixed block), bed or side; no contact is reported
+/// between fixed blocks, and a free block may not carry a fixed one.
 pub fn detect_contacts(
     bodies: &[BodySpec],
     tolerance: f64,
     set: ContactSet,
     ground_level: f64,
+    fixed: &[bool],
 ) -> Result<Vec<ContactFace>, AssemblyError> {
+    let is_fixed = |b: usize| fixed.get(b).copied().unwrap_or(false);
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(error(
             "tolerance",
@@ -260,12 +268,13 @@ pub fn detect_contacts(
         tolerance,
         ground_level,
         &reference,
+        &is_fixed,
     )?;
     let min_area = tolerance * size;
     let facing = 1.0 - 1e-9;
     let mut contacts = Vec::new();
     // On the ground: a face on the ground level whose outward normal is −z rests whole.
-    for (b, fs) in faces.iter().enumerate() {
+    for (b, fs) in faces.iter().enumerate().filter(|&(b, _)| !is_fixed(b)) {
         for f in fs {
             if f.normal.z < -facing
                 && f.polygon
@@ -295,7 +304,7 @@ pub fn detect_contacts(
             let (lo_j, hi_j) = boxes[j];
             let apart =
                 (0..3).any(|k| lo_i[k] > hi_j[k] + tolerance || lo_j[k] > hi_i[k] + tolerance);
-            if apart {
+            if apart || (is_fixed(i) && is_fixed(j)) {
                 continue;
             }
             for fa in &faces[i] {
@@ -308,7 +317,10 @@ pub fn detect_contacts(
                     // The normal from the lower body into the upper one; a side contact keeps
                     // the order of the file.
                     let bed = fa.normal.z.abs() > std::f64::consts::FRAC_1_SQRT_2;
-                    let (lower, upper, normal) = if !bed || fa.normal.z > 0.0 {
+                    let (lower, upper, normal) = if is_fixed(j) && !bed {
+                        // A side contact on a fixed block: its normal out of the ground.
+                        (j, i, fb.normal)
+                    } else if !bed || fa.normal.z > 0.0 {
                         (i, j, fa.normal)
                     } else {
                         (j, i, fb.normal)
@@ -319,8 +331,18 @@ pub fn detect_contacts(
                         return Err(non_convex(&bodies[b].name));
                     }
                     if area > min_area {
+                        if is_fixed(upper) {
+                            return Err(error(
+                                format!("body \"{}\"", bodies[lower].name),
+                                format!(
+                                    "carries the fixed block \"{}\": a fixed block is part of the \
+                                     ground and stands on the ground or on fixed blocks",
+                                    bodies[upper].name
+                                ),
+                            ));
+                        }
                         contacts.push(ContactFace {
-                            lower: Some(lower),
+                            lower: Some(lower).filter(|&b| !is_fixed(b)),
                             upper,
                             normal,
                             corners,
@@ -350,8 +372,8 @@ pub fn detect_contacts(
                 format!("body \"{}\"", bodies[c.upper].name),
                 format!(
                     "rests on {lower} on more than one face (a face split in pieces, as an \
-                     annular sector's flat side): crr assemble makes one interface per pair of \
-                     bodies and needs one bed face between them"
+                     annular sector's flat side, or faces on two fixed blocks): crr assemble \
+                     makes one interface per pair of bodies and needs one bed face between them"
                 ),
             ));
         }
@@ -359,7 +381,7 @@ pub fn detect_contacts(
     match set {
         ContactSet::Beds => {
             for (b, body) in bodies.iter().enumerate() {
-                if !contacts.iter().any(|c| c.bed && c.upper == b) {
+                if !is_fixed(b) && !contacts.iter().any(|c| c.bed && c.upper == b) {
                     return Err(error(
                         format!("body \"{}\"", body.name),
                         format!(
@@ -373,7 +395,7 @@ pub fn detect_contacts(
         }
         ContactSet::All => {
             let depth = ground_depths(bodies.len(), &contacts);
-            if let Some(b) = depth.iter().position(Option::is_none) {
+            if let Some(b) = (0..bodies.len()).find(|&b| !is_fixed(b) && depth[b].is_none()) {
                 return Err(error(
                     format!("body \"{}\"", bodies[b].name),
                     format!(
@@ -385,6 +407,32 @@ pub fn detect_contacts(
         }
     }
     Ok(contacts)
+}
+
+/// The free blocks of an assembly and its contacts ([`detect_contacts`]) renumbered for them:
+/// the blocks marked in `fixed` are part of the ground (the contacts on them already rest on it)
+/// and leave the structure.
+pub fn free_blocks(
+    bodies: &[BodySpec],
+    contacts: &[ContactFace],
+    fixed: &[bool],
+) -> (Vec<BodySpec>, Vec<ContactFace>) {
+    let is_fixed = |b: usize| fixed.get(b).copied().unwrap_or(false);
+    let mut index = vec![None; bodies.len()];
+    let mut free = Vec::with_capacity(bodies.len());
+    for (b, body) in bodies.iter().enumerate().filter(|&(b, _)| !is_fixed(b)) {
+        index[b] = Some(free.len());
+        free.push(body.clone());
+    }
+    let renumbered = contacts
+        .iter()
+        .map(|c| ContactFace {
+            lower: c.lower.and_then(|b| index[b]),
+            upper: index[c.upper].expect("a contact's upper block is free"),
+            ..c.clone()
+        })
+        .collect();
+    (free, renumbered)
 }
 
 /// What a body resting on nothing is told when no block reaches down to the ground: where the
@@ -478,10 +526,11 @@ fn refuse_overlaps(
     tolerance: f64,
     ground_level: f64,
     reference: &Vector3<f64>,
+    is_fixed: &dyn Fn(usize) -> bool,
 ) -> Result<(), AssemblyError> {
     let ground_near = ground_level - reference.z;
     for (b, (lo, _)) in boxes.iter().enumerate() {
-        if lo.z < ground_near - tolerance {
+        if lo.z < ground_near - tolerance && !is_fixed(b) {
             return Err(error(
                 format!("body \"{}\"", bodies[b].name),
                 format!(
