@@ -839,3 +839,78 @@ fn blocks_on_a_fixed_step_rock_on_the_ground_it_makes() {
     let err = refused("stepped_as_model", &site("\"step\"", ""), "simulate");
     assert!(err.contains("`fixed` names blocks of an assembly"), "{err}");
 }
+
+/// A block on two fixed slabs rests on the convex hull of its two faces on them: a block
+/// 0.4 × 0.4 × 1 m centred over the joint of two slabs 0.2 m thick (its base half on each), and
+/// over a gap of 0.1 m between them, rocks on its base's outer edges as on the ground: λ = b/h
+/// = 0.4 along ±x and ±y, one ground joint whose corners are the base's (to 1e-12 m). A block
+/// on one slab and against the side of a higher one meets the ground on faces in two planes:
+/// with every contact an interface, refused, naming the block.
+#[test]
+fn a_block_on_two_fixed_slabs_rocks_on_the_hull_of_its_faces() {
+    let body = |name: &str, centre: [f64; 3], size: [f64; 3]| {
+        format!(
+            "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
+             size = {size:?} }}\n"
+        )
+    };
+    let site = |gap: f64| {
+        let w = 1.0 - gap / 2.0;
+        "name = \"slabs\"\nfixed = [\"west\", \"east\"]\n".to_string()
+            + &body("west", [-0.5 - gap / 4.0, 0.0, 0.1], [w, 2.0, 0.2])
+            + &body("east", [0.5 + gap / 4.0, 0.0, 0.1], [w, 2.0, 0.2])
+            + &body("block", [0.0, 0.0, 0.7], [0.4, 0.4, 1.0])
+    };
+    for gap in [0.0, 0.1] {
+        let path = common::write_model(&format!("slabs_gap_{gap}"), &site(gap));
+        let a = assemble(
+            &path,
+            &read_assembly(&path).unwrap(),
+            &AssemblyOptions::default(),
+        )
+        .unwrap_or_else(|e| panic!("gap {gap}: {e}"));
+        assert_eq!(a.file.interface.len(), 1, "gap {gap}");
+        let mut corners = a.file.interface[0]
+            .rocking_base
+            .as_ref()
+            .unwrap()
+            .corners
+            .clone();
+        corners.sort_by(|p, q| p.partial_cmp(q).unwrap());
+        let base = [
+            [-0.2, -0.2, 0.2],
+            [-0.2, 0.2, 0.2],
+            [0.2, -0.2, 0.2],
+            [0.2, 0.2, 0.2],
+        ];
+        for (p, q) in corners.iter().zip(&base) {
+            assert!(
+                (0..3).all(|k| (p[k] - q[k]).abs() < 1e-12),
+                "gap {gap}: {corners:?}"
+            );
+        }
+        for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
+            let l = lambda(&a.model, d);
+            assert!((l - 0.4).abs() < 1e-9, "gap {gap}, {d:?}: {l}");
+        }
+    }
+    // A block beside a step: its base on the west slab, its east side against the east slab,
+    // 0.1 m higher. With every contact an interface it meets the ground on two faces in two
+    // planes (no hull is one face): refused, naming the block.
+    let text = "name = \"step\"\nfixed = [\"west\", \"east\"]\n".to_string()
+        + &body("west", [-0.5, 0.0, 0.1], [1.0, 2.0, 0.2])
+        + &body("east", [0.5, 0.0, 0.15], [1.0, 2.0, 0.3])
+        + &body("block", [-0.2, 0.0, 0.7], [0.4, 0.4, 1.0]);
+    let path = common::write_model("slabs_step", &text);
+    let err = assemble(
+        &path,
+        &read_assembly(&path).unwrap(),
+        &AssemblyOptions::default().with_all_contacts(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("body \"block\": rests on the ground on more than one face"),
+        "{err}"
+    );
+}

@@ -206,13 +206,16 @@ pub enum ContactSet {
 /// each other: faces facing each other in one plane (distance at most `tolerance`, m) whose
 /// overlap has an area above tolerance × the model size. Every body must be supported through
 /// the contacts of `set` (else it floats: an error naming it, and where the blocks' lowest point
-/// is when none reaches the ground), and two bodies may touch on one face only.
+/// is when none reaches the ground), and two bodies may touch on one face only (faces of a pair
+/// in one plane are one face, their convex hull, when that is a rectangle).
 ///
 /// The bodies marked in `fixed` (index by index; a shorter slice leaves the rest free) are part
 /// of the ground: abutments, foundations, the rock of a stepped site. They may reach below the
 /// ground level, they need no support, and a face of a free body on one of them rests on the
-/// ground (`lower` None, the normal out of the fixed block), bed or side; no contact is reported
-/// between fixed blocks, and a free block may not carry a fixed one.
+/// ground (`lower` None, the normal out of the fixed block), bed or side; a block on several of
+/// them (or on them and the ground plane) by faces in one plane rests on their convex hull when
+/// that is a rectangle ([`merge_coplanar`]); no contact is reported between fixed blocks, and a
+/// free block may not carry a fixed one.
 pub fn detect_contacts(
     bodies: &[BodySpec],
     tolerance: f64,
@@ -354,6 +357,10 @@ pub fn detect_contacts(
             }
         }
     }
+    // A block on two fixed blocks (or on one and the ground plane), or on a face split in
+    // pieces, by faces in one plane rests on their convex hull when that is a rectangle (exact
+    // for rigid bodies: merge_coplanar). Compared near the origin, as the faces were.
+    let mut contacts = merge_coplanar(&contacts, InterfaceStyle::RockingBase, tolerance);
     let counts = |c: &ContactFace| c.bed || set == ContactSet::All;
     let hint = ground_hint(&boxes, ground_near, reference.z, tolerance);
     for c in &mut contacts {
@@ -371,9 +378,10 @@ pub fn detect_contacts(
             return Err(error(
                 format!("body \"{}\"", bodies[c.upper].name),
                 format!(
-                    "rests on {lower} on more than one face (a face split in pieces, as an \
-                     annular sector's flat side, or faces on two fixed blocks): crr assemble \
-                     makes one interface per pair of bodies and needs one bed face between them"
+                    "rests on {lower} on more than one face, in different planes or with a \
+                     hull that is no rectangle (a stepped seat; fixed blocks at two heights): \
+                     crr assemble makes one interface per pair of bodies and needs one face \
+                     between them"
                 ),
             ));
         }
