@@ -184,18 +184,19 @@ impl Affine {
     }
 }
 
-/// The voussoirs of an n-voussoir semicircular arch of radii r_in, r_out (unit depth) from the
-/// annular sector's closed form: each spans δ = π/n, has area (δ/2)(r_out² − r_in²) and its centre
-/// on its bisector at radius (2/3)(r_out³ − r_in³)/(r_out² − r_in²) · sin(δ/2)/(δ/2). Returns the
-/// weights normalised to a total of 1 and the centres (x, z).
-fn voussoirs(n: usize, r_in: f64, r_out: f64) -> Vec<(f64, [f64; 2])> {
-    let delta = std::f64::consts::PI / n as f64;
+/// The voussoirs of an n-voussoir segmental arch of radii r_in, r_out (unit depth) from the angle
+/// α to π − α (α = 0: the semicircle) from the annular sector's closed form: each spans
+/// δ = (π − 2α)/n, has area (δ/2)(r_out² − r_in²) and its centre on its bisector at radius
+/// (2/3)(r_out³ − r_in³)/(r_out² − r_in²) · sin(δ/2)/(δ/2). Returns the weights normalised to a
+/// total of 1 and the centres (x, z).
+fn segment_voussoirs(n: usize, r_in: f64, r_out: f64, alpha: f64) -> Vec<(f64, [f64; 2])> {
+    let delta = (std::f64::consts::PI - 2.0 * alpha) / n as f64;
     let rc = 2.0 / 3.0 * (r_out.powi(3) - r_in.powi(3)) / (r_out.powi(2) - r_in.powi(2))
         * (delta / 2.0).sin()
         / (delta / 2.0);
     (0..n)
         .map(|i| {
-            let mid = delta * (i as f64 + 0.5);
+            let mid = alpha + delta * (i as f64 + 0.5);
             (1.0 / n as f64, [rc * mid.cos(), rc * mid.sin()])
         })
         .collect()
@@ -214,9 +215,17 @@ fn voussoirs(n: usize, r_in: f64, r_out: f64) -> Vec<(f64, [f64; 2])> {
 /// joint's normal pointing into that part is e_θ = (−sin θ_j, cos θ_j), so N_j = F_j · e_θ
 /// (compression ≥ 0). At j = n the part is empty: N_n = V and M_n = −M, the left springing.
 fn arch_joints(n: usize, r_in: f64, r_out: f64, dx: f64) -> Vec<(Affine, Affine)> {
-    let v = voussoirs(n, r_in, r_out);
+    segment_joints(n, r_in, r_out, 0.0, dx)
+}
+
+/// [`arch_joints`] of the segmental arch from α to π − α ([`segment_voussoirs`]): joint j at
+/// θ_j = α + j(π − 2α)/n, its supports the skewbacks at α and π − α (the left one's mid-point
+/// p_L at π − α). The statics is the same: e_θ = (−sin θ_j, cos θ_j) is the joint's normal
+/// whatever its angle, and N_n = F_n · e_θ at the inclined left skewback.
+fn segment_joints(n: usize, r_in: f64, r_out: f64, alpha: f64, dx: f64) -> Vec<(Affine, Affine)> {
+    let v = segment_voussoirs(n, r_in, r_out, alpha);
     let rm = 0.5 * (r_in + r_out);
-    let p_left = [-rm, 0.0];
+    let p_left = [-rm * alpha.cos(), rm * alpha.sin()];
     // Moment (about y, in the x–z plane) of the force f at r: r_z f_x − r_x f_z.
     let cross = |r: [f64; 2], f: [f64; 2]| r[1] * f[0] - r[0] * f[1];
     let zero = Affine {
@@ -225,12 +234,13 @@ fn arch_joints(n: usize, r_in: f64, r_out: f64, dx: f64) -> Vec<(Affine, Affine)
     };
     (0..=n)
         .map(|j| {
-            let theta = if j == n {
-                std::f64::consts::PI
+            let theta = alpha + (std::f64::consts::PI - 2.0 * alpha) * j as f64 / n as f64;
+            // At j = n, π − α: (sin α, −cos α), exact for the semicircle's (0, −1).
+            let (s, c) = if j == n {
+                (alpha.sin(), -alpha.cos())
             } else {
-                std::f64::consts::PI * j as f64 / n as f64
+                theta.sin_cos()
             };
-            let (s, c) = if j == n { (0.0, -1.0) } else { theta.sin_cos() };
             let cj = [rm * c, rm * s];
             // F_j = −(H, V) − Σ L_i, L_i = (−λ W_i dx, −W_i).
             let mut fx = Affine {
@@ -270,10 +280,15 @@ fn arch_joints(n: usize, r_in: f64, r_out: f64, dx: f64) -> Vec<(Affine, Affine)
 /// thrust line exists, N_j ≥ 0 and |M_j| ≤ N_j t/2 at every joint (t = r_out − r_in), no sliding
 /// (friction unlimited). None when no thrust line exists for any λ ≥ −cap.
 fn arch_lambda(n: usize, r_in: f64, r_out: f64, dx: f64) -> Option<f64> {
+    segment_lambda(n, r_in, r_out, 0.0, dx)
+}
+
+/// [`arch_lambda`] of the segmental arch from α to π − α between fixed skewbacks.
+fn segment_lambda(n: usize, r_in: f64, r_out: f64, alpha: f64, dx: f64) -> Option<f64> {
     let half_t = 0.5 * (r_out - r_in);
     let mut lp = Lp::new(4);
     lp.cost[3] = -1.0;
-    for (nj, mj) in arch_joints(n, r_in, r_out, dx) {
+    for (nj, mj) in segment_joints(n, r_in, r_out, alpha, dx) {
         lp.le.push(nj.scaled(-1.0).nonpositive());
         lp.le.push(mj.plus(nj.scaled(-half_t)).nonpositive());
         lp.le
@@ -918,6 +933,74 @@ fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
             let hinges = arch_hinges(n, r_in, r_out, dx);
             assert_eq!(rocking, hinges, "planar {planar}, dx = {dx:+}");
             assert_eq!(hinges.len(), 4);
+        }
+    }
+}
+
+/// A segmental arch between fixed skewbacks (an assembly's `fixed` blocks): 7 voussoirs of radii
+/// 3 and 3.5 m from α to π − α, on two skewback stones (annular sectors of 20° beyond each
+/// springing) named `fixed`, turned into a model by `crr assemble --all-contacts` (hinges about
+/// y with `--planar`, rocking bases without). Its multiplier along ±x is the thrust-line LP's
+/// for the segment, whose supports are the inclined skewback joints (1e-7): springings at
+/// α = 30° (their joints beds on the fixed stones) and at α = 50° (steeper than 45°: side
+/// contacts on them, their normals out of the fixed stones). The skewbacks are not in the model.
+#[test]
+fn a_segmental_arch_on_fixed_skewbacks_matches_the_thrust_line_lp() {
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    use crr::kinematics::assembly::ContactSet;
+    let (n, r_in, r_out) = (7, 3.0, 3.5);
+    let sector = |name: &str, from: f64, to: f64| {
+        format!(
+            "[[body]]\nname = \"{name}\"\ndensity = 2200.0\nannular_sector = {{ center = [0.0, 0.0, \
+             0.0], axis = [0.0, -1.0, 0.0], start = [1.0, 0.0, 0.0], inner_radius = {r_in:?}, \
+             outer_radius = {r_out:?}, thickness = 1.0, from_angle = {from:?}, to_angle = {to:?} }}\n"
+        )
+    };
+    for alpha_deg in [30.0f64, 50.0] {
+        let alpha = alpha_deg.to_radians();
+        let pi = std::f64::consts::PI;
+        let at = |j: usize| alpha + (pi - 2.0 * alpha) * j as f64 / n as f64;
+        let beyond = 20f64.to_radians();
+        let mut text = "name = \"segmental_arch\"\n\
+                        fixed = [\"skewback_right\", \"skewback_left\"]\n"
+            .to_string();
+        text += &sector("skewback_right", alpha - beyond, alpha);
+        for i in 0..n {
+            // The last joint at π − α exactly, as the LP's.
+            let to = if i + 1 == n { pi - alpha } else { at(i + 1) };
+            text += &sector(&format!("v{}", i + 1), at(i), to);
+        }
+        text += &sector("skewback_left", pi - alpha, pi - alpha + beyond);
+        let path = crate::common::write_model(&format!("segmental_arch_{alpha_deg}"), &text);
+        let file = read_assembly(&path).unwrap();
+        for planar in [true, false] {
+            let assembled = assemble(
+                &path,
+                &file,
+                &AssemblyOptions {
+                    planar,
+                    contacts: ContactSet::All,
+                    ..Default::default()
+                },
+            )
+            .unwrap_or_else(|e| panic!("α = {alpha_deg}°: {e}"));
+            assert_eq!(assembled.file.body.len(), n);
+            assert_eq!(assembled.model.interfaces.len(), n + 1);
+            for dx in [1.0, -1.0] {
+                let expected =
+                    segment_lambda(n, r_in, r_out, alpha, dx).expect("a thrust line exists");
+                let got = engine(&assembled.file.structure(), dx);
+                println!(
+                    "segmental arch α = {alpha_deg}°, planar {planar}, dx = {dx:+}: LP λ = \
+                     {expected:.12}, engine {got:?}"
+                );
+                assert_close(
+                    &format!("segmental arch α = {alpha_deg}°, planar {planar}, dx = {dx:+}"),
+                    got,
+                    expected,
+                    RTOL,
+                );
+            }
         }
     }
 }
