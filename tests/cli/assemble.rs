@@ -447,6 +447,7 @@ fn the_bundled_assemblies_go_from_stones_to_a_simulation() {
         ("wall", &["--planar"][..], 75, 31),
         ("facade", &["--planar"][..], 86, 34),
         ("trilithon", &["--planar"][..], 4, 1),
+        ("segmental_arch", &["--all-contacts", "--planar"][..], 8, 1),
     ] {
         let out = common::scratch(&format!("assembled_{name}"));
         let model = out.join("model.toml");

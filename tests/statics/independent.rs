@@ -944,6 +944,7 @@ fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
 /// for the segment, whose supports are the inclined skewback joints (1e-7): springings at
 /// α = 30° (their joints beds on the fixed stones) and at α = 50° (steeper than 45°: side
 /// contacts on them, their normals out of the fixed stones). The skewbacks are not in the model.
+/// The same for the bundled segmental arch (radii 3 and 3.4 m, springing at 30°), planar.
 #[test]
 fn a_segmental_arch_on_fixed_skewbacks_matches_the_thrust_line_lp() {
     use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
@@ -1002,6 +1003,26 @@ fn a_segmental_arch_on_fixed_skewbacks_matches_the_thrust_line_lp() {
                 );
             }
         }
+    }
+    // The bundled one (`examples/assemblies/segmental_arch.toml`: radii 3 and 3.4 m, springing
+    // at 30°), as written.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/assemblies/segmental_arch.toml");
+    let assembled = assemble(
+        &path,
+        &read_assembly(&path).unwrap(),
+        &AssemblyOptions::default().in_plane().with_all_contacts(),
+    )
+    .unwrap();
+    for dx in [1.0, -1.0] {
+        let expected = segment_lambda(n, 3.0, 3.4, 30f64.to_radians(), dx).expect("a thrust line");
+        let got = engine(&assembled.file.structure(), dx);
+        assert_close(
+            &format!("bundled segmental arch, dx = {dx:+}"),
+            got,
+            expected,
+            RTOL,
+        );
     }
 }
 
