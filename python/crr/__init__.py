@@ -167,6 +167,28 @@ class Model:
         return cls(_crr.Model.load(_fspath(path)))
 
     @classmethod
+    def from_assembly(
+        cls,
+        path: PathLike,
+        *,
+        planar: bool = False,
+        all_contacts: bool = False,
+        tolerance: float = 1e-6,
+        ground_level: float = 0.0,
+    ) -> "Model":
+        """The model of an assembly file (blocks only: ``[[body]]`` tables, ``[[obj]]`` files,
+        the ``fixed`` blocks that are part of the ground), as ``crr assemble`` writes it: the
+        contacts found from the blocks' shapes, every bed (``all_contacts``: every contact) a
+        rocking base (``planar``: a hinge about y), faces closer than ``tolerance`` (m) touching,
+        the ground the plane z = ``ground_level`` (m). Relative record files are read from the
+        assembly's folder. See docs/assembly.md."""
+        return cls(
+            _crr.Model.assemble(
+                _fspath(path), bool(planar), bool(all_contacts), float(tolerance), float(ground_level)
+            )
+        )
+
+    @classmethod
     def from_toml(
         cls, text: str, base_dir: Optional[PathLike] = None, label: str = "<string>"
     ) -> "Model":

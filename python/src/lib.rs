@@ -95,6 +95,43 @@ impl PyModel {
         })
     }
 
+    /// The model of an assembly file (blocks only) as `crr assemble` writes it: its contacts
+    /// found from the blocks' shapes, every bed (or, `all_contacts`, every contact) a rocking
+    /// interface (hinges about y when `planar`), faces closer than `tolerance` (m) touching, the
+    /// ground the plane z = `ground_level` (m) and the blocks the file names `fixed`. Relative
+    /// record files are read from the assembly's folder.
+    #[staticmethod]
+    fn assemble(
+        py: Python<'_>,
+        path: PathBuf,
+        planar: bool,
+        all_contacts: bool,
+        tolerance: f64,
+        ground_level: f64,
+    ) -> PyResult<Self> {
+        use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+        use crr::kinematics::assembly::ContactSet;
+        let options = AssemblyOptions {
+            planar,
+            contacts: if all_contacts {
+                ContactSet::All
+            } else {
+                ContactSet::Beds
+            },
+            tolerance,
+            ground_level,
+        };
+        let assembled = py
+            .detach(|| read_assembly(&path).and_then(|file| assemble(&path, &file, &options)))
+            .map_err(|e| input_error(py, e))?;
+        Ok(PyModel {
+            label: path,
+            base_dir: assembled.folder,
+            file: assembled.file,
+            structure: assembled.model,
+        })
+    }
+
     /// Parses a model given as text (JSON when `is_json`, else TOML); `label` names it in the
     /// errors, `base_dir` resolves its relative record files.
     #[staticmethod]

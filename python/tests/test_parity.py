@@ -359,3 +359,31 @@ def test_check_warnings_are_python_warnings_with_the_command_lines_text(cli, in_
     with warnings.catch_warnings():
         warnings.simplefilter("error", crr.CrrWarning)
         assert crr.Model.from_file("examples/models/single_block.toml").check()["warnings"] == []
+
+
+def test_an_assembly_is_the_model_the_command_line_writes(cli, in_root, tmp_path):
+    """``Model.from_assembly`` is ``crr assemble``: the bundled segmental arch between its fixed
+    skewbacks gives the written model's coordinates, interfaces and ``crr check --json`` report,
+    λ = 0.754085 along ±x; a ``fixed`` name that is no block is the command line's error."""
+    source = "examples/assemblies/segmental_arch.toml"
+    written = tmp_path / "segmental_arch_model.toml"
+    run_cli(cli, ["assemble", source, "--all-contacts", "--planar", "--out", str(written)])
+    model = crr.Model.from_assembly(source, planar=True, all_contacts=True)
+    from_file = crr.Model.from_file(written)
+    assert model.coordinates == from_file.coordinates
+    assert model.interfaces == from_file.interfaces
+    report = model.check()
+    assert report == json.loads(run_cli(cli, ["check", str(written), "--json"]).stdout)
+    along_x = [s for s in report["static_multipliers"] if abs(s["direction"][0]) == 1.0]
+    assert len(along_x) == 2
+    for side in along_x:
+        assert abs(side["lambda"] - 0.754085) < 5e-7
+    wrong = tmp_path / "wrong_fixed.toml"
+    wrong.write_text(
+        Path(source).read_text().replace('"skewback_left"]', '"skewback_west"]'), encoding="utf-8"
+    )
+    p = run_cli(cli, ["assemble", str(wrong), "--planar", "--all-contacts"], expect=2)
+    with pytest.raises(crr.InputError) as error:
+        crr.Model.from_assembly(wrong, planar=True, all_contacts=True)
+    assert str(error.value) == p.stderr.strip().removeprefix("crr: error: ")
+    assert 'fixed: no block is named "skewback_west"' in str(error.value)
