@@ -175,16 +175,23 @@ class Model:
         all_contacts: bool = False,
         tolerance: float = 1e-6,
         ground_level: float = 0.0,
+        inscribed: bool = False,
     ) -> "Model":
         """The model of an assembly file (blocks only: ``[[body]]`` tables, ``[[obj]]`` files,
         the ``fixed`` blocks that are part of the ground), as ``crr assemble`` writes it: the
         contacts found from the blocks' shapes, every bed (``all_contacts``: every contact) a
         rocking base (``planar``: a hinge about y), faces closer than ``tolerance`` (m) touching,
-        the ground the plane z = ``ground_level`` (m). Relative record files are read from the
-        assembly's folder. See docs/assembly.md."""
+        the ground the plane z = ``ground_level`` (m); with ``inscribed``, a face that is no
+        rectangle (a drum's bed) rocks on the largest rectangle of its proportions inside it.
+        Relative record files are read from the assembly's folder. See docs/assembly.md."""
         return cls(
             _crr.Model.assemble(
-                _fspath(path), bool(planar), bool(all_contacts), float(tolerance), float(ground_level)
+                _fspath(path),
+                bool(planar),
+                bool(all_contacts),
+                float(tolerance),
+                float(ground_level),
+                bool(inscribed),
             )
         )
 

@@ -13,7 +13,12 @@ class Model:
     def load(path: _Path) -> Model: ...
     @staticmethod
     def assemble(
-        path: _Path, planar: bool, all_contacts: bool, tolerance: float, ground_level: float
+        path: _Path,
+        planar: bool,
+        all_contacts: bool,
+        tolerance: float,
+        ground_level: float,
+        inscribed: bool,
     ) -> Model: ...
     @staticmethod
     def parse(text: str, is_json: bool, label: _Path, base_dir: _Path) -> Model: ...

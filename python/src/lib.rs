@@ -98,8 +98,9 @@ impl PyModel {
     /// The model of an assembly file (blocks only) as `crr assemble` writes it: its contacts
     /// found from the blocks' shapes, every bed (or, `all_contacts`, every contact) a rocking
     /// interface (hinges about y when `planar`), faces closer than `tolerance` (m) touching, the
-    /// ground the plane z = `ground_level` (m) and the blocks the file names `fixed`. Relative
-    /// record files are read from the assembly's folder.
+    /// ground the plane z = `ground_level` (m) and the blocks the file names `fixed`; with
+    /// `inscribed`, a face that is no rectangle rocks on the largest rectangle of its
+    /// proportions inside it. Relative record files are read from the assembly's folder.
     #[staticmethod]
     fn assemble(
         py: Python<'_>,
@@ -108,6 +109,7 @@ impl PyModel {
         all_contacts: bool,
         tolerance: f64,
         ground_level: f64,
+        inscribed: bool,
     ) -> PyResult<Self> {
         use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
         use crr::kinematics::assembly::ContactSet;
@@ -120,6 +122,7 @@ impl PyModel {
             },
             tolerance,
             ground_level,
+            inscribed,
         };
         let assembled = py
             .detach(|| read_assembly(&path).and_then(|file| assemble(&path, &file, &options)))

@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use crr_kinematics::assembly::{
-    ContactFace, ContactSet, InterfaceStyle, detect_contacts, free_blocks, structure_of,
+    ContactFace, ContactSet, InterfaceStyle, detect_contacts, free_blocks, inscribed_rectangle,
+    is_rectangle, structure_of,
 };
 use crr_kinematics::{Model, StructureSpec};
 
@@ -30,6 +31,11 @@ pub struct AssemblyOptions {
     /// The height of the ground (m): a site elevation where the blocks' coordinates are a
     /// survey's (the ground is the plane z = 0 by default).
     pub ground_level: f64,
+    /// A contact face that is no rectangle (a drum's polygon) becomes the largest rectangle of
+    /// its bounding box's proportions inside it ([`inscribed_rectangle`]): a rocking base is a
+    /// rectangle, and the multipliers are then lower bounds of the whole face's. Refused when
+    /// false.
+    pub inscribed: bool,
 }
 
 impl AssemblyOptions {
@@ -58,6 +64,7 @@ impl Default for AssemblyOptions {
             contacts: ContactSet::Beds,
             tolerance: DEFAULT_TOLERANCE,
             ground_level: 0.0,
+            inscribed: false,
         }
     }
 }
@@ -141,6 +148,7 @@ pub fn assemble(
         contacts: set,
         tolerance,
         ground_level,
+        inscribed,
     } = options;
     let here = |e: &dyn std::fmt::Display| Error::Argument(format!("{}: {e}", path.display()));
     let fixed: Vec<bool> = file
@@ -151,7 +159,31 @@ pub fn assemble(
     let found =
         detect_contacts(&file.body, tolerance, set, ground_level, &fixed).map_err(|e| here(&e))?;
     // The fixed blocks are ground: the model is the free blocks.
-    let (free, contacts) = free_blocks(&file.body, &found, &fixed);
+    let (free, mut contacts) = free_blocks(&file.body, &found, &fixed);
+    let interface = |c: &ContactFace| c.bed || set == ContactSet::All;
+    if inscribed && !planar {
+        for c in contacts.iter_mut().filter(|c| interface(c)) {
+            if !is_rectangle(&c.corners, tolerance) {
+                *c = inscribed_rectangle(c);
+            }
+        }
+    }
+    if !planar
+        && let Some(c) = contacts
+            .iter()
+            .find(|c| interface(c) && !is_rectangle(&c.corners, tolerance))
+    {
+        let name = |b: Option<usize>| b.map_or("ground", |b| free[b].name.as_str());
+        return Err(here(&format!(
+            "contact \"{}_on_{}\": its face is a polygon of {} corners, not a rectangle, and a \
+             rocking base is a rectangle: `crr assemble --inscribed` takes the largest rectangle \
+             of the face's proportions inside it (its multipliers are lower bounds of the whole \
+             face's)",
+            name(Some(c.upper)),
+            name(c.lower),
+            c.corners.len()
+        )));
+    }
     let style = if planar {
         InterfaceStyle::PlanarHinge
     } else {

@@ -915,3 +915,63 @@ fn a_block_on_two_fixed_slabs_rocks_on_the_hull_of_its_faces() {
         "{err}"
     );
 }
+
+/// A column of drums (`--inscribed`): three drums, regular 16-gon prisms of radius R = 0.45 m
+/// (a vertex on x) and 1.3 m high, stacked on the ground. Their beds are 16-gons, which a
+/// rocking base (a rectangle) cannot be: refused, naming the contact and the option. With
+/// `--inscribed` each bed is the square inscribed in the 16-gon, half-side b = R cos 45° (its
+/// corners are vertices at 45°, 135°, …), to 1e-12 m, and the column rocks whole on its base at
+/// λ = 2b/(3 × 1.3) = 0.163178 along ±x and ±y (the block's b/h; the bundled temple's drum
+/// shafts use the same squares), to 1e-9.
+#[test]
+fn a_column_of_drums_rocks_on_the_squares_inscribed_in_its_beds() {
+    let (radius, height) = (0.45f64, 1.3f64);
+    let mut text = String::from("name = \"drums\"\n");
+    for k in 0..3 {
+        let polygon: Vec<[f64; 3]> = (0..16)
+            .map(|i| {
+                let a = 2.0 * std::f64::consts::PI * i as f64 / 16.0;
+                [radius * a.cos(), radius * a.sin(), k as f64 * height]
+            })
+            .collect();
+        text += &format!(
+            "[[body]]\nname = \"d{}\"\ndensity = 2500.0\nprism = {{ polygon = {polygon:?}, \
+             extrude = [0.0, 0.0, {height:?}] }}\n",
+            k + 1
+        );
+    }
+    let path = common::write_model("drum_column_assembly", &text);
+    let o = common::crr(&["assemble", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("contact \"d1_on_ground\": its face is a polygon of 16 corners")
+            && err.contains("--inscribed"),
+        "{err}"
+    );
+    let options = AssemblyOptions {
+        inscribed: true,
+        ..Default::default()
+    };
+    let a = assemble(&path, &read_assembly(&path).unwrap(), &options).unwrap();
+    assert_eq!(a.file.interface.len(), 3);
+    let b = radius * std::f64::consts::FRAC_PI_4.cos();
+    for (k, interface) in a.file.interface.iter().enumerate() {
+        let corners = &interface.rocking_base.as_ref().unwrap().corners;
+        assert_eq!(corners.len(), 4);
+        for p in corners {
+            assert!(
+                (p[0].abs() - b).abs() < 1e-12
+                    && (p[1].abs() - b).abs() < 1e-12
+                    && (p[2] - k as f64 * height).abs() < 1e-12,
+                "{}: {p:?}",
+                interface.name
+            );
+        }
+    }
+    for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
+        let l = lambda(&a.model, d);
+        let expected = 2.0 * b / (3.0 * height);
+        assert!((l - expected).abs() < 1e-9, "{d:?}: {l} against {expected}");
+    }
+}

@@ -846,13 +846,82 @@ fn convex_hull_2d(points: &mut [[f64; 2]]) -> Vec<[f64; 2]> {
 
 /// Whether four corners in order make a rectangle (each corner's two edges at right angles,
 /// within `tolerance` times the edges' lengths).
-fn is_rectangle(corners: &[Vector3<f64>], tolerance: f64) -> bool {
+/// Whether the corners (in order around a face) form a rectangle: four corners, each a right
+/// angle to within the tolerance (m) over its edges' lengths.
+pub fn is_rectangle(corners: &[Vector3<f64>], tolerance: f64) -> bool {
     corners.len() == 4
         && (0..4).all(|i| {
             let (a, b, c) = (corners[(i + 3) % 4], corners[i], corners[(i + 1) % 4]);
             let (e1, e2) = (a - b, c - b);
             e1.dot(&e2).abs() <= tolerance * (e1.norm() + e2.norm())
         })
+}
+
+/// The rocking base a contact face that is no rectangle (a drum's polygon) is given with
+/// `crr assemble --inscribed`: the largest rectangle with the proportions of the face's bounding
+/// box, centred at its centroid, inside it. Its edges run along u and v = n × u in the face's
+/// plane, u = x for a horizontal face (else the horizontal direction in its plane, z × n
+/// normalised), so that a bed's rocking base tilts about x and y. The rectangle
+/// c + s(±W/2, ±H/2) (W × H the bounding box in (u, v), c the centroid) lies in the face where
+/// every corner satisfies every edge's half-plane a·p ≤ b, the worst corner
+/// a·c + s(|a_u| W/2 + |a_v| H/2) ≤ b: s is the least (b − a·c)/(|a_u| W/2 + |a_v| H/2) over the
+/// edges, in closed form. For a centrally symmetric face (a regular polygon, the drums of a
+/// column) it is the largest rectangle of any proportions along u and v that fits; a regular
+/// 16-gon of radius R with a vertex on u gives the square of half-side R cos 45°. A subset of
+/// the face carries a subset of its contact forces, so multipliers computed on it are lower
+/// bounds of the whole face's (the static theorem).
+pub fn inscribed_rectangle(face: &ContactFace) -> ContactFace {
+    let n = face.normal;
+    let u = if n.z.abs() >= 1.0 - 1e-9 {
+        Vector3::x()
+    } else {
+        Vector3::z().cross(&n).normalize()
+    };
+    let v = n.cross(&u);
+    let h = n.dot(&face.corners[0]);
+    let p: Vec<[f64; 2]> = face.corners.iter().map(|c| [u.dot(c), v.dot(c)]).collect();
+    let count = p.len();
+    // Area centroid of the polygon (corners counter-clockwise about n, so about (u, v)).
+    let (mut area2, mut cu, mut cv) = (0.0, 0.0, 0.0);
+    for i in 0..count {
+        let (a, b) = (p[i], p[(i + 1) % count]);
+        let cross = a[0] * b[1] - b[0] * a[1];
+        area2 += cross;
+        cu += (a[0] + b[0]) * cross;
+        cv += (a[1] + b[1]) * cross;
+    }
+    let c = [cu / (3.0 * area2), cv / (3.0 * area2)];
+    let (lo, hi) = p.iter().fold(
+        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+        |(lo, hi), q| {
+            (
+                [lo[0].min(q[0]), lo[1].min(q[1])],
+                [hi[0].max(q[0]), hi[1].max(q[1])],
+            )
+        },
+    );
+    let (half_w, half_h) = ((hi[0] - lo[0]) / 2.0, (hi[1] - lo[1]) / 2.0);
+    let scale = (0..count)
+        .filter_map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % count]);
+            // The edge's outward normal (the polygon counter-clockwise): (dv, −du).
+            let out = [b[1] - a[1], a[0] - b[0]];
+            let reach = out[0].abs() * half_w + out[1].abs() * half_h;
+            let slack = out[0] * (a[0] - c[0]) + out[1] * (a[1] - c[1]);
+            (reach > 0.0).then(|| slack / reach)
+        })
+        .fold(1.0f64, f64::min)
+        .max(0.0);
+    let (w, hh) = (scale * half_w, scale * half_h);
+    let corners = [[-w, -hh], [w, -hh], [w, hh], [-w, hh]]
+        .iter()
+        .map(|d| n * h + u * (c[0] + d[0]) + v * (c[1] + d[1]))
+        .collect();
+    ContactFace {
+        corners,
+        area: 4.0 * w * hh,
+        ..face.clone()
+    }
 }
 
 /// The hinge about y of a contact face of a planar layout (in the x–z plane): its plane must

@@ -1,5 +1,5 @@
 //! `crr assemble ASSEMBLY [--contacts] [--out MODEL.toml] [--all-contacts] [--planar]
-//! [--mechanism [--direction D]…] [--tolerance T] [--ground-level Z] [--force]`.
+//! [--mechanism [--direction D]…] [--tolerance T] [--ground-level Z] [--inscribed] [--force]`.
 
 use std::path::PathBuf;
 
@@ -44,6 +44,11 @@ pub(crate) struct Args {
         allow_hyphen_values = true
     )]
     pub(crate) ground_level: f64,
+    /// A contact face that is no rectangle (a drum's polygon) becomes the largest rectangle of
+    /// the proportions of its bounding box inside it (centred at its centroid): a rocking base
+    /// is a rectangle, and the multipliers are then lower bounds of the whole face's.
+    #[arg(long)]
+    pub(crate) inscribed: bool,
     /// The limit analysis of the assembly (every contact an interface) along each direction, and
     /// the model of its rigid domains: the interfaces that move in any mechanism are hinges, the
     /// blocks no mechanism separates one compound body.
@@ -96,6 +101,7 @@ fn options(a: &Args) -> AssemblyOptions {
         },
         tolerance: a.tolerance,
         ground_level: a.ground_level,
+        inscribed: a.inscribed,
     }
 }
 
