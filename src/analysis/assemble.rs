@@ -107,7 +107,19 @@ pub fn read_assembly(path: &Path) -> Result<ModelFile, Error> {
              objects of the [[obj]] files)"
         )));
     }
-    if file.fixed.len() == file.body.len() {
+    if let Some((i, name)) = file
+        .fixed
+        .iter()
+        .enumerate()
+        .find(|(i, f)| file.fixed[..*i].contains(f))
+    {
+        return Err(here(&format!(
+            "fixed: \"{name}\" is named twice (entries {} and {})",
+            file.fixed[..i].iter().position(|f| f == name).unwrap_or(0) + 1,
+            i + 1
+        )));
+    }
+    if names.iter().all(|n| file.fixed.iter().any(|f| f == n)) {
         return Err(here(
             "fixed: every block is fixed, so nothing can move (fixed names the blocks that are \
              part of the ground)",

@@ -212,10 +212,11 @@ pub enum ContactSet {
 /// The bodies marked in `fixed` (index by index; a shorter slice leaves the rest free) are part
 /// of the ground: abutments, foundations, the rock of a stepped site. They may reach below the
 /// ground level, they need no support, and a face of a free body on one of them rests on the
-/// ground (`lower` None, the normal out of the fixed block), bed or side; a block on several of
-/// them (or on them and the ground plane) by faces in one plane rests on their convex hull when
-/// that is a rectangle ([`merge_coplanar`]); no contact is reported between fixed blocks, and a
-/// free block may not carry a fixed one.
+/// ground (`lower` None, the normal out of the fixed block), bed or side, beside, on or under
+/// it; a block on several of them (or on them and the ground plane) by faces in one plane rests
+/// on their convex hull when that is a rectangle ([`merge_coplanar`]), and by faces in several
+/// planes has a ground contact on each. Fixed blocks may overlap each other; no contact is
+/// reported between them.
 pub fn detect_contacts(
     bodies: &[BodySpec],
     tolerance: f64,
@@ -318,12 +319,12 @@ pub fn detect_contacts(
                         continue;
                     }
                     // The normal from the lower body into the upper one; a side contact keeps
-                    // the order of the file.
+                    // the order of the file; a contact with a fixed block (beside, under or on
+                    // it) has its normal out of the ground.
                     let bed = fa.normal.z.abs() > std::f64::consts::FRAC_1_SQRT_2;
-                    let (lower, upper, normal) = if is_fixed(j) && !bed {
-                        // A side contact on a fixed block: its normal out of the ground.
+                    let (lower, upper, normal) = if is_fixed(j) {
                         (j, i, fb.normal)
-                    } else if !bed || fa.normal.z > 0.0 {
+                    } else if is_fixed(i) || !bed || fa.normal.z > 0.0 {
                         (i, j, fa.normal)
                     } else {
                         (j, i, fb.normal)
@@ -334,16 +335,6 @@ pub fn detect_contacts(
                         return Err(non_convex(&bodies[b].name));
                     }
                     if area > min_area {
-                        if is_fixed(upper) {
-                            return Err(error(
-                                format!("body \"{}\"", bodies[lower].name),
-                                format!(
-                                    "carries the fixed block \"{}\": a fixed block is part of the \
-                                     ground and stands on the ground or on fixed blocks",
-                                    bodies[upper].name
-                                ),
-                            ));
-                        }
                         contacts.push(ContactFace {
                             lower: Some(lower).filter(|&b| !is_fixed(b)),
                             upper,
@@ -362,7 +353,12 @@ pub fn detect_contacts(
     // for rigid bodies: merge_coplanar). Compared near the origin, as the faces were.
     let mut contacts = merge_coplanar(&contacts, InterfaceStyle::RockingBase, tolerance);
     let counts = |c: &ContactFace| c.bed || set == ContactSet::All;
-    let hint = ground_hint(&boxes, ground_near, reference.z, tolerance);
+    // Where the free blocks stand (a fixed footing may reach below the ground).
+    let free_boxes: Vec<_> = (0..boxes.len())
+        .filter(|&b| !is_fixed(b))
+        .map(|b| boxes[b])
+        .collect();
+    let hint = ground_hint(&free_boxes, ground_near, reference.z, tolerance);
     for c in &mut contacts {
         for p in &mut c.corners {
             *p += reference;
@@ -373,15 +369,19 @@ pub fn detect_contacts(
             (d.lower == c.lower && d.upper == c.upper)
                 || (d.lower == Some(c.upper) && c.lower == Some(d.upper))
         };
-        if counts(c) && contacts[..k].iter().any(|d| counts(d) && same_pair(d)) {
+        // Two blocks meet on one face (convex blocks do); a block may meet the ground (its
+        // plane and the fixed blocks) on faces in several planes: interfaces `…_on_ground`,
+        // `…_on_ground_2`.
+        if c.lower.is_some() && counts(c) && contacts[..k].iter().any(|d| counts(d) && same_pair(d))
+        {
             let lower = c.lower.map_or("the ground", |b| bodies[b].name.as_str());
+            let lower = format!("\"{lower}\"");
             return Err(error(
                 format!("body \"{}\"", bodies[c.upper].name),
                 format!(
-                    "rests on {lower} on more than one face, in different planes or with a \
-                     hull that is no rectangle (a stepped seat; fixed blocks at two heights): \
-                     crr assemble makes one interface per pair of bodies and needs one face \
-                     between them"
+                    "meets {lower} on more than one face, whose convex hull is no rectangle \
+                     (a face split in pieces): crr assemble makes one interface per pair of \
+                     blocks and needs one face between them"
                 ),
             ));
         }
@@ -389,7 +389,8 @@ pub fn detect_contacts(
     match set {
         ContactSet::Beds => {
             for (b, body) in bodies.iter().enumerate() {
-                if !is_fixed(b) && !contacts.iter().any(|c| c.bed && c.upper == b) {
+                let rests = |c: &ContactFace| c.bed && c.upper == b && c.normal.z > 0.0;
+                if !is_fixed(b) && !contacts.iter().any(rests) {
                     return Err(error(
                         format!("body \"{}\"", body.name),
                         format!(
@@ -456,7 +457,7 @@ fn ground_hint(
         .iter()
         .map(|(lo, _)| lo.z)
         .fold(f64::INFINITY, f64::min);
-    if lowest > ground_near + tolerance {
+    if lowest.is_finite() && lowest > ground_near + tolerance {
         let lowest = lowest + reference_z;
         format!(
             "; no block reaches down to the ground: the lowest stands at z = {lowest:.6} m, and \
@@ -554,8 +555,10 @@ fn refuse_overlaps(
         for j in i + 1..bodies.len() {
             let ((lo_i, hi_i), (lo_j, hi_j)) = (boxes[i], boxes[j]);
             // Bounding boxes that overlap by at most the tolerance along some axis: apart or
-            // touching.
-            if (0..3).any(|k| hi_i[k].min(hi_j[k]) - lo_i[k].max(lo_j[k]) <= tolerance) {
+            // touching. Fixed blocks are one ground and may overlap each other.
+            if (0..3).any(|k| hi_i[k].min(hi_j[k]) - lo_i[k].max(lo_j[k]) <= tolerance)
+                || (is_fixed(i) && is_fixed(j))
+            {
                 continue;
             }
             if let Some(p) =
