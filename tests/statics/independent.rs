@@ -853,6 +853,22 @@ fn arch_hinges(n: usize, r_in: f64, r_out: f64, dx: f64) -> Vec<usize> {
         .collect()
 }
 
+/// The model of the assembly `file` (read from `path`) with every contact an interface:
+/// `crr assemble --all-contacts`, with `--planar` when `planar`.
+fn every_contact(
+    path: &std::path::Path,
+    file: &crr::input::model_file::ModelFile,
+    planar: bool,
+) -> crr::analysis::assemble::Assembled {
+    use crr::analysis::assemble::{AssemblyOptions, assemble};
+    let options = AssemblyOptions {
+        planar,
+        ..Default::default()
+    }
+    .with_all_contacts();
+    assemble(path, file, &options).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 /// The arch of 9 voussoirs bundled as stones (`examples/assemblies/arch.toml`), turned into a
 /// model by `crr assemble --all-contacts` (every joint an interface; hinges about y with
 /// `--planar`, rocking bases without): its multiplier along ±x is the thrust-line LP's (1e-7),
@@ -860,24 +876,14 @@ fn arch_hinges(n: usize, r_in: f64, r_out: f64, dx: f64) -> Vec<usize> {
 /// touches the intrados or the extrados, the other joints staying closed.
 #[test]
 fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
-    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    use crr::analysis::assemble::read_assembly;
     use crr::impact::statics::Motion;
-    use crr::kinematics::assembly::ContactSet;
     let (n, r_in, r_out) = (9, 2.0, 2.5);
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/arch.toml");
     let file = read_assembly(&path).unwrap();
     for planar in [true, false] {
-        let assembled = assemble(
-            &path,
-            &file,
-            &AssemblyOptions {
-                planar,
-                contacts: ContactSet::All,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let assembled = every_contact(&path, &file, planar);
         let model = &assembled.model;
         assert_eq!(model.interfaces.len(), n + 1);
         for dx in [1.0, -1.0] {
@@ -948,7 +954,6 @@ fn the_arch_assembled_from_its_stones_matches_the_thrust_line_lp() {
 #[test]
 fn a_segmental_arch_on_fixed_skewbacks_matches_the_thrust_line_lp() {
     use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
-    use crr::kinematics::assembly::ContactSet;
     let (n, r_in, r_out) = (7, 3.0, 3.5);
     let sector = |name: &str, from: f64, to: f64| {
         format!(
@@ -975,16 +980,7 @@ fn a_segmental_arch_on_fixed_skewbacks_matches_the_thrust_line_lp() {
         let path = crate::common::write_model(&format!("segmental_arch_{alpha_deg}"), &text);
         let file = read_assembly(&path).unwrap();
         for planar in [true, false] {
-            let assembled = assemble(
-                &path,
-                &file,
-                &AssemblyOptions {
-                    planar,
-                    contacts: ContactSet::All,
-                    ..Default::default()
-                },
-            )
-            .unwrap_or_else(|e| panic!("α = {alpha_deg}°: {e}"));
+            let assembled = every_contact(&path, &file, planar);
             assert_eq!(assembled.file.body.len(), n);
             assert_eq!(assembled.model.interfaces.len(), n + 1);
             for dx in [1.0, -1.0] {
