@@ -180,22 +180,6 @@ pub fn assemble(
             }
         }
     }
-    if !planar
-        && let Some(c) = contacts
-            .iter()
-            .find(|c| interface(c) && !is_rectangle(&c.corners, tolerance))
-    {
-        let name = |b: Option<usize>| b.map_or("ground", |b| free[b].name.as_str());
-        return Err(here(&format!(
-            "contact \"{}_on_{}\": its face is a polygon of {} corners, not a rectangle, and a \
-             rocking base is a rectangle: `crr assemble --inscribed` takes the largest rectangle \
-             of the face's proportions inside it (its multipliers are lower bounds of the whole \
-             face's)",
-            name(Some(c.upper)),
-            name(c.lower),
-            c.corners.len()
-        )));
-    }
     let style = if planar {
         InterfaceStyle::PlanarHinge
     } else {
@@ -211,6 +195,24 @@ pub fn assemble(
         tolerance,
     )
     .map_err(|e| here(&e))?;
+    // A rocking base is a rectangle (named as the model names it).
+    if let Some((name, corners)) = spec.interface.iter().find_map(|i| {
+        let corners: Vec<nalgebra::Vector3<f64>> = i
+            .rocking_base
+            .as_ref()?
+            .corners
+            .iter()
+            .map(|c| nalgebra::Vector3::from(*c))
+            .collect();
+        (!is_rectangle(&corners, tolerance)).then_some((i.name.as_str(), corners.len()))
+    }) {
+        return Err(here(&format!(
+            "contact \"{name}\": its face is a polygon of {corners} corners, not a rectangle, \
+             and a rocking base is a rectangle: `crr assemble --inscribed` takes the largest \
+             rectangle of the face's proportions inside it (its multipliers are lower bounds of \
+             the whole face's)"
+        )));
+    }
     // The assembly's [[symmetry]] tables name coordinates of the model written: checked here.
     let spec = StructureSpec {
         symmetry: file.symmetry.clone(),

@@ -915,25 +915,35 @@ fn a_block_on_two_fixed_slabs_rocks_on_the_hull_of_its_faces() {
 /// `--inscribed` each bed is the square inscribed in the 16-gon, half-side b = R cos 45° (its
 /// corners are vertices at 45°, 135°, …), to 1e-12 m, and the column rocks whole on its base at
 /// λ = 2b/(3 × 1.3) = 0.163178 along ±x and ±y (the block's b/h; the bundled temple's drum
-/// shafts use the same squares), to 1e-9.
+/// shafts use the same squares), to 1e-9; the same in survey coordinates (5e5 m east, 4.5e6 m
+/// north, 350 m up), to the points' resolution (computed at absolute coordinates, the square of
+/// a drum 1e5 m away shrank to a third: an independent review).
 #[test]
 fn a_column_of_drums_rocks_on_the_squares_inscribed_in_its_beds() {
     let (radius, height) = (0.45f64, 1.3f64);
-    let mut text = String::from("name = \"drums\"\n");
-    for k in 0..3 {
-        let polygon: Vec<[f64; 3]> = (0..16)
-            .map(|i| {
-                let a = 2.0 * std::f64::consts::PI * i as f64 / 16.0;
-                [radius * a.cos(), radius * a.sin(), k as f64 * height]
-            })
-            .collect();
-        text += &format!(
-            "[[body]]\nname = \"d{}\"\ndensity = 2500.0\nprism = {{ polygon = {polygon:?}, \
-             extrude = [0.0, 0.0, {height:?}] }}\n",
-            k + 1
-        );
-    }
-    let path = common::write_model("drum_column_assembly", &text);
+    // The column standing at o (its base's centre).
+    let column = |o: [f64; 3]| {
+        let mut text = String::from("name = \"drums\"\n");
+        for k in 0..3 {
+            let polygon: Vec<[f64; 3]> = (0..16)
+                .map(|i| {
+                    let a = 2.0 * std::f64::consts::PI * i as f64 / 16.0;
+                    [
+                        o[0] + radius * a.cos(),
+                        o[1] + radius * a.sin(),
+                        o[2] + k as f64 * height,
+                    ]
+                })
+                .collect();
+            text += &format!(
+                "[[body]]\nname = \"d{}\"\ndensity = 2500.0\nprism = {{ polygon = {polygon:?}, \
+                 extrude = [0.0, 0.0, {height:?}] }}\n",
+                k + 1
+            );
+        }
+        text
+    };
+    let path = common::write_model("drum_column_assembly", &column([0.0; 3]));
     let o = common::crr(&["assemble", path.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr).to_string();
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -942,30 +952,42 @@ fn a_column_of_drums_rocks_on_the_squares_inscribed_in_its_beds() {
             && err.contains("--inscribed"),
         "{err}"
     );
-    let options = AssemblyOptions {
-        inscribed: true,
-        ..Default::default()
-    };
-    let a = assemble(&path, &read_assembly(&path).unwrap(), &options).unwrap();
-    assert_eq!(a.file.interface.len(), 3);
     let b = radius * std::f64::consts::FRAC_PI_4.cos();
-    for (k, interface) in a.file.interface.iter().enumerate() {
-        let corners = &interface.rocking_base.as_ref().unwrap().corners;
-        assert_eq!(corners.len(), 4);
-        for p in corners {
+    // At the origin (1e-12 m), and in survey coordinates, its points resolved to
+    // ulp(4.5e6) ≈ 1e-9 m (1e-8 m; λ to 1e-7).
+    for (tag, o, tol) in [
+        ("drum_column_origin", [0.0; 3], 1e-12),
+        ("drum_column_survey", [5e5, 4.5e6, 350.0], 1e-8),
+    ] {
+        let path = common::write_model(tag, &column(o));
+        let options = AssemblyOptions {
+            inscribed: true,
+            ground_level: o[2],
+            ..Default::default()
+        };
+        let a = assemble(&path, &read_assembly(&path).unwrap(), &options).unwrap();
+        assert_eq!(a.file.interface.len(), 3);
+        for (k, interface) in a.file.interface.iter().enumerate() {
+            let corners = &interface.rocking_base.as_ref().unwrap().corners;
+            assert_eq!(corners.len(), 4);
+            for p in corners {
+                assert!(
+                    ((p[0] - o[0]).abs() - b).abs() < tol
+                        && ((p[1] - o[1]).abs() - b).abs() < tol
+                        && (p[2] - o[2] - k as f64 * height).abs() < tol,
+                    "{tag}, {}: {p:?}",
+                    interface.name
+                );
+            }
+        }
+        for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
+            let l = lambda(&a.model, d);
+            let expected = 2.0 * b / (3.0 * height);
             assert!(
-                (p[0].abs() - b).abs() < 1e-12
-                    && (p[1].abs() - b).abs() < 1e-12
-                    && (p[2] - k as f64 * height).abs() < 1e-12,
-                "{}: {p:?}",
-                interface.name
+                (l - expected).abs() < 1e3 * tol,
+                "{tag}, {d:?}: {l} against {expected}"
             );
         }
-    }
-    for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
-        let l = lambda(&a.model, d);
-        let expected = 2.0 * b / (3.0 * height);
-        assert!((l - expected).abs() < 1e-9, "{d:?}: {l} against {expected}");
     }
 }
 
@@ -1031,6 +1053,22 @@ fn fixed_blocks_beside_over_and_overlapping_free_ones() {
         side.normal
     );
     assert!(side.corners.iter().all(|p| p.x.abs() < 1e-12));
+
+    // A block under a fixed roof and on nothing else hangs: refused, naming it.
+    let hanging = "name = \"hanging\"\nfixed = [\"roof\"]\n".to_string()
+        + &body("roof", [0.0, 0.0, 2.25], [3.0, 1.0, 0.5])
+        + &body("block", [0.0, 0.0, 1.5], [0.4, 0.4, 1.0]);
+    let err = built(
+        "fixed_hanging",
+        &hanging,
+        &AssemblyOptions::default().with_all_contacts(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("body \"block\": hangs: every contact of it pushes it down"),
+        "{err}"
+    );
 
     // The step of the stepped site as two overlapping fixed boxes (x from 0.5 to 1.5).
     let site = "name = \"overlapping\"\nfixed = [\"step_a\", \"step_b\"]\n".to_string()

@@ -415,6 +415,28 @@ pub fn detect_contacts(
             }
         }
     }
+    // A block whose every contact pushes it down hangs: nothing can hold it up.
+    for (b, body) in bodies.iter().enumerate().filter(|&(b, _)| !is_fixed(b)) {
+        let mut into = contacts.iter().filter(|c| counts(c)).filter_map(|c| {
+            if c.upper == b {
+                Some(c.normal.z)
+            } else if c.lower == Some(b) {
+                Some(-c.normal.z)
+            } else {
+                None
+            }
+        });
+        if let Some(first) = into.next()
+            && first < -1e-9
+            && into.all(|z| z < -1e-9)
+        {
+            return Err(error(
+                format!("body \"{}\"", body.name),
+                "hangs: every contact of it pushes it down (it lies under its supports), and \
+                 nothing holds it up",
+            ));
+        }
+    }
     Ok(contacts)
 }
 
@@ -458,7 +480,8 @@ fn ground_hint(
         .map(|(lo, _)| lo.z)
         .fold(f64::INFINITY, f64::min);
     if lowest.is_finite() && lowest > ground_near + tolerance {
-        let lowest = lowest + reference_z;
+        // To the micrometre, in the shortest form (1.8, not 1.7999999999999998).
+        let lowest = ((lowest + reference_z) * 1e6).round() / 1e6;
         format!(
             "; no block reaches down to the ground: the lowest stands at z = {lowest:.6} m, and \
              where the ground is there, give its level (`crr assemble --ground-level {lowest}`)"
@@ -868,9 +891,9 @@ pub fn is_rectangle(corners: &[Vector3<f64>], tolerance: f64) -> bool {
 /// c + s(±W/2, ±H/2) (W × H the bounding box in (u, v), c the centroid) lies in the face where
 /// every corner satisfies every edge's half-plane a·p ≤ b, the worst corner
 /// a·c + s(|a_u| W/2 + |a_v| H/2) ≤ b: s is the least (b − a·c)/(|a_u| W/2 + |a_v| H/2) over the
-/// edges, in closed form. For a centrally symmetric face (a regular polygon, the drums of a
-/// column) it is the largest rectangle of any proportions along u and v that fits; a regular
-/// 16-gon of radius R with a vertex on u gives the square of half-side R cos 45°. A subset of
+/// edges, in closed form (not the largest rectangle of any proportions: a regular hexagon with a
+/// vertex on u holds a larger one than its bounding box's shape); a regular 16-gon of radius R
+/// with a vertex on u gives the square of half-side R cos 45°. A subset of
 /// the face carries a subset of its contact forces, so multipliers computed on it are lower
 /// bounds of the whole face's (the static theorem).
 pub fn inscribed_rectangle(face: &ContactFace) -> ContactFace {
@@ -881,8 +904,14 @@ pub fn inscribed_rectangle(face: &ContactFace) -> ContactFace {
         Vector3::z().cross(&n).normalize()
     };
     let v = n.cross(&u);
-    let h = n.dot(&face.corners[0]);
-    let p: Vec<[f64; 2]> = face.corners.iter().map(|c| [u.dot(c), v.dot(c)]).collect();
+    // Relative to a corner: a face in survey coordinates keeps its precision (its centroid's
+    // shoelace sums of absolute coordinates lost it: a drum bed 1e5 m away shrank to a third).
+    let origin = face.corners[0];
+    let p: Vec<[f64; 2]> = face
+        .corners
+        .iter()
+        .map(|c| [u.dot(&(c - origin)), v.dot(&(c - origin))])
+        .collect();
     let count = p.len();
     // Area centroid of the polygon (corners counter-clockwise about n, so about (u, v)).
     let (mut area2, mut cu, mut cv) = (0.0, 0.0, 0.0);
@@ -918,7 +947,7 @@ pub fn inscribed_rectangle(face: &ContactFace) -> ContactFace {
     let (w, hh) = (scale * half_w, scale * half_h);
     let corners = [[-w, -hh], [w, -hh], [w, hh], [-w, hh]]
         .iter()
-        .map(|d| n * h + u * (c[0] + d[0]) + v * (c[1] + d[1]))
+        .map(|d| origin + u * (c[0] + d[0]) + v * (c[1] + d[1]))
         .collect();
     ContactFace {
         corners,
