@@ -494,6 +494,14 @@ fn the_bundled_assemblies_go_from_stones_to_a_simulation() {
     }
 }
 
+/// A `[[body]]` table of an assembly: a box of 2000 kg/m³ centred at `centre` (m) of `size` (m).
+fn box_body(name: &str, centre: [f64; 3], size: [f64; 3]) -> String {
+    format!(
+        "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
+         size = {size:?} }}\n"
+    )
+}
+
 /// The OBJ text of a box [lo, hi] as object `name`, its vertices numbered from `first` (OBJ
 /// indices are global to the file): six quadrilaterals, counter-clockwise seen from outside;
 /// `skip` leaves one face out.
@@ -769,17 +777,11 @@ fn an_arch_on_fixed_abutments_is_the_arch_on_the_ground_raised() {
 /// block; a model file with `fixed` given to `crr simulate`.
 #[test]
 fn blocks_on_a_fixed_step_rock_on_the_ground_it_makes() {
-    let body = |name: &str, centre: [f64; 3], size: [f64; 3]| {
-        format!(
-            "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
-             size = {size:?} }}\n"
-        )
-    };
     let site = |fixed: &str, extra: &str| {
         format!("name = \"stepped\"\nfixed = [{fixed}]\n")
-            + &body("low", [-1.0, 0.0, 0.5], [0.4, 0.4, 1.0])
-            + &body("step", [1.0, 0.0, 0.1], [1.0, 1.0, 0.8])
-            + &body("high", [1.0, 0.0, 1.25], [0.3, 0.3, 1.5])
+            + &box_body("low", [-1.0, 0.0, 0.5], [0.4, 0.4, 1.0])
+            + &box_body("step", [1.0, 0.0, 0.1], [1.0, 1.0, 0.8])
+            + &box_body("high", [1.0, 0.0, 1.25], [0.3, 0.3, 1.5])
             + extra
     };
     let path = common::write_model("stepped_site", &site("\"step\"", ""));
@@ -839,18 +841,12 @@ fn blocks_on_a_fixed_step_rock_on_the_ground_it_makes() {
 /// with every contact an interface, a ground joint on each.
 #[test]
 fn a_block_on_two_fixed_slabs_rocks_on_the_hull_of_its_faces() {
-    let body = |name: &str, centre: [f64; 3], size: [f64; 3]| {
-        format!(
-            "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
-             size = {size:?} }}\n"
-        )
-    };
     let site = |gap: f64| {
         let w = 1.0 - gap / 2.0;
         "name = \"slabs\"\nfixed = [\"west\", \"east\"]\n".to_string()
-            + &body("west", [-0.5 - gap / 4.0, 0.0, 0.1], [w, 2.0, 0.2])
-            + &body("east", [0.5 + gap / 4.0, 0.0, 0.1], [w, 2.0, 0.2])
-            + &body("block", [0.0, 0.0, 0.7], [0.4, 0.4, 1.0])
+            + &box_body("west", [-0.5 - gap / 4.0, 0.0, 0.1], [w, 2.0, 0.2])
+            + &box_body("east", [0.5 + gap / 4.0, 0.0, 0.1], [w, 2.0, 0.2])
+            + &box_body("block", [0.0, 0.0, 0.7], [0.4, 0.4, 1.0])
     };
     for gap in [0.0, 0.1] {
         let path = common::write_model(&format!("slabs_gap_{gap}"), &site(gap));
@@ -889,9 +885,9 @@ fn a_block_on_two_fixed_slabs_rocks_on_the_hull_of_its_faces() {
     // 0.1 m higher. With every contact an interface it meets the ground on two faces in two
     // planes: two ground joints, the side's normal −x, out of the east slab.
     let text = "name = \"step\"\nfixed = [\"west\", \"east\"]\n".to_string()
-        + &body("west", [-0.5, 0.0, 0.1], [1.0, 2.0, 0.2])
-        + &body("east", [0.5, 0.0, 0.15], [1.0, 2.0, 0.3])
-        + &body("block", [-0.2, 0.0, 0.7], [0.4, 0.4, 1.0]);
+        + &box_body("west", [-0.5, 0.0, 0.1], [1.0, 2.0, 0.2])
+        + &box_body("east", [0.5, 0.0, 0.15], [1.0, 2.0, 0.3])
+        + &box_body("block", [-0.2, 0.0, 0.7], [0.4, 0.4, 1.0]);
     let path = common::write_model("slabs_step", &text);
     let a = assemble(
         &path,
@@ -1004,19 +1000,13 @@ fn a_column_of_drums_rocks_on_the_squares_inscribed_in_its_beds() {
 ///   the free blocks stand, not a fixed footing below the ground.
 #[test]
 fn fixed_blocks_beside_over_and_overlapping_free_ones() {
-    let body = |name: &str, centre: [f64; 3], size: [f64; 3]| {
-        format!(
-            "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
-             size = {size:?} }}\n"
-        )
-    };
     let built = |tag: &str, text: &str, options: &AssemblyOptions| {
         let path = common::write_model(tag, text);
         assemble(&path, &read_assembly(&path).unwrap(), options)
     };
     let clamped = "name = \"clamped\"\nfixed = [\"beam\"]\n".to_string()
-        + &body("column", [0.0, 0.0, 1.0], [0.4, 0.4, 2.0])
-        + &body("beam", [0.0, 0.0, 2.25], [3.0, 1.0, 0.5]);
+        + &box_body("column", [0.0, 0.0, 1.0], [0.4, 0.4, 2.0])
+        + &box_body("beam", [0.0, 0.0, 2.25], [3.0, 1.0, 0.5]);
     let a = built("fixed_clamped", &clamped, &AssemblyOptions::default()).unwrap();
     let names: Vec<&str> = a.file.interface.iter().map(|i| i.name.as_str()).collect();
     assert_eq!(names, ["column_on_ground", "column_on_ground_2"]);
@@ -1036,8 +1026,8 @@ fn fixed_blocks_beside_over_and_overlapping_free_ones() {
     }
 
     let infill = "name = \"infill\"\nfixed = [\"pier\"]\n".to_string()
-        + &body("pier", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0])
-        + &body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]);
+        + &box_body("pier", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0])
+        + &box_body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]);
     let a = built(
         "fixed_infill",
         &infill,
@@ -1056,8 +1046,8 @@ fn fixed_blocks_beside_over_and_overlapping_free_ones() {
 
     // A block under a fixed roof and on nothing else hangs: refused, naming it.
     let hanging = "name = \"hanging\"\nfixed = [\"roof\"]\n".to_string()
-        + &body("roof", [0.0, 0.0, 2.25], [3.0, 1.0, 0.5])
-        + &body("block", [0.0, 0.0, 1.5], [0.4, 0.4, 1.0]);
+        + &box_body("roof", [0.0, 0.0, 2.25], [3.0, 1.0, 0.5])
+        + &box_body("block", [0.0, 0.0, 1.5], [0.4, 0.4, 1.0]);
     let err = built(
         "fixed_hanging",
         &hanging,
@@ -1072,10 +1062,10 @@ fn fixed_blocks_beside_over_and_overlapping_free_ones() {
 
     // The step of the stepped site as two overlapping fixed boxes (x from 0.5 to 1.5).
     let site = "name = \"overlapping\"\nfixed = [\"step_a\", \"step_b\"]\n".to_string()
-        + &body("low", [-1.0, 0.0, 0.5], [0.4, 0.4, 1.0])
-        + &body("step_a", [0.8, 0.0, 0.1], [0.6, 1.0, 0.8])
-        + &body("step_b", [1.2, 0.0, 0.1], [0.6, 1.0, 0.8])
-        + &body("high", [1.0, 0.0, 1.25], [0.3, 0.3, 1.5]);
+        + &box_body("low", [-1.0, 0.0, 0.5], [0.4, 0.4, 1.0])
+        + &box_body("step_a", [0.8, 0.0, 0.1], [0.6, 1.0, 0.8])
+        + &box_body("step_b", [1.2, 0.0, 0.1], [0.6, 1.0, 0.8])
+        + &box_body("high", [1.0, 0.0, 1.25], [0.3, 0.3, 1.5]);
     let a = built("fixed_overlapping", &site, &AssemblyOptions::default()).unwrap();
     assert_eq!(a.file.body.len(), 2);
     for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
@@ -1095,9 +1085,9 @@ fn fixed_blocks_beside_over_and_overlapping_free_ones() {
 
     // A footing fixed below the ground and two blocks 350 m up, one on the footing.
     let survey = "name = \"footing\"\nfixed = [\"footing\"]\n".to_string()
-        + &body("footing", [0.0, 0.0, 349.0], [1.0, 1.0, 2.0])
-        + &body("on_footing", [0.0, 0.0, 350.5], [0.4, 0.4, 1.0])
-        + &body("on_ground", [3.0, 0.0, 350.5], [0.4, 0.4, 1.0]);
+        + &box_body("footing", [0.0, 0.0, 349.0], [1.0, 1.0, 2.0])
+        + &box_body("on_footing", [0.0, 0.0, 350.5], [0.4, 0.4, 1.0])
+        + &box_body("on_ground", [3.0, 0.0, 350.5], [0.4, 0.4, 1.0]);
     let err = built("fixed_footing", &survey, &AssemblyOptions::default())
         .unwrap_err()
         .to_string();

@@ -372,14 +372,15 @@ pub fn detect_contacts(
         // Two blocks meet on one face (convex blocks do); a block may meet the ground (its
         // plane and the fixed blocks) on faces in several planes: interfaces `…_on_ground`,
         // `…_on_ground_2`.
-        if c.lower.is_some() && counts(c) && contacts[..k].iter().any(|d| counts(d) && same_pair(d))
+        if let Some(lower) = c.lower
+            && counts(c)
+            && contacts[..k].iter().any(|d| counts(d) && same_pair(d))
         {
-            let lower = c.lower.map_or("the ground", |b| bodies[b].name.as_str());
-            let lower = format!("\"{lower}\"");
+            let lower = &bodies[lower].name;
             return Err(error(
                 format!("body \"{}\"", bodies[c.upper].name),
                 format!(
-                    "meets {lower} on more than one face, whose convex hull is no rectangle \
+                    "meets \"{lower}\" on more than one face, whose convex hull is no rectangle \
                      (a face split in pieces): crr assemble makes one interface per pair of \
                      blocks and needs one face between them"
                 ),
@@ -872,8 +873,6 @@ fn convex_hull_2d(points: &mut [[f64; 2]]) -> Vec<[f64; 2]> {
 
 /// Whether four corners in order make a rectangle (each corner's two edges at right angles,
 /// within `tolerance` times the edges' lengths).
-/// Whether the corners (in order around a face) form a rectangle: four corners, each a right
-/// angle to within the tolerance (m) over its edges' lengths.
 pub fn is_rectangle(corners: &[Vector3<f64>], tolerance: f64) -> bool {
     corners.len() == 4
         && (0..4).all(|i| {
