@@ -425,9 +425,16 @@ pub fn to_text(r: &CheckReport) -> String {
                             lifting.join(", ")
                         );
                     }
-                    if let Some(convex) = m.convex_lambda {
+                    if m.from_sliding_search {
+                        let without = match m.convex_lambda {
+                            Some(convex) => format!("λ = {convex:.6}"),
+                            None => format!(
+                                "it holds up to λ = {}",
+                                crate::analysis::static_multiplier::LAMBDA_MAX
+                            ),
+                        };
                         s += &format!(
-                            "    found by the search for joints that open and slide (without them λ = {convex:.6}): the structure does not hold beyond this λ, but the search is not exhaustive and a lower mechanism may exist (docs/simulation.md, \"Joints that open may slide\")\n"
+                            "    found by the search for joints that open and slide (without them {without}): the structure does not hold beyond this λ, but the search is not exhaustive and a lower mechanism may exist (docs/simulation.md, \"Joints that open may slide\")\n"
                         );
                     }
                     let sliding = with(crr_impact::statics::Motion::Slides);

@@ -19,9 +19,13 @@
 //! direction gives the mirrored hinges: the arch's domains are symmetric).
 //!
 //! The merged model has the same multiplier as the model of every contact along each direction
-//! asked for: merging adds rigidity only where the mechanism has none (so its mechanism is still
-//! admissible, λ_merged ≤ λ_all), and a merged model's mechanism is one of the full model's
-//! (λ_merged ≥ λ_all). `tests/cli/mechanism.rs` checks it on every bundled assembly.
+//! asked for, by the program without sliding: merging adds rigidity only where the mechanism has
+//! none (so its mechanism is still admissible, λ_merged ≤ λ_all), and a merged model's mechanism
+//! is one of the full model's (λ_merged ≥ λ_all). `tests/cli/mechanism.rs` checks it on every
+//! bundled assembly. Where the search for joints that open and slide finds a lower λ (a block
+//! lifting off one support while sliding over another), the interfaces its mechanism moves are
+//! hinges as well, so that mechanism with its equilibrium is one of the merged model's too; the
+//! merged model's own search is not exhaustive and may answer another.
 
 use std::path::Path;
 
@@ -47,10 +51,17 @@ pub struct DirectionCollapse {
     pub direction: [f64; 3],
     /// λ (in g); `None` when the assembly holds up to the statics' λ_max.
     pub lambda: Option<f64>,
-    /// The interfaces of the model of every contact that move in the mechanism (`UPPER_on_LOWER`).
+    /// The interfaces of the model of every contact that move in the mechanism (`UPPER_on_LOWER`),
+    /// and, where `lambda` comes from the search for joints that open and slide, those that move
+    /// in the mechanism of the program without sliding too.
     pub hinges: Vec<String>,
     /// Whether the mechanism lifts a block off a support (outside the CRR chain).
     pub lifts_off: bool,
+    /// Whether `lambda` comes from the search for joints that open and slide
+    /// ([`crr_impact::statics::Collapse::from_sliding_search`]), below `convex_lambda`.
+    pub from_sliding_search: bool,
+    /// The program without sliding's λ (`None`: it holds up to λ_max); the merged model keeps it.
+    pub convex_lambda: Option<f64>,
 }
 
 /// One rigid domain: a body of the merged model and the blocks it is made of.
@@ -135,19 +146,42 @@ pub fn mechanism_model(
 }
 
 /// The collapse of `model` along `direction` and the interfaces that move in it.
+/// Where the search for joints that open and slide lowers λ, the mechanism of the program
+/// without sliding is read as well and its moving interfaces are hinges too: the merged model
+/// then keeps that program's λ exactly (see the module's docs), and the sliding mechanism's
+/// blocks stay separate.
 fn collapse_along(model: &Model, direction: Vector3<f64>) -> Result<DirectionCollapse, String> {
     let c = collapse_multiplier(model, direction, &StaticsOptions::default())
         .map_err(|e| e.to_string())?;
+    let moving = |c: &crr_impact::statics::Collapse| -> Vec<usize> {
+        c.interfaces
+            .iter()
+            .filter(|i| i.motion != Motion::Closed)
+            .map(|i| i.interface)
+            .collect()
+    };
+    let mut hinges = moving(&c);
+    if c.from_sliding_search() {
+        let without_sliding = StaticsOptions {
+            sliding_lift_off: false,
+            ..StaticsOptions::default()
+        };
+        let convex =
+            collapse_multiplier(model, direction, &without_sliding).map_err(|e| e.to_string())?;
+        hinges.extend(moving(&convex));
+        hinges.sort_unstable();
+        hinges.dedup();
+    }
     Ok(DirectionCollapse {
         direction: c.direction,
         lambda: c.lambda,
-        hinges: c
-            .interfaces
-            .iter()
-            .filter(|i| i.motion != Motion::Closed)
-            .map(|i| i.name.clone())
+        hinges: hinges
+            .into_iter()
+            .map(|k| model.interfaces[k].name.clone())
             .collect(),
         lifts_off: c.lifting_off().next().is_some(),
+        from_sliding_search: c.from_sliding_search(),
+        convex_lambda: c.convex_lambda,
     })
 }
 

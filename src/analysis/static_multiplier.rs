@@ -75,8 +75,12 @@ pub struct StaticMultiplier {
     /// The convex program's λ, where `lambda` lies below it: `lambda` is then the search's
     /// answer for joints that open and slide, an admissible mechanism (the structure does not
     /// hold beyond it) from a search that is not exhaustive, so a lower one may exist. `None`
-    /// where `lambda` is the convex program's own answer (exact for joints that do not slide).
+    /// where `lambda` is the convex program's own answer (exact for joints that do not slide),
+    /// and where the convex program holds up to the cap (`from_sliding_search` then says).
     pub convex_lambda: Option<f64>,
+    /// Whether `lambda` comes from the search for joints that open and slide, below the convex
+    /// program's answer (`convex_lambda`, or holding up to the cap where that is `None`).
+    pub from_sliding_search: bool,
 }
 
 impl StaticMultiplier {
@@ -131,6 +135,7 @@ pub fn static_multiplier_with(
             out_of_plane: along_axis,
             hinges_out_of_plane: Vec::new(),
             convex_lambda: None,
+            from_sliding_search: false,
         });
     }
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
@@ -299,5 +304,6 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
             .from_sliding_search()
             .then_some(collapse.convex_lambda)
             .flatten(),
+        from_sliding_search: collapse.from_sliding_search(),
     }
 }

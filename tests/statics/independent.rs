@@ -38,24 +38,24 @@ const RTOL: f64 = 1e-7;
 
 /// A linear program: minimise cᵀx subject to rows `eq` (aᵀx = b) and `le` (aᵀx ≤ b), each row a
 /// sparse list of (variable, coefficient) and its right-hand side.
-struct Lp {
-    vars: usize,
-    cost: Vec<f64>,
-    eq: Vec<(Vec<(usize, f64)>, f64)>,
-    le: Vec<(Vec<(usize, f64)>, f64)>,
+pub(crate) struct Lp {
+    pub(crate) vars: usize,
+    pub(crate) cost: Vec<f64>,
+    pub(crate) eq: Vec<(Vec<(usize, f64)>, f64)>,
+    pub(crate) le: Vec<(Vec<(usize, f64)>, f64)>,
 }
 
 /// The optimum of an [`Lp`]: x, the multipliers of the equality rows, and clarabel's primal and
 /// dual objectives.
-struct LpSolution {
-    x: Vec<f64>,
+pub(crate) struct LpSolution {
+    pub(crate) x: Vec<f64>,
     y_eq: Vec<f64>,
     primal: f64,
     dual: f64,
 }
 
 impl Lp {
-    fn new(vars: usize) -> Lp {
+    pub(crate) fn new(vars: usize) -> Lp {
         Lp {
             vars,
             cost: vec![0.0; vars],
@@ -65,7 +65,7 @@ impl Lp {
     }
 
     /// Solves it; Err with clarabel's status when it is not `Solved`.
-    fn solve(&self) -> Result<LpSolution, SolverStatus> {
+    pub(crate) fn solve(&self) -> Result<LpSolution, SolverStatus> {
         let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
         let mut b = Vec::new();
         for (r, (row, rhs)) in self.eq.iter().chain(self.le.iter()).enumerate() {

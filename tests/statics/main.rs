@@ -5,6 +5,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod collapse_state;
 mod duality;
 mod friction;
 mod independent;

@@ -213,17 +213,24 @@ pub struct Collapse {
     /// Virtual velocities of the bodies in the mechanism, scaled so that the largest of |v| and
     /// size·|ω| over the bodies is 1 (all zero when it holds).
     pub bodies: Vec<BodyMotion>,
-    /// The convex program's λ (no joint freed to slide where it opens). Where `lambda` lies
-    /// below it, `lambda` is the search's answer for joints that open and slide: an admissible
-    /// mechanism with an equilibrium at its λ, so the structure does not hold beyond it, but
-    /// the search is not exhaustive and a lower one may exist ([`collapse_multiplier`]).
+    /// The convex program's λ (no joint freed to slide where it opens; `None` where it holds up
+    /// to `lambda_max`). Where `lambda` lies below it ([`Collapse::from_sliding_search`]),
+    /// `lambda` is the search's answer for joints that open and slide: an admissible mechanism
+    /// with an equilibrium at its λ on the points it keeps in contact, so the structure does not
+    /// hold beyond it, but the search is not exhaustive and a lower one may exist
+    /// ([`collapse_multiplier`]).
     pub convex_lambda: Option<f64>,
 }
 
 impl Collapse {
-    /// Whether λ comes from the search for joints that open and slide (below the convex answer).
+    /// Whether λ comes from the search for joints that open and slide (below the convex answer,
+    /// or where the convex program holds up to the cap).
     pub fn from_sliding_search(&self) -> bool {
-        matches!((self.lambda, self.convex_lambda), (Some(l), Some(c)) if l < c)
+        match (self.lambda, self.convex_lambda) {
+            (Some(l), Some(c)) => l < c,
+            (Some(_), None) => true,
+            (None, _) => false,
+        }
     }
 
     /// The interfaces that lift off in the mechanism.
@@ -267,7 +274,7 @@ pub fn collapse_multiplier(
     }
     let faces = contact_faces(model);
     let mut free = vec![false; faces.len()];
-    let convex = solve_program(model, &faces, d, options, &free)?;
+    let convex = solve_program(model, &faces, d, options, &free, &[])?;
     if !options.sliding_lift_off || options.friction != Friction::NoSliding {
         return Ok(convex);
     }
@@ -309,7 +316,7 @@ pub fn hinges_out_of_plane(
     let d = unit_direction(direction)?;
     let faces = contact_faces(model);
     let free = vec![false; faces.len()];
-    let program = Program::build(model, &faces, d, options, &free);
+    let program = Program::build(model, &faces, d, options, &free, &[]);
     let columns: Vec<usize> = program
         .unknowns
         .iter()
@@ -360,15 +367,16 @@ pub fn hinges_out_of_plane(
 }
 
 /// One program: `free` marks the interfaces whose points carry normal forces only (they may
-/// slide where they separate).
+/// slide where they separate); the points `unloaded` ((interface, point)) carry no force at all.
 fn solve_program(
     model: &Model,
     faces: &[ContactFace],
     d: Vector3<f64>,
     options: &StaticsOptions,
     free: &[bool],
+    unloaded: &[(usize, usize)],
 ) -> Result<Collapse, StaticsError> {
-    let program = Program::build(model, faces, d, options, free);
+    let program = Program::build(model, faces, d, options, free, unloaded);
     let solution = program.solve()?;
     let lambda = solution.x[0];
     if lambda < -1e-9 {
@@ -393,10 +401,13 @@ fn solve_program(
 /// This freedom (non-associated: the separated joint's slip does no work against friction) makes
 /// the problem non-convex. Its mechanisms are admissible in the convex program with a finite
 /// friction μ wherever their separation exceeds μ times their slip, so probes with
-/// μ = 2, 1, 0.5, 0.25 find candidates: the interfaces that separate and slide in a probe's
-/// mechanism are freed (normal forces only) and the program without sliding is solved again. A
-/// candidate is kept when its λ is lower and its mechanism is physical: every freed interface
-/// either separates at all its points or does not slide (a compressed joint cannot slide). Each
+/// μ = 2, 1, 0.5, 0.25 find candidates: the interfaces that separate at every point in a
+/// probe's mechanism are freed (normal forces only) and the program without sliding is solved
+/// again. A candidate is kept when its λ is lower and its mechanism is physical: every point of
+/// a freed interface that slides either separates or carries no force in an equilibrium at that
+/// λ (a compressed point cannot slide; see [`physical`]). The search also runs where the convex
+/// program holds up to the cap: a block against a pier, turning about its far foot, slides up
+/// the pier at its lowest edge while the rest of that face opens, and overturns at b/h. Each
 /// probe's interfaces are tried freed together, each of the probes' interfaces alone and, where
 /// none of those lowers λ, each pair of them; the lowest physical candidate is kept. Rounds
 /// repeat until no probe lowers λ. Every answer kept is an admissible mechanism with an
@@ -410,9 +421,11 @@ fn sliding_lift_offs(
     free: &mut Vec<bool>,
     convex: Collapse,
 ) -> Result<Collapse, StaticsError> {
-    let Some(mut best_lambda) = convex.lambda else {
-        return Ok(convex);
-    };
+    // Where the convex program holds up to the cap, a sliding mechanism may still open below
+    // it: a block standing against a pier, turning about its far foot, slides up the pier at
+    // its lowest edge (which the program without sliding forbids) while the rest of that face
+    // opens, and overturns at b/h.
+    let mut best_lambda = convex.lambda.unwrap_or(options.lambda_max);
     let convex_lambda = convex.lambda;
     let mut best = convex;
     for _ in 0..LIFT_OFF_ROUNDS {
@@ -454,8 +467,9 @@ fn sliding_lift_offs(
 }
 
 /// The probes with friction that lower λ below `best_lambda`, each as the interfaces its
-/// mechanism separates at all their points while sliding (not yet freed, not pins; empty sets
-/// left out). λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a
+/// mechanism separates at all their points (not yet freed, not pins; empty sets left out): a
+/// probe's friction makes every point that slides separate too (its flow is associated), so a
+/// face that, freed, slides at a point it keeps contact at is among them. λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a
 /// smaller one, with the same freed interfaces, so where the smallest probe does not lower λ,
 /// none does, and one program answers for the four.
 fn lowering_probes(
@@ -481,6 +495,7 @@ fn lowering_probes(
         d,
         &probe_options(smallest_mu),
         free,
+        &[],
     ));
     if let Some(Ok(probe)) = &smallest
         && !lowers(probe)
@@ -491,7 +506,7 @@ fn lowering_probes(
     for mu in PROBE_FRICTION {
         let probe = match smallest.take_if(|_| mu == smallest_mu) {
             Some(probe) => probe,
-            None => solve_program(model, faces, d, &probe_options(mu), free),
+            None => solve_program(model, faces, d, &probe_options(mu), free, &[]),
         };
         let Ok(probe) = probe else {
             continue;
@@ -504,7 +519,6 @@ fn lowering_probes(
             .iter()
             .filter(|i| {
                 i.gap_rates.iter().all(|&g| g > MECHANISM_TOLERANCE)
-                    && i.slip_rate > MECHANISM_TOLERANCE
                     && !free[i.interface]
                     && !faces[i.interface].pin
             })
@@ -535,27 +549,103 @@ fn lowest_physical(
         for &i in set {
             trial[i] = true;
         }
-        let Ok(candidate) = solve_program(model, faces, d, options, &trial) else {
+        let Ok(candidate) = solve_program(model, faces, d, options, &trial, &[]) else {
             continue;
         };
         let Some(lambda) = candidate.lambda else {
             continue;
         };
         let lowest = found.as_ref().map_or(best_lambda, |f| f.0);
-        if lambda < lowest * (1.0 - 1e-9) && physical(&candidate, &trial) {
-            found = Some((lambda, candidate, trial));
+        let lowers = lambda < lowest * (1.0 - 1e-9);
+        if !lowers {
+            continue;
+        }
+        if let Some(physical) = physical(model, faces, d, options, &trial, candidate) {
+            found = Some((lambda, physical, trial));
         }
     }
     found
 }
 
-/// Whether every freed interface of a mechanism separates at all its points or does not slide.
-fn physical(collapse: &Collapse, free: &[bool]) -> bool {
-    collapse.interfaces.iter().all(|i| {
-        !free[i.interface]
-            || i.slip_rate <= MECHANISM_TOLERANCE
-            || i.gap_rates.iter().all(|&g| g > MECHANISM_TOLERANCE)
-    })
+/// Relative loss of λ within which the points that separate or slide count as unloaded at the
+/// multiplier (the solver's gaps are 1e-12; its λ agrees to about
+/// 1e-10).
+const UNLOADED_TOLERANCE: f64 = 1e-8;
+
+/// `collapse` (the program's answer with the interfaces `free` freed) as a physical collapse,
+/// or None. The program without sliding lets a contact carry shear with no compression, so its
+/// forces may put shear across a joint that opens, and a freed joint may slide at a point that
+/// keeps contact. A physical collapse has an equilibrium at λ with forces only where the
+/// mechanism keeps contact without sliding (a point that separates carries nothing, and so does
+/// one that slides: a compressed point cannot). The program with every other point unloaded
+/// (pins aside) is solved: where it reaches the same λ, its forces and the mechanism are a
+/// primal and a dual optimum of the same program (its feasible set holds the unloaded
+/// program's), so they are complementary, and its forces are reported with the mechanism.
+/// Without that check, the façade of the bundled assemblies answered 1.000484 along +x from a
+/// mechanism whose equilibrium relied on shear across opened joints (none exists on the points
+/// that hold: `tests/statics/collapse_state.rs`).
+fn physical(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    free: &[bool],
+    collapse: Collapse,
+) -> Option<Collapse> {
+    let lambda = collapse.lambda?;
+    let mut unloaded = Vec::new();
+    for i in &collapse.interfaces {
+        let face = &faces[i.interface];
+        if face.pin {
+            continue;
+        }
+        let slips = point_slips(model, face, &collapse.bodies);
+        for (p, (&gap, slip)) in i.gap_rates.iter().zip(slips).enumerate() {
+            if gap > MECHANISM_TOLERANCE || slip > MECHANISM_TOLERANCE {
+                unloaded.push((i.interface, p));
+            }
+        }
+    }
+    if unloaded.is_empty() {
+        return Some(collapse);
+    }
+    let spared = solve_program(model, faces, d, options, free, &unloaded).ok()?;
+    if !spared
+        .lambda
+        .is_some_and(|l| l >= lambda * (1.0 - UNLOADED_TOLERANCE))
+    {
+        return None;
+    }
+    let mut collapse = collapse;
+    for (kept, spared) in collapse.interfaces.iter_mut().zip(spared.interfaces) {
+        kept.forces = spared.forces;
+    }
+    Some(collapse)
+}
+
+/// The tangential slip rate of each point of `face` in the mechanism `bodies` (child relative
+/// to parent, in the face's friction tangents).
+fn point_slips(model: &Model, face: &ContactFace, bodies: &[BodyMotion]) -> Vec<f64> {
+    let interface = &model.interfaces[face.interface];
+    let velocity = |of: Parent, x: &Vector3<f64>| match of {
+        Parent::Ground => Vector3::zeros(),
+        Parent::Body(n) => {
+            let b = &bodies[n];
+            Vector3::from(b.velocity) + Vector3::from(b.angular).cross(&(x - model.bodies[n].com))
+        }
+    };
+    face.points
+        .iter()
+        .map(|x| {
+            let relative =
+                velocity(Parent::Body(interface.child), x) - velocity(interface.parent, x);
+            face.tangents[..face.friction_tangents]
+                .iter()
+                .map(|t| t.dot(&relative).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .collect()
 }
 
 /// The smallest Coulomb friction coefficient (pyramid on each tangent, exact for planar loads)
@@ -645,6 +735,7 @@ impl Program {
         d: Vector3<f64>,
         options: &StaticsOptions,
         free: &[bool],
+        unloaded: &[(usize, usize)],
     ) -> Program {
         let mut unknowns = Vec::new();
         let mut point_columns = Vec::with_capacity(faces.len());
@@ -687,7 +778,7 @@ impl Program {
             weight,
         };
         program.equilibrium_rows(model, faces, d, total_mass, size);
-        program.free_rows(faces, free);
+        program.free_rows(faces, free, unloaded);
         program.inequality_rows(faces, options);
         program
     }
@@ -752,17 +843,24 @@ impl Program {
         self.cones.push(SupportedConeT::ZeroConeT(6 * bodies));
     }
 
-    /// The tangential forces of the freed interfaces' points are zero (another zero cone).
-    fn free_rows(&mut self, faces: &[ContactFace], free: &[bool]) {
+    /// The tangential forces of the freed interfaces' points and every force (normal, both
+    /// tangents) of the unloaded points are zero (another zero cone; pins are not unloaded).
+    fn free_rows(&mut self, faces: &[ContactFace], free: &[bool], unloaded: &[(usize, usize)]) {
         let first = self.rows;
         let mut row = first;
         for (face, columns) in faces.iter().zip(self.point_columns.clone()) {
-            if !free[face.interface] || face.pin {
+            if face.pin {
                 continue;
             }
-            for [_, t1, t2] in columns {
-                for &t in &[t1, t2][..face.friction_tangents] {
-                    self.push(row, t, 1.0);
+            let freed = free[face.interface];
+            for (p, [n, t1, t2]) in columns.into_iter().enumerate() {
+                let zero: &[usize] = match (unloaded.contains(&(face.interface, p)), freed) {
+                    (true, _) => &[n, t1, t2],
+                    (false, true) => &[t1, t2][..face.friction_tangents],
+                    (false, false) => &[],
+                };
+                for &column in zero {
+                    self.push(row, column, 1.0);
                     row += 1;
                 }
             }

@@ -1,0 +1,317 @@
+//! Collapses with joints that open and slide, certified as collapse states from first principles.
+//!
+//! Where a block turns about one support while it slides over another with no force on it (a
+//! block against a pier turning about its far foot slides up the pier at its lowest edge; a wall's
+//! end half block turning about its outer foot slides up its head joint), the program without
+//! sliding cannot answer, and `statics::collapse_multiplier` searches for such mechanisms. Its
+//! answer is not a bound by the static theorem (the sliding is not associated with friction), so
+//! it is checked here as what it claims to be, a collapse state, without the statics' program:
+//!
+//! - **equilibrium**: the point forces it reports at λ, put together from the model's own corners
+//!   and normals (`InterfaceKind`), balance every body's weight and the load −λ m g d (forces and
+//!   moments about its centre of mass; in a planar model the in-plane rows, the hinges carrying
+//!   the rest bilaterally);
+//! - **admissible forces**: no tension; a point that separates or slides carries no normal force
+//!   (a compressed point cannot slide); a face's shear, wherever the program puts it, must be
+//!   carried where the face keeps contact without sliding: anything at two such points or more,
+//!   no torsion about the normal at a single one (a corner pivot), nothing where there is none
+//!   (a joint that opens or slides everywhere carries nothing);
+//! - **admissible mechanism**: from the bodies' virtual velocities alone, no point penetrates and
+//!   a hinge that keeps contact turns about its axis only;
+//! - **work**: the load's virtual power balances the weight's, λ_kin = −Σ mᵢ ẑ·vᵢ / Σ mᵢ d·vᵢ = λ.
+//!
+//! Together these say that the structure, at λ, has an equilibrium and a motion consistent with
+//! it: it does not hold beyond λ. Tolerances: the mechanism is scaled to unit speed and the
+//! solver's gaps are 1e-12 of the weight W, so rates are zero to 1e-7, forces to 1e-6 W, moments
+//! to 1e-6 W·L, and λ_kin = λ to 1e-7 relative.
+use std::path::Path;
+
+use nalgebra::Vector3;
+
+use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+use crr::impact::statics::{Collapse, StaticsOptions, collapse_multiplier};
+use crr::kinematics::{InterfaceKind, Model, Parent};
+
+use crate::common;
+use crate::independent::Lp;
+
+/// A body's virtual velocity (v at the centre of mass, ω).
+type Velocity = (Vector3<f64>, Vector3<f64>);
+
+fn point_velocity(
+    model: &Model,
+    bodies: &[Velocity],
+    of: Parent,
+    x: &Vector3<f64>,
+) -> Vector3<f64> {
+    match of {
+        Parent::Ground => Vector3::zeros(),
+        Parent::Body(n) => bodies[n].0 + bodies[n].1.cross(&(x - model.bodies[n].com)),
+    }
+}
+
+/// The contact points and the normal (into the child) of interface `k`, from the model alone.
+fn points_and_normal(model: &Model, k: usize) -> (Vec<Vector3<f64>>, Vector3<f64>) {
+    match &model.interfaces[k].kind {
+        InterfaceKind::RockingBase {
+            corners, normal, ..
+        } => (corners.to_vec(), *normal),
+        InterfaceKind::Hinge {
+            axis,
+            pivot_positive,
+            pivot_negative,
+        } => (
+            vec![*pivot_positive, *pivot_negative],
+            axis.cross(&(pivot_negative - pivot_positive)).normalize(),
+        ),
+    }
+}
+
+/// A point that keeps contact without sliding in the mechanism, where forces may act.
+struct Holding {
+    body: usize,
+    parent: Parent,
+    point: Vector3<f64>,
+    normal: Vector3<f64>,
+}
+
+/// Checks that `c` is a collapse state of `model` along `d` (see the module's docs) and returns
+/// λ_kin. In a planar model (hinges about one axis a) the in-plane rows only: what the hinges
+/// carry along a and about axes normal to a is bilateral.
+fn certify(model: &Model, d: Vector3<f64>, c: &Collapse) -> f64 {
+    let lambda = c.lambda.expect("a mechanism");
+    let rate_tol = 1e-7;
+    let size = model.size;
+    let planar = model.planar_axis();
+    let bodies: Vec<Velocity> = c
+        .bodies
+        .iter()
+        .map(|b| (Vector3::from(b.velocity), Vector3::from(b.angular)))
+        .collect();
+    // The mechanism: admissible, and the points that hold.
+    let mut holding = Vec::new();
+    for (k, interface) in model.interfaces.iter().enumerate() {
+        let name = &interface.name;
+        let (points, normal) = points_and_normal(model, k);
+        let relative = |x: &Vector3<f64>| {
+            point_velocity(model, &bodies, Parent::Body(interface.child), x)
+                - point_velocity(model, &bodies, interface.parent, x)
+        };
+        let opens = points.iter().all(|p| normal.dot(&relative(p)) > rate_tol);
+        if let InterfaceKind::Hinge { axis, .. } = &interface.kind
+            && !opens
+        {
+            let parent_w = match interface.parent {
+                Parent::Ground => Vector3::zeros(),
+                Parent::Body(n) => bodies[n].1,
+            };
+            let w = bodies[interface.child].1 - parent_w;
+            assert!(
+                (w - axis * axis.dot(&w)).norm() * size < rate_tol,
+                "{name}: {w}"
+            );
+        }
+        for p in points {
+            let v = relative(&p);
+            let gap = normal.dot(&v);
+            assert!(gap > -rate_tol, "{name}: penetrates at {p}");
+            let slip = v - normal * gap;
+            let slip = planar.map_or(slip, |a| slip - a * a.dot(&slip)).norm();
+            if gap <= rate_tol && slip <= rate_tol {
+                holding.push(Holding {
+                    body: interface.child,
+                    parent: interface.parent,
+                    point: p,
+                    normal,
+                });
+            }
+        }
+    }
+    let kinematic = kinematic_multiplier(model, d, &bodies);
+    assert!(
+        (kinematic - lambda).abs() <= 1e-7 * lambda,
+        "static {lambda}, kinematic {kinematic}"
+    );
+    let statical = equilibrium_on(model, d, planar, &holding)
+        .unwrap_or_else(|status| panic!("no equilibrium on the points that hold: {status:?}"));
+    assert!(
+        (statical - lambda).abs() <= 1e-7 * lambda,
+        "engine {lambda}, equilibrium on the points that hold {statical}"
+    );
+    kinematic
+}
+
+/// λ_kin = −Σ mᵢ ẑ·vᵢ / Σ mᵢ d·vᵢ, the load doing positive work.
+fn kinematic_multiplier(model: &Model, d: Vector3<f64>, bodies: &[Velocity]) -> f64 {
+    let power = |along: Vector3<f64>| -> f64 {
+        model
+            .bodies
+            .iter()
+            .zip(bodies)
+            .map(|(b, (v, _))| -b.mass * along.dot(v))
+            .sum()
+    };
+    let load_power = power(d);
+    assert!(load_power > 0.0, "the load does positive work");
+    -power(Vector3::z()) / load_power
+}
+
+/// The largest λ (≤ 10) with an equilibrium of every body under its weight and −λ m g d whose
+/// forces act at the points `holding` only (a compressive normal force, any shear; in a planar
+/// model the in-plane rows), by an LP written here. Where the mechanism's points that hold carry
+/// such an equilibrium, its forces do no virtual work, so it exists at λ_kin alone.
+fn equilibrium_on(
+    model: &Model,
+    d: Vector3<f64>,
+    planar: Option<Vector3<f64>>,
+    holding: &[Holding],
+) -> Result<f64, clarabel::solver::SolverStatus> {
+    let weight = model.bodies.iter().map(|b| b.mass).sum::<f64>() * model.gravity;
+    let size = model.size;
+    // Rows kept: force components and moment components (of a body's 6).
+    let (force_axes, moment_axes): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = match planar {
+        Some(a) => {
+            let e1 = a.cross(&Vector3::z()).normalize();
+            (vec![e1, a.cross(&e1)], vec![a])
+        }
+        None => (
+            vec![Vector3::x(), Vector3::y(), Vector3::z()],
+            vec![Vector3::x(), Vector3::y(), Vector3::z()],
+        ),
+    };
+    let rows_per_body = force_axes.len() + moment_axes.len();
+    // Unknowns: λ, then per point fₙ and two shears (units of the weight W).
+    let mut lp = Lp::new(1 + 3 * holding.len());
+    lp.cost[0] = -1.0;
+    let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); rows_per_body * model.bodies.len()];
+    let mut rhs = vec![0.0; rows.len()];
+    for (n, b) in model.bodies.iter().enumerate() {
+        let share = b.mass * model.gravity / weight;
+        for (k, e) in force_axes.iter().enumerate() {
+            // Σ F − λ share d = share ẑ.
+            rows[rows_per_body * n + k].push((0, -share * e.dot(&d)));
+            rhs[rows_per_body * n + k] = share * e.z;
+        }
+    }
+    for (j, h) in holding.iter().enumerate() {
+        let t1 = h.normal.cross(&Vector3::x());
+        let t1 = if t1.norm() > 0.5 {
+            t1.normalize()
+        } else {
+            h.normal.cross(&Vector3::y()).normalize()
+        };
+        let t2 = h.normal.cross(&t1);
+        for (c, direction) in [h.normal, t1, t2].into_iter().enumerate() {
+            let column = 1 + 3 * j + c;
+            let mut add = |body: usize, sign: f64| {
+                let arm = (h.point - model.bodies[body].com).cross(&direction) / size;
+                for (k, e) in force_axes.iter().enumerate() {
+                    rows[rows_per_body * body + k].push((column, sign * e.dot(&direction)));
+                }
+                for (k, e) in moment_axes.iter().enumerate() {
+                    rows[rows_per_body * body + force_axes.len() + k]
+                        .push((column, sign * e.dot(&arm)));
+                }
+            };
+            add(h.body, 1.0);
+            if let Parent::Body(parent) = h.parent {
+                add(parent, -1.0);
+            }
+        }
+        lp.le.push((vec![(1 + 3 * j, -1.0)], 0.0));
+    }
+    lp.eq = rows.into_iter().zip(rhs).collect();
+    lp.le.push((vec![(0, 1.0)], 10.0));
+    lp.solve().map(|solution| solution.x[0])
+}
+
+fn assembled(path: &Path, planar: bool) -> Model {
+    let file = read_assembly(path).unwrap();
+    let options = AssemblyOptions {
+        planar,
+        ..AssemblyOptions::default()
+    }
+    .with_all_contacts();
+    assemble(path, &file, &options).unwrap().model
+}
+
+fn box_body(name: &str, centre: [f64; 3], size: [f64; 3]) -> String {
+    format!(
+        "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
+         size = {size:?} }}\n"
+    )
+}
+
+fn collapse(model: &Model, d: Vector3<f64>) -> Collapse {
+    collapse_multiplier(model, d, &StaticsOptions::default()).unwrap()
+}
+
+/// A block 0.4 m (x) × 1 m (y) × 1 m high standing against the +x face of a pier 2 m high, every
+/// contact an interface. Away from the pier (−x) it turns about its far foot and slides up the
+/// pier at its lowest edge, which carries nothing: λ = b/h = 0.4/1 by the virtual work of the
+/// block alone; the program without sliding forbids that slip and finds it holding up to the cap
+/// (a fixed pier). Across (±y) it turns about its base's edge, its face sliding over the pier's:
+/// λ = 1/1. Into a fixed pier (+x) it cannot move. With the pier a free block the same block
+/// overturns away from it at 0.4 (the pier alone: 0.5/1, and pushing the block into it loads
+/// both).
+#[test]
+fn a_block_against_a_pier_overturns_away_from_it_at_b_over_h() {
+    let dir = common::scratch("statics_pier");
+    for fixed in [true, false] {
+        let text = format!(
+            "name = \"infill\"\n{}{}{}",
+            if fixed { "fixed = [\"pier\"]\n" } else { "" },
+            box_body("pier", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0]),
+            box_body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]),
+        );
+        let path = dir.join(format!("pier_{fixed}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let model = assembled(&path, false);
+        let away = collapse(&model, -Vector3::x());
+        assert!(away.from_sliding_search());
+        certify(&model, -Vector3::x(), &away);
+        let into = collapse(&model, Vector3::x());
+        if fixed {
+            assert_eq!(into.lambda, None);
+            assert_eq!(away.convex_lambda, None, "holds without sliding");
+            for d in [Vector3::y(), -Vector3::y()] {
+                let across = collapse(&model, d);
+                assert!((across.lambda.unwrap() - 1.0).abs() < 1e-7);
+                certify(&model, d, &across);
+            }
+        } else {
+            certify(&model, Vector3::x(), &into);
+        }
+    }
+}
+
+/// The bundled running-bond wall (8 courses of 0.25 m, blocks 0.6 m long), planar, with its head
+/// joints as contacts: the end half block of the top course turns about its outer foot and
+/// slides up its head joint, λ = (L/4)/(h_b/2) = 0.15/0.125 = 1.2 by the virtual work of that
+/// block alone, below the 1.5 of the whole wall overturning (the program without sliding).
+#[test]
+fn the_running_bond_wall_loses_the_end_half_block_of_its_top_course() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/wall.toml");
+    let model = assembled(&path, true);
+    for d in [Vector3::x(), -Vector3::x()] {
+        let c = collapse(&model, d);
+        assert!((c.lambda.unwrap() - 1.2).abs() < 1e-7, "{:?}", c.lambda);
+        assert!((c.convex_lambda.unwrap() - 1.5).abs() < 1e-7);
+        certify(&model, d, &c);
+    }
+}
+
+/// The bundled façade with a door, planar, every contact an interface: whatever mechanism the
+/// search answers along ±x (below the 1.25 of the program without sliding), it is a collapse
+/// state.
+#[test]
+fn the_facade_collapses_where_its_search_says() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/facade.toml");
+    let model = assembled(&path, true);
+    for d in [Vector3::x(), -Vector3::x()] {
+        let c = collapse(&model, d);
+        let lambda = c.lambda.unwrap();
+        assert!(lambda <= c.convex_lambda.unwrap());
+        certify(&model, d, &c);
+    }
+}
