@@ -145,6 +145,9 @@ pub struct Assembled {
     pub ground_level: f64,
     /// The blocks that were part of the ground (the assembly's `fixed`), not in the model.
     pub fixed: Vec<String>,
+    /// The names of the assembly's blocks, fixed ones included (`ContactFace::support` indexes
+    /// them).
+    pub assembly_blocks: Vec<String>,
 }
 
 /// Finds the contacts of the assembly `file` (read from `path`) on the ground of `options` and
@@ -236,5 +239,6 @@ pub fn assemble(
         folder: path.parent().map(Path::to_path_buf).unwrap_or_default(),
         ground_level,
         fixed: file.fixed.clone(),
+        assembly_blocks: file.body.iter().map(|b| b.name.clone()).collect(),
     })
 }

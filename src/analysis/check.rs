@@ -281,11 +281,19 @@ pub fn check_with(
         )
     };
     // The statics run on the contact faces whatever the CRR chain's mobility: a chain locked by
-    // its hinges can still open by a block lifting off a support.
-    let statics = directions
-        .iter()
-        .map(|&d| static_multiplier_with(model, d, friction))
-        .collect::<Result<Vec<_>, _>>();
+    // its hinges can still open by a block lifting off a support. The directions are
+    // independent, each on its own thread (the search for joints that open and slide can run
+    // hundreds of programs along one); the first error in the directions' order is reported.
+    let statics = std::thread::scope(|scope| {
+        let handles: Vec<_> = directions
+            .iter()
+            .map(|&d| scope.spawn(move || static_multiplier_with(model, d, friction)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect::<Result<Vec<_>, _>>()
+    });
     let (statics, statics_note) = match statics {
         Ok(v) => (v, None),
         Err(e) => (Vec::new(), Some(e)),

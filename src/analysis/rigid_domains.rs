@@ -347,5 +347,6 @@ fn merged_model(
         folder: all.folder.clone(),
         ground_level: all.ground_level,
         fixed: all.fixed.clone(),
+        assembly_blocks: all.assembly_blocks.clone(),
     })
 }

@@ -12,11 +12,15 @@ use crate::analysis::assemble::Assembled;
 use crate::analysis::rigid_domains::MechanismModel;
 use crate::input::model_file::ModelFile;
 
-/// One line per contact: the bodies (lower first; `ground`), bed or side, area (m²), normal and
-/// number of corners.
+/// One line per contact: the bodies (lower first; `ground`, or `ground (fixed NAME)` on a fixed
+/// block), bed or side, area (m²), normal and number of corners.
 pub fn contacts_text(a: &Assembled) -> String {
     let bodies = &a.file.body;
-    let name = |b: Option<usize>| b.map_or("ground", |b| bodies[b].name.as_str());
+    let name = |c: &ContactFace, b: Option<usize>| match (b, c.support) {
+        (Some(b), _) => bodies[b].name.clone(),
+        (None, Some(fixed)) => format!("ground (fixed {})", a.assembly_blocks[fixed]),
+        (None, None) => "ground".to_string(),
+    };
     let mut s = String::new();
     let beds = a.contacts.iter().filter(|c| c.bed).count();
     let sides = match a.set {
@@ -33,7 +37,7 @@ pub fn contacts_text(a: &Assembled) -> String {
         let _ = writeln!(
             s,
             "  {}",
-            contact_line(c, name(c.lower), name(Some(c.upper)))
+            contact_line(c, &name(c, c.lower), &name(c, Some(c.upper)))
         );
     }
     s

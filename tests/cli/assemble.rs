@@ -1043,6 +1043,13 @@ fn fixed_blocks_beside_over_and_overlapping_free_ones() {
         side.normal
     );
     assert!(side.corners.iter().all(|p| p.x.abs() < 1e-12));
+    // The contacts report names the fixed block a ground contact rests against.
+    let report = crr::output::assemble::contacts_text(&a);
+    assert!(
+        report.contains("ground (fixed pier) | block: side")
+            && report.contains("ground | block: bed"),
+        "{report}"
+    );
 
     // A block under a fixed roof and on nothing else hangs: refused, naming it.
     let hanging = "name = \"hanging\"\nfixed = [\"roof\"]\n".to_string()

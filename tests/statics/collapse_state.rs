@@ -373,8 +373,9 @@ fn the_running_bond_wall_loses_the_end_half_block_of_its_top_course() {
 /// The bundled façade with a door, planar, every contact an interface: the mechanism the search
 /// answers along ±x, below the 1.25 of the program without sliding (the portal frame of its two
 /// piers and the lintel zone), is a collapse state, and the façade being symmetric about x = 0,
-/// the two directions give the same λ (1e-7 relative). Before the search asked for an equilibrium
-/// on the holding points, it answered 1.000484 and 1.001462 from mechanisms with none.
+/// the two directions give the same λ (1e-7 relative). A search that only unloaded a freed
+/// joint's sliding points answered 1.000484 and 1.001462, from mechanisms with no equilibrium on
+/// the points that hold.
 #[test]
 fn the_facade_collapses_where_its_search_says() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/facade.toml");

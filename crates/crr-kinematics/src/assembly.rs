@@ -33,6 +33,10 @@ pub struct ContactFace {
     pub area: f64,
     /// Whether it is a bed (normal within 45° of the vertical) or a side contact.
     pub bed: bool,
+    /// For a contact with the ground (`lower` None), the fixed block it rests on or against
+    /// (an index into the assembly's bodies; None: the ground plane, or faces merged over
+    /// several supports), for the reports: the model has one ground.
+    pub support: Option<usize>,
 }
 
 /// Why an assembly cannot be turned into a structure.
@@ -297,6 +301,7 @@ pub fn detect_contacts(
                         corners,
                         area,
                         bed: true,
+                        support: None,
                     });
                 }
             }
@@ -342,6 +347,7 @@ pub fn detect_contacts(
                             corners,
                             area,
                             bed,
+                            support: Some(lower).filter(|&b| is_fixed(b)),
                         });
                     }
                 }
@@ -837,9 +843,11 @@ fn coplanar_hull(faces: &[ContactFace], tolerance: f64) -> ContactFace {
         .flat_map(|f| f.corners.iter().map(|p| [u.dot(p), v.dot(p)]))
         .collect();
     let hull = simplified(convex_hull_2d(&mut points), tolerance);
+    let support = faces[0].support;
     ContactFace {
         corners: hull.iter().map(|p| u * p[0] + v * p[1] + n * h).collect(),
         area: area_2d(&hull),
+        support: support.filter(|_| faces.iter().all(|f| f.support == support)),
         ..faces[0].clone()
     }
 }
@@ -1010,6 +1018,7 @@ mod tests {
             corners: vec![c(0.0, 0.0), c(1.0, 0.0), c(1.0, 1.0), c(0.0, 1.0)],
             area: 1.0,
             bed: true,
+            support: None,
         }
     }
 
