@@ -442,7 +442,7 @@ pub fn to_text(r: &CheckReport) -> String {
                             ),
                         };
                         s += &format!(
-                            "    found by the search for joints that open and slide (without them {without}): the structure does not hold beyond this λ, but the search is not exhaustive and a lower mechanism may exist (docs/simulation.md, \"Joints that open may slide\")\n"
+                            "    found by the search for joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, so the structure can move from it on, but the search is not exhaustive and a lower mechanism may exist (docs/simulation.md, \"Joints that open may slide\")\n"
                         );
                     }
                     let sliding = with(crr_impact::statics::Motion::Slides);

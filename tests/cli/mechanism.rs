@@ -129,7 +129,9 @@ fn a_panel_cut_into_courses_is_one_rigid_domain_rocking_at_b_over_h() {
 /// with its head joints as contacts (no sliding where a joint keeps contact). The end half block
 /// of the top course turns about its outer foot and slides up its head joint, which carries
 /// nothing: λ = (L/4)/(h_b/2) = 0.15/0.125 = 1.2 by the virtual work of that block alone
-/// (`tests/statics/collapse_state.rs` certifies it as a collapse state). Without that sliding
+/// (`tests/statics/collapse_state.rs` certifies it as a collapse state; an upper bound of the
+/// wall's multiplier: a corner wedge of 16 blocks collapses at 2/3, which the search for joints
+/// that open and slide does not find). Without that sliding
 /// the blocks are locked together and the wall overturns whole about a base corner,
 /// λ = (3/2)/(2/2) = 1.5 by the virtual work of the monolith. Both mechanisms' joints are hinges,
 /// so the domains are the two end half blocks of the top course and the 42 other blocks as one

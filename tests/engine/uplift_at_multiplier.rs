@@ -164,16 +164,17 @@ fn walls_release_their_wedges_loops_above_their_multiplier() {
 }
 
 /// Models of rigid domains (`crr assemble --mechanism`: compound bodies) leave rest at their
-/// multiplier too: the bundled façade as 9 domains (λ = 1.228336 along ±x, its piers rocking
-/// while blocks of the course under the lintel open and slide, so blocks lift off), and the arch
-/// of 9 stones as 5 domains on 6 hinges (λ = 0.365716, the domains rocking with no lift-off);
-/// the multiplier is the one the model of every stone has (`tests/cli/mechanism.rs`,
-/// `tests/statics/collapse_state.rs`).
+/// multiplier too: the bundled façade as 5 domains (its two piers, the zone over the lintel and
+/// its two top-corner wedges), whose model answers the portal frame, λ = 1.25 along ±x, and the
+/// arch of 9 stones as 5 domains on 6 hinges (λ = 0.365716), the domains rocking with no
+/// lift-off; the multiplier is the one the model of every stone has without sliding
+/// (`tests/cli/mechanism.rs`; with sliding, the façade's wedges open at 25/42, which the merged
+/// model's own search does not find).
 #[test]
 fn models_of_rigid_domains_leave_rest_at_their_multiplier() {
     use crr::analysis::assemble::{AssemblyOptions, read_assembly};
     use crr::analysis::rigid_domains::mechanism_model;
-    for (name, lambda, lifts_off) in [("facade", 1.228336, true), ("arch", 0.365716, false)] {
+    for (name, lambda) in [("facade", 1.25), ("arch", 0.365716)] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("examples/assemblies/{name}.toml"));
         let file = read_assembly(&path).unwrap();
@@ -199,11 +200,10 @@ fn models_of_rigid_domains_leave_rest_at_their_multiplier() {
                 .lambda
                 .unwrap();
             assert!((found - lambda).abs() < 1e-6, "{name} {d:?}: {found}");
-            assert!((found - every_stone.lambda.unwrap()).abs() < 1e-7 * found);
-            assert_eq!(
-                check_threshold(name, &m.merged.model, d),
-                lifts_off,
-                "{name}: lift-off"
+            assert!((found - every_stone.convex_lambda.unwrap()).abs() < 1e-7 * found);
+            assert!(
+                !check_threshold(name, &m.merged.model, d),
+                "{name}: the domains rock, no lift-off"
             );
         }
     }
