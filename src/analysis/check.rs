@@ -434,13 +434,8 @@ pub fn to_text(r: &CheckReport) -> String {
                         );
                     }
                     if m.from_sliding_search {
-                        let without = match m.convex_lambda {
-                            Some(convex) => format!("λ = {convex:.6}"),
-                            None => format!(
-                                "it holds up to λ = {}",
-                                crate::analysis::static_multiplier::LAMBDA_MAX
-                            ),
-                        };
+                        let without =
+                            crate::analysis::static_multiplier::without_sliding(m.convex_lambda);
                         s += &format!(
                             "    found by the search for joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, so the structure can move from it on, but the search is not exhaustive and a lower mechanism may exist (docs/simulation.md, \"Joints that open may slide\")\n"
                         );

@@ -83,6 +83,15 @@ pub struct StaticMultiplier {
     pub from_sliding_search: bool,
 }
 
+/// What the program without sliding answered, for the reports of an answer the search for
+/// joints that open and slide found below it: "λ = 1.250000", or "it holds up to λ = 10".
+pub fn without_sliding(convex_lambda: Option<f64>) -> String {
+    match convex_lambda {
+        Some(convex) => format!("λ = {convex:.6}"),
+        None => format!("it holds up to λ = {LAMBDA_MAX}"),
+    }
+}
+
 impl StaticMultiplier {
     /// Whether the mechanism lifts a block off a support (outside the CRR chain).
     pub fn lifts_off(&self) -> bool {

@@ -160,10 +160,8 @@ pub fn mechanism_text(m: &MechanismModel) -> String {
                     c.hinges.join(", ")
                 );
                 if c.from_sliding_search {
-                    let without = match c.convex_lambda {
-                        Some(convex) => format!("λ = {convex:.6}"),
-                        None => format!("it holds up to λ = {}", crr_impact::statics::LAMBDA_MAX),
-                    };
+                    let without =
+                        crate::analysis::static_multiplier::without_sliding(c.convex_lambda);
                     let _ = writeln!(
                         s,
                         "    found by the search for joints that open and slide (without them \

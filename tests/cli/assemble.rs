@@ -13,6 +13,7 @@ use crr::impact::statics::{StaticsOptions, collapse_multiplier};
 use crr::kinematics::spec::PivotSpec;
 
 use crate::common;
+use crate::common::box_body;
 
 /// The bodies of a model file (its text up to the first interface) written as an assembly.
 fn assembly_of(model: &str, tag: &str) -> std::path::PathBuf {
@@ -492,14 +493,6 @@ fn the_bundled_assemblies_go_from_stones_to_a_simulation() {
         );
         assert!(results.join("summary.json").exists(), "{name}");
     }
-}
-
-/// A `[[body]]` table of an assembly: a box of 2000 kg/m³ centred at `centre` (m) of `size` (m).
-fn box_body(name: &str, centre: [f64; 3], size: [f64; 3]) -> String {
-    format!(
-        "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
-         size = {size:?} }}\n"
-    )
 }
 
 /// The OBJ text of a box [lo, hi] as object `name`, its vertices numbered from `first` (OBJ

@@ -207,3 +207,24 @@ pub fn tilted_block(theta: f64) -> String {
         turn(-0.2, 0.2, 0.0),
     )
 }
+
+/// A `[[body]]` table of an assembly: a box of 2000 kg/m³ centred at `centre` (m) of `size` (m).
+pub fn box_body(name: &str, centre: [f64; 3], size: [f64; 3]) -> String {
+    format!(
+        "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
+         size = {size:?} }}\n"
+    )
+}
+
+/// The bundled models whose static multipliers the statics tests certify.
+pub const BUNDLED_STATICS: [&str; 9] = [
+    "single_block",
+    "two_block_stack",
+    "drum_column",
+    "trilithon",
+    "arch",
+    "arch_3d",
+    "baldachin",
+    "temple",
+    "wall",
+];

@@ -33,22 +33,12 @@ use crr::impact::statics::{Collapse, StaticsOptions, collapse_multiplier};
 use crr::kinematics::{InterfaceKind, Model, Parent};
 
 use crate::common;
+use crate::common::{BUNDLED_STATICS, box_body};
+use crate::duality::point_velocity;
 use crate::independent::Lp;
 
 /// A body's virtual velocity (v at the centre of mass, ω).
 type Velocity = (Vector3<f64>, Vector3<f64>);
-
-fn point_velocity(
-    model: &Model,
-    bodies: &[Velocity],
-    of: Parent,
-    x: &Vector3<f64>,
-) -> Vector3<f64> {
-    match of {
-        Parent::Ground => Vector3::zeros(),
-        Parent::Body(n) => bodies[n].0 + bodies[n].1.cross(&(x - model.bodies[n].com)),
-    }
-}
 
 /// The contact points and the normal (into the child) of interface `k`, from the model alone;
 /// a pin (a hinge whose two pivots coincide) has no normal: `None`.
@@ -306,13 +296,6 @@ fn assembled(path: &Path, planar: bool) -> Model {
     assemble(path, &file, &options).unwrap().model
 }
 
-fn box_body(name: &str, centre: [f64; 3], size: [f64; 3]) -> String {
-    format!(
-        "[[body]]\nname = \"{name}\"\ndensity = 2000.0\nbox = {{ center = {centre:?}, \
-         size = {size:?} }}\n"
-    )
-}
-
 fn collapse(model: &Model, d: Vector3<f64>) -> Collapse {
     collapse_multiplier(model, d, &StaticsOptions::default()).unwrap()
 }
@@ -409,17 +392,7 @@ fn the_facade_collapses_where_its_search_says() {
 /// corner wedge, 7/11) alike have an equilibrium on the points their mechanism keeps in contact.
 #[test]
 fn every_bundled_multiplier_is_a_collapse_state() {
-    for name in [
-        "single_block",
-        "two_block_stack",
-        "drum_column",
-        "trilithon",
-        "arch",
-        "arch_3d",
-        "baldachin",
-        "temple",
-        "wall",
-    ] {
+    for name in BUNDLED_STATICS {
         let model = common::bundled_model(name);
         for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
             let c = collapse(&model, d);

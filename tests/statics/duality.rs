@@ -23,7 +23,7 @@ use crr::impact::statics::{StaticsOptions, collapse_multiplier};
 use crr::kinematics::{InterfaceKind, Model, Parent};
 
 /// Velocity of the material point at `x` of the body (or ground) `of`.
-fn point_velocity(
+pub(crate) fn point_velocity(
     model: &Model,
     bodies: &[(Vector3<f64>, Vector3<f64>)],
     of: Parent,
@@ -115,17 +115,7 @@ fn kinematic_multiplier(
 
 #[test]
 fn every_bundled_multiplier_is_certified_by_its_mechanism() {
-    for name in [
-        "single_block",
-        "two_block_stack",
-        "drum_column",
-        "trilithon",
-        "arch",
-        "arch_3d",
-        "baldachin",
-        "temple",
-        "wall",
-    ] {
+    for name in crate::common::BUNDLED_STATICS {
         let model = bundled(name);
         for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
             let c = collapse_multiplier(&model, d, &StaticsOptions::default()).unwrap();

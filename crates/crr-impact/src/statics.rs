@@ -185,7 +185,9 @@ pub struct InterfaceCollapse {
     pub pivots: Vec<usize>,
     /// Gap rates n·(v_child − v_parent) of the face's points in the mechanism.
     pub gap_rates: Vec<f64>,
-    /// Largest tangential slip rate of its points (0 without sliding).
+    /// Tangential slip rates |(v_child − v_parent)_t| of the face's points in the mechanism.
+    pub slip_rates: Vec<f64>,
+    /// Largest of `slip_rates` (0 without sliding).
     pub slip_rate: f64,
     /// Relative angular velocity ω_child − ω_parent in the mechanism (rad/s at unit scale).
     pub rotation: [f64; 3],
@@ -475,9 +477,10 @@ fn sliding_lift_offs(
 /// The probes with friction that lower λ below `best_lambda`, each as the interfaces its
 /// mechanism separates at all their points while sliding (not yet freed, not pins; empty sets
 /// left out): a probe's friction makes every point that slides separate too (its flow is
-/// associated), so a face that, freed, slides at a point it keeps contact at is among them. λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a
-/// smaller one, with the same freed interfaces, so where the smallest probe does not lower λ,
-/// none does, and one program answers for the four.
+/// associated), so a face that, freed, slides at a point it keeps contact at is among them.
+/// λ(μ) grows with μ: the pyramid of a larger μ holds every distribution of a smaller one, with
+/// the same freed interfaces, so where the smallest probe does not lower λ, none does, and one
+/// program answers for the four.
 fn lowering_probes(
     model: &Model,
     faces: &[ContactFace],
@@ -554,10 +557,7 @@ fn lowest_physical(
     // lowest λ up, until one passes: the test runs once where the lowest candidate is physical.
     let mut candidates: Vec<(f64, Collapse, Vec<bool>)> = Vec::new();
     for set in sets {
-        let mut trial = free.to_vec();
-        for &i in set {
-            trial[i] = true;
-        }
+        let trial = freed_with(free, set);
         let Ok(candidate) = solve_program(model, faces, d, options, &trial, &[]) else {
             continue;
         };
@@ -575,6 +575,15 @@ fn lowest_physical(
         .find_map(|(lambda, candidate, trial)| {
             physical(model, faces, d, options, &trial, candidate).map(|c| (lambda, c, trial))
         })
+}
+
+/// `free` with the interfaces `set` freed as well.
+fn freed_with(free: &[bool], set: &[usize]) -> Vec<bool> {
+    let mut trial = free.to_vec();
+    for &i in set {
+        trial[i] = true;
+    }
+    trial
 }
 
 /// Most programs of [`repaired_set`].
@@ -595,10 +604,7 @@ fn repaired_set(
     best_lambda: f64,
     set: &[usize],
 ) -> Option<(f64, Collapse, Vec<bool>)> {
-    let mut trial = free.to_vec();
-    for &i in set {
-        trial[i] = true;
-    }
+    let mut trial = freed_with(free, set);
     for _ in 0..REPAIRS {
         let candidate = solve_program(model, faces, d, options, &trial, &[]).ok()?;
         let lambda = candidate.lambda?;
@@ -657,12 +663,10 @@ fn physical(
     let lambda = collapse.lambda?;
     let mut unloaded = Vec::new();
     for i in &collapse.interfaces {
-        let face = &faces[i.interface];
-        if face.pin {
+        if faces[i.interface].pin {
             continue;
         }
-        let slips = point_slips(model, face, &collapse.bodies);
-        for (p, (&gap, slip)) in i.gap_rates.iter().zip(slips).enumerate() {
+        for (p, (&gap, &slip)) in i.gap_rates.iter().zip(&i.slip_rates).enumerate() {
             if gap > MECHANISM_TOLERANCE || slip > MECHANISM_TOLERANCE {
                 unloaded.push((i.interface, p));
             }
@@ -683,31 +687,6 @@ fn physical(
         kept.forces = spared.forces;
     }
     Some(collapse)
-}
-
-/// The tangential slip rate of each point of `face` in the mechanism `bodies` (child relative
-/// to parent, in the face's friction tangents).
-fn point_slips(model: &Model, face: &ContactFace, bodies: &[BodyMotion]) -> Vec<f64> {
-    let interface = &model.interfaces[face.interface];
-    let velocity = |of: Parent, x: &Vector3<f64>| match of {
-        Parent::Ground => Vector3::zeros(),
-        Parent::Body(n) => {
-            let b = &bodies[n];
-            Vector3::from(b.velocity) + Vector3::from(b.angular).cross(&(x - model.bodies[n].com))
-        }
-    };
-    face.points
-        .iter()
-        .map(|x| {
-            let relative =
-                velocity(Parent::Body(interface.child), x) - velocity(interface.parent, x);
-            face.tangents[..face.friction_tangents]
-                .iter()
-                .map(|t| t.dot(&relative).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .collect()
 }
 
 /// The smallest Coulomb friction coefficient (pyramid on each tangent, exact for planar loads)
@@ -1137,18 +1116,20 @@ impl Program {
                     })
                     .collect();
                 let mut gap_rates = Vec::with_capacity(face.points.len());
-                let mut slip_rate: f64 = 0.0;
+                let mut slip_rates = Vec::with_capacity(face.points.len());
                 for x in &face.points {
                     let relative = point_velocity(Parent::Body(interface.child), x)
                         - point_velocity(interface.parent, x);
                     gap_rates.push(face.normal.dot(&relative));
-                    let slip = face.tangents[..face.friction_tangents]
-                        .iter()
-                        .map(|t| t.dot(&relative).powi(2))
-                        .sum::<f64>()
-                        .sqrt();
-                    slip_rate = slip_rate.max(slip);
+                    slip_rates.push(
+                        face.tangents[..face.friction_tangents]
+                            .iter()
+                            .map(|t| t.dot(&relative).powi(2))
+                            .sum::<f64>()
+                            .sqrt(),
+                    );
                 }
+                let slip_rate = slip_rates.iter().copied().fold(0.0, f64::max);
                 let parent_angular = match interface.parent {
                     Parent::Ground => Vector3::zeros(),
                     Parent::Body(n) => bodies[n].1,
@@ -1199,6 +1180,7 @@ impl Program {
                     sides,
                     pivots: if measure <= zero { Vec::new() } else { pivots },
                     gap_rates,
+                    slip_rates,
                     slip_rate,
                     rotation: [rotation.x, rotation.y, rotation.z],
                 }
