@@ -126,37 +126,32 @@ fn a_panel_cut_into_courses_is_one_rigid_domain_rocking_at_b_over_h() {
 }
 
 /// The bundled running-bond wall (8 courses of 0.25 m, blocks 0.6 m long, 3 m long, 2 m high)
-/// with its head joints as contacts (no sliding where a joint keeps contact). The end half block
-/// of the top course turns about its outer foot and slides up its head joint, which carries
-/// nothing: λ = (L/4)/(h_b/2) = 0.15/0.125 = 1.2 by the virtual work of that block alone
-/// (`tests/statics/collapse_state.rs` certifies it as a collapse state; an upper bound of the
-/// wall's multiplier: a corner wedge of 16 blocks collapses at 2/3, which the search for joints
-/// that open and slide does not find). Without that sliding
-/// the blocks are locked together and the wall overturns whole about a base corner,
-/// λ = (3/2)/(2/2) = 1.5 by the virtual work of the monolith. Both mechanisms' joints are hinges,
-/// so the domains are the two end half blocks of the top course and the 42 other blocks as one
-/// compound body (with their mass), and the merged model answers both: 1.5 without sliding,
-/// 1.2 with.
+/// with its head joints as contacts (no sliding where a joint keeps contact). Its corner wedge,
+/// the staircase of 16 blocks over the outer foot of course 1's end half block, turns about that
+/// foot while its head and bed joints open and slide: λ = (0.3/0.25)(2·7 + 1)/(4·7 − 1) = 2/3 by
+/// virtual work (`tests/statics/collapse_state.rs` derives it and certifies it as a collapse
+/// state). Without that sliding the blocks are locked together and the wall overturns whole
+/// about a base corner, λ = (3/2)/(2/2) = 1.5 by the virtual work of the monolith. Both
+/// mechanisms' joints are hinges: the domains are the two wedges less the three blocks they
+/// share near the top (13 blocks each), those three, and the rest of the wall (15 blocks), and
+/// the merged model answers both: 1.5 without sliding, 2/3 with.
 #[test]
-fn the_running_bond_wall_loses_its_top_half_blocks_before_it_overturns_whole() {
+fn the_running_bond_wall_loses_its_corner_wedges_before_it_overturns_whole() {
     let m = mechanism(&bundled_assembly("wall"), true, &along_x());
     for c in &m.collapses {
-        assert!((c.lambda.unwrap() - 1.2).abs() < 1e-7, "{c:?}");
+        assert!((c.lambda.unwrap() - 2.0 / 3.0).abs() < 1e-7, "{c:?}");
         assert!(c.from_sliding_search);
         assert!((c.convex_lambda.unwrap() - 1.5).abs() < 1e-7, "{c:?}");
     }
     let sizes: Vec<usize> = m.domains.iter().map(|d| d.blocks.len()).collect();
-    assert_eq!(sizes, [42, 1, 1]);
-    assert_eq!(
-        [&m.domains[1].blocks[0], &m.domains[2].blocks[0]],
-        ["c7_b0", "c7_b5"]
-    );
+    assert_eq!(sizes, [15, 13, 13, 3]);
+    assert!(m.domains[1].blocks.contains(&"c1_b0".to_string()));
+    assert!(m.domains[2].blocks.contains(&"c1_b5".to_string()));
     let total: f64 = m.all_contacts.model.bodies.iter().map(|b| b.mass).sum();
-    let half = 2000.0 * 0.3 * 0.3 * 0.25;
-    let merged = &m.merged.model.bodies[0];
-    assert!((merged.mass - (total - 2.0 * half)).abs() <= 1e-12 * total);
+    let merged: f64 = m.merged.model.bodies.iter().map(|b| b.mass).sum();
+    assert!((merged - total).abs() <= 1e-12 * total);
     for d in along_x() {
-        assert!((lambda(&m.merged.model, d).unwrap() - 1.2).abs() < 1e-7);
+        assert!((lambda(&m.merged.model, d).unwrap() - 2.0 / 3.0).abs() < 1e-7);
         assert!((convex_lambda(&m.merged.model, d).unwrap() - 1.5).abs() < 1e-7);
     }
 }

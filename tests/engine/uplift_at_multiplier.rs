@@ -164,17 +164,16 @@ fn walls_release_their_wedges_loops_above_their_multiplier() {
 }
 
 /// Models of rigid domains (`crr assemble --mechanism`: compound bodies) leave rest at their
-/// multiplier too: the bundled façade as 5 domains (its two piers, the zone over the lintel and
-/// its two top-corner wedges), whose model answers the portal frame, λ = 1.25 along ±x, and the
-/// arch of 9 stones as 5 domains on 6 hinges (λ = 0.365716), the domains rocking with no
-/// lift-off; the multiplier is the one the model of every stone has without sliding
-/// (`tests/cli/mechanism.rs`; with sliding, the façade's wedges open at 25/42, which the merged
-/// model's own search does not find).
+/// multiplier too: the arch of 9 stones as 5 domains on 6 hinges (λ = 0.365716), the domains
+/// rocking with no lift-off; the multiplier is the one the model of every stone has without
+/// sliding (`tests/cli/mechanism.rs`). (The bundled façade's domains collapse by its corner
+/// wedges lifting off their supports at 65/138 since the search for wedges, 2026-12-03: outside
+/// the CRR chain, so not a case for this test.)
 #[test]
 fn models_of_rigid_domains_leave_rest_at_their_multiplier() {
     use crr::analysis::assemble::{AssemblyOptions, read_assembly};
     use crr::analysis::rigid_domains::mechanism_model;
-    for (name, lambda) in [("facade", 1.25), ("arch", 0.365716)] {
+    for (name, lambda) in [("arch", 0.365716)] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("examples/assemblies/{name}.toml"));
         let file = read_assembly(&path).unwrap();

@@ -21,8 +21,8 @@
 //!
 //! Together: at λ the structure has an equilibrium and a motion consistent with it, so it can move
 //! from λ on. That makes λ an upper bound of the multiplier, not its value: a lower collapse state
-//! may exist (the wall's and the façade's corner wedges, docs/simulation.md, "Joints that open
-//! may slide"), and the hand values below are those of the mechanisms named. Tolerances: the mechanism is scaled to unit speed and the solver's gaps are
+//! may exist (docs/simulation.md, "Joints that open may slide"), and the hand values below are
+//! those of the mechanisms named. Tolerances: the mechanism is scaled to unit speed and the solver's gaps are
 //! 1e-12 of the weight, so rates are zero to 1e-7 and both λ agree to 1e-7 relative.
 use std::path::Path;
 
@@ -339,45 +339,80 @@ fn a_block_against_a_pier_overturns_away_from_it_at_b_over_h() {
     }
 }
 
+/// The kinematic multiplier of a staircase wedge in running bond, by virtual work about the outer
+/// foot of the end half block of course 1: courses k = 1…n above that foot, course k spanning
+/// k·s from the wall's end (s the half block's length, the step of the bond) with its centre at
+/// height (k − ½)h above the foot. Its weight ∝ k·s·h; the weight's virtual power ∝ Σ k s (k s/2)
+/// and the load's ∝ Σ k s (k − ½) h, so
+///
+///   λ = (s/2) Σk² / (h (Σk² − Σk/2)) = (s/h)(2n + 1)/(4n − 1),
+///
+/// falling towards s/(2h) as the wedge deepens.
+fn staircase(s: f64, h: f64, n: usize) -> f64 {
+    let n = n as f64;
+    s / h * (2.0 * n + 1.0) / (4.0 * n - 1.0)
+}
+
+/// The bodies the collapse's mechanism moves (speed above 1e-7 of the largest, which is 1).
+fn moving(model: &Model, c: &Collapse) -> Vec<String> {
+    c.bodies
+        .iter()
+        .zip(&model.bodies)
+        .filter(|(m, _)| {
+            Vector3::from(m.velocity).norm() > 1e-7
+                || model.size * Vector3::from(m.angular).norm() > 1e-7
+        })
+        .map(|(_, b)| b.name.clone())
+        .collect()
+}
+
 /// The bundled running-bond wall (8 courses of 0.25 m, blocks 0.6 m long), planar, with its head
-/// joints as contacts: the end half block of the top course turns about its outer foot and
-/// slides up its head joint, λ = (L/4)/(h_b/2) = 0.15/0.125 = 1.2 by the virtual work of that
-/// block alone, below the 1.5 of the whole wall overturning (the program without sliding). An
-/// upper bound: a corner wedge of 16 blocks collapses at 2/3, which the search does not find.
+/// joints as contacts: its corner wedge, the staircase of 16 blocks over the outer foot of course
+/// 1's end half block (1, 1, 2, 2, 3, 3, 4 blocks in courses 1 to 7), turns about that foot, its
+/// head and bed joints opening and sliding: λ = (0.3/0.25)(15/27) = 2/3 ([`staircase`], n = 7),
+/// below the 1.5 of the whole wall overturning (the program without sliding) and the 1.2 of the
+/// top course's end half block alone (the answer before the wedges, 2026-12-03).
 #[test]
-fn the_running_bond_wall_loses_the_end_half_block_of_its_top_course() {
+fn the_running_bond_wall_loses_its_corner_wedge() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/wall.toml");
     let model = assembled(&path, true);
-    for d in [Vector3::x(), -Vector3::x()] {
+    for (d, end) in [(Vector3::x(), "c1_b0"), (-Vector3::x(), "c1_b5")] {
         let c = collapse(&model, d);
-        assert!((c.lambda.unwrap() - 1.2).abs() < 1e-7, "{:?}", c.lambda);
+        let hand = staircase(0.3, 0.25, 7);
+        assert!((hand - 2.0 / 3.0).abs() < 1e-15);
+        assert!((c.lambda.unwrap() - hand).abs() < 1e-7, "{:?}", c.lambda);
         assert!((c.convex_lambda.unwrap() - 1.5).abs() < 1e-7);
+        let wedge = moving(&model, &c);
+        assert_eq!(wedge.len(), 16, "{wedge:?}");
+        assert!(wedge.iter().any(|b| b == end), "{wedge:?}");
+        assert!(wedge.iter().all(|b| !b.starts_with("c0_")), "{wedge:?}");
         certify(&model, d, &c);
     }
 }
 
-/// The bundled façade with a door, planar, every contact an interface: the search answers a
-/// top-corner wedge along ±x, the end half block of course 5 (0.25 × 0.3 m) and the block over it
-/// (0.5 × 0.3 m) turning about the half block's outer foot, the block over it leaving its other
-/// support: by virtual work about that foot, λ = Σ W (x − p)/Σ W (z − p) =
-/// (0.075 · 0.125 + 0.15 · 0.25)/(0.075 · 0.15 + 0.15 · 0.45) = 25/42, below the 1.25 of the
-/// program without sliding (the portal frame of its two piers and the lintel zone). It is a
+/// The bundled façade with a door, planar, every contact an interface: the corner wedge of 12
+/// blocks over the outer foot of course 1's end half block (0.25 m, courses of 0.3 m) turns about
+/// that foot: λ = (0.25/0.3)(13/23) = 65/138 = 0.471014 ([`staircase`], n = 6), below the 1.25 of
+/// the program without sliding (the portal frame of its two piers and the lintel zone) and the
+/// 25/42 of the top-corner wedge of two blocks the search answered before the wedges. It is a
 /// collapse state, and the façade being symmetric about x = 0, both directions give it (1e-7).
-/// An upper bound still: an independent review found a wedge from a lower course at 0.471014. A search that only unloaded a freed
-/// joint's sliding points answered 1.000484 and 1.001462, from mechanisms with no equilibrium on
-/// the points that hold.
+/// (A search that only unloaded a freed joint's sliding points answered 1.000484 and 1.001462,
+/// from mechanisms with no equilibrium on the points that hold.)
 #[test]
 fn the_facade_collapses_where_its_search_says() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/facade.toml");
     let model = assembled(&path, true);
+    let hand = staircase(0.25, 0.3, 6);
+    assert!((hand - 65.0 / 138.0).abs() < 1e-15);
     let lambdas: Vec<f64> = [Vector3::x(), -Vector3::x()]
         .into_iter()
         .map(|d| {
             let c = collapse(&model, d);
             let lambda = c.lambda.unwrap();
-            assert!((lambda - 25.0 / 42.0).abs() < 1e-7, "{d:?}: {lambda}");
+            assert!((lambda - hand).abs() < 1e-7, "{d:?}: {lambda}");
             assert!(c.from_sliding_search());
             assert!((c.convex_lambda.unwrap() - 1.25).abs() < 1e-7);
+            assert_eq!(moving(&model, &c).len(), 12);
             certify(&model, d, &c)
         })
         .collect();
@@ -385,6 +420,83 @@ fn the_facade_collapses_where_its_search_says() {
         (lambdas[0] - lambdas[1]).abs() <= 1e-7 * lambdas[0],
         "{lambdas:?}"
     );
+}
+
+/// A planar wall in running bond of `courses` courses of `blocks` blocks 0.6 × 0.3 × 0.25 m,
+/// odd courses offset by half a block with half blocks at their ends, centred on x = 0.
+fn running_bond(courses: usize, blocks: usize) -> String {
+    let (length, height) = (0.6, 0.25);
+    let half_width = blocks as f64 * length / 2.0;
+    let mut text = format!("name = \"wall_{courses}x{blocks}\"\n");
+    for c in 0..courses {
+        let mut ends: Vec<f64> = (0..=blocks)
+            .map(|i| -half_width + i as f64 * length)
+            .collect();
+        if c % 2 == 1 {
+            ends = std::iter::once(-half_width)
+                .chain((0..blocks).map(|i| -half_width + (i as f64 + 0.5) * length))
+                .chain(std::iter::once(half_width))
+                .collect();
+        }
+        for (i, w) in ends.windows(2).enumerate() {
+            let centre = [(w[0] + w[1]) / 2.0, 0.0, (c as f64 + 0.5) * height];
+            text += &box_body(&format!("c{c}_b{i}"), centre, [w[1] - w[0], 0.3, height]);
+        }
+    }
+    text
+}
+
+/// Walls in running bond of 3 to 6 courses, every contact an interface (head joints included),
+/// planar and, for two of them, in 3D: each loses the staircase wedge over its end half block of
+/// course 1, λ = 1.2 (2n + 1)/(4n − 1) with n = courses − 1 ([`staircase`]): 6/7 for 3 courses,
+/// 42/55 for 4, 18/25 for 5, 66/95 for 6, the same along ±x, each a collapse state. Before the
+/// wedges (2026-12-03) the answers were those without sliding, with no caveat: 1.6 (3 × 2), 2.4
+/// (3 × 3), 1.2 (4 × 2), 2.4 (5 × 5), which an independent review's LP showed to be above these
+/// wedges.
+#[test]
+fn walls_in_running_bond_lose_the_staircase_over_their_end_half_block() {
+    let dir = common::scratch("statics_running_bond");
+    for (courses, blocks, planar) in [
+        (3, 2, true),
+        (3, 3, true),
+        (4, 2, true),
+        (4, 3, true),
+        (5, 5, true),
+        (6, 4, true),
+        (3, 2, false),
+        (4, 3, false),
+    ] {
+        let path = dir.join(format!("wall_{courses}x{blocks}.toml"));
+        std::fs::write(&path, running_bond(courses, blocks)).unwrap();
+        let model = assembled(&path, planar);
+        let hand = staircase(0.3, 0.25, courses - 1);
+        for d in [Vector3::x(), -Vector3::x()] {
+            let c = collapse(&model, d);
+            let lambda = c.lambda.unwrap();
+            assert!(
+                (lambda - hand).abs() < 1e-7,
+                "{courses} × {blocks} (planar {planar}) along {d:?}: {lambda}, by hand {hand}"
+            );
+            certify(&model, d, &c);
+        }
+    }
+}
+
+/// The bundled wall in 3D with every contact an interface, out of its plane (±y): whatever the
+/// search answers (a part of the wall turning about a base edge, its head joints sliding with no
+/// force on them) is a collapse state, and at most the 0.15/1 = t/h of the wall overturning
+/// whole about a base edge (its program without sliding).
+#[test]
+fn the_wall_out_of_its_plane_collapses_where_its_search_says() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/wall.toml");
+    let model = assembled(&path, false);
+    for d in [Vector3::y(), -Vector3::y()] {
+        let c = collapse(&model, d);
+        let lambda = c.lambda.unwrap();
+        assert!(lambda <= 0.15 * (1.0 + 1e-7), "{lambda}");
+        assert!((c.convex_lambda.unwrap() - 0.15).abs() < 1e-7);
+        certify(&model, d, &c);
+    }
 }
 
 /// Every bundled model's multipliers along ±x and ±y are collapse states in the sense above:

@@ -36,6 +36,9 @@ use clarabel::solver::{
 };
 use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent, Side, contact_faces};
 
+mod closure;
+mod wedges;
+
 /// Largest multiplier sought by default (a ground acceleration of 10 g): a structure that holds
 /// beyond it is reported as holding.
 pub const LAMBDA_MAX: f64 = 10.0;
@@ -431,8 +434,27 @@ fn sliding_lift_offs(
     let convex_lambda = convex.lambda;
     let mut best = convex;
     for _ in 0..LIFT_OFF_ROUNDS {
+        // Rigid wedges first (one program each, the search below costs many): a wedge found
+        // lowers λ, so fewer probes lower it further.
+        let wedge_sets: Vec<Vec<usize>> = wedges::wedges(model, faces, d, free, best_lambda)
+            .into_iter()
+            .map(|w| w.freed)
+            .collect();
+        let wedge = lowest_physical(model, faces, d, options, free, best_lambda, &wedge_sets);
+        let lowered = wedge.is_some();
+        if let Some((lambda, candidate, trial)) = wedge {
+            best_lambda = lambda;
+            best = Collapse {
+                convex_lambda,
+                ..candidate
+            };
+            *free = trial;
+        }
         let probes = lowering_probes(model, faces, d, options, free, best_lambda);
         if probes.is_empty() {
+            if lowered {
+                continue;
+            }
             break;
         }
         // The interfaces that separate and slide in some probe's mechanism, in the file's order.
@@ -462,6 +484,9 @@ fn sliding_lift_offs(
             found = lowest_physical(model, faces, d, options, free, best_lambda, &pairs);
         }
         let Some((lambda, candidate, trial)) = found else {
+            if lowered {
+                continue;
+            }
             break;
         };
         best_lambda = lambda;

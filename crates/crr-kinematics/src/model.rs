@@ -497,6 +497,44 @@ fn pivot_point(
     }
 }
 
+/// A point on the child's side of an interface whose points are `face`: its centre of mass, or
+/// for a compound body (a rigid domain of several blocks, not convex) the centroid of the part
+/// the face's centre lies on (the least excess beyond the planes of a part's faces; of equal
+/// excess, the nearest centroid): the domain's centre of mass may lie beyond the plane of a face
+/// on its other side (a corner wedge of a wall, whose head joints face its own centre).
+fn side_point(body: &Body, face: &[[f64; 3]]) -> Vector3<f64> {
+    let Shape::Compound(parts) = &body.shape else {
+        return body.com;
+    };
+    if face.is_empty() {
+        return body.com;
+    }
+    let centre = face.iter().map(|x| Vector3::from(*x)).sum::<Vector3<f64>>() / face.len() as f64;
+    let excess = |surface: &crate::shapes::Surface| {
+        (0..surface.face_count())
+            .map(|f| {
+                let on = surface.vertices[surface.faces[f][0]];
+                surface.face_normal(f).dot(&(centre - on))
+            })
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let scale = body.volume.cbrt();
+    parts
+        .iter()
+        .filter_map(|part| {
+            let surface = part.surface().ok()?;
+            let centroid = part.mass_properties().ok()?.centroid;
+            // Excess rounded to the geometry's tolerance, so that parts touching the face
+            // compare by their centroids' distance.
+            let beyond = (excess(&surface) / (GEOMETRY_TOLERANCE * scale))
+                .round()
+                .max(0.0);
+            Some((beyond, (centroid - centre).norm(), centroid))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)))
+        .map_or(body.com, |(_, _, centroid)| centroid)
+}
+
 fn hinge_kind(
     spec: &InterfaceSpec,
     child_com: &Vector3<f64>,
@@ -1289,6 +1327,7 @@ fn build_interfaces(
                 ),
             ));
         }
+        let child_side = side_point(&bodies[child], &given);
         let kind = match &i.rocking_base {
             Some(rb) => {
                 if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some() {
@@ -1297,9 +1336,9 @@ fn build_interfaces(
                         "a rocking_base defines its own axes and pivots: remove axis, pivot_positive and pivot_negative",
                     ));
                 }
-                rocking_base_kind(&rb.corners, rb.twist, &child_com, &item, size)?
+                rocking_base_kind(&rb.corners, rb.twist, &child_side, &item, size)?
             }
-            None => hinge_kind(i, &child_com, &item, size)?,
+            None => hinge_kind(i, &child_side, &item, size)?,
         };
         check_impact_law(&i.impact, &item)?;
         ends.push((parent, child, kind));
