@@ -335,7 +335,48 @@ fn a_block_against_a_pier_overturns_away_from_it_at_b_over_h() {
             }
         } else {
             certify(&model, Vector3::x(), &into);
+            // Across, the pier (1 × 1 × 2 m) tips alone about its base edge, its face sliding
+            // past the block's with no force on it: b/h = 1/2.
+            for d in [Vector3::y(), -Vector3::y()] {
+                let across = collapse(&model, d);
+                assert!(
+                    (across.lambda.unwrap() - 0.5).abs() < 1e-7,
+                    "{:?}",
+                    across.lambda
+                );
+                certify(&model, d, &across);
+            }
         }
+    }
+}
+
+/// The same block between two fixed piers, touching both: along the line of the piers it cannot
+/// turn (its diagonal would cut into one of them), and across it tips about its base edge with
+/// both side faces sliding unloaded, λ = b/h = 1/1 (found holding up to the cap before the
+/// search's rigid wedges, 2026-12-03).
+#[test]
+fn a_block_between_two_piers_tips_across_them_at_b_over_h() {
+    let dir = common::scratch("statics_between_piers");
+    let text = format!(
+        "name = \"between\"\nfixed = [\"left\", \"right\"]\n{}{}{}",
+        box_body("left", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0]),
+        box_body("right", [0.9, 0.0, 1.0], [1.0, 1.0, 2.0]),
+        box_body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]),
+    );
+    let path = dir.join("between.toml");
+    std::fs::write(&path, text).unwrap();
+    let model = assembled(&path, false);
+    for d in [Vector3::x(), -Vector3::x()] {
+        assert_eq!(collapse(&model, d).lambda, None);
+    }
+    for d in [Vector3::y(), -Vector3::y()] {
+        let across = collapse(&model, d);
+        assert!(
+            (across.lambda.unwrap() - 1.0).abs() < 1e-7,
+            "{:?}",
+            across.lambda
+        );
+        certify(&model, d, &across);
     }
 }
 

@@ -413,7 +413,10 @@ fn solve_program(
 /// λ (a compressed point cannot slide; see [`physical`]). The search also runs where the convex
 /// program holds up to the cap: a block against a pier, turning about its far foot, slides up
 /// the pier at its lowest edge while the rest of that face opens, and overturns at b/h. Each
-/// probe's interfaces are tried freed together, each of the probes' interfaces alone and, where
+/// round first tries rigid wedges ([`wedges`]: on each support, the set of blocks turning as one
+/// about a horizontal axis of least kinematic multiplier, found exactly by minimum cuts), whose
+/// joints open and slide many at once (a running-bond wall's staircase over its end half block
+/// of course 1). Then each probe's interfaces are tried freed together, each of the probes' interfaces alone and, where
 /// none of those lowers λ, each pair of them; the lowest physical candidate is kept. Rounds
 /// repeat until no probe lowers λ. Every answer kept is an admissible mechanism with an
 /// equilibrium at its λ (an upper bound of the true multiplier, never above the convex one); the
@@ -676,7 +679,7 @@ const UNLOADED_TOLERANCE: f64 = 1e-8;
 /// Where only a freed joint's sliding points were unloaded, the façade of the bundled assemblies
 /// answered 1.000484 along +x (1.001462 along −x, though it is symmetric) from a mechanism whose
 /// equilibrium relied on shear across opened joints (none exists on the points that hold:
-/// `tests/statics/collapse_state.rs`); it answers 25/42 both ways (with [`repaired_set`]).
+/// `tests/statics/collapse_state.rs`); it answers 65/138 both ways (its corner wedges).
 fn physical(
     model: &Model,
     faces: &[ContactFace],
