@@ -18,7 +18,7 @@ use serde::Serialize;
 
 use crr_impact::statics::{
     Collapse, Friction, Motion, StaticsError, StaticsOptions, collapse_multiplier,
-    hinges_out_of_plane, required_friction,
+    hinges_out_of_plane, required_friction, state_friction,
 };
 use crr_kinematics::{Model, Side};
 
@@ -55,7 +55,9 @@ pub struct StaticMultiplier {
     /// Every interface that moves in the mechanism.
     pub mechanism: Vec<MechanismJoint>,
     /// The smallest Coulomb friction coefficient with which λ is reached (the no-sliding answer
-    /// relies on it); `None` when `lambda` is.
+    /// relies on it); for an answer of the search for joints that open and slide, the one its
+    /// collapse state needs at the points it keeps in contact
+    /// ([`crr_impact::statics::state_friction`]); `None` when `lambda` is.
     pub required_friction: Option<f64>,
     /// For a planar model (every interface a hinge about one common unit axis a,
     /// [`Model::planar_axis`]): |d·a|, the part of the load along a, which the hinges carry
@@ -148,7 +150,12 @@ pub fn static_multiplier_with(
         });
     }
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
+    // The friction the answer relies on: for a collapse state of the search for joints that
+    // open and slide, that of its own holding points (more than the convex program's).
     let required = match (collapse.lambda, friction) {
+        (Some(_), None) if collapse.from_sliding_search() => {
+            state_friction(model, &collapse, options.lambda_max).map_err(|e| e.to_string())?
+        }
         (Some(lambda), None) => Some(
             required_friction(model, direction, options.lambda_max, lambda)
                 .map_err(|e| e.to_string())?,

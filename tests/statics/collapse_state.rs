@@ -77,6 +77,29 @@ struct Holding {
 /// carries any couple out of its plane (a line joint), and a pin any force.
 fn certify(model: &Model, d: Vector3<f64>, c: &Collapse) -> f64 {
     let lambda = c.lambda.expect("a mechanism");
+    let holding = holding_points(model, c);
+    let bodies: Vec<Velocity> = c
+        .bodies
+        .iter()
+        .map(|b| (Vector3::from(b.velocity), Vector3::from(b.angular)))
+        .collect();
+    let kinematic = kinematic_multiplier(model, d, &bodies);
+    assert!(
+        (kinematic - lambda).abs() <= 1e-7 * lambda,
+        "static {lambda}, kinematic {kinematic}"
+    );
+    let statical = equilibrium_on(model, d, model.planar_axis(), &holding, None)
+        .unwrap_or_else(|status| panic!("no equilibrium on the points that hold: {status:?}"));
+    assert!(
+        (statical - lambda).abs() <= 1e-7 * lambda,
+        "engine {lambda}, equilibrium on the points that hold {statical}"
+    );
+    kinematic
+}
+
+/// The points the collapse's mechanism keeps in contact without sliding, after asserting the
+/// mechanism admissible (from the bodies' velocities and the model's own geometry).
+fn holding_points(model: &Model, c: &Collapse) -> Vec<Holding> {
     let rate_tol = 1e-7;
     let size = model.size;
     let planar = model.planar_axis();
@@ -142,18 +165,7 @@ fn certify(model: &Model, d: Vector3<f64>, c: &Collapse) -> f64 {
             }
         }
     }
-    let kinematic = kinematic_multiplier(model, d, &bodies);
-    assert!(
-        (kinematic - lambda).abs() <= 1e-7 * lambda,
-        "static {lambda}, kinematic {kinematic}"
-    );
-    let statical = equilibrium_on(model, d, planar, &holding)
-        .unwrap_or_else(|status| panic!("no equilibrium on the points that hold: {status:?}"));
-    assert!(
-        (statical - lambda).abs() <= 1e-7 * lambda,
-        "engine {lambda}, equilibrium on the points that hold {statical}"
-    );
-    kinematic
+    holding
 }
 
 /// The bodies a holding point's forces act on, with their signs (child +, parent −).
@@ -204,6 +216,7 @@ fn equilibrium_on(
     d: Vector3<f64>,
     planar: Option<Vector3<f64>>,
     holding: &[Holding],
+    friction: Option<f64>,
 ) -> Result<f64, clarabel::solver::SolverStatus> {
     let weight = model.bodies.iter().map(|b| b.mass).sum::<f64>() * model.gravity;
     let size = model.size;
@@ -260,6 +273,7 @@ fn equilibrium_on(
                         .push((column, sign * e.dot(&moment)));
                 }
             };
+        let normal_column = column;
         for (direction, compressive) in forces {
             for (body, sign) in bodies_of(h) {
                 let arm = (h.point - model.bodies[body].com).cross(&direction) / size;
@@ -267,6 +281,10 @@ fn equilibrium_on(
             }
             if compressive {
                 lp_le.push((vec![(column, -1.0)], 0.0));
+            } else if let (Some(mu), Some(_)) = (friction, h.normal) {
+                // Coulomb's pyramid on each tangent: |f_t| ≤ μ fₙ.
+                lp_le.push((vec![(column, 1.0), (normal_column, -mu)], 0.0));
+                lp_le.push((vec![(column, -1.0), (normal_column, -mu)], 0.0));
             }
             column += 1;
         }
@@ -429,6 +447,33 @@ fn the_running_bond_wall_loses_its_corner_wedge() {
         assert!(wedge.iter().all(|b| !b.starts_with("c0_")), "{wedge:?}");
         certify(&model, d, &c);
     }
+}
+
+/// The friction a collapse state relies on (`statics::state_friction`, the μ `crr check` reports
+/// for an answer of the search): with Coulomb's pyramid μ at the points the wall's corner wedge
+/// keeps in contact (and nothing elsewhere), the LP written here reaches its λ = 2/3 at 1.001 μ
+/// and not at 0.999 μ (the engine's bisection stops at 1e-4 of μ). It is more than the friction
+/// the convex program needs to reach 2/3 with every point loaded (`required_friction`, 0.7134):
+/// an independent review's LP found 0.7468 for the wedge.
+#[test]
+fn the_corner_wedge_needs_the_friction_its_holding_points_carry() {
+    use crr::impact::statics::{required_friction, state_friction};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/wall.toml");
+    let model = assembled(&path, true);
+    let d = Vector3::x();
+    let c = collapse(&model, d);
+    let lambda = c.lambda.unwrap();
+    let mu = state_friction(&model, &c, 10.0).unwrap().unwrap();
+    let convex = required_friction(&model, d, 10.0, lambda).unwrap();
+    assert!(mu > convex + 0.02, "{mu} against {convex}");
+    assert!((mu - 0.7468).abs() < 1e-3, "{mu}");
+    let holding = holding_points(&model, &c);
+    let reached = |mu: f64| {
+        equilibrium_on(&model, d, model.planar_axis(), &holding, Some(mu))
+            .is_ok_and(|l| l >= lambda * (1.0 - 1e-6))
+    };
+    assert!(reached(mu * 1.001));
+    assert!(!reached(mu * 0.999));
 }
 
 /// The bundled façade with a door, planar, every contact an interface: the corner wedge of 12

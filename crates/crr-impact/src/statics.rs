@@ -728,7 +728,7 @@ pub fn required_friction(
     lambda: f64,
 ) -> Result<f64, StaticsError> {
     let target = lambda - 1e-6 * lambda.abs();
-    let reaches = |mu: f64| -> Result<bool, StaticsError> {
+    smallest_friction(|mu: f64| -> Result<bool, StaticsError> {
         let options = StaticsOptions {
             friction: Friction::Pyramid(mu),
             lambda_max,
@@ -739,7 +739,61 @@ pub fn required_friction(
             Err(StaticsError::DoesNotHold(_)) => Ok(false),
             Err(e) => Err(e),
         }
+    })
+}
+
+/// The smallest Coulomb friction coefficient (pyramid on each tangent) with which the collapse
+/// state `collapse` (an answer of [`collapse_multiplier`] with its λ) has an equilibrium at
+/// (1 − 1e-6) of its λ with forces only at the points its mechanism keeps in contact without
+/// sliding: the friction that state relies on. For an answer of the search for joints that open
+/// and slide this is more than [`required_friction`], whose program lets every point carry load
+/// (the wall assembly's corner wedge at 2/3: 0.7469 against 0.7134). 0 when it needs none,
+/// infinity beyond μ = 1000; `None` for a collapse that holds (no λ).
+pub fn state_friction(
+    model: &Model,
+    collapse: &Collapse,
+    lambda_max: f64,
+) -> Result<Option<f64>, StaticsError> {
+    let Some(lambda) = collapse.lambda else {
+        return Ok(None);
     };
+    let d = unit_direction(Vector3::from(collapse.direction))?;
+    let faces = contact_faces(model);
+    let mut unloaded = Vec::new();
+    for i in &collapse.interfaces {
+        if faces[i.interface].pin {
+            continue;
+        }
+        for (p, (&gap, &slip)) in i.gap_rates.iter().zip(&i.slip_rates).enumerate() {
+            if gap > MECHANISM_TOLERANCE || slip > MECHANISM_TOLERANCE {
+                unloaded.push((i.interface, p));
+            }
+        }
+    }
+    let free = vec![false; faces.len()];
+    let target = lambda - 1e-6 * lambda.abs();
+    smallest_friction(|mu: f64| -> Result<bool, StaticsError> {
+        let options = StaticsOptions {
+            friction: Friction::Pyramid(mu),
+            lambda_max,
+            sliding_lift_off: false,
+        };
+        // With few points loaded and little friction the program may have no equilibrium at
+        // any λ ≥ 0, which the solver reports as not converging: that μ does not reach λ.
+        match solve_program(model, &faces, d, &options, &free, &unloaded) {
+            Ok(c) => Ok(c.lambda.is_none_or(|l| l >= target)),
+            Err(StaticsError::DoesNotHold(_) | StaticsError::Solver(_)) => Ok(false),
+            Err(e) => Err(e),
+        }
+    })
+    .map(Some)
+}
+
+/// The smallest μ ≥ 0 with `reaches(μ)` (monotone in μ), to four significant digits: 0 where μ
+/// = 0 reaches, infinity beyond 1000.
+fn smallest_friction(
+    reaches: impl Fn(f64) -> Result<bool, StaticsError>,
+) -> Result<f64, StaticsError> {
     if reaches(0.0)? {
         return Ok(0.0);
     }
@@ -752,7 +806,6 @@ pub fn required_friction(
             return Ok(f64::INFINITY);
         }
     }
-    // μ to four significant digits.
     while high - low > 1e-4 * high {
         let mid = 0.5 * (low + high);
         if reaches(mid)? {
