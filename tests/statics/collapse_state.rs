@@ -468,12 +468,15 @@ fn the_corner_wedge_needs_the_friction_its_holding_points_carry() {
     assert!(mu > convex + 0.02, "{mu} against {convex}");
     assert!((mu - 0.7468).abs() < 1e-3, "{mu}");
     let holding = holding_points(&model, &c);
-    let reached = |mu: f64| {
-        equilibrium_on(&model, d, model.planar_axis(), &holding, Some(mu))
-            .is_ok_and(|l| l >= lambda * (1.0 - 1e-6))
-    };
-    assert!(reached(mu * 1.001));
-    assert!(!reached(mu * 0.999));
+    let equilibrium = |mu: f64| equilibrium_on(&model, d, model.planar_axis(), &holding, Some(mu));
+    let target = lambda * (1.0 - 1e-6);
+    assert!(equilibrium(mu * 1.001).is_ok_and(|l| l >= target));
+    // Below, the LP proves it: infeasible (no equilibrium on those points at any λ ≥ 0) or a
+    // lower λ, not a solver that stopped.
+    match equilibrium(mu * 0.999) {
+        Ok(l) => assert!(l < target, "{l} at 0.999 μ"),
+        Err(status) => assert_eq!(status, clarabel::solver::SolverStatus::PrimalInfeasible),
+    }
 }
 
 /// The bundled façade with a door, planar, every contact an interface: the corner wedge of 12

@@ -414,7 +414,8 @@ fn solve_program(
 /// program holds up to the cap: a block against a pier, turning about its far foot, slides up
 /// the pier at its lowest edge while the rest of that face opens, and overturns at b/h. Each
 /// round first tries rigid wedges ([`wedges`]: on each support, the set of blocks turning as one
-/// about a horizontal axis of least kinematic multiplier, found exactly by minimum cuts), whose
+/// about a horizontal axis of least kinematic multiplier, found by minimum cuts: exactly where
+/// no body falls on its own and the least closure is connected), whose
 /// joints open and slide many at once (a running-bond wall's staircase over its end half block
 /// of course 1). Then each probe's interfaces are tried freed together, each of the probes' interfaces alone and, where
 /// none of those lowers λ, each pair of them; the lowest physical candidate is kept. Rounds
@@ -746,9 +747,16 @@ pub fn required_friction(
 /// state `collapse` (an answer of [`collapse_multiplier`] with its λ) has an equilibrium at
 /// (1 − 1e-6) of its λ with forces only at the points its mechanism keeps in contact without
 /// sliding: the friction that state relies on. For an answer of the search for joints that open
-/// and slide this is more than [`required_friction`], whose program lets every point carry load
+/// and slide this is at least [`required_friction`], whose program lets every point carry load
 /// (the wall assembly's corner wedge at 2/3: 0.7469 against 0.7134). 0 when it needs none,
 /// infinity beyond μ = 1000; `None` for a collapse that holds (no λ).
+///
+/// With only the holding points loaded the equilibrium does no virtual work, so its program is
+/// degenerate (λ is fixed at the mechanism's own), and the solver may stop without converging
+/// where an equilibrium exists: such a μ counts as not reaching λ, which can only raise the
+/// answer (a bracket of 1e-4 of μ on the wall's wedge, `tests/statics/collapse_state.rs`). Where
+/// no μ up to 1000 reaches λ and the solver failed on the way, that failure is returned instead
+/// of infinity.
 pub fn state_friction(
     model: &Model,
     collapse: &Collapse,
@@ -772,7 +780,8 @@ pub fn state_friction(
     }
     let free = vec![false; faces.len()];
     let target = lambda - 1e-6 * lambda.abs();
-    smallest_friction(|mu: f64| -> Result<bool, StaticsError> {
+    let failure = std::cell::RefCell::new(None);
+    let mu = smallest_friction(|mu: f64| -> Result<bool, StaticsError> {
         let options = StaticsOptions {
             friction: Friction::Pyramid(mu),
             lambda_max,
@@ -782,11 +791,18 @@ pub fn state_friction(
         // any λ ≥ 0, which the solver reports as not converging: that μ does not reach λ.
         match solve_program(model, &faces, d, &options, &free, &unloaded) {
             Ok(c) => Ok(c.lambda.is_none_or(|l| l >= target)),
-            Err(StaticsError::DoesNotHold(_) | StaticsError::Solver(_)) => Ok(false),
+            Err(StaticsError::DoesNotHold(_)) => Ok(false),
+            Err(StaticsError::Solver(status)) => {
+                *failure.borrow_mut() = Some(status);
+                Ok(false)
+            }
             Err(e) => Err(e),
         }
-    })
-    .map(Some)
+    })?;
+    match (mu.is_finite(), failure.into_inner()) {
+        (false, Some(status)) => Err(StaticsError::Solver(status)),
+        _ => Ok(Some(mu)),
+    }
 }
 
 /// The smallest μ ≥ 0 with `reaches(μ)` (monotone in μ), to four significant digits: 0 where μ
