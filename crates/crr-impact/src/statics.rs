@@ -690,17 +690,7 @@ fn physical(
     collapse: Collapse,
 ) -> Option<Collapse> {
     let lambda = collapse.lambda?;
-    let mut unloaded = Vec::new();
-    for i in &collapse.interfaces {
-        if faces[i.interface].pin {
-            continue;
-        }
-        for (p, (&gap, &slip)) in i.gap_rates.iter().zip(&i.slip_rates).enumerate() {
-            if gap > MECHANISM_TOLERANCE || slip > MECHANISM_TOLERANCE {
-                unloaded.push((i.interface, p));
-            }
-        }
-    }
+    let unloaded = moving_points(faces, &collapse);
     if unloaded.is_empty() {
         return Some(collapse);
     }
@@ -767,20 +757,10 @@ pub fn state_friction(
     };
     let d = unit_direction(Vector3::from(collapse.direction))?;
     let faces = contact_faces(model);
-    let mut unloaded = Vec::new();
-    for i in &collapse.interfaces {
-        if faces[i.interface].pin {
-            continue;
-        }
-        for (p, (&gap, &slip)) in i.gap_rates.iter().zip(&i.slip_rates).enumerate() {
-            if gap > MECHANISM_TOLERANCE || slip > MECHANISM_TOLERANCE {
-                unloaded.push((i.interface, p));
-            }
-        }
-    }
+    let unloaded = moving_points(&faces, collapse);
     let free = vec![false; faces.len()];
     let target = lambda - 1e-6 * lambda.abs();
-    let failure = std::cell::RefCell::new(None);
+    let mut failure = None;
     let mu = smallest_friction(|mu: f64| -> Result<bool, StaticsError> {
         let options = StaticsOptions {
             friction: Friction::Pyramid(mu),
@@ -793,22 +773,39 @@ pub fn state_friction(
             Ok(c) => Ok(c.lambda.is_none_or(|l| l >= target)),
             Err(StaticsError::DoesNotHold(_)) => Ok(false),
             Err(StaticsError::Solver(status)) => {
-                *failure.borrow_mut() = Some(status);
+                failure = Some(status);
                 Ok(false)
             }
             Err(e) => Err(e),
         }
     })?;
-    match (mu.is_finite(), failure.into_inner()) {
+    match (mu.is_finite(), failure) {
         (false, Some(status)) => Err(StaticsError::Solver(status)),
         _ => Ok(Some(mu)),
     }
 }
 
+/// The points (interface, point) of a collapse's mechanism that open or slide, pins aside: a
+/// collapse state loads only the others.
+fn moving_points(faces: &[ContactFace], collapse: &Collapse) -> Vec<(usize, usize)> {
+    let mut moving = Vec::new();
+    for i in &collapse.interfaces {
+        if faces[i.interface].pin {
+            continue;
+        }
+        for (p, (&gap, &slip)) in i.gap_rates.iter().zip(&i.slip_rates).enumerate() {
+            if gap > MECHANISM_TOLERANCE || slip > MECHANISM_TOLERANCE {
+                moving.push((i.interface, p));
+            }
+        }
+    }
+    moving
+}
+
 /// The smallest μ ≥ 0 with `reaches(μ)` (monotone in μ), to four significant digits: 0 where μ
 /// = 0 reaches, infinity beyond 1000.
 fn smallest_friction(
-    reaches: impl Fn(f64) -> Result<bool, StaticsError>,
+    mut reaches: impl FnMut(f64) -> Result<bool, StaticsError>,
 ) -> Result<f64, StaticsError> {
     if reaches(0.0)? {
         return Ok(0.0);

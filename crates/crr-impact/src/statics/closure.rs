@@ -144,8 +144,20 @@ pub(super) fn minimum_closure(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::minimum_closure;
+
+    /// A deterministic sequence of numbers uniform in [0, 1) (a linear congruential generator),
+    /// for the random graphs of the statics' unit tests.
+    pub(in crate::statics) fn uniform_sequence(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as f64 / (1u64 << 31) as f64
+        }
+    }
 
     /// Every subset of a small graph, closed ones only: the least weight by enumeration.
     fn by_enumeration(
@@ -175,13 +187,7 @@ mod tests {
     fn the_cut_finds_the_least_closure_of_every_small_graph() {
         // A deterministic family of graphs of 7 nodes: weights and arcs from a linear
         // congruential sequence, against the enumeration of all 128 subsets.
-        let mut state: u64 = 12345;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) as f64 / (1u64 << 31) as f64
-        };
+        let mut next = uniform_sequence(12345);
         for _ in 0..300 {
             let n = 7;
             let weights: Vec<f64> = (0..n).map(|_| next() * 2.0 - 1.0).collect();

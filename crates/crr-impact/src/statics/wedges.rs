@@ -308,8 +308,9 @@ fn least_wedge(
 /// falls on its own (every riseᵢ ≥ 0: a closure of negative weight is then driven). A least
 /// closure that is not driven falls under gravity with the load against it, which the
 /// program's sliding joints may allow where no friction holds them; its most falling body
-/// (least riseᵢ) is held and the least closure sought again at the same λ, one body at a
-/// time, instead of ending the search there (a driven closure below may remain).
+/// (least riseᵢ; bodies tied there together, so that the order the file lists them in does not
+/// choose) is held and the least closure sought again at the same λ, instead of ending the
+/// search there (a driven closure below may remain).
 fn least_ratio(
     rise: &[f64],
     drive: &[f64],
@@ -322,8 +323,8 @@ fn least_ratio(
     let mut held = held.to_vec();
     let mut lambda = below;
     let mut best = None;
-    // Each pass lowers λ strictly (never to a closure seen before) or holds one more body (at
-    // most n). 2n + 2 passes is a cap, not a proved count (the drives may be negative): where it
+    // Each pass lowers λ strictly (never to a closure seen before) or holds at least one more
+    // body (at most n). 2n + 2 passes is a cap, not a proved count (the drives may be negative): where it
     // is reached the closure kept is still admissible and driven, only perhaps not the least.
     for _ in 0..2 * n + 2 {
         let weights: Vec<f64> = (0..n).map(|i| rise[i] - lambda * drive[i]).collect();
@@ -335,16 +336,18 @@ fn least_ratio(
             .fold((0.0, 0.0), |(r, dr), i| (r + rise[i], dr + drive[i]));
         let driven = dr > 0.0 && r >= 0.0;
         if !driven {
-            let falling = (0..n)
-                .filter(|&i| members[i] && i != turning && rise[i] < 0.0)
-                .min_by(|&a, &b| rise[a].total_cmp(&rise[b]));
-            match falling {
-                Some(i) => {
-                    held[i] = true;
-                    continue;
-                }
-                None => break,
+            let falling = |i: usize| members[i] && i != turning && rise[i] < 0.0;
+            let least = (0..n)
+                .filter(|&i| falling(i))
+                .map(|i| rise[i])
+                .fold(f64::INFINITY, f64::min);
+            if least == f64::INFINITY {
+                break;
             }
+            for i in (0..n).filter(|&i| falling(i)) {
+                held[i] |= rise[i] <= least - 1e-12 * least;
+            }
+            continue;
         }
         let ratio = r / dr;
         let falls = ratio < lambda * (1.0 - 1e-12);
@@ -383,6 +386,14 @@ fn connected_to(model: &Model, members: &[bool], start: usize) -> Vec<bool> {
 mod tests {
     use super::least_ratio;
     use crate::statics::closure::minimum_closure;
+    use crate::statics::closure::tests::uniform_sequence;
+
+    /// Σ rise and Σ drive over the members.
+    fn sums(rise: &[f64], drive: &[f64], members: &[bool]) -> (f64, f64) {
+        (0..rise.len())
+            .filter(|&i| members[i])
+            .fold((0.0, 0.0), |(r, dr), i| (r + rise[i], dr + drive[i]))
+    }
 
     /// Dinkelbach as it stood until 2026-12-04: the search ends at the first least closure
     /// that is not driven. The baseline the holding of falling bodies must never fall behind.
@@ -401,9 +412,7 @@ mod tests {
             let Some(members) = minimum_closure(&weights, arcs, Some(turning), held) else {
                 return best;
             };
-            let (r, dr) = (0..n)
-                .filter(|&i| members[i])
-                .fold((0.0, 0.0), |(r, dr), i| (r + rise[i], dr + drive[i]));
+            let (r, dr) = sums(rise, drive, &members);
             if !(dr > 0.0 && r >= 0.0) || r / dr >= lambda * (1.0 - 1e-12) {
                 return best;
             }
@@ -431,8 +440,8 @@ mod tests {
                     && (0..n).all(|i| !held[i] || !has(i))
             })
             .filter_map(|s| {
-                let members = (0..n).filter(|&i| s & (1 << i) != 0);
-                let (r, dr) = members.fold((0.0, 0.0), |(r, dr), i| (r + rise[i], dr + drive[i]));
+                let members: Vec<bool> = (0..n).map(|i| s & (1 << i) != 0).collect();
+                let (r, dr) = sums(rise, drive, &members);
                 (dr > 0.0 && r >= 0.0).then_some(r / dr)
             })
             .filter(|&ratio| ratio < below)
@@ -463,13 +472,7 @@ mod tests {
     /// rule until 2026-12-04), which it beats on some graphs.
     #[test]
     fn the_least_ratio_is_exact_where_nothing_falls_and_admissible_elsewhere() {
-        let mut state: u64 = 2024;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) as f64 / (1u64 << 31) as f64
-        };
+        let mut next = uniform_sequence(2024);
         let n = 7;
         let (mut exact, mut falling_cases, mut falling_exact, mut improved) = (0, 0, 0, 0);
         for case in 0..600 {
@@ -495,9 +498,7 @@ mod tests {
                 assert!(members[turning]);
                 assert!(arcs.iter().all(|&(i, j)| !members[i] || members[j]));
                 assert!((0..n).all(|i| !held[i] || !members[i]));
-                let (r, dr) = (0..n)
-                    .filter(|&i| members[i])
-                    .fold((0.0, 0.0), |(r, dr), i| (r + rise[i], dr + drive[i]));
+                let (r, dr) = sums(&rise, &drive, members);
                 assert!(dr > 0.0 && r >= 0.0, "not driven: {r} {dr}");
                 assert!((lambda - r / dr).abs() <= 1e-12 * lambda.abs().max(1.0));
                 assert!(*lambda < below);
