@@ -499,9 +499,16 @@ fn pivot_point(
 
 /// A point on the child's side of an interface whose points are `face`: its centre of mass, or
 /// for a compound body (a rigid domain of several blocks, not convex) the centroid of the part
-/// the face's centre lies on (the least excess beyond the planes of a part's faces; of equal
-/// excess, the nearest centroid): the domain's centre of mass may lie beyond the plane of a face
-/// on its other side (a corner wedge of a wall, whose head joints face its own centre).
+/// the face lies on: the part on whose surface most of the face's points lie; among equals, the
+/// one of least excess of the face's centre beyond the planes of its faces, then the nearest
+/// centroid. The domain's centre of mass may lie beyond the plane of a face on its other side
+/// (a corner wedge of a wall, whose head joints face its own centre).
+///
+/// The face's points, not its centre alone, name the part: `crr assemble` writes the coplanar
+/// faces of two domains as one interface on the convex hull of their corners, whose centre may
+/// lie between the parts that touch (the two legs of a bridge-shaped domain), even on a part of
+/// the child across the face's plane; each of the hull's corners is a corner of a face that
+/// touches, so it lies on a part on the child's side.
 fn side_point(body: &Body, face: &[[f64; 3]]) -> Vector3<f64> {
     let Shape::Compound(parts) = &body.shape else {
         return body.com;
@@ -509,30 +516,39 @@ fn side_point(body: &Body, face: &[[f64; 3]]) -> Vector3<f64> {
     if face.is_empty() {
         return body.com;
     }
-    let centre = face.iter().map(|x| Vector3::from(*x)).sum::<Vector3<f64>>() / face.len() as f64;
-    let excess = |surface: &crate::shapes::Surface| {
-        (0..surface.face_count())
+    let points: Vec<Vector3<f64>> = face.iter().map(|x| Vector3::from(*x)).collect();
+    let centre = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
+    let scale = body.volume.cbrt();
+    // How far x lies beyond the planes of the part's faces, in units of the geometry's
+    // tolerance, rounded: 0 on or in the part, so that parts touching x compare as equals.
+    let excess = |surface: &crate::shapes::Surface, x: &Vector3<f64>| {
+        let beyond = (0..surface.face_count())
             .map(|f| {
                 let on = surface.vertices[surface.faces[f][0]];
-                surface.face_normal(f).dot(&(centre - on))
+                surface.face_normal(f).dot(&(x - on))
             })
-            .fold(f64::NEG_INFINITY, f64::max)
+            .fold(f64::NEG_INFINITY, f64::max);
+        (beyond / (GEOMETRY_TOLERANCE * scale)).round().max(0.0)
     };
-    let scale = body.volume.cbrt();
     parts
         .iter()
         .filter_map(|part| {
             let surface = part.surface().ok()?;
             let centroid = part.mass_properties().ok()?.centroid;
-            // Excess rounded to the geometry's tolerance, so that parts touching the face
-            // compare by their centroids' distance.
-            let beyond = (excess(&surface) / (GEOMETRY_TOLERANCE * scale))
-                .round()
-                .max(0.0);
-            Some((beyond, (centroid - centre).norm(), centroid))
+            let touching = points.iter().filter(|x| excess(&surface, x) == 0.0).count();
+            Some((
+                touching,
+                excess(&surface, &centre),
+                (centroid - centre).norm(),
+                centroid,
+            ))
         })
-        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)))
-        .map_or(body.com, |(_, _, centroid)| centroid)
+        .min_by(|a, b| {
+            b.0.cmp(&a.0)
+                .then(a.1.total_cmp(&b.1))
+                .then(a.2.total_cmp(&b.2))
+        })
+        .map_or(body.com, |(_, _, _, centroid)| centroid)
 }
 
 fn hinge_kind(

@@ -227,3 +227,82 @@ box = { center = [0.1, 0.0, 1.6], size = [0.4, 0.6, 0.8] }
     let json: StructureSpec = serde_json::from_str(&serde_json::to_string(&spec).unwrap()).unwrap();
     assert_eq!(spec, json);
 }
+
+/// A bridge-shaped rigid domain (two legs 1 m wide at the ends of a 10 m lintel) standing on a
+/// plinth, with a plug of the domain set in a notch of the plinth under its middle: the legs'
+/// beds, written as one interface on their convex hull (as `crr assemble` writes coplanar faces
+/// of two domains), have their centre at x = 5, on the plug's top face, across the bed's plane
+/// from the rest of the domain. The child lies above the bed, so its normal points up (+z), as
+/// it does for the same domain without the plug; taken from the part at the hull's centre it
+/// pointed down into the plinth (the rule until 2026-12-04).
+#[test]
+fn a_bed_on_the_hull_of_two_legs_faces_the_legs_not_a_part_under_its_centre() {
+    let domain = |plug: &str| {
+        format!(
+            r#"
+name = "bridge on a plinth"
+[[body]]
+name = "plinth"
+density = 2400.0
+[[body.block]]
+name = "left"
+box = {{ center = [2.0, 0.0, -0.5], size = [4.0, 1.0, 1.0] }}
+[[body.block]]
+name = "right"
+box = {{ center = [8.0, 0.0, -0.5], size = [4.0, 1.0, 1.0] }}
+[[body.block]]
+name = "bottom"
+box = {{ center = [5.0, 0.0, -1.5], size = [10.0, 1.0, 1.0] }}
+[[body]]
+name = "bridge"
+density = 2400.0
+[[body.block]]
+name = "leg_left"
+box = {{ center = [0.5, 0.0, 0.5], size = [1.0, 1.0, 1.0] }}
+[[body.block]]
+name = "leg_right"
+box = {{ center = [9.5, 0.0, 0.5], size = [1.0, 1.0, 1.0] }}
+[[body.block]]
+name = "lintel"
+box = {{ center = [5.0, 0.0, 1.5], size = [10.0, 1.0, 1.0] }}
+{plug}
+[[interface]]
+name = "plinth_on_ground"
+parent = "ground"
+child = "plinth"
+rocking_base = {{ corners = [[0.0, -0.5, -2.0], [10.0, -0.5, -2.0], [10.0, 0.5, -2.0], [0.0, 0.5, -2.0]] }}
+[[interface]]
+name = "bridge_on_plinth"
+parent = "plinth"
+child = "bridge"
+rocking_base = {{ corners = [[0.0, -0.5, 0.0], [10.0, -0.5, 0.0], [10.0, 0.5, 0.0], [0.0, 0.5, 0.0]] }}
+"#
+        )
+    };
+    let plug = r#"
+[[body.block]]
+name = "plug"
+box = { center = [5.0, 0.0, -0.5], size = [2.0, 1.0, 1.0] }
+"#;
+    let normal = |text: &str| {
+        let model = build(text).expect("the model builds");
+        let bed = model
+            .interfaces
+            .iter()
+            .find(|i| i.name == "bridge_on_plinth")
+            .expect("the bed is an interface");
+        match &bed.kind {
+            crr_kinematics::InterfaceKind::RockingBase { normal, .. } => *normal,
+            other => panic!("the bed is a rocking base, not {other:?}"),
+        }
+    };
+    // Unit vectors from the corners' cross products: exact to a few ulps.
+    let up = Vector3::z();
+    let without = normal(&domain(""));
+    assert!(
+        (without - up).norm() <= 1e-12,
+        "without the plug: {without:?}"
+    );
+    let with = normal(&domain(plug));
+    assert!((with - up).norm() <= 1e-12, "with the plug: {with:?}");
+}
