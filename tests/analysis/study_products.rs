@@ -454,8 +454,8 @@ fn violation_times(dir: &Path) -> Vec<Option<f64>> {
 
 /// A case whose run leaves crr's model says so in its row, as `crr simulate` does for the same
 /// run. The bundled drum column under its own pulse (one sine of 2.5 m/s², 0.5 s, 4 s from rest)
-/// rocks, and at 0.5295 s the bed under the fourth drum would have to pull (the drums above
-/// fly; tests/cli/warnings.rs): the study's case of that pulse gives the same time, bit for bit,
+/// rocks, and at 0.5028 s the bed under the seventh drum would have to pull (the drums above
+/// hop; tests/cli/warnings.rs): the study's case of that pulse gives the same time, bit for bit,
 /// the same kind and interface as `summary.json`'s `hypothesis_violation` of `crr simulate` on
 /// the model file, and counts it in `study.json` (a run's and a merge's of its two shards), on
 /// stderr and in the map's caption and legend. Under 1.0 m/s², below the column's uplift acceleration g tan α ≈ 1.34 m/s² (the
@@ -500,7 +500,7 @@ fn a_case_that_leaves_the_model_says_so_as_crr_simulate_does() {
     let summary = read_json(&single.join("summary.json"));
     let v = &summary["hypothesis_violation"];
     let t = v["time"].as_f64().unwrap();
-    assert!((t - 0.5295).abs() < 1e-4, "{v}");
+    assert!((t - 0.5028).abs() < 1e-4, "{v}");
     assert_eq!(rows[1][1].parse::<f64>().unwrap().to_bits(), t.to_bits());
     assert_eq!(rows[1][2], v["kind"].as_str().unwrap());
     assert_eq!(rows[1][2], "tension");
@@ -726,8 +726,8 @@ fn a_case_stopped_by_an_error_keeps_the_measures_its_run_reached() {
     );
 }
 
-/// A study's `hop_tolerance` replaces the model's: the drum column's pull at 0.5295 s under its
-/// own pulse is a hop of 1.5e-10 m (docs/simulation.md, "Hops"), so with a tolerance of 1 µm the
+/// A study's `hop_tolerance` replaces the model's: the drum column's pull at 0.5028 s under its
+/// own pulse is a hop of 1.1e-8 m (docs/simulation.md, "Hops"), so with a tolerance of 1 µm the
 /// case stays inside the model, with the same impacts; a negative tolerance is refused, naming
 /// the key.
 #[test]

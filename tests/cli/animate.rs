@@ -699,7 +699,7 @@ fn bundled_models_gifs_are_under_5_mb() {
 
 /// An animation of a run that leaves crr's model says so on every frame after the run's first
 /// hypotheses violation (its time read from summary.json), and on none before: the bundled drum
-/// column, whose bed under the fourth drum would have to pull at 0.5295 s.
+/// column, whose bed under the seventh drum would have to pull at 0.5028 s.
 #[test]
 fn frames_after_a_violation_say_they_are_outside_the_model() {
     use crr::output::animate::{gif::caption, read_run};
@@ -708,7 +708,7 @@ fn frames_after_a_violation_say_they_are_outside_the_model() {
         serde_json::from_str(&std::fs::read_to_string(results.join("summary.json")).unwrap())
             .unwrap();
     let t_v = summary["hypothesis_violation"]["time"].as_f64().unwrap();
-    assert!((t_v - 0.5295).abs() < 1e-4, "{t_v}");
+    assert!((t_v - 0.5028).abs() < 1e-4, "{t_v}");
     let run = read_run(&results).unwrap();
     assert_eq!(run.violation_time, Some(t_v));
     let (mut before, mut after) = (0, 0);
@@ -728,7 +728,7 @@ fn frames_after_a_violation_say_they_are_outside_the_model() {
     }
     assert!(before > 10 && after > 10, "{before} before, {after} after");
     // The GIF is written with those captions: the same folder with the violation removed from
-    // its summary.json animates to other pixels (only the captions after 0.5295 s differ).
+    // its summary.json animates to other pixels (only the captions after 0.5028 s differ).
     ok(&["animate", s(&results), "--out", s(&results.join("anim"))]);
     let clean = results.with_file_name("clean");
     std::fs::create_dir_all(&clean).unwrap();

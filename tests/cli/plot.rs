@@ -90,8 +90,8 @@ fn simulate_plot_writes_the_three_plots_of_the_single_block() {
 
 /// The time histories and the energy balance of a run that leaves crr's model shade the time
 /// after its first hypotheses violation and name it in the legend, at the time and interface
-/// `summary.json` gives: the bundled drum column, whose bed under the fourth drum would have to
-/// pull at 0.5295 s (the drums above fly, tests/cli/warnings.rs).
+/// `summary.json` gives: the bundled drum column, whose bed under the seventh drum would have to
+/// pull at 0.5028 s (the drums above hop, tests/cli/warnings.rs).
 #[test]
 fn plots_shade_the_time_outside_the_model() {
     let out = scratch("plot_outside_model");
@@ -115,7 +115,7 @@ fn plots_shade_the_time_outside_the_model() {
     );
     assert_eq!(
         label,
-        "outside crr's model from t = 0.5295 s (tension at bed_4)"
+        "outside crr's model from t = 0.5028 s (tension at bed_7)"
     );
     for stem in ["coordinates", "energy"] {
         assert_png(&out.join(format!("{stem}.png")));

@@ -9,8 +9,8 @@
 //!
 //! Runs: the bundled 3D arch under its record (bases rocking on an edge: the states the
 //! certificate covers since it was extended to them), the bundled temple with its seats made
-//! rigid (`twist = false`, the model on which a wider rule was found unsound), the bundled
-//! temple as it is (seats that may twist) at 0.8 of its record, and running-bond walls under a
+//! rigid (`twist = false`, the model on which a wider rule was found unsound) and as it is (seats
+//! that may twist), both at 0.8 of its record, and running-bond walls under a
 //! pulse above their collapse multiplier.
 //!
 //! The check has teeth: with the certificate not bounded by the locked solve's closure residual
@@ -140,11 +140,24 @@ fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_3d_arch() {
 
 #[test]
 fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_rigid_seated_temple() {
-    let text = common::bundled_text_with_records("temple").replace("twist = true", "twist = false");
+    // At 0.8 of its record, which the bay rocks through for the whole 6 s. Under the whole
+    // record the rigid bay's rattling from 2.05 s is not resolved by the default steps: with
+    // `max_step = 1e-4` the capital c13 flies at 2.0541 s, while the default steps went on to a
+    // flight at 3.159 s (483 impacts) before the impact angles were read inside the steps, and
+    // since then into a chatter of the necks at 2.667 s whose steps take minutes.
+    let text = common::bundled_text_with_records("temple")
+        .replace("twist = true", "twist = false")
+        .replace(
+            "format = \"peer-at2\" }",
+            "format = \"peer-at2\" }, scale = 0.8",
+        );
+    assert_eq!(text.matches("scale = 0.8").count(), 2, "both components");
     let path = common::write_model("temple_rigid_seats_audit", &text);
-    let run = audited_file("temple, rigid seats", &path, 6.0);
-    assert_sound("temple, rigid seats", &run);
-    assert!(run.0.certified > 800, "{} certified", run.0.certified);
+    let run = audited_file("temple at 0.8, rigid seats", &path, 6.0);
+    assert_sound("temple at 0.8, rigid seats", &run);
+    // Measured 2 949 (2026-12-05).
+    assert!(run.0.certified > 2000, "{} certified", run.0.certified);
+    assert_eq!(run.1, 6.0, "the run ends at 6 s");
 }
 
 #[test]

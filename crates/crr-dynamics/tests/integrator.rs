@@ -745,6 +745,72 @@ fn earliest_of_several_events_wins() {
     assert!((t - 0.9f64.asin()).abs() < 1e-2, "{t}");
 }
 
+/// g = x + `DIP_LEVEL` on the oscillator's x = cos t, falling: below zero only for
+/// |t − π| < acos(`DIP_LEVEL`) ≈ 0.0316, a dip well inside one step of 0.5 ([3.0, 3.5], where
+/// g = 0.0095 and 0.063) or of 0.25 ([3.0, 3.25], g = 0.0095 and 0.0055), whose ends are both
+/// positive.
+struct Dip {
+    inside: bool,
+}
+const DIP_LEVEL: f64 = 0.9995;
+impl EventFunctions for Dip {
+    fn count(&self) -> usize {
+        1
+    }
+    fn eval(&mut self, _t: f64, y: &[f64], g: &mut [f64]) {
+        g[0] = y[0] + DIP_LEVEL;
+    }
+    fn direction(&self, _i: usize) -> Direction {
+        Direction::Falling
+    }
+    fn checked_inside(&self, _i: usize) -> bool {
+        self.inside
+    }
+}
+
+#[test]
+fn a_crossing_and_its_return_inside_one_step_fire_where_the_function_is_checked_inside() {
+    // The first root of cos t + 0.9995 = 0, in closed form.
+    let root = PI - DIP_LEVEL.acos();
+    // RK4 with steps of 0.5 errs by about 1e-3 in x over these 3 s, more than the dip is deep
+    // (5e-4): its solution does not dip at all; with 0.25 it errs 16 times less.
+    for (m, h) in [("dop853", 0.5), ("dopri5", 0.5), ("rk4", 0.25)] {
+        let run = |inside: bool| {
+            let (method, opts) = method_fixed(m, h);
+            let mut s = Solver::new(method, opts, 2).unwrap();
+            s.reset(0.0, &[1.0, 0.0]);
+            let stop = s
+                .advance(&mut Oscillator, 4.0, &mut Dip { inside }, &mut ignore)
+                .unwrap();
+            (stop, s.y().to_vec())
+        };
+        // Read at the steps' ends only, the dip is stepped over.
+        assert!(matches!(run(false).0, Stop::Reached), "{m}");
+        let (stop, y) = run(true);
+        let Stop::Event { index: 0, t } = stop else {
+            panic!("{m}: {stop:?}")
+        };
+        // The interpolant's error in x over a step of 0.5 (DOP853's seventh-order dense output
+        // about 1e-8, Dopri5's fourth-order one and RK4's cubic about 1e-4 of |x| ≤ 1) over the
+        // slope |g'| = sin t* = 0.0316 at the root: at most 3e-7 s and 3e-3 s.
+        let tolerance = if m == "dop853" { 3e-7 } else { 3e-3 };
+        assert!(
+            (t - root).abs() < tolerance,
+            "{m}: t* − root = {:e}",
+            t - root
+        );
+        // The state is a real step's (to t*): on the dip's falling side, g within the step's
+        // error of 0.
+        assert!(
+            (y[0] + DIP_LEVEL).abs() < 1e-4,
+            "{m}: g = {:e}",
+            y[0] + DIP_LEVEL
+        );
+        // Before π, where x = cos t still falls (v = −sin t < 0): the first root, not the second.
+        assert!(y[1] < 0.0, "{m}: v = {}", y[1]);
+    }
+}
+
 // ------------------------------------------------------------------ breakpoints
 
 #[test]
