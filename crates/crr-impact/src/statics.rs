@@ -1335,12 +1335,15 @@ pub struct RestStatics {
     /// stand); `None` until first needed.
     axes: [Option<f64>; 6],
     /// Answers along directions asked before (exact bits of the unit direction).
-    by_direction: Vec<([u64; 3], Collapse)>,
+    by_direction: ByDirection,
     /// The programs' answers as boundary points and cuts (the axes' included).
     known: Vec<KnownAnswer>,
     /// Programs solved (the axes' and the directions').
     programs: usize,
 }
+
+/// Collapses by the exact bits of their unit direction ([`direction_key`]).
+type ByDirection = Vec<([u64; 3], Collapse)>;
 
 /// Most directions a [`RestStatics`] keeps.
 const REST_DIRECTIONS: usize = 64;
@@ -1591,15 +1594,27 @@ fn direction_key(d: &Vector3<f64>) -> [u64; 3] {
 /// file puts it), and two chains over the same interfaces differ only in their tree and loops
 /// (which interfaces close loops, which sense a re-rooted interface is written in), not in the
 /// faces or the bodies. The answers' boundary points and cuts (the bodies' momentum in the
-/// mechanism, a world vector) are kept with them; the mechanisms (slots of one chain) are not.
+/// mechanism, a world vector) are kept with them. The collapses themselves (mechanisms written
+/// in one chain's interfaces, slots and senses) are kept with the last chain over those
+/// interfaces that computed one, and given back only to a chain equal to it: the same chain
+/// met again (a wedge that lands whole) does not search its mechanism again.
 #[derive(Clone, Debug, Default)]
 pub struct AxisMemory {
     entries: Vec<MemoryEntry>,
 }
 
-/// What [`AxisMemory`] keeps for one set of interfaces: its sorted names, the axis multipliers
-/// and the answers.
-type MemoryEntry = (Vec<String>, [Option<f64>; 6], Vec<KnownAnswer>);
+/// What [`AxisMemory`] keeps for one set of interfaces.
+#[derive(Clone, Debug)]
+struct MemoryEntry {
+    /// The interfaces' names, sorted.
+    key: Vec<String>,
+    /// λ along the axes, as [`RestStatics`] keeps them.
+    axes: [Option<f64>; 6],
+    /// The answers' boundary points and cuts.
+    known: Vec<KnownAnswer>,
+    /// The chain that computed `collapses`, and those collapses by direction.
+    collapses: Option<(Model, ByDirection)>,
+}
 
 /// Most structures an [`AxisMemory`] keeps (the oldest is dropped beyond).
 const AXIS_MEMORY: usize = 64;
@@ -1615,17 +1630,17 @@ impl AxisMemory {
     /// Rest statics for `model` that start from the axes known for its interfaces.
     pub fn statics_for(&self, model: &Model) -> RestStatics {
         let key = Self::key(model);
-        let (axes, known) = self
-            .entries
-            .iter()
-            .find(|(k, ..)| *k == key)
-            .map_or(([None; 6], Vec::new()), |(_, axes, known)| {
-                (*axes, known.clone())
-            });
+        let Some(entry) = self.entries.iter().find(|e| e.key == key) else {
+            return RestStatics::default();
+        };
+        let by_direction = match &entry.collapses {
+            Some((chain, collapses)) if chain == model => collapses.clone(),
+            _ => Vec::new(),
+        };
         RestStatics {
-            axes,
-            by_direction: Vec::new(),
-            known,
+            axes: entry.axes,
+            by_direction,
+            known: entry.known.clone(),
             programs: 0,
         }
     }
@@ -1637,22 +1652,45 @@ impl AxisMemory {
             return;
         }
         let key = Self::key(model);
-        match self.entries.iter_mut().find(|(k, ..)| *k == key) {
-            Some((_, axes, known)) => {
-                for (kept, new) in axes.iter_mut().zip(statics.axes) {
-                    *kept = kept.or(new);
-                }
-                for answer in &statics.known {
-                    keep_known(known, answer.clone());
-                }
-            }
+        let index = match self.entries.iter().position(|e| e.key == key) {
+            Some(index) => index,
             None => {
                 if self.entries.len() >= AXIS_MEMORY {
                     self.entries.remove(0);
                 }
-                self.entries
-                    .push((key, statics.axes, statics.known.clone()));
+                self.entries.push(MemoryEntry {
+                    key,
+                    axes: [None; 6],
+                    known: Vec::new(),
+                    collapses: None,
+                });
+                self.entries.len() - 1
             }
+        };
+        let entry = &mut self.entries[index];
+        for (kept, new) in entry.axes.iter_mut().zip(statics.axes) {
+            *kept = kept.or(new);
+        }
+        for answer in &statics.known {
+            keep_known(&mut entry.known, answer.clone());
+        }
+        if statics.by_direction.is_empty() {
+            return;
+        }
+        // The collapses of this very chain: those kept before (from statics_for, or computed
+        // since) and the new ones, each direction once, the newest last.
+        match &mut entry.collapses {
+            Some((chain, kept)) if chain == model => {
+                for (direction, collapse) in &statics.by_direction {
+                    if !kept.iter().any(|(k, _)| k == direction) {
+                        if kept.len() >= REST_DIRECTIONS {
+                            kept.remove(0);
+                        }
+                        kept.push((*direction, collapse.clone()));
+                    }
+                }
+            }
+            _ => entry.collapses = Some((model.clone(), statics.by_direction.clone())),
         }
     }
 }
@@ -1719,5 +1757,49 @@ mod tests {
             let on_cut = (lambda * d).dot(&v) / c;
             assert!((on_cut - 1.0).abs() <= 1e-9, "φ = {phi}: {on_cut}");
         }
+    }
+
+    /// The memory gives a collapse back only to the chain that computed it, and what it gives
+    /// back is what that chain's program answers: a trilithon loaded at 1.5 λ along x solves
+    /// its program once, the same chain met again solves none and gets the collapse computed
+    /// afresh, bit for bit; a trilithon over the same interfaces with wider columns (half
+    /// width 0.25 instead of 0.2: the same names, other faces) solves its own and gets its own
+    /// λ, not the first one's.
+    #[test]
+    fn the_memory_gives_a_collapse_back_only_to_an_equal_chain() {
+        let build = |b: f64| {
+            Model::from_spec(&crr_kinematics::fixtures::trilithon(b, 1.0, 2.0, 0.4, 0.3))
+                .expect("the fixture builds")
+        };
+        let (narrow, wide) = (build(0.2), build(0.25));
+        let fresh = |model: &Model| {
+            collapse_multiplier(model, Vector3::x(), &StaticsOptions::default()).unwrap()
+        };
+        let (narrow_collapse, wide_collapse) = (fresh(&narrow), fresh(&wide));
+        let lambda = narrow_collapse.lambda.expect("the trilithon collapses");
+        assert!(
+            wide_collapse
+                .lambda
+                .is_some_and(|l| (l - lambda).abs() > 1e-6 * lambda)
+        );
+        let a = Vector3::x() * 1.5 * lambda * narrow.gravity;
+
+        let mut memory = AxisMemory::default();
+        let mut statics = memory.statics_for(&narrow);
+        let first = statics.exceeded(&narrow, &a).unwrap().cloned();
+        assert_eq!(first.as_ref(), Some(&narrow_collapse));
+        assert!(statics.programs_solved() >= 1);
+        memory.remember(&narrow, &statics);
+
+        let mut again = memory.statics_for(&narrow);
+        let second = again.exceeded(&narrow, &a).unwrap().cloned();
+        assert_eq!(second.as_ref(), Some(&narrow_collapse));
+        assert_eq!(again.programs_solved(), 0);
+
+        let mut other = memory.statics_for(&wide);
+        let a_wide = Vector3::x() * 1.5 * wide_collapse.lambda.unwrap() * wide.gravity;
+        let third = other.exceeded(&wide, &a_wide).unwrap().cloned();
+        assert_eq!(third.as_ref(), Some(&wide_collapse));
+        assert!(other.programs_solved() >= 1);
     }
 }
