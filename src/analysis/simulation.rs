@@ -827,6 +827,19 @@ fn warnings(
             loops.largest / p.model.gravity
         ));
     }
+    if let Some(check) = &t.doubtful_check {
+        out.push(format!(
+            "at t = {} s the contact program found that {} open(s), and the closed-chain solve \
+             that checks its releases, which left the loops open at acceleration level by \
+             {:.3e} m/s² ({:.1e} g; rows nearly dependent near a hyperstatic seat, taken as \
+             dependent), kept them seated: the decisions from then on rest on that solve's \
+             word (docs/simulation.md, Limitations)",
+            check.t,
+            check.interfaces.join(", "),
+            check.residual,
+            check.residual / p.model.gravity
+        ));
+    }
     if let Some(part) = out_of_plane_ground_motion(&p.model, &p.ground) {
         out.push(part);
     }

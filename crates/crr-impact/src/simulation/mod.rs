@@ -74,7 +74,9 @@ pub use opening_qp::{
 };
 pub use samples::{FaceOpening, Iter as SampleIter, Sample, Samples};
 pub(crate) use seating::other_pivot_rest;
-pub use seating::{CERTIFIED_CLOSURE_RESIDUAL, opening_mode, openings_slide_nowhere};
+pub use seating::{
+    CERTIFIED_CLOSURE_RESIDUAL, DOUBTFUL_CHECK_RESIDUAL, opening_mode, openings_slide_nowhere,
+};
 use seating::{UndecidedRow, opening_mode_in};
 pub use slots::check_initial_state;
 pub(crate) use slots::slot_interface;
@@ -538,6 +540,8 @@ pub struct Simulation<'a> {
     pub violation: Option<crate::monitor::Violation>,
     /// The largest opening of the loops at acceleration level left by the monitor's solves.
     loop_residual: LoopResidual,
+    /// The first decision that rested on a solve left with the loops open.
+    doubtful_check: Option<DoubtfulCheck>,
     /// The pulls at pivots where segments start, measured (module `hops`).
     hops: hops::Hops,
 }
@@ -554,6 +558,22 @@ pub struct LoopResidual {
     pub largest: f64,
     /// The sample's time (s).
     pub t: f64,
+}
+
+/// A decision of the uplift test that rests on a closed-chain solve the run does not trust: the
+/// contact program found that joints open, and the chain's solve that checks each release (it
+/// must open on its side) left the loops open at acceleration level by more than
+/// [`DOUBTFUL_CHECK_RESIDUAL`] g (rows nearly dependent near a hyperstatic seat, taken
+/// as dependent: docs/simulation.md, Limitations) and sent some back to their seats. The
+/// joints then stay seated on that solve's word alone.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct DoubtfulCheck {
+    /// The instant of the decision (s).
+    pub t: f64,
+    /// The loops' opening left by the checking solve, Φ_q q̈ + Φ̇_q q̇ (m/s²).
+    pub residual: f64,
+    /// The interfaces whose releases were sent back.
+    pub interfaces: Vec<String>,
 }
 
 /// The buffers of one integration segment ([`Simulation::step`]): the events' state and pivots,
@@ -1009,6 +1029,7 @@ impl<'a> Simulation<'a> {
             collapse: None,
             violation: None,
             loop_residual: LoopResidual::default(),
+            doubtful_check: None,
             hops: hops::Hops::default(),
         };
         // Released beyond the point of no return (its potential energy already below the rest
@@ -1185,7 +1206,9 @@ impl<'a> Simulation<'a> {
     /// it stops the run with [`SimulationError::Invariant`] instead of going on from a wrong
     /// state.
     pub fn step(&mut self) -> Result<StopReason, SimulationError> {
-        let stop = self.step_unchecked()?;
+        let stop = self.step_unchecked();
+        self.collect_doubtful_checks();
+        let stop = stop?;
         if let Err(e) = self.check_invariant() {
             // A collapse declared from a state outside the model is no collapse: the run stops
             // with the error alone.
@@ -1195,6 +1218,20 @@ impl<'a> Simulation<'a> {
             return Err(e);
         }
         Ok(stop)
+    }
+
+    /// Keeps the first doubtful check ([`DoubtfulCheck`]) on the run's trajectory: the checks
+    /// made up to the time reached (those of the root location past an event are not on it).
+    fn collect_doubtful_checks(&mut self) {
+        let checks = std::mem::take(&mut self.spare.rest.doubtful);
+        if self.doubtful_check.is_some() {
+            return;
+        }
+        let reached = self.t + 1e-12 * self.t.abs().max(1.0);
+        self.doubtful_check = checks
+            .into_iter()
+            .filter(|c| c.t <= reached)
+            .min_by(|a, b| a.t.total_cmp(&b.t));
     }
 
     /// The run's invariant, in every build: every slot that rocks has its angle on the side of
@@ -1999,6 +2036,7 @@ impl<'a> Simulation<'a> {
             end_time: self.t,
             solver_stats: self.solver.stats(),
             loop_residual: self.loop_residual,
+            doubtful_check: self.doubtful_check.clone(),
             hops: self.hops.done,
         }
     }
@@ -2038,6 +2076,9 @@ pub struct Trajectory {
     pub solver_stats: crr_dynamics::integrator::Stats,
     /// How far the closed-chain solves left the loops open at acceleration level.
     pub loop_residual: LoopResidual,
+    /// The first decision of the uplift test that rested on a solve left with the loops open
+    /// ([`DoubtfulCheck`]); None where there was none.
+    pub doubtful_check: Option<DoubtfulCheck>,
     /// Every pull at a pivot where a segment started, with the bound on how far its face would
     /// open (module `hops`), in the order they ended.
     pub hops: Vec<Hop>,
@@ -2061,6 +2102,7 @@ impl Trajectory {
             end_time: 0.0,
             solver_stats: Default::default(),
             loop_residual: LoopResidual::default(),
+            doubtful_check: None,
             hops: Vec::new(),
         }
     }

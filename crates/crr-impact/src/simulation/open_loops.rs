@@ -390,8 +390,11 @@ impl Simulation<'_> {
             &q,
             &qdot,
             tol,
+            &mut rest.doubtful,
         )
         .flatten();
+        // Its checks decide this run's faces: kept with the run's own.
+        self.spare.rest.doubtful.append(&mut rest.doubtful);
         for &(k, side) in releases.iter().flatten() {
             d.pivots.sides[k] = side;
             d.seated.retain(|&s| s != k);
@@ -486,9 +489,11 @@ impl Simulation<'_> {
         self.axis_memory
             .remember(&self.model, &self.spare.rest.global);
         let audit = self.spare.rest.audit.take();
+        let doubtful = std::mem::take(&mut self.spare.rest.doubtful);
         self.spare = Workspaces::new(&chain, trial, &dynamics.pivots);
         self.spare.rest.global = self.axis_memory.statics_for(&chain);
         self.spare.rest.audit = audit;
+        self.spare.rest.doubtful = doubtful;
         self.dynamics = dynamics;
         self.regularised = Regularised::of(&chain);
         self.contact_slots = super::slots::contact_slots(&chain);

@@ -435,6 +435,13 @@ pub fn openings_slide_nowhere(model: &Model) -> bool {
 /// (`tests/engine/certificate_audit.rs`, 2026-11-30).
 pub const CERTIFIED_CLOSURE_RESIDUAL: f64 = 1e-11;
 
+/// The loops' opening at acceleration level (g) above which the closed-chain solve that checks
+/// the contact program's releases (each must open on its side) is not trusted to send one back to
+/// its seat: such a check is recorded ([`super::DoubtfulCheck`]) and the run warns of it. The
+/// level of the output samples' warning (1e-6 g); round-off is 1e-11 g or less on the bundled
+/// models.
+pub const DOUBTFUL_CHECK_RESIDUAL: f64 = 1e-6;
+
 /// The locked solve's closure residual (m/s², [`Dynamics::loop_residual`]) where it keeps every
 /// loop closed at acceleration level to [`CERTIFIED_CLOSURE_RESIDUAL`] g; None where it does not.
 fn closed_loops_residual(model: &Model, trial: &Dynamics) -> Option<f64> {
@@ -536,6 +543,7 @@ fn loop_opening(
         q,
         qdot,
         tol,
+        &mut rest.doubtful,
     )
 }
 
@@ -543,7 +551,8 @@ fn loop_opening(
 /// solved together and every one must open on its side by more than `tol`; one that does not
 /// (the program's round-off near a threshold, or a release that came with a lift-off the chain
 /// does not confirm) goes back to its seat and the rest are solved again. Some(None) when
-/// nothing opens; None when a solve fails.
+/// nothing opens; None when a solve fails. A solve that sends releases back while it leaves the
+/// loops open by more than [`DOUBTFUL_CHECK_RESIDUAL`] g is recorded in `doubtful`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn confirmed_releases(
     model: &Model,
@@ -555,6 +564,7 @@ pub(super) fn confirmed_releases(
     q: &DVector<f64>,
     qdot: &DVector<f64>,
     tol: f64,
+    doubtful: &mut Vec<super::DoubtfulCheck>,
 ) -> Option<Option<Vec<(usize, Side)>>> {
     let mut row = DVector::zeros(model.dof());
     while !releases.is_empty() {
@@ -571,14 +581,37 @@ pub(super) fn confirmed_releases(
                 .filter(|s| !releases.iter().any(|r| r.0 == *s)),
         );
         trial.accelerations(model, ground, t, q, qdot).ok()?;
-        let before = releases.len();
-        releases.retain(|&(k, side)| {
-            let bias = slot_row(model, &trial.kin, k, &mut row);
-            side.sign() * (row.dot(&trial.qddot) + bias) > tol
-        });
-        if releases.len() == before {
+        let opens: Vec<bool> = releases
+            .iter()
+            .map(|&(k, side)| {
+                let bias = slot_row(model, &trial.kin, k, &mut row);
+                side.sign() * (row.dot(&trial.qddot) + bias) > tol
+            })
+            .collect();
+        if opens.iter().all(|&o| o) {
             return Some(Some(releases));
         }
+        // Near a hyperstatic seat the solve takes nearly dependent rows as dependent and leaves
+        // the loops open; its accelerations are then not the chain's, and the releases it sends
+        // back are sent back on its word alone (the rigid-seated temple at 2.0395 s: the
+        // program's necks and seats, open by 3.7e-3 m/s², all sent back).
+        let residual = trial.loop_residual(model);
+        if residual > DOUBTFUL_CHECK_RESIDUAL * model.gravity {
+            let mut interfaces: Vec<String> = releases
+                .iter()
+                .zip(&opens)
+                .filter(|(_, o)| !**o)
+                .map(|(&(k, _), _)| model.interfaces[slot_interface(model, k)].name.clone())
+                .collect();
+            interfaces.dedup();
+            doubtful.push(super::DoubtfulCheck {
+                t,
+                residual,
+                interfaces,
+            });
+        }
+        let mut kept = opens.iter();
+        releases.retain(|_| *kept.next().unwrap_or(&false));
     }
     Some(None)
 }
@@ -1503,6 +1536,7 @@ impl Simulation<'_> {
                 &q,
                 &qdot,
                 tol,
+                &mut self.spare.rest.doubtful,
             )
             .flatten()
             .or_else(|| {
@@ -1598,6 +1632,7 @@ impl Simulation<'_> {
             &q,
             &qdot,
             0.0,
+            &mut self.spare.rest.doubtful,
         )
         .flatten();
         self.spare.trial = Some(trial);

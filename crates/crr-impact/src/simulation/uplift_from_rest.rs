@@ -57,6 +57,9 @@ pub(super) struct RestCache {
     /// The certificate's audit, when the run is audited
     /// ([`super::Simulation::audit_certificate`]).
     pub(super) audit: Option<super::CertificateAudit>,
+    /// The checks of the contact program's releases made on a solve that left the loops open
+    /// ([`super::seating::confirmed_releases`]) since the run last collected them.
+    pub(super) doubtful: Vec<super::DoubtfulCheck>,
 }
 
 #[derive(Clone, Debug)]
