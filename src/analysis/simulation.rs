@@ -636,6 +636,7 @@ impl Prepared {
                 friction: p.friction,
                 hold_seated_at_impacts: p.hold_seated_at_impacts,
                 hop_tolerance: p.hop_tolerance,
+                stop_at_violation: p.stop_at_violation,
             },
             solver_stats: SolverStats {
                 steps: t.solver_stats.steps,

@@ -165,6 +165,10 @@ pub struct SolverSettings {
     /// `hop_tolerance` (m; read as 0 from a summary written before 2026-12-01).
     #[serde(default)]
     pub hop_tolerance: f64,
+    /// The run ended at its first hypotheses violation (`[analysis] stop_at_violation`; read
+    /// as false from a summary written before 2026-12-05).
+    #[serde(default)]
+    pub stop_at_violation: bool,
 }
 
 /// The integrator's work over the run.

@@ -775,3 +775,66 @@ fn a_study_s_hop_tolerance_accepts_the_hops_that_land_within_it() {
         "{err}"
     );
 }
+
+/// A study's `stop_at_violation` replaces the model's: the drum column's case under its own
+/// pulse fails the hypotheses at 0.5028 s (a pull of `bed_7` just after an impact, measured as a
+/// hop to 0.50292 s); with the setting the case ends within a step of that, with the same
+/// violation, and fewer impacts than the case that runs its 4 s; a value that is not a boolean
+/// is refused, naming the key.
+#[test]
+fn a_study_s_stop_at_violation_ends_each_case_at_its_first_violation() {
+    let dir = scratch("study_stop_at_violation");
+    let model = models().join("drum_column.toml");
+    let text = |stop: &str| {
+        format!(
+            "model = \"{}\"\nduration = 4.0\nstop_at_violation = {stop}\n\n[pulses]\n\
+             kind = \"one_sine_pulse\"\namplitudes = [2.5]\nperiods = [0.5]\n",
+            model.display()
+        )
+    };
+    let columns = [
+        "impacts",
+        "violation_time_s",
+        "violation",
+        "violation_interface",
+        "end_time_s",
+    ];
+    let mut rows = Vec::new();
+    for (name, stop) in [("on", "false"), ("stopped", "true")] {
+        let study = write(&dir, &format!("{name}.toml"), &text(stop));
+        let out = dir.join(name);
+        let o = crr(&[
+            "study",
+            study.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        rows.push(cases_columns(&out, &columns).remove(0));
+    }
+    let number = |s: &str| s.parse::<f64>().unwrap();
+    assert_eq!(rows[0][1..4], rows[1][1..4], "the same first violation");
+    assert_eq!(rows[0][2], "tension");
+    let (violation, end) = (number(&rows[1][1]), number(&rows[1][4]));
+    assert_eq!(number(&rows[0][4]), 4.0);
+    assert!(
+        end >= violation && end < violation + 0.05,
+        "{end} against {violation}"
+    );
+    assert!(number(&rows[1][0]) < number(&rows[0][0]), "{rows:?}");
+    let bad = write(&dir, "bad.toml", &text("\"yes\""));
+    let o = crr(&[
+        "study",
+        bad.to_str().unwrap(),
+        "--out",
+        dir.join("bad").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("stop_at_violation") && err.contains("bad.toml"),
+        "{err}"
+    );
+}

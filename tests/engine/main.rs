@@ -20,6 +20,7 @@ mod opening_program;
 mod order_invariance;
 mod out_of_plane;
 mod stack_planar_and_3d;
+mod stop_at_violation;
 mod streaming;
 mod temple;
 mod twist_closure;

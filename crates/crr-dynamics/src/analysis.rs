@@ -64,6 +64,10 @@ pub struct AnalysisSpec {
     /// of that size is below what the rigid-contact idealisation resolves. Default 0: every
     /// such pull is reported, with its separation.
     pub hop_tolerance: f64,
+    /// End the run at the first failure of the rigid-contact hypotheses (the monitor's first
+    /// violation), within a step or two of it (a pull at a pivot being measured is measured to
+    /// its end first), instead of going on outside the model. Default false.
+    pub stop_at_violation: bool,
 }
 
 impl Default for AnalysisSpec {
@@ -84,6 +88,7 @@ impl Default for AnalysisSpec {
             collapse_drop: 1e-3,
             hold_seated_at_impacts: false,
             hop_tolerance: 0.0,
+            stop_at_violation: false,
         }
     }
 }

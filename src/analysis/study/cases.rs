@@ -293,6 +293,9 @@ impl Study {
             }
             params.hop_tolerance = tolerance;
         }
+        if let Some(stop) = spec.stop_at_violation {
+            params.stop_at_violation = stop;
+        }
         let mechanism = mechanism_scales(&model, axis);
         let lambda_p = mechanism.map(|m| (m.0, m.1));
         let alpha_eq = mechanism.map(|m| m.2).filter(|a| a.is_finite() && *a > 0.0);

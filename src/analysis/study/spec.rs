@@ -224,6 +224,10 @@ pub struct StudySpec {
     /// violation (docs/simulation.md, "Hops").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hop_tolerance: Option<f64>,
+    /// Replaces the model's `[analysis] stop_at_violation`: every case ends at its first
+    /// failure of the rigid-contact hypotheses instead of running on outside the model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_at_violation: Option<bool>,
     /// Where every case starts: `"rest"` (default; maps and fragility studies start at rest) or
     /// `"model"` (the model file's `[initial]` state).
     #[serde(default)]

@@ -177,6 +177,13 @@ impl Hops {
     pub(super) fn logging(&self) -> bool {
         !self.open.is_empty()
     }
+
+    /// Whether no pull is being measured and no tension waits for one: the run's first
+    /// violation is then final up to the time reached (an episode that ends records its
+    /// violation at its start, which can be earlier than one recorded meanwhile).
+    pub(super) fn settled(&self) -> bool {
+        self.open.is_empty() && self.waiting.is_empty()
+    }
 }
 
 impl Episode {

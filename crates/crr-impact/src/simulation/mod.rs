@@ -133,6 +133,12 @@ pub struct Parameters {
     /// chain's motion by no more than this (m) is not a violation (module `hops`). Default 0:
     /// every such pull is one.
     pub hop_tolerance: f64,
+    /// End the run at the first violation of the rigid-contact hypotheses
+    /// ([`Trajectory::violation`]): at the end of the first step that starts after it with no
+    /// pull at a pivot being measured (module `hops`: a pull found just after an impact is
+    /// measured to its end, and its hop completes the record). What follows is outside the
+    /// model. Default false: the run goes on to its duration.
+    pub stop_at_violation: bool,
 }
 
 impl Default for Parameters {
@@ -165,6 +171,7 @@ impl Parameters {
             collapse_drop: a.collapse_drop,
             hold_seated_at_impacts: a.hold_seated_at_impacts,
             hop_tolerance: a.hop_tolerance,
+            stop_at_violation: a.stop_at_violation,
         })
     }
 }
@@ -1206,9 +1213,22 @@ impl<'a> Simulation<'a> {
     /// it stops the run with [`SimulationError::Invariant`] instead of going on from a wrong
     /// state.
     pub fn step(&mut self) -> Result<StopReason, SimulationError> {
+        let start = self.t;
         let stop = self.step_unchecked();
         self.collect_doubtful_checks();
-        let stop = stop?;
+        let mut stop = stop?;
+        // The first violation is final once a step has started after it with no pull being
+        // measured: whatever is recorded later is at or after that start.
+        if self.params.stop_at_violation
+            && self.violation.as_ref().is_some_and(|v| v.t < start)
+            && self.hops.settled()
+            && !matches!(stop, StopReason::End(_) | StopReason::Collapse(_))
+        {
+            // The results keep the state the step reached; nothing after it is integrated.
+            self.finished = true;
+            self.record_final_sample();
+            stop = StopReason::End(self.t);
+        }
         if let Err(e) = self.check_invariant() {
             // A collapse declared from a state outside the model is no collapse: the run stops
             // with the error alone.
