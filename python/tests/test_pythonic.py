@@ -104,6 +104,25 @@ def test_a_sample_limit_stops_the_run_with_its_results() -> None:
         crr.simulate(BLOCK, duration=1.0, max_samples=0)
 
 
+def test_stop_at_violation_ends_the_run_at_its_first_violation() -> None:
+    # The bundled drum column fails the hypotheses at 0.5028 s (a pull of bed_7 just after an
+    # impact, measured to 0.50292 s); the run that stops there is the full run cut there.
+    column = ROOT / "examples" / "models" / "drum_column.toml"
+    full = crr.simulate(column, duration=1.0)
+    with pytest.warns(crr.CrrWarning):
+        cut = crr.simulate(column, duration=1.0, stop_at_violation=True)
+    violation = cut.summary["hypothesis_violation"]
+    assert violation == full.summary["hypothesis_violation"]
+    assert cut.completed and cut.summary["solver"]["stop_at_violation"]
+    end = cut.summary["end_time"]
+    assert violation["time"] <= end < violation["time"] + 0.05
+    assert full.summary["end_time"] == 1.0
+    n = int(np.searchsorted(cut.t, end))
+    assert n > 40
+    np.testing.assert_array_equal(cut.t[:n], full.t[:n])
+    np.testing.assert_array_equal(cut.q[:n], full.q[:n])
+
+
 def test_a_dict_model_error_names_the_key_path() -> None:
     d = crr.Model.from_file(BLOCK).to_dict()
     d["body"][0]["densty"] = d["body"][0].pop("density")
