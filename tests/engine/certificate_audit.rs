@@ -141,10 +141,10 @@ fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_3d_arch() {
 #[test]
 fn the_certificate_holds_only_where_the_program_opens_nothing_on_the_rigid_seated_temple() {
     // At 0.8 of its record, which the bay rocks through for the whole 6 s. Under the whole
-    // record the rigid bay's rattling from 2.05 s is not resolved by the default steps: with
-    // `max_step = 1e-4` the capital c13 flies at 2.0541 s, while the default steps went on to a
-    // flight at 3.159 s (483 impacts) before the impact angles were read inside the steps, and
-    // since then into a chatter of the necks at 2.667 s whose steps take minutes.
+    // record the rigid bay's decisions from 2.0385 s rest on closed-chain solves left open by
+    // 3.7e-3 to 8.8e-3 m/s² (docs/simulation.md, Limitations, "Decisions checked on loops left
+    // open"): with `max_step = 1e-4` the capital c13 flies at 2.0541 s, while the default steps
+    // go on into a chatter of the necks at 2.667 s whose steps take minutes.
     let text = common::bundled_text_with_records("temple")
         .replace("twist = true", "twist = false")
         .replace(
