@@ -726,42 +726,37 @@ fn a_case_stopped_by_an_error_keeps_the_measures_its_run_reached() {
     );
 }
 
-/// A study's `hop_tolerance` replaces the model's: the drum column's pull at 0.5028 s under its
-/// own pulse is a hop of 1.1e-8 m (docs/simulation.md, "Hops"), so with a tolerance of 1 µm the
-/// case stays inside the model, with the same impacts; a negative tolerance is refused, naming
-/// the key.
-#[test]
-fn a_study_s_hop_tolerance_accepts_the_hops_that_land_within_it() {
-    let dir = scratch("study_hop_tolerance");
-    let model = models().join("drum_column.toml");
-    let text = |tolerance: &str| {
-        format!(
-            "model = \"{}\"\nduration = 4.0\nhop_tolerance = {tolerance}\n\n[pulses]\n\
-             kind = \"one_sine_pulse\"\namplitudes = [2.5]\nperiods = [0.5]\n",
-            model.display()
-        )
-    };
-    let columns = ["impacts", "violation_time_s", "violation"];
-    let mut rows = Vec::new();
-    for (name, tolerance) in [("strict", "0.0"), ("micrometre", "1e-6")] {
-        let study = write(&dir, &format!("{name}.toml"), &text(tolerance));
-        let out = dir.join(name);
-        let o = crr(&[
-            "study",
-            study.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.success(), "{err}");
-        assert_eq!(err.contains("left crr's model"), name == "strict", "{err}");
-        rows.push(cases_columns(&out, &columns).remove(0));
-    }
-    assert_eq!(rows[0][2], "tension");
-    assert_eq!((rows[1][1].as_str(), rows[1][2].as_str()), ("", ""));
-    assert_eq!(rows[0][0], rows[1][0], "the same impacts");
-    let bad = write(&dir, "bad.toml", &text("-1.0"));
+/// A study of the bundled drum column under one-sine pulses of 2.5 m/s² and 0.5 s for 4 s,
+/// with `setting` (one `key = value` line) among its keys.
+fn drum_column_study(setting: &str) -> String {
+    format!(
+        "model = \"{}\"\nduration = 4.0\n{setting}\n\n[pulses]\n\
+         kind = \"one_sine_pulse\"\namplitudes = [2.5]\nperiods = [0.5]\n",
+        models().join("drum_column.toml").display()
+    )
+}
+
+/// Writes `text` as `DIR/NAME.toml` and runs `crr study` on it into `DIR/NAME`, which must
+/// succeed; its output folder and stderr.
+fn study_quietly(dir: &Path, name: &str, text: &str) -> (PathBuf, String) {
+    let study = write(dir, &format!("{name}.toml"), text);
+    let out = dir.join(name);
+    let o = crr(&[
+        "study",
+        study.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(o.status.success(), "{err}");
+    (out, err)
+}
+
+/// Writes `text` as `DIR/bad.toml` and runs `crr study` on it, which must be refused (status
+/// 2) naming the file and `key`.
+fn study_refused(dir: &Path, text: &str, key: &str) {
+    let bad = write(dir, "bad.toml", text);
     let o = crr(&[
         "study",
         bad.to_str().unwrap(),
@@ -770,10 +765,28 @@ fn a_study_s_hop_tolerance_accepts_the_hops_that_land_within_it() {
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("hop_tolerance") && err.contains("bad.toml"),
-        "{err}"
-    );
+    assert!(err.contains(key) && err.contains("bad.toml"), "{err}");
+}
+
+/// A study's `hop_tolerance` replaces the model's: the drum column's pull at 0.5028 s under its
+/// own pulse is a hop of 1.1e-8 m (docs/simulation.md, "Hops"), so with a tolerance of 1 µm the
+/// case stays inside the model, with the same impacts; a negative tolerance is refused, naming
+/// the key.
+#[test]
+fn a_study_s_hop_tolerance_accepts_the_hops_that_land_within_it() {
+    let dir = scratch("study_hop_tolerance");
+    let text = |tolerance: &str| drum_column_study(&format!("hop_tolerance = {tolerance}"));
+    let columns = ["impacts", "violation_time_s", "violation"];
+    let mut rows = Vec::new();
+    for (name, tolerance) in [("strict", "0.0"), ("micrometre", "1e-6")] {
+        let (out, err) = study_quietly(&dir, name, &text(tolerance));
+        assert_eq!(err.contains("left crr's model"), name == "strict", "{err}");
+        rows.push(cases_columns(&out, &columns).remove(0));
+    }
+    assert_eq!(rows[0][2], "tension");
+    assert_eq!((rows[1][1].as_str(), rows[1][2].as_str()), ("", ""));
+    assert_eq!(rows[0][0], rows[1][0], "the same impacts");
+    study_refused(&dir, &text("-1.0"), "hop_tolerance");
 }
 
 /// A study's `stop_at_violation` replaces the model's: the drum column's case under its own
@@ -784,14 +797,7 @@ fn a_study_s_hop_tolerance_accepts_the_hops_that_land_within_it() {
 #[test]
 fn a_study_s_stop_at_violation_ends_each_case_at_its_first_violation() {
     let dir = scratch("study_stop_at_violation");
-    let model = models().join("drum_column.toml");
-    let text = |stop: &str| {
-        format!(
-            "model = \"{}\"\nduration = 4.0\nstop_at_violation = {stop}\n\n[pulses]\n\
-             kind = \"one_sine_pulse\"\namplitudes = [2.5]\nperiods = [0.5]\n",
-            model.display()
-        )
-    };
+    let text = |stop: &str| drum_column_study(&format!("stop_at_violation = {stop}"));
     let columns = [
         "impacts",
         "violation_time_s",
@@ -801,17 +807,7 @@ fn a_study_s_stop_at_violation_ends_each_case_at_its_first_violation() {
     ];
     let mut rows = Vec::new();
     for (name, stop) in [("on", "false"), ("stopped", "true")] {
-        let study = write(&dir, &format!("{name}.toml"), &text(stop));
-        let out = dir.join(name);
-        let o = crr(&[
-            "study",
-            study.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--quiet",
-        ]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(o.status.success(), "{err}");
+        let (out, _) = study_quietly(&dir, name, &text(stop));
         rows.push(cases_columns(&out, &columns).remove(0));
     }
     let number = |s: &str| s.parse::<f64>().unwrap();
@@ -824,17 +820,5 @@ fn a_study_s_stop_at_violation_ends_each_case_at_its_first_violation() {
         "{end} against {violation}"
     );
     assert!(number(&rows[1][0]) < number(&rows[0][0]), "{rows:?}");
-    let bad = write(&dir, "bad.toml", &text("\"yes\""));
-    let o = crr(&[
-        "study",
-        bad.to_str().unwrap(),
-        "--out",
-        dir.join("bad").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("stop_at_violation") && err.contains("bad.toml"),
-        "{err}"
-    );
+    study_refused(&dir, &text("\"yes\""), "stop_at_violation");
 }

@@ -597,13 +597,14 @@ pub(super) fn confirmed_releases(
         // program's necks and seats, open by 3.7e-3 m/s², all sent back).
         let residual = trial.loop_residual(model);
         if residual > DOUBTFUL_CHECK_RESIDUAL * model.gravity {
-            let mut interfaces: Vec<String> = releases
-                .iter()
-                .zip(&opens)
-                .filter(|(_, o)| !**o)
-                .map(|(&(k, _), _)| model.interfaces[slot_interface(model, k)].name.clone())
-                .collect();
-            interfaces.dedup();
+            // Each interface once (a rocking base's two tilts), in the releases' order.
+            let mut interfaces: Vec<String> = Vec::new();
+            for (&(k, _), _) in releases.iter().zip(&opens).filter(|(_, o)| !**o) {
+                let name = &model.interfaces[slot_interface(model, k)].name;
+                if !interfaces.contains(name) {
+                    interfaces.push(name.clone());
+                }
+            }
             doubtful.push(super::DoubtfulCheck {
                 t,
                 residual,
