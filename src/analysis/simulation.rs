@@ -922,6 +922,13 @@ fn warnings(
              that keeps every contact compressive (the program's own needs the face to slide \
              while it lifts)"
                 .to_string()
+        } else if v.kind == "sliding_unloaded" {
+            "slides while keeping contact, carrying nothing, in a mechanism whose multiplier \
+             the ground acceleration exceeds (found by the search for joints that open and \
+             slide, `crr check`); the CRR chain, whose joints do not slide, holds the structure \
+             at rest by shear across it with no compression, which no friction gives: a real \
+             structure may move from here (docs/simulation.md, \"Joints that open may slide\")"
+                .to_string()
         } else {
             format!(
                 "needs friction |F_t|/N = {:.4} above μ: it slides",

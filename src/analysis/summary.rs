@@ -219,7 +219,9 @@ pub struct ViolationSummary {
     /// `lift_off` (a face the contact program lifts off that the model cannot follow; no force
     /// is computed: its normal force is then 0 and its friction demand `None`), or
     /// `impulse_tension` (a landing's impulse that pulls: `normal_force` is then the least
-    /// normal impulse, N s, and the friction demand `None`).
+    /// normal impulse, N s, and the friction demand `None`), or `sliding_unloaded` (at rest
+    /// under a load beyond a mechanism in which this joint slides unloaded while keeping
+    /// contact, which the model cannot follow; normal force 0, friction demand `None`).
     pub kind: String,
     /// Its normal force (N); for `outside_face`, the force of the edge that would pull; for
     /// `impulse_tension`, the least normal impulse (N s).

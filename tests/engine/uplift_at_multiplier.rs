@@ -279,3 +279,118 @@ fn a_structure_under_a_turning_load_leaves_rest_where_it_first_passes_its_multip
     );
     assert!((uplift - upper).abs() <= 1e-7, "{uplift} against {upper}");
 }
+
+/// The run's end under a constant load from rest: its first violation, whether it left rest, and
+/// the largest angle any sample reached (rad).
+struct Held {
+    violation: Option<crr::impact::monitor::Violation>,
+    uplift: Option<f64>,
+    largest_angle: f64,
+}
+
+fn held_under(model: &Model, a: Vector3<f64>) -> Held {
+    let ground = constant_ground(a);
+    let initial = solve_initial(model, &InitialSpec::default()).unwrap();
+    let params = Parameters {
+        duration: 0.05,
+        ..Default::default()
+    };
+    let t = Simulation::new(model, &ground, &initial, params)
+        .unwrap()
+        .run()
+        .unwrap();
+    let largest_angle = t
+        .samples
+        .iter()
+        .flat_map(|s| s.q.iter())
+        .fold(0.0_f64, |m, q| m.max(q.abs()));
+    Held {
+        violation: t.violation,
+        uplift: t.uplift_time,
+        largest_angle,
+    }
+}
+
+/// A block b × h = 0.4 × 1 m (1 m deep) standing against the +x face of a pier 1 × 1 × 2 m,
+/// every contact an interface. Away from the pier it overturns at λ = b/h = 0.4 (virtual work of
+/// the block alone): it turns about its far foot while its lowest edge slides up the pier,
+/// carrying nothing. The CRR chain cannot follow that: its face on the pier is a joint, which
+/// does not slide. Without sliding the pier and the block turn as one about the block's far foot
+/// (the free pier), at the lever of their common centre: (0.4 + 23/60)/(11/12) = 47/55; a fixed
+/// pier holds up to the cap. Between the two the run stays at rest, held by shear across the
+/// pier's face with no compression, and says so at t = 0 (`sliding_unloaded`, on that face);
+/// below 0.4 there is nothing to say; beyond 47/55 the structure leaves rest. Until 2026-12-05
+/// the run released the sliding mechanism's sides at 1.01 × 0.4, moved nothing and reported an
+/// uplift at t = 0 with no warning.
+#[test]
+fn a_load_beyond_a_sliding_mechanism_the_chain_cannot_follow_is_a_violation() {
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    let dir = crate::common::scratch("sliding_unloaded");
+    let g_away = |model: &Model, lambda: f64| -Vector3::x() * (lambda * model.gravity);
+    for fixed in [true, false] {
+        let text = format!(
+            "name = \"infill\"\n{}{}{}",
+            if fixed { "fixed = [\"pier\"]\n" } else { "" },
+            crate::common::box_body("pier", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0]),
+            crate::common::box_body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]),
+        );
+        let path = dir.join(format!("pier_{fixed}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let file = read_assembly(&path).unwrap();
+        let options = AssemblyOptions::default().with_all_contacts();
+        let model = assemble(&path, &file, &options).unwrap().model;
+        // The face on the pier: the block's interface whose face normal is along x.
+        let on_pier = (0..model.interfaces.len())
+            .find(|&i| {
+                crr::kinematics::ContactFace::of_interface(&model, i)
+                    .normal
+                    .x
+                    .abs()
+                    > 0.99
+            })
+            .map(|i| model.interfaces[i].name.clone())
+            .expect("a face on the pier");
+
+        let below = held_under(&model, g_away(&model, 0.99 * 0.4));
+        assert!(
+            below.violation.is_none(),
+            "fixed {fixed}: {:?}",
+            below.violation
+        );
+        assert_eq!(below.uplift, None);
+
+        // 1 % above b/h, and (fixed pier) far beyond it: at rest, and said at t = 0.
+        let loads: &[f64] = if fixed {
+            &[1.01 * 0.4, 2.0]
+        } else {
+            &[1.01 * 0.4]
+        };
+        for &lambda in loads {
+            let held = held_under(&model, g_away(&model, lambda));
+            assert_eq!(held.uplift, None, "fixed {fixed}, {lambda} g: no uplift");
+            assert_eq!(
+                held.largest_angle, 0.0,
+                "fixed {fixed}, {lambda} g: nothing moves"
+            );
+            let v = held.violation.expect("the hold is a violation");
+            assert_eq!(
+                (v.kind.as_str(), v.t, v.interface.as_str()),
+                ("sliding_unloaded", 0.0, on_pier.as_str()),
+                "fixed {fixed}, {lambda} g"
+            );
+        }
+        if !fixed {
+            let moved = held_under(&model, g_away(&model, 1.01 * 47.0 / 55.0));
+            assert_eq!(moved.uplift, Some(0.0), "beyond 47/55 it leaves rest");
+            assert!(moved.largest_angle > 1e-6, "{}", moved.largest_angle);
+            assert!(
+                moved
+                    .violation
+                    .as_ref()
+                    .is_none_or(|v| v.kind != "sliding_unloaded"),
+                "{:?}",
+                moved.violation
+            );
+        }
+    }
+}

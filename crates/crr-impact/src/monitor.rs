@@ -96,7 +96,10 @@ pub struct Violation {
     /// no release the engine tries opens; `normal` is then 0 and `friction_demand` infinite: no
     /// force is computed), or `"impulse_tension"` (recorded by the simulation at a landing whose
     /// plastic impulse needs tension: `normal` is the least normal impulse of the most
-    /// compressive distribution, N s, and `friction_demand` infinite).
+    /// compressive distribution, N s, and `friction_demand` infinite), or `"sliding_unloaded"`
+    /// (recorded by the simulation at rest: the load exceeds a mechanism in which this joint
+    /// slides while keeping contact, carrying nothing, which the CRR chain cannot follow, so it
+    /// holds by shear with no compression; `normal` 0, `friction_demand` infinite).
     pub kind: String,
     /// N at that time (N); for `"outside_face"` the normal force of the edge that would pull;
     /// for `"impulse_tension"` an impulse (N s).

@@ -1216,6 +1216,7 @@ impl<'a> Simulation<'a> {
         let start = self.t;
         let stop = self.step_unchecked();
         self.collect_doubtful_checks();
+        self.collect_sliding_unloaded();
         let mut stop = stop?;
         // The first violation is final once a step has started after it with no pull being
         // measured: whatever is recorded later is at or after that start.
@@ -1252,6 +1253,43 @@ impl<'a> Simulation<'a> {
             .into_iter()
             .filter(|c| c.t <= reached)
             .min_by(|a, b| a.t.total_cmp(&b.t));
+    }
+
+    /// Records the first instant on the run's trajectory at which the structure at rest was held
+    /// against a load beyond a mechanism whose joints slide while keeping contact
+    /// (`seating::followable_collapse`) as a violation of kind `sliding_unloaded` (the first
+    /// joint by name; no force is computed: N = 0, |F_t|/N infinite, shear with no
+    /// compression), unless one came before.
+    fn collect_sliding_unloaded(&mut self) {
+        let held = std::mem::take(&mut self.spare.rest.sliding_unloaded);
+        let reached = self.t + 1e-12 * self.t.abs().max(1.0);
+        let Some((t, interfaces)) = held
+            .into_iter()
+            .filter(|(t, _)| *t <= reached)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+        else {
+            return;
+        };
+        let Some(first) = interfaces.into_iter().next() else {
+            return;
+        };
+        // At rest nothing moves between that instant and now: the energies are those of now.
+        let snaps = SnapsAndLosses {
+            t,
+            snaps: self.energy_at_snaps,
+            lost: self.lost_at_impacts(),
+        };
+        self.record_violation(
+            crate::monitor::Violation {
+                t,
+                interface: first,
+                kind: "sliding_unloaded".to_string(),
+                normal: 0.0,
+                friction_demand: f64::INFINITY,
+                hop: None,
+            },
+            snaps,
+        );
     }
 
     /// The run's invariant, in every build: every slot that rocks has its angle on the side of

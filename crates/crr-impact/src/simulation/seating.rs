@@ -196,6 +196,8 @@ fn opening_mode_decided(
     {
         return Some(local);
     }
+    // (None: held, the chain cannot follow the mechanism.)
+    let collapse = followable_collapse(model, rest, collapse, &a, t)?;
     let lifting: Vec<String> = collapse.lifting_off().map(|i| i.name.clone()).collect();
     let sides: Vec<(usize, Side)> = collapse
         .interfaces
@@ -217,6 +219,51 @@ fn opening_mode_decided(
         model, ground, &start, trial, rest, slot_part, t, q, qdot, true,
     )
     .or(Some(sides))
+}
+
+/// The collapse exceeded by the load `a` that the CRR chain can follow, or None where it holds.
+///
+/// A mechanism of the search for joints that open and slide whose sliding joints keep contact
+/// while carrying nothing, with no block lifting off (a block against a pier turning about its
+/// far foot, its lowest edge sliding up the pier; part of a 3D wall turning out of its plane,
+/// its head joints sliding past their neighbours), is one the chain cannot follow: its joints do
+/// not slide, and its own local test has found no opening. Up to the convex program's λ along
+/// the load (no sliding anywhere, the chain's own mechanisms included) the chain holds by shear
+/// across those joints with no compression, which no friction gives: the instant and the joints
+/// are recorded in `rest.sliding_unloaded` (the run's `sliding_unloaded` violation) and the
+/// structure stays at rest. Beyond it, the convex program's collapse along the load decides, as
+/// for a structure without such a mechanism. Releasing the sliding mechanism's sides, as before
+/// 2026-12-05, moved nothing (rates of 1e-17 rad/s) and reported an uplift.
+fn followable_collapse(
+    model: &Model,
+    rest: &mut RestCache,
+    collapse: crate::statics::Collapse,
+    a: &Vector3<f64>,
+    t: f64,
+) -> Option<crate::statics::Collapse> {
+    let mut sliding: Vec<String> = collapse
+        .sliding_in_contact()
+        .map(|i| i.name.clone())
+        .collect();
+    if sliding.is_empty() || collapse.lifting_off().next().is_some() {
+        return Some(collapse);
+    }
+    let beyond_convex = collapse
+        .convex_lambda
+        .is_some_and(|l| a.norm() > l * model.gravity * (1.0 + 1e-9));
+    if !beyond_convex {
+        // In name order: the same record whatever order the file lists the joints in.
+        sliding.sort_unstable();
+        rest.sliding_unloaded.push((t, sliding));
+        return None;
+    }
+    let convex = crate::statics::StaticsOptions {
+        sliding_lift_off: false,
+        ..Default::default()
+    };
+    crate::statics::collapse_multiplier(model, a.normalize(), &convex)
+        .ok()
+        .filter(|c| c.lambda.is_some())
 }
 
 /// The faces on the ground where the effective gravity g_eff(t) pulls a structure at rest off

@@ -60,6 +60,10 @@ pub(super) struct RestCache {
     /// The checks of the contact program's releases made on a solve that left the loops open
     /// ([`super::seating::confirmed_releases`]) since the run last collected them.
     pub(super) doubtful: Vec<super::DoubtfulCheck>,
+    /// The instants at which the structure at rest was held against a load beyond a mechanism
+    /// whose joints slide while keeping contact (`seating::opening_mode_in`), with those
+    /// interfaces, since the run last collected them.
+    pub(super) sliding_unloaded: Vec<(f64, Vec<String>)>,
 }
 
 #[derive(Clone, Debug)]
