@@ -311,6 +311,66 @@ fn held_under(model: &Model, a: Vector3<f64>) -> Held {
     }
 }
 
+/// The model `crr assemble --all-contacts [--planar]` makes of the blocks `bodies` (assembly
+/// text), written under `tag`.
+fn assembled(tag: &str, bodies: &str, planar: bool) -> Model {
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    let path = crate::common::scratch("sliding_unloaded").join(format!("{tag}.toml"));
+    std::fs::write(&path, bodies).unwrap();
+    let file = read_assembly(&path).unwrap();
+    let options = AssemblyOptions {
+        planar,
+        ..AssemblyOptions::default()
+    }
+    .with_all_contacts();
+    assemble(&path, &file, &options).unwrap().model
+}
+
+/// Under constant loads along `d` from rest: 1 % below `lambda` (a mechanism whose joints slide
+/// unloaded while keeping contact, which the CRR chain cannot follow) nothing happens; 1 % above
+/// it, and at each load of `held` (× λ_c g, below the convex program's multiplier), the run
+/// stays at rest, nothing moves, and a `sliding_unloaded` violation names a joint of `sliding`
+/// at t = 0; 1 % above `convex` (when given) it leaves rest and moves.
+fn held_between(
+    name: &str,
+    model: &Model,
+    d: Vector3<f64>,
+    lambda: f64,
+    held: &[f64],
+    sliding: &[&str],
+    convex: Option<f64>,
+) {
+    let g = model.gravity;
+    let below = held_under(model, d * (0.99 * lambda * g));
+    assert!(below.violation.is_none(), "{name}: {:?}", below.violation);
+    assert_eq!(below.uplift, None, "{name}");
+    for &load in [1.01 * lambda].iter().chain(held) {
+        let run = held_under(model, d * (load * g));
+        assert_eq!(run.uplift, None, "{name}, {load} g: no uplift");
+        assert_eq!(run.largest_angle, 0.0, "{name}, {load} g: nothing moves");
+        let v = run.violation.expect("the hold is a violation");
+        assert_eq!((v.kind.as_str(), v.t), ("sliding_unloaded", 0.0), "{name}");
+        assert!(
+            sliding.contains(&v.interface.as_str()),
+            "{name}: {}",
+            v.interface
+        );
+    }
+    if let Some(convex) = convex {
+        let moved = held_under(model, d * (1.01 * convex * g));
+        assert_eq!(
+            moved.uplift,
+            Some(0.0),
+            "{name}: beyond {convex} it leaves rest"
+        );
+        assert!(
+            moved.largest_angle > 1e-6,
+            "{name}: {}",
+            moved.largest_angle
+        );
+    }
+}
+
 /// A block b × h = 0.4 × 1 m (1 m deep) standing against the +x face of a pier 1 × 1 × 2 m,
 /// every contact an interface. Away from the pier it overturns at λ = b/h = 0.4 (virtual work of
 /// the block alone): it turns about its far foot while its lowest edge slides up the pier,
@@ -324,21 +384,14 @@ fn held_under(model: &Model, a: Vector3<f64>) -> Held {
 /// uplift at t = 0 with no warning.
 #[test]
 fn a_load_beyond_a_sliding_mechanism_the_chain_cannot_follow_is_a_violation() {
-    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
-    let dir = crate::common::scratch("sliding_unloaded");
-    let g_away = |model: &Model, lambda: f64| -Vector3::x() * (lambda * model.gravity);
     for fixed in [true, false] {
-        let text = format!(
+        let bodies = format!(
             "name = \"infill\"\n{}{}{}",
             if fixed { "fixed = [\"pier\"]\n" } else { "" },
             crate::common::box_body("pier", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0]),
             crate::common::box_body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]),
         );
-        let path = dir.join(format!("pier_{fixed}.toml"));
-        std::fs::write(&path, text).unwrap();
-        let file = read_assembly(&path).unwrap();
-        let options = AssemblyOptions::default().with_all_contacts();
-        let model = assemble(&path, &file, &options).unwrap().model;
+        let model = assembled(&format!("pier_{fixed}"), &bodies, false);
         // The face on the pier: the block's interface whose face normal is along x.
         let on_pier = (0..model.interfaces.len())
             .find(|&i| {
@@ -350,47 +403,61 @@ fn a_load_beyond_a_sliding_mechanism_the_chain_cannot_follow_is_a_violation() {
             })
             .map(|i| model.interfaces[i].name.clone())
             .expect("a face on the pier");
-
-        let below = held_under(&model, g_away(&model, 0.99 * 0.4));
-        assert!(
-            below.violation.is_none(),
-            "fixed {fixed}: {:?}",
-            below.violation
-        );
-        assert_eq!(below.uplift, None);
-
-        // 1 % above b/h, and (fixed pier) far beyond it: at rest, and said at t = 0.
-        let loads: &[f64] = if fixed {
-            &[1.01 * 0.4, 2.0]
+        let (held, convex): (&[f64], _) = if fixed {
+            (&[2.0], None)
         } else {
-            &[1.01 * 0.4]
+            (&[], Some(47.0 / 55.0))
         };
-        for &lambda in loads {
-            let held = held_under(&model, g_away(&model, lambda));
-            assert_eq!(held.uplift, None, "fixed {fixed}, {lambda} g: no uplift");
-            assert_eq!(
-                held.largest_angle, 0.0,
-                "fixed {fixed}, {lambda} g: nothing moves"
-            );
-            let v = held.violation.expect("the hold is a violation");
-            assert_eq!(
-                (v.kind.as_str(), v.t, v.interface.as_str()),
-                ("sliding_unloaded", 0.0, on_pier.as_str()),
-                "fixed {fixed}, {lambda} g"
-            );
-        }
-        if !fixed {
-            let moved = held_under(&model, g_away(&model, 1.01 * 47.0 / 55.0));
-            assert_eq!(moved.uplift, Some(0.0), "beyond 47/55 it leaves rest");
-            assert!(moved.largest_angle > 1e-6, "{}", moved.largest_angle);
-            assert!(
-                moved
-                    .violation
-                    .as_ref()
-                    .is_none_or(|v| v.kind != "sliding_unloaded"),
-                "{:?}",
-                moved.violation
-            );
-        }
+        let name = format!("block against a pier (fixed: {fixed})");
+        held_between(&name, &model, -Vector3::x(), 0.4, held, &[&on_pier], convex);
     }
+}
+
+/// A wall of three courses in running bond, blocks 1 × 0.5 × 0.5 m (half blocks at the ends of
+/// the middle course), every contact a joint (planar). Along +x its corner wedge, the left half
+/// block of course 1 and the block over it, turns about the half block's outer foot at
+/// λ = 5/7 (their common centre 5/12 m beside and 7/12 m above that foot, by hand): the block
+/// over it lifts off its other support, and the half block's head joint slides up its
+/// neighbour's, carrying nothing, which the CRR chain cannot follow. Until 2026-12-05 the run
+/// lifted the faces off, moved nothing, landed them at once and stopped at t = 0 on 200
+/// "impacts" of zero rates (`SimulationError::Chatter`), or reported an uplift with nothing
+/// moving; now it stays at rest with the violation up to the convex program's multiplier, and
+/// leaves rest beyond it.
+#[test]
+fn a_corner_wedge_that_slides_up_its_head_joint_is_a_violation() {
+    let mut bodies = String::from("name = \"wall\"\n");
+    for (name, centre, width) in [
+        ("c0_b0", [-0.5, 0.0, 0.25], 1.0),
+        ("c0_b1", [0.5, 0.0, 0.25], 1.0),
+        ("c1_b0", [-0.75, 0.0, 0.75], 0.5),
+        ("c1_b1", [0.0, 0.0, 0.75], 1.0),
+        ("c1_b2", [0.75, 0.0, 0.75], 0.5),
+        ("c2_b0", [-0.5, 0.0, 1.25], 1.0),
+        ("c2_b1", [0.5, 0.0, 1.25], 1.0),
+    ] {
+        bodies.push_str(&crate::common::box_body(name, centre, [width, 0.5, 0.5]));
+    }
+    let model = assembled("wall_3x2", &bodies, true);
+    let d = Vector3::x();
+    let wedge = collapse_multiplier(&model, d, &StaticsOptions::default()).unwrap();
+    assert!(
+        (wedge.lambda.unwrap() - 5.0 / 7.0).abs() < 1e-9,
+        "{:?}",
+        wedge.lambda
+    );
+    assert!(
+        wedge.lifting_off().next().is_some(),
+        "a block lifts off a support"
+    );
+    let convex = wedge.convex_lambda.expect("the convex program's mechanism");
+    assert!(convex > 1.1 * 5.0 / 7.0, "{convex}");
+    held_between(
+        "3 × 2 wall",
+        &model,
+        d,
+        5.0 / 7.0,
+        &[0.99 * convex],
+        &["c1_b1_on_c1_b0", "c1_b0_on_c1_b1"],
+        Some(convex),
+    );
 }

@@ -224,16 +224,18 @@ fn opening_mode_decided(
 /// The collapse exceeded by the load `a` that the CRR chain can follow, or None where it holds.
 ///
 /// A mechanism of the search for joints that open and slide whose sliding joints keep contact
-/// while carrying nothing, with no block lifting off (a block against a pier turning about its
-/// far foot, its lowest edge sliding up the pier; part of a 3D wall turning out of its plane,
-/// its head joints sliding past their neighbours), is one the chain cannot follow: its joints do
-/// not slide, and its own local test has found no opening. Up to the convex program's λ along
+/// while carrying nothing (a block against a pier turning about its far foot, its lowest edge
+/// sliding up the pier; part of a 3D wall turning out of its plane, its head joints sliding
+/// past their neighbours; a corner wedge whose half block slides up its head joint) is one the
+/// chain cannot follow, with or without the faces it lifts off: its joints do not slide, and its
+/// own local test has found no opening. Up to the convex program's λ along
 /// the load (no sliding anywhere, the chain's own mechanisms included) the chain holds by shear
 /// across those joints with no compression, which no friction gives: the instant and the joints
 /// are recorded in `rest.sliding_unloaded` (the run's `sliding_unloaded` violation) and the
 /// structure stays at rest. Beyond it, the convex program's collapse along the load decides, as
 /// for a structure without such a mechanism. Releasing the sliding mechanism's sides, as before
-/// 2026-12-05, moved nothing (rates of 1e-17 rad/s) and reported an uplift.
+/// 2026-12-05, moved nothing (rates of 1e-17 rad/s) and reported an uplift; lifting its faces
+/// off, the faces landed at once, for ever (a `Chatter` stop at t = 0).
 fn followable_collapse(
     model: &Model,
     rest: &mut RestCache,
@@ -245,7 +247,7 @@ fn followable_collapse(
         .sliding_in_contact()
         .map(|i| i.name.clone())
         .collect();
-    if sliding.is_empty() || collapse.lifting_off().next().is_some() {
+    if sliding.is_empty() {
         return Some(collapse);
     }
     let beyond_convex = collapse
