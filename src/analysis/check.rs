@@ -321,6 +321,26 @@ pub fn check_with(
     }
 }
 
+/// The lines of a multiplier's report on joints that open and slide: where λ comes from them,
+/// and whether every set of them was tried (docs/simulation.md, "Joints that open may slide").
+fn sliding_note(m: &crate::analysis::static_multiplier::StaticMultiplier) -> String {
+    let see = "(docs/simulation.md, \"Joints that open may slide\")";
+    let without = crate::analysis::static_multiplier::without_sliding(m.convex_lambda);
+    match (m.from_sliding_search, m.exhaustive) {
+        (true, true) => format!(
+            "    found among the joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, and every set of joints that may open and slide was tried, so none opens lower {see}\n"
+        ),
+        (true, false) => format!(
+            "    found by the search for joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, so the structure can move from it on, but the search is not exhaustive and a lower mechanism may exist {see}\n"
+        ),
+        (false, false) => format!(
+            "    not exhaustive: the structure's loops give more sets of joints that may open and slide than the statics try ({}), and the search among them found none lower; this λ is an upper bound and a lower mechanism may exist {see}\n",
+            crr_impact::statics::EXHAUSTIVE_SETS
+        ),
+        (false, true) => String::new(),
+    }
+}
+
 /// The report as text.
 pub fn to_text(r: &CheckReport) -> String {
     let m = &r.mobility;
@@ -433,13 +453,7 @@ pub fn to_text(r: &CheckReport) -> String {
                             lifting.join(", ")
                         );
                     }
-                    if m.from_sliding_search {
-                        let without =
-                            crate::analysis::static_multiplier::without_sliding(m.convex_lambda);
-                        s += &format!(
-                            "    found by the search for joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, so the structure can move from it on, but the search is not exhaustive and a lower mechanism may exist (docs/simulation.md, \"Joints that open may slide\")\n"
-                        );
-                    }
+                    s += &sliding_note(m);
                     let sliding = with(crr_impact::statics::Motion::Slides);
                     if !sliding.is_empty() {
                         s += &format!(
@@ -452,7 +466,8 @@ pub fn to_text(r: &CheckReport) -> String {
                     s += &format!(
                         "  d = {dir}: holds up to λ = {}\n",
                         crate::analysis::static_multiplier::LAMBDA_MAX
-                    )
+                    );
+                    s += &sliding_note(m);
                 }
             }
             if !m.hinges_out_of_plane.is_empty() {

@@ -83,6 +83,12 @@ pub struct StaticMultiplier {
     /// Whether `lambda` comes from the search for joints that open and slide, below the convex
     /// program's answer (`convex_lambda`, or holding up to the cap where that is `None`).
     pub from_sliding_search: bool,
+    /// Whether `lambda` is the least over every collapse state of the contact model, joints that
+    /// open and slide included ([`crr_impact::statics::Collapse::exhaustive`]): a structure
+    /// without loops, or one whose sets of joints that may open and slide were all tried.
+    /// `false`: more sets than the statics try, so `lambda` is the search's answer, an upper
+    /// bound of the multiplier (a lower mechanism may exist). Always with `--friction`.
+    pub exhaustive: bool,
 }
 
 /// What the program without sliding answered, for the reports of an answer the search for
@@ -147,6 +153,7 @@ pub fn static_multiplier_with(
             hinges_out_of_plane: Vec::new(),
             convex_lambda: None,
             from_sliding_search: false,
+            exhaustive: true,
         });
     }
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
@@ -321,5 +328,6 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
             .then_some(collapse.convex_lambda)
             .flatten(),
         from_sliding_search: collapse.from_sliding_search(),
+        exhaustive: collapse.exhaustive,
     }
 }

@@ -49,7 +49,7 @@ pub(crate) struct Lp {
 /// dual objectives.
 pub(crate) struct LpSolution {
     pub(crate) x: Vec<f64>,
-    y_eq: Vec<f64>,
+    pub(crate) y_eq: Vec<f64>,
     primal: f64,
     dual: f64,
 }

@@ -7,6 +7,7 @@ mod common;
 
 mod collapse_state;
 mod duality;
+mod exhaustive;
 mod friction;
 mod independent;
 mod invariance;

@@ -11,15 +11,16 @@
 //! tolerance (duality gap 1e-12 of the weight), not by the statics.
 use nalgebra::Vector3;
 
-use crr::impact::statics::{RestStatics, StaticsOptions, collapse_multiplier};
+use crr::impact::statics::{RestStatics, collapse_multiplier, rest_options};
 use crr::kinematics::Model;
 use crr::kinematics::fixtures::{SplitMix, running_bond_wall_3d};
 
 use crate::common::bundled_model;
 
-/// λ(d) solved afresh (the cap of a structure that holds reads as infinite).
+/// λ(d) solved afresh with the rest statics' options along d (the cap of a structure that
+/// holds reads as infinite).
 fn fresh_lambda(model: &Model, d: &Vector3<f64>) -> f64 {
-    collapse_multiplier(model, *d, &StaticsOptions::default())
+    collapse_multiplier(model, *d, &rest_options(d))
         .expect("the program solves")
         .lambda
         .unwrap_or(f64::INFINITY)

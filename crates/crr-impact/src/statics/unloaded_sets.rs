@@ -1,0 +1,273 @@
+//! The exhaustive pass over the sets of joints that may open and slide.
+//!
+//! **Why it is exact.** In a collapse state (an equilibrium at λ with forces only where a
+//! mechanism keeps contact without sliding), an interface either carries load or carries none.
+//! One that carries load has a point that neither separates nor slides; where it has two or
+//! more such points, or a hinge's line, the relative motion is a rotation about them, which
+//! moves every other point of the face along its normal only: the interface obeys the convex
+//! program's rule (no tangential velocity at any point). One that carries none may separate
+//! and slide anywhere, with only its gaps kept open (gₖ ≥ 0). So a collapse state is the
+//! convex program with a set U of interfaces unloaded; its λ is the program's with U freed
+//! (normal forces only, whose dual leaves U's slips free and keeps its gaps), and it exists
+//! where that program's answer has an equilibrium with U and every moving point unloaded: the
+//! physical test of [`super::physical`], which the optimal pair of a true collapse state
+//! passes (any primal and dual optimum of one program are complementary). Every body carries
+//! its weight, so the interfaces outside U still join every body to the ground: U holds no
+//! bridge of the graph of bodies and interfaces, and at most as many interfaces as it has
+//! independent loops. The least λ over those sets is the multiplier of the contact model with
+//! joints that open and slide (a face that keeps a single loaded corner and twists about it in
+//! a 3D model aside: its other corners slide while keeping contact, which neither rule holds).
+//! A tree (no loop) has no such set: the convex program's answer is exact.
+//!
+//! **Cost.** The sets are counted first, without a program, keeping those that leave every body
+//! joined to the ground and, under a load that presses every body down, resting on a face that
+//! can push it up ([`holdable`]). Beyond the options' `exhaustive_sets` the pass does not run and
+//! the search's answer stands, marked as not exhaustive (walls of many courses with every
+//! contact a joint). Otherwise each set costs one to three programs.
+use nalgebra::Vector3;
+
+use super::{Collapse, StaticsError, StaticsOptions, physical, solve_program};
+use crr_kinematics::{ContactFace, Model, Parent};
+
+/// The interfaces that may be unloaded in a collapse state: on a loop of the graph of bodies
+/// and interfaces (not a bridge, whose removal leaves a body unsupported) and not pins (a pin
+/// is bilateral). Empty for a tree.
+pub(super) fn candidates(model: &Model, faces: &[ContactFace]) -> Vec<usize> {
+    let all = vec![false; model.interfaces.len()];
+    (0..model.interfaces.len())
+        .filter(|&i| {
+            !faces[i].pin && {
+                let mut removed = all.clone();
+                removed[i] = true;
+                supported(model, &removed)
+            }
+        })
+        .collect()
+}
+
+/// The number of independent loops of the graph of bodies and interfaces (ground included):
+/// the most interfaces a set may unload while every body stays joined to the ground.
+pub(super) fn loops(model: &Model) -> usize {
+    // E − V + 1 with V = bodies + ground, for a connected graph.
+    (model.interfaces.len() + 1).saturating_sub(model.bodies.len() + 1)
+}
+
+/// Whether a face can push body `b` upwards (against gravity): by compression where b is the
+/// child on a normal with an upward part (or the parent on one with a downward part), by shear
+/// where a tangent has a vertical part (the convex program's shear is unlimited).
+fn lifts(face: &ContactFace, child: usize, b: usize) -> bool {
+    let tilt = 1e-9;
+    let n = face.normal.z * if child == b { 1.0 } else { -1.0 };
+    n > tilt || face.tangents.iter().any(|t| t.z.abs() > tilt)
+}
+
+/// Whether the interfaces not `removed` can hold every body: each is joined to the ground, and,
+/// where the load keeps pressing every body down (`downward`), each keeps a face that can push
+/// it up ([`lifts`]). Necessary for an equilibrium with the removed interfaces unloaded, and it
+/// stays false when more are removed.
+fn holdable(model: &Model, faces: &[ContactFace], removed: &[bool], downward: bool) -> bool {
+    supported(model, removed)
+        && (!downward
+            || (0..model.bodies.len()).all(|b| {
+                model.interfaces.iter().enumerate().any(|(i, interface)| {
+                    !removed[i]
+                        && (interface.child == b || interface.parent == Parent::Body(b))
+                        && lifts(&faces[i], interface.child, b)
+                })
+            }))
+}
+
+/// Whether every body is joined to the ground through the interfaces not `removed`.
+pub(super) fn supported(model: &Model, removed: &[bool]) -> bool {
+    // Union–find over the bodies and the ground (index n).
+    let n = model.bodies.len();
+    let mut root: Vec<usize> = (0..=n).collect();
+    fn find(root: &mut [usize], mut a: usize) -> usize {
+        while root[a] != a {
+            root[a] = root[root[a]];
+            a = root[a];
+        }
+        a
+    }
+    for (i, interface) in model.interfaces.iter().enumerate() {
+        if removed[i] {
+            continue;
+        }
+        let parent = match interface.parent {
+            Parent::Ground => n,
+            Parent::Body(b) => b,
+        };
+        let (a, b) = (find(&mut root, parent), find(&mut root, interface.child));
+        root[a] = b;
+    }
+    let ground = find(&mut root, n);
+    (0..n).all(|b| find(&mut root, b) == ground)
+}
+
+/// The least collapse over every set U that a collapse state may unload, below `best`
+/// (λ = `best_lambda`, the search's answer): `Some` with the lowest found (`best` itself where
+/// none lowers it), `None` where there are more sets than `options.exhaustive_sets` or a
+/// program failed to solve.
+///
+/// A depth-first walk over the sets, each set's children adding one candidate after its last
+/// (every set is met once). First, every candidate freed at once bounds every set's λ (freeing
+/// more only removes equilibria): where that is not below the best, no set is tried. At a set U:
+/// - it must be [`holdable`], else it and every set below it are dropped;
+/// - its program with every point of U unloaded must have an equilibrium at some λ ≥ 0, else U
+///   and every set below it are dropped (they unload more, so they hold less: a column hanging
+///   from the lintel it carries once its base is unloaded). Its λ_u bounds U's own collapse
+///   (λ = λ_u = λ_f there), so U is tried only where λ_u lies below the best;
+/// - U is tried freed (normal forces only: λ_f) and, where that lowers the best, by the physical
+///   test ([`physical`]).
+pub(super) fn least_collapse(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    best: Collapse,
+    best_lambda: f64,
+) -> Option<Collapse> {
+    let candidates = candidates(model, faces);
+    // The net load on every body points down for every λ below the best where gravity wins
+    // over the load's vertical part: (1 + λ d_z) > 0 (the inertial load is −λ g d).
+    let downward = 1.0 + best_lambda * d.z.min(0.0) > 0.0;
+    let mut pass = Pass {
+        model,
+        faces,
+        d,
+        options,
+        candidates: &candidates,
+        depth: loops(model),
+        downward,
+        best,
+        best_lambda,
+    };
+    pass.count_sets(options.exhaustive_sets)?;
+    if pass.below_best(&candidates)? {
+        pass.children(&[], 0)?;
+    }
+    Some(pass.best)
+}
+
+/// The state of [`least_collapse`]'s branch and bound.
+struct Pass<'a> {
+    model: &'a Model,
+    faces: &'a [ContactFace],
+    d: Vector3<f64>,
+    options: &'a StaticsOptions,
+    candidates: &'a [usize],
+    /// The most interfaces a set may hold (the loops).
+    depth: usize,
+    /// Whether the load presses every body down below the best λ ([`holdable`]).
+    downward: bool,
+    best: Collapse,
+    best_lambda: f64,
+}
+
+impl Pass<'_> {
+    fn lowers(&self, lambda: f64) -> bool {
+        lambda < self.best_lambda * (1.0 - 1e-9)
+    }
+
+    /// The interfaces `set` as flags over the model's interfaces.
+    fn flags(&self, set: &[usize]) -> Vec<bool> {
+        let mut flags = vec![false; self.faces.len()];
+        for &i in set {
+            flags[i] = true;
+        }
+        flags
+    }
+
+    /// Whether the program with `set` freed answers below the best (None: a solver failure): a
+    /// bound of the sets it holds. With no equilibrium at any λ ≥ 0 it bounds nothing (its
+    /// subsets may hold).
+    fn below_best(&mut self, set: &[usize]) -> Option<bool> {
+        let free = self.flags(set);
+        match solve_program(self.model, self.faces, self.d, self.options, &free, &[]) {
+            Ok(c) => Some(c.lambda.is_some_and(|l| self.lowers(l))),
+            Err(StaticsError::DoesNotHold(_)) => Some(true),
+            Err(_) => None,
+        }
+    }
+
+    /// How many sets [`holdable`] keeps (None beyond `most`), without a program.
+    fn count_sets(&self, most: usize) -> Option<usize> {
+        let mut found = 0usize;
+        let mut stack: Vec<(Vec<usize>, usize)> = vec![(Vec::new(), 0)];
+        while let Some((set, from)) = stack.pop() {
+            if set.len() >= self.depth {
+                continue;
+            }
+            for k in from..self.candidates.len() {
+                let mut trial = set.clone();
+                trial.push(self.candidates[k]);
+                if holdable(self.model, self.faces, &self.flags(&trial), self.downward) {
+                    found += 1;
+                    if found > most {
+                        return None;
+                    }
+                    stack.push((trial, k + 1));
+                }
+            }
+        }
+        Some(found)
+    }
+
+    /// Every set `set` + {candidates[k]} for k ≥ `from`, and the sets below each.
+    fn children(&mut self, set: &[usize], from: usize) -> Option<()> {
+        if set.len() >= self.depth {
+            return Some(());
+        }
+        for k in from..self.candidates.len() {
+            let mut trial = set.to_vec();
+            trial.push(self.candidates[k]);
+            if !holdable(self.model, self.faces, &self.flags(&trial), self.downward) {
+                continue;
+            }
+            // U unloaded: no equilibrium at λ ≥ 0 drops U and the sets below it.
+            let unloaded: Vec<(usize, usize)> = trial
+                .iter()
+                .flat_map(|&i| (0..self.faces[i].points.len()).map(move |p| (i, p)))
+                .collect();
+            let none = vec![false; self.faces.len()];
+            let holding = match solve_program(
+                self.model,
+                self.faces,
+                self.d,
+                self.options,
+                &none,
+                &unloaded,
+            ) {
+                Ok(c) => c.lambda.unwrap_or(self.options.lambda_max),
+                Err(StaticsError::DoesNotHold(_)) => continue,
+                Err(_) => return None,
+            };
+            if self.lowers(holding) {
+                self.try_set(&trial)?;
+            }
+            if trial.len() < self.depth {
+                self.children(&trial, k + 1)?;
+            }
+        }
+        Some(())
+    }
+
+    /// U freed, kept as the best where it lowers λ and passes the physical test.
+    fn try_set(&mut self, set: &[usize]) -> Option<()> {
+        let free = self.flags(set);
+        let freed = match solve_program(self.model, self.faces, self.d, self.options, &free, &[]) {
+            Ok(freed) => freed,
+            Err(StaticsError::DoesNotHold(_)) => return Some(()),
+            Err(_) => return None,
+        };
+        let Some(lambda) = freed.lambda.filter(|&l| self.lowers(l)) else {
+            return Some(());
+        };
+        if let Some(collapse) = physical(self.model, self.faces, self.d, self.options, &free, freed)
+        {
+            self.best = collapse;
+            self.best_lambda = lambda;
+        }
+        Some(())
+    }
+}
