@@ -841,6 +841,30 @@ fn warnings(
             check.residual / p.model.gravity
         ));
     }
+    if let Some(held) = &t.held_on_search {
+        let a = nalgebra::Vector3::from(held.load);
+        let d = a / a.norm();
+        out.push(format!(
+            "at t = {} s the structure at rest was held under a ground acceleration of {:.4} m/s² \
+             along ({:.3}, {:.3}, {:.3}) on a static multiplier that is not exhaustive: along \
+             that direction it has more sets of joints that may open and slide than a run tries \
+             ({} along an axis, {} along another direction), the search among them found none \
+             below the load, but a lower mechanism may exist and the structure may leave rest \
+             earlier (`crr check --direction {:.6},{:.6},{:.6}` tries up to {}; \
+             docs/simulation.md, \"The exhaustive pass\")",
+            held.t,
+            a.norm(),
+            d.x + 0.0,
+            d.y + 0.0,
+            d.z + 0.0,
+            crr_impact::statics::REST_EXHAUSTIVE_SETS,
+            crr_impact::statics::REST_DIRECTION_SETS,
+            d.x + 0.0,
+            d.y + 0.0,
+            d.z + 0.0,
+            crr_impact::statics::EXHAUSTIVE_SETS,
+        ));
+    }
     if let Some(part) = out_of_plane_ground_motion(&p.model, &p.ground) {
         out.push(part);
     }

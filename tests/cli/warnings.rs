@@ -175,6 +175,8 @@ fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
 /// entablature's seat on that capital compressive (the capital would hang from it). The 3D arch used to be flagged too, a springing held seated with an edge of its
 /// face pulling at 2.68 s, after a snap of seated angles whose change of energy went unbooked
 /// (1.3e-3 J of energy-balance error; 4.4e-6 J since the snaps are made at the impacts).
+/// The temple also warns that at 1.6 s it was held at rest on a static multiplier that is not
+/// exhaustive (docs/simulation.md, "The exhaustive pass").
 #[test]
 fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/models");
@@ -221,7 +223,19 @@ fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
             _ => None,
         };
         if let Some(words) = flagged {
-            let w = warnings(&s);
+            let mut w = warnings(&s);
+            // The temple at rest at 1.6 s, under a load along (0.342, 0.940, 0) held on the
+            // search's multiplier: 62 sets of joints that may open and slide there, more than the
+            // 32 a run tries off the axes (`crr check --direction` there, exhaustive, gives the
+            // search's own 0.173391: the load, 1.3642 m/s², holds).
+            if stem == "temple" {
+                assert!(
+                    w[0].starts_with("at t = 1.6 s the structure at rest was held under")
+                        && w[0].contains("not exhaustive"),
+                    "{stem}: {w:?}"
+                );
+                w.remove(0);
+            }
             assert_eq!(w.len(), 1, "{stem}: {w:?}");
             assert!(w[0].contains(words), "{stem}: {w:?}");
             continue;

@@ -461,3 +461,50 @@ fn a_corner_wedge_that_slides_up_its_head_joint_is_a_violation() {
         Some(convex),
     );
 }
+
+/// The first instant a run from rest holds a constant load `a` on a multiplier that is not
+/// exhaustive (`Trajectory::held_on_search`), and whether it left rest.
+fn held_on_search(model: &Model, a: Vector3<f64>) -> (Option<crr::impact::HeldOnSearch>, bool) {
+    let ground = constant_ground(a);
+    let initial = solve_initial(model, &InitialSpec::default()).unwrap();
+    let params = Parameters {
+        duration: 0.05,
+        ..Default::default()
+    };
+    let t = Simulation::new(model, &ground, &initial, params)
+        .unwrap()
+        .run()
+        .unwrap();
+    (t.held_on_search, t.uplift_time.is_some())
+}
+
+/// A run that holds a load at rest on a multiplier the search alone found says so. The bundled
+/// wall has 2186 sets of joints that may open and slide along ±x (more than the 256 a run tries
+/// along an axis, fewer than the 4096 of `crr check`): under half its multiplier along +x it
+/// stays at rest and records that instant (t = 0) with the load; `crr check`'s pass, exhaustive
+/// there, confirms the search's 7/11. The trilithon, whose answer is exhaustive, records none.
+#[test]
+fn a_run_held_on_a_multiplier_that_is_not_exhaustive_says_so() {
+    use crr::impact::statics::rest_options;
+    let x = Vector3::x();
+    let wall = bundled("wall");
+    let run = collapse_multiplier(&wall, x, &rest_options(&x)).unwrap();
+    let check = collapse_multiplier(&wall, x, &StaticsOptions::default()).unwrap();
+    assert!(!run.exhaustive && check.exhaustive);
+    let lambda = check.lambda.unwrap();
+    assert!((lambda - 7.0 / 11.0).abs() < 1e-7 && (run.lambda.unwrap() - lambda).abs() < 1e-7);
+    let a = 0.5 * lambda * wall.gravity * x;
+    let (held, moved) = held_on_search(&wall, a);
+    let held = held.expect("the wall is held on the search's answer");
+    assert!(!moved);
+    assert_eq!(held.t, 0.0);
+    assert_eq!(held.load, [a.x, a.y, a.z]);
+
+    let trilithon = bundled("trilithon");
+    let c = collapse_multiplier(&trilithon, x, &rest_options(&x)).unwrap();
+    assert!(c.exhaustive);
+    let a = 0.5 * c.lambda.unwrap() * trilithon.gravity * x;
+    let (held, moved) = held_on_search(&trilithon, a);
+    assert_eq!(held, None);
+    assert!(!moved);
+}

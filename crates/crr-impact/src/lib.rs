@@ -53,6 +53,6 @@ pub mod simulation;
 pub mod statics;
 
 pub use simulation::{
-    Interrupted, Parameters, Sample, Samples, Simulation, SimulationError, SlotState, StopReason,
-    Trajectory, UNDECIDED_GAP, UNDECIDED_UPLIFTS,
+    HeldOnSearch, Interrupted, Parameters, Sample, Samples, Simulation, SimulationError, SlotState,
+    StopReason, Trajectory, UNDECIDED_GAP, UNDECIDED_UPLIFTS,
 };

@@ -1412,21 +1412,37 @@ pub struct RestStatics {
     known: Vec<KnownAnswer>,
     /// Programs solved (the axes' and the directions').
     programs: usize,
+    /// Whether each axis's answer is not exhaustive ([`Collapse::exhaustive`]).
+    axes_searched: [bool; 6],
+    /// Whether some answer kept is not exhaustive.
+    any_searched: bool,
+    /// Whether the last load [`Self::exceeded`] found holding was held on an answer that is not
+    /// exhaustive (the search for joints that open and slide alone: a lower mechanism may exist).
+    held_on_search: bool,
 }
 
 /// Most sets of joints that may open and slide the rest statics try exhaustively along an axis.
 pub const REST_EXHAUSTIVE_SETS: usize = 256;
 
+/// Most sets the rest statics try exhaustively along any other direction.
+pub const REST_DIRECTION_SETS: usize = 32;
+
 /// The options [`RestStatics`] solves its programs with along the unit direction `d`:
 /// [`StaticsOptions::default`] with at most [`REST_EXHAUSTIVE_SETS`] sets of joints that may
 /// open and slide tried exhaustively along an axis (±x, ±y, ±z), which a run asks for once per
-/// chain (the bundled temple's run: 1.3 s without the pass, 2.2 s with it), and the search
-/// alone along any other direction: a record in two components asks for many, each its own
-/// program, and the pass along each multiplied the temple's run time by nine.
+/// chain (the bundled temple's run: 1.3 s without the pass, 2.2 s with it), and at most
+/// [`REST_DIRECTION_SETS`] along any other direction: a record in two components asks for many,
+/// each its own program, and the pass along each multiplied the temple's run time (62 sets) by
+/// nine. Where a load is held on an answer that is not exhaustive,
+/// [`RestStatics::held_on_search`] says so.
 pub fn rest_options(d: &Vector3<f64>) -> StaticsOptions {
     let on_axis = (0..3).filter(|&k| d[k] != 0.0).count() == 1;
     StaticsOptions {
-        exhaustive_sets: if on_axis { REST_EXHAUSTIVE_SETS } else { 0 },
+        exhaustive_sets: if on_axis {
+            REST_EXHAUSTIVE_SETS
+        } else {
+            REST_DIRECTION_SETS
+        },
         ..StaticsOptions::default()
     }
 }
@@ -1490,6 +1506,8 @@ impl RestStatics {
             .collect();
         let needed = if needed.is_empty() { vec![0] } else { needed };
         let mut hull = 0.0;
+        self.held_on_search = false;
+        let mut searched_axes = false;
         for k in needed {
             // Both senses of the axis: the loads a structure holds form a convex set, and one
             // that cannot stand under no load (0 outside the set) meets the axis line on one
@@ -1502,11 +1520,13 @@ impl RestStatics {
                 }
             }
             hull += a[k / 2].abs() / (self.axis(model, k)? * g);
+            searched_axes |= self.axes_searched[k];
         }
         if magnitude == 0.0 || !magnitude.is_finite() {
             return Ok(None);
         }
         if hull < 1.0 && !self.beyond_a_cut(&(a / g), 0.0) {
+            self.held_on_search = searched_axes;
             return Ok(None);
         }
         let d = a / magnitude;
@@ -1519,10 +1539,12 @@ impl RestStatics {
             Some(i) => i,
             None => {
                 if self.within_known_loads(&(a / g)) {
+                    self.held_on_search = self.any_searched;
                     return Ok(None);
                 }
                 self.programs += 1;
                 let c = collapse_multiplier(model, d, &rest_options(&d))?;
+                self.any_searched |= !c.exhaustive;
                 self.keep_answer(KnownAnswer::of(model, &d, &c));
                 self.keep_direction(key, c)
             }
@@ -1530,8 +1552,19 @@ impl RestStatics {
         let collapse = &self.by_direction[index].1;
         Ok(match collapse.lambda {
             Some(l) if magnitude > l * g * (1.0 + 1e-9) => Some(collapse),
-            _ => None,
+            _ => {
+                self.held_on_search = !collapse.exhaustive;
+                None
+            }
         })
+    }
+
+    /// Whether the last load [`Self::exceeded`] found holding was held on an answer that is not
+    /// exhaustive: the search for joints that open and slide alone, along a direction where the
+    /// structure has more sets of such joints than [`rest_options`] tries, so a lower mechanism
+    /// may exist and the structure may leave rest under that load.
+    pub fn held_on_search(&self) -> bool {
+        self.held_on_search
     }
 
     /// λ along axis `k` (+x, −x, +y, −y, +z, −z), computed once: capped at [`LAMBDA_MAX`], 0
@@ -1547,6 +1580,8 @@ impl RestStatics {
         let lambda = match collapse_multiplier(model, d, &rest_options(&d)) {
             Ok(c) => {
                 let lambda = c.lambda.unwrap_or(LAMBDA_MAX);
+                self.axes_searched[k] = !c.exhaustive;
+                self.any_searched |= !c.exhaustive;
                 // A structure that cannot stand along this axis (λ ≤ 0) has no boundary point
                 // or cut to keep: the standing check stops every test first.
                 if lambda > 0.0 {
@@ -1721,6 +1756,10 @@ struct MemoryEntry {
     key: Vec<String>,
     /// λ along the axes, as [`RestStatics`] keeps them.
     axes: [Option<f64>; 6],
+    /// Whether each axis's answer is not exhaustive.
+    axes_searched: [bool; 6],
+    /// Whether some answer kept is not exhaustive.
+    any_searched: bool,
     /// The answers' boundary points and cuts.
     known: Vec<KnownAnswer>,
     /// The chain that computed `collapses`, and those collapses by direction.
@@ -1753,6 +1792,9 @@ impl AxisMemory {
             by_direction,
             known: entry.known.clone(),
             programs: 0,
+            axes_searched: entry.axes_searched,
+            any_searched: entry.any_searched,
+            held_on_search: false,
         }
     }
 
@@ -1772,6 +1814,8 @@ impl AxisMemory {
                 self.entries.push(MemoryEntry {
                     key,
                     axes: [None; 6],
+                    axes_searched: [false; 6],
+                    any_searched: false,
                     known: Vec::new(),
                     collapses: None,
                 });
@@ -1779,9 +1823,13 @@ impl AxisMemory {
             }
         };
         let entry = &mut self.entries[index];
-        for (kept, new) in entry.axes.iter_mut().zip(statics.axes) {
-            *kept = kept.or(new);
+        for k in 0..6 {
+            if entry.axes[k].is_none() && statics.axes[k].is_some() {
+                entry.axes[k] = statics.axes[k];
+                entry.axes_searched[k] = statics.axes_searched[k];
+            }
         }
+        entry.any_searched |= statics.any_searched;
         for answer in &statics.known {
             keep_known(&mut entry.known, answer.clone());
         }

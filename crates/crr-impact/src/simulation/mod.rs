@@ -549,6 +549,8 @@ pub struct Simulation<'a> {
     loop_residual: LoopResidual,
     /// The first decision that rested on a solve left with the loops open.
     doubtful_check: Option<DoubtfulCheck>,
+    /// The first instant at rest held on a multiplier that is not exhaustive.
+    held_on_search: Option<HeldOnSearch>,
     /// The pulls at pivots where segments start, measured (module `hops`).
     hops: hops::Hops,
 }
@@ -581,6 +583,19 @@ pub struct DoubtfulCheck {
     pub residual: f64,
     /// The interfaces whose releases were sent back.
     pub interfaces: Vec<String>,
+}
+
+/// An instant at which the structure at rest was held on a static multiplier that is not
+/// exhaustive ([`crate::statics::RestStatics::held_on_search`]): along that load's direction
+/// the structure has more sets of joints that may open and slide than the rest statics try, and
+/// the search for them found none below the load, but a lower mechanism may exist
+/// (docs/simulation.md, "The exhaustive pass").
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HeldOnSearch {
+    /// The instant (s).
+    pub t: f64,
+    /// The ground acceleration held (m/s²).
+    pub load: [f64; 3],
 }
 
 /// The buffers of one integration segment ([`Simulation::step`]): the events' state and pivots,
@@ -1037,6 +1052,7 @@ impl<'a> Simulation<'a> {
             violation: None,
             loop_residual: LoopResidual::default(),
             doubtful_check: None,
+            held_on_search: None,
             hops: hops::Hops::default(),
         };
         // Released beyond the point of no return (its potential energy already below the rest
@@ -1217,6 +1233,7 @@ impl<'a> Simulation<'a> {
         let stop = self.step_unchecked();
         self.collect_doubtful_checks();
         self.collect_sliding_unloaded();
+        self.collect_held_on_search();
         let mut stop = stop?;
         // The first violation is final once a step has started after it with no pull being
         // measured: whatever is recorded later is at or after that start.
@@ -1253,6 +1270,24 @@ impl<'a> Simulation<'a> {
             .into_iter()
             .filter(|c| c.t <= reached)
             .min_by(|a, b| a.t.total_cmp(&b.t));
+    }
+
+    /// Keeps the first instant on the run's trajectory at which the structure at rest was held on
+    /// a multiplier that is not exhaustive ([`HeldOnSearch`]).
+    fn collect_held_on_search(&mut self) {
+        let held = std::mem::take(&mut self.spare.rest.held_on_search);
+        if self.held_on_search.is_some() {
+            return;
+        }
+        let reached = self.t + 1e-12 * self.t.abs().max(1.0);
+        self.held_on_search = held
+            .into_iter()
+            .filter(|(t, _)| *t <= reached)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(t, a)| HeldOnSearch {
+                t,
+                load: [a.x, a.y, a.z],
+            });
     }
 
     /// Records the first instant on the run's trajectory at which the structure at rest was held
@@ -2095,6 +2130,7 @@ impl<'a> Simulation<'a> {
             solver_stats: self.solver.stats(),
             loop_residual: self.loop_residual,
             doubtful_check: self.doubtful_check.clone(),
+            held_on_search: self.held_on_search.clone(),
             hops: self.hops.done,
         }
     }
@@ -2137,6 +2173,9 @@ pub struct Trajectory {
     /// The first decision of the uplift test that rested on a solve left with the loops open
     /// ([`DoubtfulCheck`]); None where there was none.
     pub doubtful_check: Option<DoubtfulCheck>,
+    /// The first instant at rest held on a static multiplier that is not exhaustive
+    /// ([`HeldOnSearch`]); None where there was none.
+    pub held_on_search: Option<HeldOnSearch>,
     /// Every pull at a pivot where a segment started, with the bound on how far its face would
     /// open (module `hops`), in the order they ended.
     pub hops: Vec<Hop>,
@@ -2161,6 +2200,7 @@ impl Trajectory {
             solver_stats: Default::default(),
             loop_residual: LoopResidual::default(),
             doubtful_check: None,
+            held_on_search: None,
             hops: Vec::new(),
         }
     }

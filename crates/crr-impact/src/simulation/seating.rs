@@ -178,7 +178,12 @@ fn opening_mode_decided(
     }
     // (A local test already run found no opening; it would find none again.)
     let collapse = match rest.global.exceeded(model, &a) {
-        Ok(None) => return None,
+        Ok(None) => {
+            if rest.global.held_on_search() {
+                rest.held_on_search.push((t, a));
+            }
+            return None;
+        }
         Ok(Some(collapse)) => collapse.clone(),
         Err(_) if local_first => return None,
         Err(_) => {

@@ -64,6 +64,10 @@ pub(super) struct RestCache {
     /// whose joints slide while keeping contact (`seating::opening_mode_in`), with those
     /// interfaces, since the run last collected them.
     pub(super) sliding_unloaded: Vec<(f64, Vec<String>)>,
+    /// The instants at which the structure at rest was held on a multiplier that is not
+    /// exhaustive (`statics::RestStatics::held_on_search`), with the load (m/s²), since the run
+    /// last collected them.
+    pub(super) held_on_search: Vec<(f64, nalgebra::Vector3<f64>)>,
 }
 
 #[derive(Clone, Debug)]
