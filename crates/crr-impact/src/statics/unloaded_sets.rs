@@ -19,6 +19,15 @@
 //! a 3D model aside: its other corners slide while keeping contact, which neither rule holds).
 //! A tree (no loop) has no such set: the convex program's answer is exact.
 //!
+//! "Exact" is in the sense of the convex program's closure: a joint that keeps contact may
+//! carry shear with no compression left (the friction cone's closure as μ → ∞), and a hinge
+//! that keeps one line carries its in-plane shear there (the same wrench at either line). An
+//! answer that relies on shear across a joint its mechanism lifts off is the limit of
+//! equilibria whose compression there vanishes: it needs unbounded friction, which
+//! [`super::state_friction`] and `crr check` report ("needs μ > 1000"; an independent review
+//! found 15 such answers on 134 directions of random walls with beds only, and no answer above
+//! a collapse state it verified).
+//!
 //! **Cost.** The sets are counted first, without a program, keeping those that leave every body
 //! joined to the ground and, under a load that presses every body down, resting on a face that
 //! can push it up ([`holdable`]). Beyond the options' `exhaustive_sets` the pass does not run and
