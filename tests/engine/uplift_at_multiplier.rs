@@ -286,6 +286,7 @@ struct Held {
     violation: Option<crr::impact::monitor::Violation>,
     uplift: Option<f64>,
     largest_angle: f64,
+    held_on_search: Option<crr::impact::HeldOnSearch>,
 }
 
 fn held_under(model: &Model, a: Vector3<f64>) -> Held {
@@ -308,6 +309,7 @@ fn held_under(model: &Model, a: Vector3<f64>) -> Held {
         violation: t.violation,
         uplift: t.uplift_time,
         largest_angle,
+        held_on_search: t.held_on_search,
     }
 }
 
@@ -462,22 +464,6 @@ fn a_corner_wedge_that_slides_up_its_head_joint_is_a_violation() {
     );
 }
 
-/// The first instant a run from rest holds a constant load `a` on a multiplier that is not
-/// exhaustive (`Trajectory::held_on_search`), and whether it left rest.
-fn held_on_search(model: &Model, a: Vector3<f64>) -> (Option<crr::impact::HeldOnSearch>, bool) {
-    let ground = constant_ground(a);
-    let initial = solve_initial(model, &InitialSpec::default()).unwrap();
-    let params = Parameters {
-        duration: 0.05,
-        ..Default::default()
-    };
-    let t = Simulation::new(model, &ground, &initial, params)
-        .unwrap()
-        .run()
-        .unwrap();
-    (t.held_on_search, t.uplift_time.is_some())
-}
-
 /// A run that holds a load at rest on a multiplier the search alone found says so. The bundled
 /// wall has 2186 sets of joints that may open and slide along ±x (more than the 256 a run tries
 /// along an axis, fewer than the 4096 of `crr check`): under half its multiplier along +x it
@@ -494,9 +480,11 @@ fn a_run_held_on_a_multiplier_that_is_not_exhaustive_says_so() {
     let lambda = check.lambda.unwrap();
     assert!((lambda - 7.0 / 11.0).abs() < 1e-7 && (run.lambda.unwrap() - lambda).abs() < 1e-7);
     let a = 0.5 * lambda * wall.gravity * x;
-    let (held, moved) = held_on_search(&wall, a);
-    let held = held.expect("the wall is held on the search's answer");
-    assert!(!moved);
+    let run = held_under(&wall, a);
+    let held = run
+        .held_on_search
+        .expect("the wall is held on the search's answer");
+    assert!(run.uplift.is_none());
     assert_eq!(held.t, 0.0);
     assert_eq!(held.load, [a.x, a.y, a.z]);
 
@@ -504,7 +492,7 @@ fn a_run_held_on_a_multiplier_that_is_not_exhaustive_says_so() {
     let c = collapse_multiplier(&trilithon, x, &rest_options(&x)).unwrap();
     assert!(c.exhaustive);
     let a = 0.5 * c.lambda.unwrap() * trilithon.gravity * x;
-    let (held, moved) = held_on_search(&trilithon, a);
-    assert_eq!(held, None);
-    assert!(!moved);
+    let run = held_under(&trilithon, a);
+    assert_eq!(run.held_on_search, None);
+    assert!(run.uplift.is_none());
 }

@@ -316,7 +316,8 @@ pub fn collapse_multiplier(
         });
     }
     // A tree has no interface that a collapse state may unload: the convex answer is exact.
-    if unloaded_sets::candidates(model, &faces).is_empty() {
+    let candidates = unloaded_sets::candidates(model, &faces);
+    if candidates.is_empty() {
         return Ok(Collapse {
             exhaustive: true,
             ..convex
@@ -334,6 +335,7 @@ pub fn collapse_multiplier(
         match unloaded_sets::least_collapse(
             model,
             &faces,
+            &candidates,
             d,
             options,
             searched.clone(),

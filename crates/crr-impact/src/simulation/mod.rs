@@ -1262,32 +1262,28 @@ impl<'a> Simulation<'a> {
     /// made up to the time reached (those of the root location past an event are not on it).
     fn collect_doubtful_checks(&mut self) {
         let checks = std::mem::take(&mut self.spare.rest.doubtful);
-        if self.doubtful_check.is_some() {
-            return;
+        if self.doubtful_check.is_none() {
+            self.doubtful_check = self.first_reached(checks, |c| c.t);
         }
-        let reached = self.t + 1e-12 * self.t.abs().max(1.0);
-        self.doubtful_check = checks
-            .into_iter()
-            .filter(|c| c.t <= reached)
-            .min_by(|a, b| a.t.total_cmp(&b.t));
     }
 
     /// Keeps the first instant on the run's trajectory at which the structure at rest was held on
     /// a multiplier that is not exhaustive ([`HeldOnSearch`]).
     fn collect_held_on_search(&mut self) {
         let held = std::mem::take(&mut self.spare.rest.held_on_search);
-        if self.held_on_search.is_some() {
-            return;
+        if self.held_on_search.is_none() {
+            self.held_on_search = self.first_reached(held, |h| h.t);
         }
+    }
+
+    /// The earliest of `records` (instant `t`) made up to the time reached: those of a root
+    /// location past an event are not on the trajectory.
+    fn first_reached<T>(&self, records: Vec<T>, t: impl Fn(&T) -> f64) -> Option<T> {
         let reached = self.t + 1e-12 * self.t.abs().max(1.0);
-        self.held_on_search = held
+        records
             .into_iter()
-            .filter(|(t, _)| *t <= reached)
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map(|(t, a)| HeldOnSearch {
-                t,
-                load: [a.x, a.y, a.z],
-            });
+            .filter(|r| t(r) <= reached)
+            .min_by(|a, b| t(a).total_cmp(&t(b)))
     }
 
     /// Records the first instant on the run's trajectory at which the structure at rest was held

@@ -180,7 +180,10 @@ fn opening_mode_decided(
     let collapse = match rest.global.exceeded(model, &a) {
         Ok(None) => {
             if rest.global.held_on_search() {
-                rest.held_on_search.push((t, a));
+                rest.held_on_search.push(super::HeldOnSearch {
+                    t,
+                    load: [a.x, a.y, a.z],
+                });
             }
             return None;
         }

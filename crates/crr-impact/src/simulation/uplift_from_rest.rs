@@ -65,9 +65,9 @@ pub(super) struct RestCache {
     /// interfaces, since the run last collected them.
     pub(super) sliding_unloaded: Vec<(f64, Vec<String>)>,
     /// The instants at which the structure at rest was held on a multiplier that is not
-    /// exhaustive (`statics::RestStatics::held_on_search`), with the load (m/s²), since the run
-    /// last collected them.
-    pub(super) held_on_search: Vec<(f64, nalgebra::Vector3<f64>)>,
+    /// exhaustive (`statics::RestStatics::held_on_search`), with the load, since the run last
+    /// collected them.
+    pub(super) held_on_search: Vec<super::HeldOnSearch>,
 }
 
 #[derive(Clone, Debug)]

@@ -30,7 +30,7 @@
 //!
 //! **Cost.** The sets are counted first, without a program, keeping those that leave every body
 //! joined to the ground and, under a load that presses every body down, resting on a face that
-//! can push it up ([`holdable`]). Beyond the options' `exhaustive_sets` the pass does not run and
+//! can push it up ([`Pass::holdable`]). Beyond the options' `exhaustive_sets` the pass does not run and
 //! the search's answer stands, marked as not exhaustive (walls of many courses with every
 //! contact a joint). Otherwise each set costs one to three programs.
 use nalgebra::Vector3;
@@ -70,20 +70,21 @@ fn lifts(face: &ContactFace, child: usize, b: usize) -> bool {
     n > tilt || face.tangents.iter().any(|t| t.z.abs() > tilt)
 }
 
-/// Whether the interfaces not `removed` can hold every body: each is joined to the ground, and,
-/// where the load keeps pressing every body down (`downward`), each keeps a face that can push
-/// it up ([`lifts`]). Necessary for an equilibrium with the removed interfaces unloaded, and it
-/// stays false when more are removed.
-fn holdable(model: &Model, faces: &[ContactFace], removed: &[bool], downward: bool) -> bool {
-    supported(model, removed)
-        && (!downward
-            || (0..model.bodies.len()).all(|b| {
-                model.interfaces.iter().enumerate().any(|(i, interface)| {
-                    !removed[i]
-                        && (interface.child == b || interface.parent == Parent::Body(b))
-                        && lifts(&faces[i], interface.child, b)
-                })
-            }))
+/// Per body, the interfaces whose face can push it up ([`lifts`]).
+fn lifters(model: &Model, faces: &[ContactFace]) -> Vec<Vec<usize>> {
+    let mut lifters = vec![Vec::new(); model.bodies.len()];
+    for (i, interface) in model.interfaces.iter().enumerate() {
+        let child = interface.child;
+        if lifts(&faces[i], child, child) {
+            lifters[child].push(i);
+        }
+        if let Parent::Body(b) = interface.parent
+            && lifts(&faces[i], child, b)
+        {
+            lifters[b].push(i);
+        }
+    }
+    lifters
 }
 
 /// Whether every body is joined to the ground through the interfaces not `removed`.
@@ -121,7 +122,7 @@ pub(super) fn supported(model: &Model, removed: &[bool]) -> bool {
 /// A depth-first walk over the sets, each set's children adding one candidate after its last
 /// (every set is met once). First, every candidate freed at once bounds every set's λ (freeing
 /// more only removes equilibria): where that is not below the best, no set is tried. At a set U:
-/// - it must be [`holdable`], else it and every set below it are dropped;
+/// - it must be [`Pass::holdable`], else it and every set below it are dropped;
 /// - its program with every point of U unloaded must have an equilibrium at some λ ≥ 0, else U
 ///   and every set below it are dropped (they unload more, so they hold less: a column hanging
 ///   from the lintel it carries once its base is unloaded). Its λ_u bounds U's own collapse
@@ -131,12 +132,12 @@ pub(super) fn supported(model: &Model, removed: &[bool]) -> bool {
 pub(super) fn least_collapse(
     model: &Model,
     faces: &[ContactFace],
+    candidates: &[usize],
     d: Vector3<f64>,
     options: &StaticsOptions,
     best: Collapse,
     best_lambda: f64,
 ) -> Option<Collapse> {
-    let candidates = candidates(model, faces);
     // The net load on every body points down for every λ below the best where gravity wins
     // over the load's vertical part: (1 + λ d_z) > 0 (the inertial load is −λ g d).
     let downward = 1.0 + best_lambda * d.z.min(0.0) > 0.0;
@@ -145,20 +146,20 @@ pub(super) fn least_collapse(
         faces,
         d,
         options,
-        candidates: &candidates,
+        candidates,
         depth: loops(model),
-        downward,
+        lifters: downward.then(|| lifters(model, faces)),
         best,
         best_lambda,
     };
     pass.count_sets(options.exhaustive_sets)?;
-    if pass.below_best(&candidates)? {
+    if pass.below_best(candidates)? {
         pass.children(&[], 0)?;
     }
     Some(pass.best)
 }
 
-/// The state of [`least_collapse`]'s branch and bound.
+/// The state of [`least_collapse`]'s depth-first walk.
 struct Pass<'a> {
     model: &'a Model,
     faces: &'a [ContactFace],
@@ -167,8 +168,9 @@ struct Pass<'a> {
     candidates: &'a [usize],
     /// The most interfaces a set may hold (the loops).
     depth: usize,
-    /// Whether the load presses every body down below the best λ ([`holdable`]).
-    downward: bool,
+    /// Where the load presses every body down below the best λ, per body the interfaces that
+    /// can push it up ([`lifters`]); None otherwise.
+    lifters: Option<Vec<Vec<usize>>>,
     best: Collapse,
     best_lambda: f64,
 }
@@ -176,6 +178,19 @@ struct Pass<'a> {
 impl Pass<'_> {
     fn lowers(&self, lambda: f64) -> bool {
         lambda < self.best_lambda * (1.0 - 1e-9)
+    }
+
+    /// Whether the interfaces not `removed` can hold every body: each is joined to the ground,
+    /// and, where the load keeps pressing every body down, each keeps a face that can push it up
+    /// ([`lifts`]). Necessary for an equilibrium with the removed interfaces unloaded, and it
+    /// stays false when more are removed.
+    fn holdable(&self, removed: &[bool]) -> bool {
+        supported(self.model, removed)
+            && self.lifters.as_ref().is_none_or(|lifters| {
+                lifters
+                    .iter()
+                    .all(|interfaces| interfaces.iter().any(|&i| !removed[i]))
+            })
     }
 
     /// The interfaces `set` as flags over the model's interfaces.
@@ -199,7 +214,7 @@ impl Pass<'_> {
         }
     }
 
-    /// How many sets [`holdable`] keeps (None beyond `most`), without a program.
+    /// How many sets [`Pass::holdable`] keeps (None beyond `most`), without a program.
     fn count_sets(&self, most: usize) -> Option<usize> {
         let mut found = 0usize;
         let mut stack: Vec<(Vec<usize>, usize)> = vec![(Vec::new(), 0)];
@@ -210,7 +225,7 @@ impl Pass<'_> {
             for k in from..self.candidates.len() {
                 let mut trial = set.clone();
                 trial.push(self.candidates[k]);
-                if holdable(self.model, self.faces, &self.flags(&trial), self.downward) {
+                if self.holdable(&self.flags(&trial)) {
                     found += 1;
                     if found > most {
                         return None;
@@ -230,7 +245,7 @@ impl Pass<'_> {
         for k in from..self.candidates.len() {
             let mut trial = set.to_vec();
             trial.push(self.candidates[k]);
-            if !holdable(self.model, self.faces, &self.flags(&trial), self.downward) {
+            if !self.holdable(&self.flags(&trial)) {
                 continue;
             }
             // U unloaded: no equilibrium at λ ≥ 0 drops U and the sets below it.
