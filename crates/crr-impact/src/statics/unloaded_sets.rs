@@ -35,7 +35,10 @@
 //! contact a joint). Otherwise each set costs one to three programs.
 use nalgebra::Vector3;
 
-use super::{Collapse, StaticsError, StaticsOptions, physical, solve_program};
+use super::{
+    Collapse, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, moving_points, physical,
+    solve_program,
+};
 use crr_kinematics::{ContactFace, Model, Parent};
 
 /// The interfaces that may be unloaded in a collapse state: on a loop of the graph of bodies
@@ -214,6 +217,21 @@ impl Pass<'_> {
         }
     }
 
+    /// Whether the physical test of U's freed answer (λ_f = `lambda`) must fail, without its
+    /// program: a collapse state with U unloaded has λ = λ_u = λ_f (its forces are feasible
+    /// where U carries nothing, and optimal where U is freed). Where every point of U opens or
+    /// slides in the freed mechanism, the test's program unloads them all, so it answers at most
+    /// λ_u (`holding`): below λ_f, the test fails. On the bundled temple this is most sets (its
+    /// columns standing free under an entablature that slides on them).
+    fn unloads_below(&self, set: &[usize], freed: &Collapse, holding: f64, lambda: f64) -> bool {
+        if holding >= lambda * (1.0 - UNLOADED_TOLERANCE) {
+            return false;
+        }
+        let moving = moving_points(self.faces, freed);
+        set.iter()
+            .all(|&i| (0..self.faces[i].points.len()).all(|p| moving.contains(&(i, p))))
+    }
+
     /// How many sets [`Pass::holdable`] keeps (None beyond `most`), without a program.
     fn count_sets(&self, most: usize) -> Option<usize> {
         let mut found = 0usize;
@@ -267,7 +285,7 @@ impl Pass<'_> {
                 Err(_) => return None,
             };
             if self.lowers(holding) {
-                self.try_set(&trial)?;
+                self.try_set(&trial, holding)?;
             }
             if trial.len() < self.depth {
                 self.children(&trial, k + 1)?;
@@ -276,8 +294,9 @@ impl Pass<'_> {
         Some(())
     }
 
-    /// U freed, kept as the best where it lowers λ and passes the physical test.
-    fn try_set(&mut self, set: &[usize]) -> Option<()> {
+    /// U freed, kept as the best where it lowers λ and passes the physical test. `holding` is
+    /// λ_u, U's program with every point of U unloaded.
+    fn try_set(&mut self, set: &[usize], holding: f64) -> Option<()> {
         let free = self.flags(set);
         let freed = match solve_program(self.model, self.faces, self.d, self.options, &free, &[]) {
             Ok(freed) => freed,
@@ -287,6 +306,9 @@ impl Pass<'_> {
         let Some(lambda) = freed.lambda.filter(|&l| self.lowers(l)) else {
             return Some(());
         };
+        if self.unloads_below(set, &freed, holding, lambda) {
+            return Some(());
+        }
         if let Some(collapse) = physical(self.model, self.faces, self.d, self.options, &free, freed)
         {
             self.best = collapse;
