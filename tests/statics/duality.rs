@@ -199,3 +199,65 @@ fn the_temple_along_y_is_below_the_frame_rule() {
         assert!((l - 0.162905).abs() < 1e-6, "{l}");
     }
 }
+
+/// The forces a collapse reports balance every body at its λ, computed here from the point
+/// forces alone: Σ F = m g (ẑ + λ d) (the weight and the inertial load −λ m g d, both at the
+/// centre of mass) and Σ (x − c) × F = 0, with F = fₙ n + f₁ t₁ + f₂ t₂ from the parent on the
+/// child, and no tension. On rocking bases without sliding the program lumps each face's shear
+/// into a shear and a twist and splits them over the points it reports: a wrong split leaves a
+/// body out of balance. Models whose contacts are all rocking bases (a hinge's couples are not
+/// point forces). Tolerance: the solver's residuals are 1e-12 of the weight; 1e-8 of the total
+/// weight (and of weight × size for moments) leaves room for the split's round-off.
+#[test]
+fn the_reported_forces_balance_every_body() {
+    use crr::kinematics::contact_face::ContactFace;
+    for name in ["temple", "baldachin"] {
+        let model = bundled(name);
+        let faces: Vec<ContactFace> = (0..model.interfaces.len())
+            .map(|k| ContactFace::of_interface(&model, k))
+            .collect();
+        assert!(
+            faces.iter().all(|f| f.bilateral_couples.is_empty()),
+            "{name}"
+        );
+        let weight: f64 = model.bodies.iter().map(|b| b.mass * model.gravity).sum();
+        let up = Vector3::z();
+        for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
+            let c = collapse_multiplier(&model, d, &StaticsOptions::default()).unwrap();
+            let lambda = c.lambda.expect("a mechanism");
+            let mut force = vec![Vector3::zeros(); model.bodies.len()];
+            let mut moment = vec![Vector3::zeros(); model.bodies.len()];
+            for (interface, face) in c.interfaces.iter().zip(&faces) {
+                let joint = &model.interfaces[interface.interface];
+                for f in &interface.forces {
+                    assert!(
+                        f.normal >= -1e-9 * weight,
+                        "{name} {}: {f:?}",
+                        interface.name
+                    );
+                    let x = Vector3::from(f.point);
+                    let on_child = face.normal * f.normal
+                        + face.tangents[0] * f.tangential[0]
+                        + face.tangents[1] * f.tangential[1];
+                    let mut add = |body: usize, vector: Vector3<f64>| {
+                        force[body] += vector;
+                        moment[body] += (x - model.bodies[body].com).cross(&vector);
+                    };
+                    add(joint.child, on_child);
+                    if let Parent::Body(parent) = joint.parent {
+                        add(parent, -on_child);
+                    }
+                }
+            }
+            for (n, body) in model.bodies.iter().enumerate() {
+                let load = (up + d * lambda) * body.mass * model.gravity;
+                let off = (force[n] - load).norm() / weight;
+                let turn = moment[n].norm() / (weight * model.size);
+                assert!(
+                    off < 1e-8 && turn < 1e-8,
+                    "{name} {d:?} body {n}: {off:e}, {turn:e}"
+                );
+            }
+        }
+    }
+}

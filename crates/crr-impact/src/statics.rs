@@ -957,18 +957,43 @@ pub fn horizontal_multipliers(model: &Model) -> Result<Vec<Collapse>, StaticsErr
 struct Unknown {
     /// Interface index.
     interface: usize,
-    /// Point index within the face (couples: none).
+    /// Point index within the face for a point's own force (a face's lumped shear and couples:
+    /// none).
     point: Option<usize>,
+    /// Where a force acts (m, world at rest); none for a couple.
+    at: Option<Vector3<f64>>,
     /// Its direction (world).
     direction: Vector3<f64>,
+}
+
+/// The column of a point's tangential force on a face whose shear is lumped ([`LumpedShear`]).
+const NO_COLUMN: usize = usize::MAX;
+
+/// Without sliding, a rocking base's tangential forces at its loaded points are free, and only
+/// their wrench counts: a shear (f₁, f₂) at the loaded points' centroid c and a twist couple T
+/// about n (any two distinct points carry it). Three columns instead of two per point (the
+/// temple's faces: 3 instead of 8), the same program (its dual asks the same of the mechanism:
+/// no slip at any loaded point). The reported point forces are the least-norm split
+/// fᵢ = f/k + T n × (pᵢ − c) / Σ|pⱼ − c|², which sums to the shear and the twist.
+#[derive(Clone, Debug)]
+struct LumpedShear {
+    /// Columns of f₁, f₂ and (with two or more loaded points) T.
+    columns: [usize; 3],
+    /// The points that may carry load (not unloaded).
+    loaded: Vec<usize>,
+    /// Their centroid c.
+    centroid: Vector3<f64>,
 }
 
 /// The linear (conic) program: min −λ s.t. A x + s = b, s ∈ K.
 struct Program {
     /// Columns 1.. (column 0 is λ).
     unknowns: Vec<Unknown>,
-    /// Per interface, per point, the columns of (fₙ, f₁, f₂).
+    /// Per interface, per point, the columns of (fₙ, f₁, f₂) ([`NO_COLUMN`] for the tangents of
+    /// a lumped face).
     point_columns: Vec<Vec<[usize; 3]>>,
+    /// Per interface, its lumped shear ([`LumpedShear`]), where it has one.
+    shears: Vec<Option<LumpedShear>>,
     rows: usize,
     triplets: (Vec<usize>, Vec<usize>, Vec<f64>),
     b: Vec<f64>,
@@ -988,27 +1013,39 @@ impl Program {
     ) -> Program {
         let mut unknowns = Vec::new();
         let mut point_columns = Vec::with_capacity(faces.len());
+        let mut shears = Vec::with_capacity(faces.len());
         for face in faces {
+            // A rocking base without sliding, not freed: its shear is lumped.
+            let lumped = options.friction == Friction::NoSliding
+                && face.bilateral_couples.is_empty()
+                && !face.pin
+                && !free[face.interface];
             let mut columns = Vec::with_capacity(face.points.len());
-            for p in 0..face.points.len() {
-                let mut triple = [0; 3];
-                for (k, direction) in [face.normal, face.tangents[0], face.tangents[1]]
-                    .into_iter()
-                    .enumerate()
-                {
+            for (p, &x) in face.points.iter().enumerate() {
+                let mut triple = [NO_COLUMN; 3];
+                let directions = [face.normal, face.tangents[0], face.tangents[1]];
+                let own = if lumped { 1 } else { 3 };
+                for (k, direction) in directions.into_iter().enumerate().take(own) {
                     triple[k] = 1 + unknowns.len();
                     unknowns.push(Unknown {
                         interface: face.interface,
                         point: Some(p),
+                        at: Some(x),
                         direction,
                     });
                 }
                 columns.push(triple);
             }
+            shears.push(
+                lumped
+                    .then(|| Self::lumped_shear(face, unloaded, &mut unknowns))
+                    .flatten(),
+            );
             for &direction in &face.bilateral_couples {
                 unknowns.push(Unknown {
                     interface: face.interface,
                     point: None,
+                    at: None,
                     direction,
                 });
             }
@@ -1020,16 +1057,60 @@ impl Program {
         let mut program = Program {
             unknowns,
             point_columns,
+            shears,
             rows: 0,
             triplets: (Vec::new(), Vec::new(), Vec::new()),
             b: Vec::new(),
             cones: Vec::new(),
             weight,
         };
-        program.equilibrium_rows(model, faces, d, total_mass, size);
+        program.equilibrium_rows(model, d, total_mass, size);
         program.free_rows(faces, free, unloaded);
         program.inequality_rows(faces, options);
         program
+    }
+
+    /// The lumped shear of `face` ([`LumpedShear`]) and its columns, none where every point is
+    /// unloaded.
+    fn lumped_shear(
+        face: &ContactFace,
+        unloaded: &[(usize, usize)],
+        unknowns: &mut Vec<Unknown>,
+    ) -> Option<LumpedShear> {
+        let loaded: Vec<usize> = (0..face.points.len())
+            .filter(|&p| !unloaded.contains(&(face.interface, p)))
+            .collect();
+        let centroid = loaded.iter().map(|&p| face.points[p]).sum::<Vector3<f64>>()
+            / loaded.len().max(1) as f64;
+        let spread: f64 = loaded
+            .iter()
+            .map(|&p| (face.points[p] - centroid).norm_squared())
+            .sum();
+        let mut columns = [NO_COLUMN; 3];
+        let mut column = |direction: Vector3<f64>, at: Option<Vector3<f64>>| {
+            unknowns.push(Unknown {
+                interface: face.interface,
+                point: None,
+                at,
+                direction,
+            });
+            unknowns.len()
+        };
+        match loaded.len() {
+            0 => return None,
+            _ => {
+                columns[0] = column(face.tangents[0], Some(centroid));
+                columns[1] = column(face.tangents[1], Some(centroid));
+            }
+        }
+        if spread > 0.0 {
+            columns[2] = column(face.normal, None);
+        }
+        Some(LumpedShear {
+            columns,
+            loaded,
+            centroid,
+        })
     }
 
     fn push(&mut self, row: usize, column: usize, value: f64) {
@@ -1042,26 +1123,18 @@ impl Program {
 
     /// Six rows per body: Σ forces + weight − λ·load = 0, Σ moments about the centre of mass /
     /// size = 0 (the zero cone).
-    fn equilibrium_rows(
-        &mut self,
-        model: &Model,
-        faces: &[ContactFace],
-        d: Vector3<f64>,
-        total_mass: f64,
-        size: f64,
-    ) {
+    fn equilibrium_rows(&mut self, model: &Model, d: Vector3<f64>, total_mass: f64, size: f64) {
         let bodies = model.bodies.len();
         let first = self.rows;
         for (column, u) in self.unknowns.clone().into_iter().enumerate() {
             let column = column + 1;
             let interface = &model.interfaces[u.interface];
-            let face = &faces[u.interface];
             let add = |body: usize, sign: f64, program: &mut Program| {
                 let row = first + 6 * body;
                 let com = model.bodies[body].com;
-                match u.point {
-                    Some(p) => {
-                        let arm = (face.points[p] - com).cross(&u.direction) / size;
+                match u.at {
+                    Some(x) => {
+                        let arm = (x - com).cross(&u.direction) / size;
                         for k in 0..3 {
                             program.push(row + k, column, sign * u.direction[k]);
                             program.push(row + 3 + k, column, sign * arm[k]);
@@ -1116,7 +1189,7 @@ impl Program {
                     (false, true) => &[t1, t2][..face.friction_tangents],
                     (false, false) => &[],
                 };
-                for &column in zero {
+                for &column in zero.iter().filter(|&&c| c != NO_COLUMN) {
                     self.push(row, column, 1.0);
                     row += 1;
                 }
@@ -1273,6 +1346,43 @@ impl Program {
         Err(StaticsError::Solver(failed.unwrap_or_default()))
     }
 
+    /// A lumped face's tangential forces (N) per point, the least-norm split of its shear and
+    /// twist over its loaded points ([`LumpedShear`]); none where the face is not lumped.
+    fn lumped_split(
+        &self,
+        face: &ContactFace,
+        solution: &clarabel::solver::DefaultSolution<f64>,
+    ) -> Option<Vec<[f64; 2]>> {
+        if self.point_columns[face.interface]
+            .first()
+            .is_none_or(|c| c[1] != NO_COLUMN)
+        {
+            return None;
+        }
+        let mut split = vec![[0.0; 2]; face.points.len()];
+        let Some(lumped) = &self.shears[face.interface] else {
+            return Some(split);
+        };
+        let value = |c: usize| if c == NO_COLUMN { 0.0 } else { solution.x[c] };
+        let [t1, t2] = face.tangents;
+        let shear = (t1 * value(lumped.columns[0]) + t2 * value(lumped.columns[1]))
+            / lumped.loaded.len() as f64;
+        let spread: f64 = lumped
+            .loaded
+            .iter()
+            .map(|&p| (face.points[p] - lumped.centroid).norm_squared())
+            .sum();
+        let twist = value(lumped.columns[2]);
+        for &p in &lumped.loaded {
+            let mut f = shear;
+            if spread > 0.0 {
+                f += face.normal.cross(&(face.points[p] - lumped.centroid)) * (twist / spread);
+            }
+            split[p] = [self.weight * f.dot(&t1), self.weight * f.dot(&t2)];
+        }
+        Some(split)
+    }
+
     fn collapse(
         &self,
         model: &Model,
@@ -1320,13 +1430,18 @@ impl Program {
             .iter()
             .map(|face| {
                 let interface = &model.interfaces[face.interface];
+                let shear = self.lumped_split(face, solution);
                 let forces = self.point_columns[face.interface]
                     .iter()
                     .zip(&face.points)
-                    .map(|(&[n, t1, t2], x)| PointForce {
+                    .enumerate()
+                    .map(|(p, (&[n, t1, t2], x))| PointForce {
                         point: [x.x, x.y, x.z],
                         normal: self.weight * solution.x[n],
-                        tangential: [self.weight * solution.x[t1], self.weight * solution.x[t2]],
+                        tangential: match &shear {
+                            Some(split) => split[p],
+                            None => [self.weight * solution.x[t1], self.weight * solution.x[t2]],
+                        },
                     })
                     .collect();
                 let mut gap_rates = Vec::with_capacity(face.points.len());
