@@ -369,7 +369,7 @@ pub struct HingeOutOfPlane {
 /// `direction` loads out of their plane (above 1e-6 of W or W·L, W the weight, L the model
 /// size): the program with λ fixed at lambda·(1 − 1e-7) (inside its feasible interval
 /// [0, λ_c]) and ½Σx² of the hinges' out-of-plane unknowns (their bilateral couples and their
-/// points' forces along the axis) minimised, so that a hinge is named only where no
+/// forces along the axis) minimised, so that a hinge is named only where no
 /// distribution spares it, not where the interior point's central answer happens to load it.
 /// Each one's load is its wrench about its first pivot point in that distribution. Empty for a
 /// model without hinges. Errors as [`collapse_multiplier`]'s.
@@ -393,7 +393,7 @@ pub fn hinges_out_of_plane(
         .enumerate()
         .filter(|(_, u)| {
             is_hinge(u.interface)
-                && u.point.is_none_or(|_| {
+                && u.at.is_none_or(|_| {
                     let axis = faces[u.interface].tangents[1];
                     u.direction.dot(&axis).abs() > 1.0 - 1e-12
                 })
@@ -412,11 +412,11 @@ pub fn hinges_out_of_plane(
                 continue;
             }
             let value = weight * solution.x[j + 1];
-            match u.point {
-                Some(p) => {
+            match u.at {
+                Some(x) => {
                     let f = u.direction * value;
                     force += f;
-                    moment += (face.points[p] - origin).cross(&f);
+                    moment += (x - origin).cross(&f);
                 }
                 // The couples' rows are M/(W·L) with entries direction/L: x is C/W.
                 None => moment += u.direction * value,
@@ -957,27 +957,76 @@ pub fn horizontal_multipliers(model: &Model) -> Result<Vec<Collapse>, StaticsErr
 struct Unknown {
     /// Interface index.
     interface: usize,
-    /// Point index within the face for a point's own force (a face's lumped shear and couples:
-    /// none).
-    point: Option<usize>,
     /// Where a force acts (m, world at rest); none for a couple.
     at: Option<Vector3<f64>>,
     /// Its direction (world).
     direction: Vector3<f64>,
 }
 
-/// The column of a point's tangential force on a face whose shear is lumped ([`LumpedShear`]).
+/// The column of a force the program does not carry: a point's tangential force on a face whose
+/// shear is lumped ([`LumpedShear`]), or a force that is zero ([`ZeroForces`]).
 const NO_COLUMN: usize = usize::MAX;
 
-/// Without sliding, a rocking base's tangential forces at its loaded points are free, and only
-/// their wrench counts: a shear (f₁, f₂) at the loaded points' centroid c and a twist couple T
-/// about n (any two distinct points carry it). Three columns instead of two per point (the
-/// temple's faces: 3 instead of 8), the same program (its dual asks the same of the mechanism:
-/// no slip at any loaded point). The reported point forces are the least-norm split
-/// fᵢ = f/k + T n × (pᵢ − c) / Σ|pⱼ − c|², which sums to the shear and the twist.
+/// The forces of one face that a program holds at zero, so that it has no column for them
+/// (rather than a column and a row fixing it at 0: the same program, a smaller system): the
+/// tangential forces of a freed face's points (normal forces only: they may slide), every force
+/// of an unloaded point, and the couples of a hinge unloaded at all its points (a line joint that
+/// opens carries nothing). A hinge that keeps one of its lines carries its shear in its plane
+/// there: shear along t₁ is the same wrench at either line (they lie apart along t₁), so only the
+/// normal force of a line that opens goes. Pins are never unloaded.
+struct ZeroForces<'a> {
+    face: &'a ContactFace,
+    freed: bool,
+    unloaded: &'a [(usize, usize)],
+    /// Every point unloaded (not a pin): the face has opened.
+    opened: bool,
+}
+
+impl<'a> ZeroForces<'a> {
+    fn of(face: &'a ContactFace, free: &[bool], unloaded: &'a [(usize, usize)]) -> Self {
+        let mut zero = ZeroForces {
+            face,
+            freed: free[face.interface] && !face.pin,
+            unloaded,
+            opened: false,
+        };
+        zero.opened = !face.pin
+            && !face.points.is_empty()
+            && (0..face.points.len()).all(|p| zero.unloaded_point(p));
+        zero
+    }
+
+    fn unloaded_point(&self, p: usize) -> bool {
+        !self.face.pin && self.unloaded.contains(&(self.face.interface, p))
+    }
+
+    /// Whether component k (0: normal, 1: t₁, 2: t₂) of point p's force is zero.
+    fn is_zero(&self, p: usize, k: usize) -> bool {
+        let keeps_a_line = !self.face.bilateral_couples.is_empty() && !self.opened;
+        match (self.unloaded_point(p), self.freed) {
+            (true, _) if keeps_a_line => k == 0,
+            (true, _) => true,
+            (false, true) => (1..=self.face.friction_tangents).contains(&k),
+            (false, false) => false,
+        }
+    }
+}
+
+/// Without sliding, a face's tangential forces at its loaded points are free, and only their
+/// wrench counts: a shear (f₁, f₂) at the loaded points' centroid c and a twist couple T about n
+/// (any two distinct points carry it). On a rocking base that is three columns instead of two per
+/// point (the temple's faces: 3 instead of 8), the same program (its dual asks the same of the
+/// mechanism: no slip at any loaded point). The reported point forces are the least-norm split
+/// fᵢ = f/k + T n × (pᵢ − c) / Σ|pⱼ − c|², which sums to the shear and the twist. A hinge (a
+/// line joint) carries its couples about n and t₁ bilaterally anyway, so its twist is that couple
+/// and its shear is two columns where its two lines had four: its lines lie apart along t₁, so
+/// the forces along t₁ at either line are one wrench, and those along u differ by a couple about n
+/// (8 unknowns → 6). A hinge keeping one line carries that shear there (its centroid), as the
+/// per-line program did (the physical test's rule, [`ZeroForces`]).
 #[derive(Clone, Debug)]
 struct LumpedShear {
-    /// Columns of f₁, f₂ (with a loaded point) and T (with two or more), else [`NO_COLUMN`].
+    /// Columns of f₁, f₂ (with a loaded point) and T (with two or more, not on a hinge), else
+    /// [`NO_COLUMN`].
     columns: [usize; 3],
     /// The points that may carry load (not unloaded).
     loaded: Vec<usize>,
@@ -1017,21 +1066,22 @@ impl Program {
         let mut point_columns = Vec::with_capacity(faces.len());
         let mut shears = Vec::with_capacity(faces.len());
         for face in faces {
-            // A rocking base without sliding, not freed: its shear is lumped.
-            let lumped = options.friction == Friction::NoSliding
-                && face.bilateral_couples.is_empty()
-                && !face.pin
-                && !free[face.interface];
+            // A face without sliding, not freed: its shear is lumped.
+            let lumped =
+                options.friction == Friction::NoSliding && !face.pin && !free[face.interface];
+            let zero = ZeroForces::of(face, free, unloaded);
             let mut columns = Vec::with_capacity(face.points.len());
             for (p, &x) in face.points.iter().enumerate() {
                 let mut triple = [NO_COLUMN; 3];
                 let directions = [face.normal, face.tangents[0], face.tangents[1]];
                 let own = if lumped { 1 } else { 3 };
                 for (k, direction) in directions.into_iter().enumerate().take(own) {
+                    if zero.is_zero(p, k) {
+                        continue;
+                    }
                     triple[k] = 1 + unknowns.len();
                     unknowns.push(Unknown {
                         interface: face.interface,
-                        point: Some(p),
                         at: Some(x),
                         direction,
                     });
@@ -1039,10 +1089,14 @@ impl Program {
                 columns.push(triple);
             }
             shears.push(lumped.then(|| Self::lumped_shear(face, unloaded, &mut unknowns)));
-            for &direction in &face.bilateral_couples {
+            let couples = if zero.opened {
+                &[][..]
+            } else {
+                &face.bilateral_couples[..]
+            };
+            for &direction in couples {
                 unknowns.push(Unknown {
                     interface: face.interface,
-                    point: None,
                     at: None,
                     direction,
                 });
@@ -1063,7 +1117,6 @@ impl Program {
             weight,
         };
         program.equilibrium_rows(model, d, total_mass, size);
-        program.free_rows(faces, free, unloaded);
         program.inequality_rows(faces, options);
         program
     }
@@ -1087,7 +1140,6 @@ impl Program {
         let mut column = |direction: Vector3<f64>, at: Option<Vector3<f64>>| {
             unknowns.push(Unknown {
                 interface: face.interface,
-                point: None,
                 at,
                 direction,
             });
@@ -1098,7 +1150,8 @@ impl Program {
             columns[0] = column(face.tangents[0], Some(centroid));
             columns[1] = column(face.tangents[1], Some(centroid));
         }
-        if spread > 0.0 {
+        // A hinge carries its couple about n bilaterally already ([`ContactFace::bilateral_couples`]).
+        if spread > 0.0 && face.bilateral_couples.is_empty() {
             columns[2] = column(face.normal, None);
         }
         LumpedShear {
@@ -1109,8 +1162,9 @@ impl Program {
         }
     }
 
+    /// Adds `value` at (row, column); nothing for a column that does not exist ([`NO_COLUMN`]).
     fn push(&mut self, row: usize, column: usize, value: f64) {
-        if value != 0.0 {
+        if value != 0.0 && column != NO_COLUMN {
             self.triplets.0.push(row);
             self.triplets.1.push(column);
             self.triplets.2.push(value);
@@ -1161,58 +1215,6 @@ impl Program {
         self.cones.push(SupportedConeT::ZeroConeT(6 * bodies));
     }
 
-    /// The tangential forces of the freed interfaces' points, every force (normal, both
-    /// tangents) of the unloaded points and the couples of a hinge unloaded at all its points
-    /// are zero (another zero cone; pins are not unloaded).
-    fn free_rows(&mut self, faces: &[ContactFace], free: &[bool], unloaded: &[(usize, usize)]) {
-        let first = self.rows;
-        let mut row = first;
-        for (face, columns) in faces.iter().zip(self.point_columns.clone()) {
-            if face.pin {
-                continue;
-            }
-            let freed = free[face.interface];
-            let unloaded_here = |p: usize| unloaded.contains(&(face.interface, p));
-            // A line joint (a hinge) that keeps one of its lines carries its shear in its plane
-            // there: shear along t₁ is the same wrench at either line (they lie apart along t₁),
-            // so only the normal force of a line that opens goes.
-            let keeps_a_line =
-                !face.bilateral_couples.is_empty() && !(0..columns.len()).all(unloaded_here);
-            for (p, [n, t1, t2]) in columns.iter().copied().enumerate() {
-                let zero: &[usize] = match (unloaded_here(p), freed) {
-                    (true, _) if keeps_a_line => &[n],
-                    (true, _) => &[n, t1, t2],
-                    (false, true) => &[t1, t2][..face.friction_tangents],
-                    (false, false) => &[],
-                };
-                for &column in zero.iter().filter(|&&c| c != NO_COLUMN) {
-                    self.push(row, column, 1.0);
-                    row += 1;
-                }
-            }
-            // A hinge unloaded at both its points has opened: its couples out of its plane go
-            // too (a line joint that opens carries nothing).
-            if !columns.is_empty() && (0..columns.len()).all(unloaded_here) {
-                let couples: Vec<usize> = self
-                    .unknowns
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, u)| u.interface == face.interface && u.point.is_none())
-                    .map(|(j, _)| j + 1)
-                    .collect();
-                for column in couples {
-                    self.push(row, column, 1.0);
-                    row += 1;
-                }
-            }
-        }
-        if row > first {
-            self.b.resize(row, 0.0);
-            self.rows = row;
-            self.cones.push(SupportedConeT::ZeroConeT(row - first));
-        }
-    }
-
     /// No tension, λ ≤ λ_max, friction.
     fn inequality_rows(&mut self, faces: &[ContactFace], options: &StaticsOptions) {
         let first = self.rows;
@@ -1223,16 +1225,25 @@ impl Program {
                 continue;
             }
             for [normal, t1, t2] in columns {
-                self.push(row, normal, -1.0);
-                row += 1;
+                if normal != NO_COLUMN {
+                    self.push(row, normal, -1.0);
+                    row += 1;
+                }
                 let tangents = [t1, t2];
                 match options.friction {
                     Friction::NoSliding => {}
                     Friction::Cone(mu) if face.friction_tangents == 2 => {
-                        cone_rows.push((normal, t1, t2, mu));
+                        if t1 != NO_COLUMN || t2 != NO_COLUMN {
+                            cone_rows.push((normal, t1, t2, mu));
+                        }
                     }
                     Friction::Pyramid(mu) | Friction::Cone(mu) => {
-                        for &t in &tangents[..face.friction_tangents] {
+                        // A hinge's line that opens keeps its t₁ column (its shear is the other
+                        // line's): with no normal force there, friction holds it at 0.
+                        for &t in tangents[..face.friction_tangents]
+                            .iter()
+                            .filter(|&&t| t != NO_COLUMN)
+                        {
                             for sign in [1.0, -1.0] {
                                 self.push(row, t, sign);
                                 self.push(row, normal, -mu);
@@ -1418,13 +1429,22 @@ impl Program {
                     .iter()
                     .zip(&face.points)
                     .enumerate()
-                    .map(|(p, (&[n, t1, t2], x))| PointForce {
-                        point: [x.x, x.y, x.z],
-                        normal: self.weight * solution.x[n],
-                        tangential: match &shear {
-                            Some(split) => split[p],
-                            None => [self.weight * solution.x[t1], self.weight * solution.x[t2]],
-                        },
+                    .map(|(p, (&[n, t1, t2], x))| {
+                        let value = |c: usize| {
+                            if c == NO_COLUMN {
+                                0.0
+                            } else {
+                                self.weight * solution.x[c]
+                            }
+                        };
+                        PointForce {
+                            point: [x.x, x.y, x.z],
+                            normal: value(n),
+                            tangential: match &shear {
+                                Some(split) => split[p],
+                                None => [value(t1), value(t2)],
+                            },
+                        }
                     })
                     .collect();
                 let mut gap_rates = Vec::with_capacity(face.points.len());
