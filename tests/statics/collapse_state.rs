@@ -148,6 +148,25 @@ fn holding_points(model: &Model, c: &Collapse) -> Vec<Holding> {
         } else {
             hinge_couples(&interface.kind, planar)
         };
+        // A rocking base that keeps a single corner and does not turn about its normal (it cannot
+        // twist) carries the couple about n of that constraint, which then does no virtual work.
+        let holds = |p: &Vector3<f64>| {
+            let v = relative(p);
+            let gap = normal.dot(&v);
+            gap <= rate_tol && (v - normal * gap).norm() <= rate_tol
+        };
+        if matches!(interface.kind, InterfaceKind::RockingBase { .. })
+            && points.iter().filter(|p| holds(p)).count() == 1
+        {
+            let parent_w = match interface.parent {
+                Parent::Ground => Vector3::zeros(),
+                Parent::Body(n) => bodies[n].1,
+            };
+            let twist = normal.dot(&(bodies[interface.child].1 - parent_w));
+            if twist.abs() * size < rate_tol {
+                couples.push(normal);
+            }
+        }
         for p in points {
             let v = relative(&p);
             let gap = normal.dot(&v);
@@ -586,6 +605,65 @@ fn the_wall_out_of_its_plane_collapses_where_its_search_says() {
         assert!((c.convex_lambda.unwrap() - 0.15).abs() < 1e-7);
         certify(&model, d, &c);
     }
+}
+
+/// A slab on four columns (beds only), loaded obliquely along (0.3, 1, 0): the slab lifts off
+/// one column, which stays at rest, and rests on a single corner of each of the other three,
+/// which tip about their bases' −y edges. Its equilibrium on the points that hold needs, at each
+/// single corner, the couple about the face normal that a rocking base's no-twist constraint
+/// carries (without it there is none: checked here), so the state needs unbounded friction, as
+/// the program without sliding's own answer 0.149064 does, which rests on the same reactions
+/// and which the engine gave, marked exhaustive, until 2026-12-06. An independent review's
+/// mixed-integer program (2026-12-06, its own code, HiGHS) found this state at 0.1408290185,
+/// the least collapse of the contact model with that reaction: agreed here to 1e-9.
+#[test]
+fn a_slab_on_four_columns_rests_on_single_corners_of_three() {
+    use crr::impact::statics::state_friction;
+    let dir = common::scratch("statics_slab_on_columns");
+    let mut text = String::from("name = \"frame\"\n");
+    for (name, centre, size) in [
+        ("c0", [-0.84, -0.55, 1.48], [0.34, 0.4, 2.96]),
+        ("c1", [-0.84, 0.55, 1.48], [0.34, 0.36, 2.96]),
+        ("c2", [0.84, -0.55, 1.48], [0.44, 0.42, 2.96]),
+        ("c3", [0.84, 0.55, 1.48], [0.36, 0.48, 2.96]),
+        ("slab", [-0.14, -0.06, 3.08], [2.28, 1.7, 0.24]),
+    ] {
+        text += &box_body(name, centre, size);
+    }
+    let path = dir.join("frame.toml");
+    std::fs::write(&path, text).unwrap();
+    let file = read_assembly(&path).unwrap();
+    let model = assemble(&path, &file, &AssemblyOptions::default())
+        .unwrap()
+        .model;
+    let d = Vector3::new(0.3, 1.0, 0.0).normalize();
+    let c = collapse(&model, d);
+    let lambda = c.lambda.unwrap();
+    assert!((lambda - 0.1408290185).abs() < 1e-9, "{lambda}");
+    assert!(c.exhaustive);
+    assert!((c.convex_lambda.unwrap() - 0.149064).abs() < 1e-6);
+    certify(&model, d, &c);
+    // The slab lifts off c3, which stays at rest; it keeps one corner on each other column.
+    let of = |name: &str| c.interfaces.iter().find(|i| i.name == name).unwrap();
+    assert!(of("slab_on_c3").forces.iter().all(|f| f.normal == 0.0));
+    assert!(c.bodies[3].velocity.iter().all(|v| v.abs() < 1e-9));
+    for column in ["c0", "c1", "c2"] {
+        assert_eq!(of(&format!("slab_on_{column}")).pivots.len(), 1, "{column}");
+    }
+    // Without the twist reactions the points that hold carry no equilibrium at λ.
+    let point_forces_only: Vec<Holding> = holding_points(&model, &c)
+        .into_iter()
+        .map(|h| Holding {
+            couples: Vec::new(),
+            ..h
+        })
+        .collect();
+    if let Ok(strict) = equilibrium_on(&model, d, None, &point_forces_only, None) {
+        assert!(strict < 0.99 * lambda, "{strict}");
+    }
+    // Point forces cannot carry those couples, whatever the friction.
+    let mu = state_friction(&model, &c, 10.0).unwrap().unwrap();
+    assert!(mu.is_infinite(), "{mu}");
 }
 
 /// Every bundled model's multipliers along ±x and ±y are collapse states in the sense above:

@@ -215,7 +215,14 @@ fn the_temple_along_y_is_below_the_frame_rule() {
 #[test]
 fn the_reported_forces_balance_every_body() {
     use crr::kinematics::contact_face::ContactFace;
-    for name in ["temple", "baldachin", "wall", "arch", "trilithon", "two_block_stack"] {
+    for name in [
+        "temple",
+        "baldachin",
+        "wall",
+        "arch",
+        "trilithon",
+        "two_block_stack",
+    ] {
         let model = bundled(name);
         let faces: Vec<ContactFace> = (0..model.interfaces.len())
             .map(|k| ContactFace::of_interface(&model, k))
@@ -257,6 +264,11 @@ fn the_reported_forces_balance_every_body() {
                     if let Parent::Body(parent) = joint.parent {
                         add(parent, -on_child);
                     }
+                }
+                // The couple about n no point force carries (a single loaded corner's).
+                moment[joint.child] += face.normal * interface.twist;
+                if let Parent::Body(parent) = joint.parent {
+                    moment[parent] -= face.normal * interface.twist;
                 }
             }
             for (n, body) in model.bodies.iter().enumerate() {

@@ -189,6 +189,12 @@ pub struct InterfaceCollapse {
     pub name: String,
     /// Contact forces at λ_c (N).
     pub forces: Vec<PointForce>,
+    /// The couple about the face's normal n (N m, from the parent on the child) that no point
+    /// force carries: a rocking base loaded at a single corner that does not turn about n (a
+    /// rocking base cannot twist) carries it as that constraint's reaction, with no friction
+    /// to do so, so a collapse that relies on it needs unbounded friction. 0 elsewhere (a hinge's
+    /// couples are not reported).
+    pub twist: f64,
     /// How it moves.
     pub motion: Motion,
     /// The pivot side of each of its angles that opens (by slot index), from the sign of the
@@ -386,7 +392,7 @@ pub fn hinges_out_of_plane(
     let d = unit_direction(direction)?;
     let faces = contact_faces(model);
     let free = vec![false; faces.len()];
-    let program = Program::build(model, &faces, d, options, &free, &[]);
+    let program = Program::build(model, &faces, d, options, &free, &[], &[]);
     let columns: Vec<usize> = program
         .unknowns
         .iter()
@@ -446,7 +452,23 @@ fn solve_program(
     free: &[bool],
     unloaded: &[(usize, usize)],
 ) -> Result<Collapse, StaticsError> {
-    let program = Program::build(model, faces, d, options, free, unloaded);
+    solve_built(
+        model,
+        faces,
+        d,
+        options,
+        &Program::build(model, faces, d, options, free, unloaded, &[]),
+    )
+}
+
+/// [`solve_program`] on a program built.
+fn solve_built(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    program: &Program,
+) -> Result<Collapse, StaticsError> {
     let solution = program.solve()?;
     let lambda = solution.x[0];
     if lambda < -1e-9 {
@@ -759,7 +781,16 @@ fn physical(
     if unloaded.is_empty() {
         return Some(collapse);
     }
-    let spared = solve_program(model, faces, d, options, free, &unloaded).ok()?;
+    let program = Program::build(
+        model,
+        faces,
+        d,
+        options,
+        free,
+        &unloaded,
+        &twist_reactions(faces, &collapse, model.size),
+    );
+    let spared = solve_built(model, faces, d, options, &program).ok()?;
     if !spared
         .lambda
         .is_some_and(|l| l >= lambda * (1.0 - UNLOADED_TOLERANCE))
@@ -769,8 +800,27 @@ fn physical(
     let mut collapse = collapse;
     for (kept, spared) in collapse.interfaces.iter_mut().zip(spared.interfaces) {
         kept.forces = spared.forces;
+        kept.twist = spared.twist;
     }
     Some(collapse)
+}
+
+/// The interfaces whose faces may carry the no-twist reaction at a single loaded corner in the
+/// physical test of `collapse` ([`LumpedShear`]): rocking bases that do not turn about their
+/// normal in its mechanism (where one does, that couple would do virtual work).
+fn twist_reactions(faces: &[ContactFace], collapse: &Collapse, size: f64) -> Vec<usize> {
+    collapse
+        .interfaces
+        .iter()
+        .filter(|i| {
+            let face = &faces[i.interface];
+            let turn = face.normal.dot(&Vector3::from(i.rotation));
+            face.bilateral_couples.is_empty()
+                && !face.pin
+                && size * turn.abs() <= MECHANISM_TOLERANCE
+        })
+        .map(|i| i.interface)
+        .collect()
 }
 
 /// The smallest Coulomb friction coefficient (pyramid on each tangent, exact for planar loads)
@@ -1023,10 +1073,23 @@ impl<'a> ZeroForces<'a> {
 /// the forces along t₁ at either line are one wrench, and those along u differ by a couple about n
 /// (8 unknowns → 6). A hinge keeping one line carries that shear there (its centroid), as the
 /// per-line program did (the physical test's rule, [`ZeroForces`]).
+///
+/// A rocking base loaded at a single corner (the others unloaded: the physical test of a
+/// mechanism that keeps only that corner) keeps its twist column where the mechanism does not
+/// turn the face about its normal ([`twist_reactions`]). A rocking base cannot turn about n (the
+/// CRR interface: two tilts, no twist), and the face carries the reaction of that constraint,
+/// as the convex program's closure lets a face carry shear with no compression at its other
+/// corners; where the mechanism does not turn it, that couple does no virtual work. No point
+/// force carries it: it is reported as [`InterfaceCollapse::twist`], and a state that relies on
+/// it needs unbounded friction (the friction programs, point forces only, cannot carry it:
+/// "needs μ > 1000"). Without it the physical test rejected such states while the convex
+/// program's answer, which rests on the same reactions, stood: an independent review
+/// (2026-12-06) found a slab on four columns, loaded obliquely, answered 0.149064 (μ ≥ 476) and
+/// marked exhaustive, where the slab lifts off one column and rests on single corners of the
+/// other three at 0.140829 (`tests/statics/collapse_state.rs`).
 #[derive(Clone, Debug)]
 struct LumpedShear {
-    /// Columns of f₁, f₂ (with a loaded point) and T (with two or more, not on a hinge), else
-    /// [`NO_COLUMN`].
+    /// Columns of f₁, f₂ and T (T not on a hinge), with a loaded point, else [`NO_COLUMN`].
     columns: [usize; 3],
     /// The points that may carry load (not unloaded).
     loaded: Vec<usize>,
@@ -1061,6 +1124,7 @@ impl Program {
         options: &StaticsOptions,
         free: &[bool],
         unloaded: &[(usize, usize)],
+        twist_reactions: &[usize],
     ) -> Program {
         let mut unknowns = Vec::new();
         let mut point_columns = Vec::with_capacity(faces.len());
@@ -1088,7 +1152,10 @@ impl Program {
                 }
                 columns.push(triple);
             }
-            shears.push(lumped.then(|| Self::lumped_shear(face, unloaded, &mut unknowns)));
+            shears.push(lumped.then(|| {
+                let reaction = twist_reactions.contains(&face.interface);
+                Self::lumped_shear(face, unloaded, reaction, &mut unknowns)
+            }));
             let couples = if zero.opened {
                 &[][..]
             } else {
@@ -1126,6 +1193,7 @@ impl Program {
     fn lumped_shear(
         face: &ContactFace,
         unloaded: &[(usize, usize)],
+        twist_reaction: bool,
         unknowns: &mut Vec<Unknown>,
     ) -> LumpedShear {
         let loaded: Vec<usize> = (0..face.points.len())
@@ -1150,8 +1218,11 @@ impl Program {
             columns[0] = column(face.tangents[0], Some(centroid));
             columns[1] = column(face.tangents[1], Some(centroid));
         }
-        // A hinge carries its couple about n bilaterally already ([`ContactFace::bilateral_couples`]).
-        if spread > 0.0 && face.bilateral_couples.is_empty() {
+        // A hinge carries its couple about n bilaterally already ([`ContactFace::bilateral_couples`]);
+        // a single loaded corner only as the no-twist reaction, where asked ([`LumpedShear`]).
+        if (spread > 0.0 || (loaded.len() == 1 && twist_reaction))
+            && face.bilateral_couples.is_empty()
+        {
             columns[2] = column(face.normal, None);
         }
         LumpedShear {
@@ -1354,12 +1425,13 @@ impl Program {
     }
 
     /// A lumped face's tangential forces (N) per point, the least-norm split of its shear and
-    /// twist over its loaded points ([`LumpedShear`]); none where the face is not lumped.
+    /// twist over its loaded points ([`LumpedShear`]), and the twist no point carries (N m: a
+    /// single loaded corner's); none where the face is not lumped.
     fn lumped_split(
         &self,
         face: &ContactFace,
         solution: &clarabel::solver::DefaultSolution<f64>,
-    ) -> Option<Vec<[f64; 2]>> {
+    ) -> Option<(Vec<[f64; 2]>, f64)> {
         let lumped = self.shears[face.interface].as_ref()?;
         let value = |c: usize| if c == NO_COLUMN { 0.0 } else { solution.x[c] };
         let [t1, t2] = face.tangents;
@@ -1374,7 +1446,13 @@ impl Program {
             }
             split[p] = [self.weight * f.dot(&t1), self.weight * f.dot(&t2)];
         }
-        Some(split)
+        // The couples' rows are M/(W·L) with entries direction/L: T is C/W.
+        let unsplit = if lumped.spread > 0.0 {
+            0.0
+        } else {
+            self.weight * twist
+        };
+        Some((split, unsplit))
     }
 
     fn collapse(
@@ -1441,7 +1519,7 @@ impl Program {
                             point: [x.x, x.y, x.z],
                             normal: value(n),
                             tangential: match &shear {
-                                Some(split) => split[p],
+                                Some((split, _)) => split[p],
                                 None => [value(t1), value(t2)],
                             },
                         }
@@ -1508,6 +1586,7 @@ impl Program {
                     interface: face.interface,
                     name: interface.name.clone(),
                     forces,
+                    twist: shear.as_ref().map_or(0.0, |(_, twist)| *twist),
                     motion,
                     sides,
                     pivots: if measure <= zero { Vec::new() } else { pivots },

@@ -21,7 +21,9 @@
 //!
 //! "Exact" is in the sense of the convex program's closure: a joint that keeps contact may
 //! carry shear with no compression left (the friction cone's closure as μ → ∞), and a hinge
-//! that keeps one line carries its in-plane shear there (the same wrench at either line). An
+//! that keeps one line carries its in-plane shear there (the same wrench at either line), and a
+//! rocking base that keeps a single corner and does not twist carries the couple about its
+//! normal of the no-twist constraint (`LumpedShear` in the parent module). An
 //! answer that relies on shear across a joint its mechanism lifts off is the limit of
 //! equilibria whose compression there vanishes: it needs unbounded friction, which
 //! [`super::state_friction`] and `crr check` report ("needs μ > 1000"; an independent review
