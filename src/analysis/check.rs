@@ -326,16 +326,24 @@ pub fn check_with(
 fn sliding_note(m: &crate::analysis::static_multiplier::StaticMultiplier) -> String {
     let see = "(docs/simulation.md, \"Joints that open may slide\")";
     let without = crate::analysis::static_multiplier::without_sliding(m.convex_lambda);
+    let why = match &m.not_exhaustive_because {
+        Some(crr_impact::statics::Unexhausted::SolverFailed(status)) => format!(
+            "a program of the pass over the sets of joints that may open and slide did not solve ({status}), so not every set was tried"
+        ),
+        _ => format!(
+            "the structure's loops give more sets of joints that may open and slide than the statics try ({})",
+            crr_impact::statics::EXHAUSTIVE_SETS
+        ),
+    };
     match (m.from_sliding_search, m.exhaustive) {
         (true, true) => format!(
             "    found among the joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, and every set of joints that may open and slide was tried, so none opens lower {see}\n"
         ),
         (true, false) => format!(
-            "    found by the search for joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, so the structure can move from it on, but the search is not exhaustive and a lower mechanism may exist {see}\n"
+            "    found by the search for joints that open and slide (without them {without}): a mechanism with an equilibrium on the contacts it keeps exists at this λ, so the structure can move from it on, but the search is not exhaustive ({why}) and a lower mechanism may exist {see}\n"
         ),
         (false, false) => format!(
-            "    not exhaustive: the structure's loops give more sets of joints that may open and slide than the statics try ({}), and the search among them found none lower; this λ is an upper bound and a lower mechanism may exist {see}\n",
-            crr_impact::statics::EXHAUSTIVE_SETS
+            "    not exhaustive: {why}, and the search found none lower; this λ is an upper bound and a lower mechanism may exist {see}\n"
         ),
         (false, true) => String::new(),
     }

@@ -848,9 +848,9 @@ fn warnings(
             "at t = {} s the structure at rest was held under a ground acceleration of {:.4} m/s² \
              along ({:.3}, {:.3}, {:.3}) on a static multiplier that is not exhaustive: along \
              that direction it has more sets of joints that may open and slide than a run tries \
-             ({} along an axis, {} along another direction), the search among them found none \
-             below the load, but a lower mechanism may exist and the structure may leave rest \
-             earlier (`crr check --direction {:.6},{:.6},{:.6}` tries up to {}; \
+             ({} along an axis, {} along another direction), or a program of the pass over them \
+             did not solve; the search found none below the load, but a lower mechanism may \
+             exist and the structure may leave rest earlier (`crr check --direction {:.6},{:.6},{:.6}` tries up to {}; \
              docs/simulation.md, \"The exhaustive pass\")",
             held.t,
             a.norm(),

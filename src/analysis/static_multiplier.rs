@@ -86,9 +86,14 @@ pub struct StaticMultiplier {
     /// Whether `lambda` is the least over every collapse state of the contact model, joints that
     /// open and slide included ([`crr_impact::statics::Collapse::exhaustive`]): a structure
     /// without loops, or one whose sets of joints that may open and slide were all tried.
-    /// `false`: more sets than the statics try, so `lambda` is the search's answer, an upper
-    /// bound of the multiplier (a lower mechanism may exist). Always with `--friction`.
+    /// `false`: not every set was tried (`not_exhaustive_because` says why), so `lambda` is the
+    /// search's answer, an upper bound of the multiplier (a lower mechanism may exist). Always
+    /// with `--friction`.
     pub exhaustive: bool,
+    /// Why `exhaustive` is false: `too_many_sets` (more sets of joints that may open and slide
+    /// than the statics try, [`crr_impact::statics::EXHAUSTIVE_SETS`]) or `{"solver_failed":
+    /// status}` (a program of the exhaustive pass did not solve); `None` where it is true.
+    pub not_exhaustive_because: Option<crr_impact::statics::Unexhausted>,
 }
 
 /// What the program without sliding answered, for the reports of an answer the search for
@@ -154,6 +159,7 @@ pub fn static_multiplier_with(
             convex_lambda: None,
             from_sliding_search: false,
             exhaustive: true,
+            not_exhaustive_because: None,
         });
     }
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
@@ -329,5 +335,6 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
             .flatten(),
         from_sliding_search: collapse.from_sliding_search(),
         exhaustive: collapse.exhaustive,
+        not_exhaustive_because: collapse.unexhausted.clone(),
     }
 }

@@ -29,7 +29,7 @@
 use nalgebra::Vector3;
 
 use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
-use crr::impact::statics::{StaticsOptions, collapse_multiplier};
+use crr::impact::statics::{StaticsOptions, Unexhausted, collapse_multiplier};
 use crr::kinematics::Model;
 
 use super::independent::Lp;
@@ -399,6 +399,7 @@ fn the_exhaustive_pass_finds_the_least_collapse_of_small_walls() {
             let got = c.lambda.expect("the wall has a multiplier");
             println!("wall {w}, dx {dx:+}: engine {got:.12}, enumeration {expected:.12}");
             assert!(c.exhaustive, "wall {w}, dx {dx:+}: not exhaustive");
+            assert_eq!(c.unexhausted, None, "wall {w}, dx {dx:+}");
             assert!(
                 (got - expected).abs() <= RTOL * expected,
                 "wall {w}, dx {dx:+}: engine {got} against the enumeration's {expected}"
@@ -413,6 +414,11 @@ fn the_exhaustive_pass_finds_the_least_collapse_of_small_walls() {
                 assert!(
                     !alone.exhaustive,
                     "wall {w}: the search alone is not exhaustive"
+                );
+                assert_eq!(
+                    alone.unexhausted,
+                    Some(Unexhausted::TooManySets),
+                    "wall {w}"
                 );
                 assert!(
                     above > expected * (1.0 + 1e-6),

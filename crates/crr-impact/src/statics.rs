@@ -250,6 +250,30 @@ pub struct Collapse {
     /// (`sliding_lift_off: false`) on a structure with loops. In a 3D model, a face that keeps a
     /// single loaded corner and twists about it is outside both passes.
     pub exhaustive: bool,
+    /// Why `exhaustive` is false (`None` where it is true).
+    pub unexhausted: Option<Unexhausted>,
+}
+
+/// Why a collapse multiplier is not exhaustive ([`Collapse::exhaustive`]): why not every set of
+/// joints that may open and slide was tried.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Unexhausted {
+    /// The structure has more such sets than the options' `exhaustive_sets`.
+    TooManySets,
+    /// A program of the exhaustive pass failed to solve (the solver's status).
+    SolverFailed(String),
+    /// Only the convex program was asked (`sliding_lift_off: false`) on a structure with loops.
+    ConvexOnly,
+}
+
+impl Unexhausted {
+    fn failed(error: StaticsError) -> Self {
+        match error {
+            StaticsError::Solver(status) => Unexhausted::SolverFailed(status),
+            other => Unexhausted::SolverFailed(other.to_string()),
+        }
+    }
 }
 
 impl Collapse {
@@ -318,6 +342,7 @@ pub fn collapse_multiplier(
     if options.friction != Friction::NoSliding {
         return Ok(Collapse {
             exhaustive: true,
+            unexhausted: None,
             ..convex
         });
     }
@@ -326,6 +351,7 @@ pub fn collapse_multiplier(
     if candidates.is_empty() {
         return Ok(Collapse {
             exhaustive: true,
+            unexhausted: None,
             ..convex
         });
     }
@@ -347,12 +373,16 @@ pub fn collapse_multiplier(
             searched.clone(),
             best_lambda,
         ) {
-            Some(least) => Collapse {
+            Ok(least) => Collapse {
                 convex_lambda,
                 exhaustive: true,
+                unexhausted: None,
                 ..least
             },
-            None => searched,
+            Err(why) => Collapse {
+                unexhausted: Some(why),
+                ..searched
+            },
         },
     )
 }
@@ -1602,6 +1632,7 @@ impl Program {
             lambda: (!holds).then_some(lambda),
             convex_lambda: (!holds).then_some(lambda),
             exhaustive: false,
+            unexhausted: Some(Unexhausted::ConvexOnly),
             interfaces,
             bodies: bodies
                 .iter()

@@ -38,8 +38,8 @@
 use nalgebra::Vector3;
 
 use super::{
-    Collapse, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, moving_points, physical,
-    solve_program,
+    Collapse, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted, moving_points,
+    physical, solve_program,
 };
 use crr_kinematics::{ContactFace, Model, Parent};
 
@@ -120,9 +120,9 @@ pub(super) fn supported(model: &Model, removed: &[bool]) -> bool {
 }
 
 /// The least collapse over every set U that a collapse state may unload, below `best`
-/// (λ = `best_lambda`, the search's answer): `Some` with the lowest found (`best` itself where
-/// none lowers it), `None` where there are more sets than `options.exhaustive_sets` or a
-/// program failed to solve.
+/// (λ = `best_lambda`, the search's answer): the lowest found (`best` itself where none lowers
+/// it), or why not every set was tried: more sets than `options.exhaustive_sets`, or a program
+/// that failed to solve.
 ///
 /// A depth-first walk over the sets, each set's children adding one candidate after its last
 /// (every set is met once). First, every candidate freed at once bounds every set's λ (freeing
@@ -142,7 +142,7 @@ pub(super) fn least_collapse(
     options: &StaticsOptions,
     best: Collapse,
     best_lambda: f64,
-) -> Option<Collapse> {
+) -> Result<Collapse, Unexhausted> {
     // The net load on every body points down for every λ below the best where gravity wins
     // over the load's vertical part: (1 + λ d_z) > 0 (the inertial load is −λ g d).
     let downward = 1.0 + best_lambda * d.z.min(0.0) > 0.0;
@@ -157,11 +157,12 @@ pub(super) fn least_collapse(
         best,
         best_lambda,
     };
-    pass.count_sets(options.exhaustive_sets)?;
+    pass.count_sets(options.exhaustive_sets)
+        .ok_or(Unexhausted::TooManySets)?;
     if pass.below_best(candidates)? {
         pass.children(&[], 0)?;
     }
-    Some(pass.best)
+    Ok(pass.best)
 }
 
 /// The state of [`least_collapse`]'s depth-first walk.
@@ -207,15 +208,14 @@ impl Pass<'_> {
         flags
     }
 
-    /// Whether the program with `set` freed answers below the best (None: a solver failure): a
-    /// bound of the sets it holds. With no equilibrium at any λ ≥ 0 it bounds nothing (its
-    /// subsets may hold).
-    fn below_best(&mut self, set: &[usize]) -> Option<bool> {
+    /// Whether the program with `set` freed answers below the best: a bound of the sets it
+    /// holds. With no equilibrium at any λ ≥ 0 it bounds nothing (its subsets may hold).
+    fn below_best(&mut self, set: &[usize]) -> Result<bool, Unexhausted> {
         let free = self.flags(set);
         match solve_program(self.model, self.faces, self.d, self.options, &free, &[]) {
-            Ok(c) => Some(c.lambda.is_some_and(|l| self.lowers(l))),
-            Err(StaticsError::DoesNotHold(_)) => Some(true),
-            Err(_) => None,
+            Ok(c) => Ok(c.lambda.is_some_and(|l| self.lowers(l))),
+            Err(StaticsError::DoesNotHold(_)) => Ok(true),
+            Err(e) => Err(Unexhausted::failed(e)),
         }
     }
 
@@ -258,9 +258,9 @@ impl Pass<'_> {
     }
 
     /// Every set `set` + {candidates[k]} for k ≥ `from`, and the sets below each.
-    fn children(&mut self, set: &[usize], from: usize) -> Option<()> {
+    fn children(&mut self, set: &[usize], from: usize) -> Result<(), Unexhausted> {
         if set.len() >= self.depth {
-            return Some(());
+            return Ok(());
         }
         for k in from..self.candidates.len() {
             let mut trial = set.to_vec();
@@ -284,7 +284,7 @@ impl Pass<'_> {
             ) {
                 Ok(c) => c.lambda.unwrap_or(self.options.lambda_max),
                 Err(StaticsError::DoesNotHold(_)) => continue,
-                Err(_) => return None,
+                Err(e) => return Err(Unexhausted::failed(e)),
             };
             if self.lowers(holding) {
                 self.try_set(&trial, holding)?;
@@ -293,29 +293,29 @@ impl Pass<'_> {
                 self.children(&trial, k + 1)?;
             }
         }
-        Some(())
+        Ok(())
     }
 
     /// U freed, kept as the best where it lowers λ and passes the physical test. `holding` is
     /// λ_u, U's program with every point of U unloaded.
-    fn try_set(&mut self, set: &[usize], holding: f64) -> Option<()> {
+    fn try_set(&mut self, set: &[usize], holding: f64) -> Result<(), Unexhausted> {
         let free = self.flags(set);
         let freed = match solve_program(self.model, self.faces, self.d, self.options, &free, &[]) {
             Ok(freed) => freed,
-            Err(StaticsError::DoesNotHold(_)) => return Some(()),
-            Err(_) => return None,
+            Err(StaticsError::DoesNotHold(_)) => return Ok(()),
+            Err(e) => return Err(Unexhausted::failed(e)),
         };
         let Some(lambda) = freed.lambda.filter(|&l| self.lowers(l)) else {
-            return Some(());
+            return Ok(());
         };
         if self.unloads_below(set, &freed, holding, lambda) {
-            return Some(());
+            return Ok(());
         }
         if let Some(collapse) = physical(self.model, self.faces, self.d, self.options, &free, freed)
         {
             self.best = collapse;
             self.best_lambda = lambda;
         }
-        Some(())
+        Ok(())
     }
 }
