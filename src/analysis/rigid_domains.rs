@@ -38,7 +38,7 @@ use crr_kinematics::assembly::{
     ContactFace, ContactSet, InterfaceStyle, merge_coplanar, structure_of,
 };
 use crr_kinematics::spec::{BlockSpec, BodySpec, SymmetrySpec};
-use crr_kinematics::{ActivePivots, Model, Parent, Side, StructureSpec};
+use crr_kinematics::{ActivePivots, DisjointSets, Model, Parent, Side, StructureSpec};
 
 use crate::Error;
 use crate::analysis::assemble::{Assembled, AssemblyOptions, assemble};
@@ -190,26 +190,17 @@ fn collapse_along(model: &Model, direction: Vector3<f64>) -> Result<DirectionCol
 /// block). Domains are numbered in the order of their first bodies.
 fn rigid_domains(model: &Model, collapses: &[DirectionCollapse]) -> Vec<usize> {
     let n = model.bodies.len();
-    let mut root: Vec<usize> = (0..n).collect();
-    fn find(root: &mut [usize], mut b: usize) -> usize {
-        while root[b] != b {
-            root[b] = root[root[b]];
-            b = root[b];
-        }
-        b
-    }
+    let mut sets = DisjointSets::new(n);
     for iface in &model.interfaces {
         let Parent::Body(p) = iface.parent else {
             continue;
         };
         let moves = collapses.iter().any(|c| c.hinges.contains(&iface.name));
         if !moves {
-            let (a, b) = (find(&mut root, p), find(&mut root, iface.child));
-            let (lo, hi) = (a.min(b), a.max(b));
-            root[hi] = lo;
+            sets.union(p, iface.child);
         }
     }
-    let roots: Vec<usize> = (0..n).map(|b| find(&mut root, b)).collect();
+    let roots: Vec<usize> = (0..n).map(|b| sets.find(b)).collect();
     let mut number = vec![usize::MAX; n];
     let mut next = 0;
     for &r in &roots {

@@ -36,6 +36,7 @@ pub mod closure;
 pub mod contact_face;
 pub mod contact_kinematics;
 pub mod data;
+pub mod disjoint_sets;
 pub mod error;
 pub mod fixtures;
 pub mod gamma;
@@ -57,6 +58,7 @@ pub use closure::{
 pub use contact_face::{ContactFace, contact_faces};
 pub use contact_kinematics::{ContactKinematics, contact_bias, contact_geometry};
 pub use data::Data;
+pub use disjoint_sets::DisjointSets;
 pub use error::ModelError;
 pub use gamma::mass_matrix_gamma;
 pub use kinematics::{body_point, body_points, body_rotation, forward_kinematics, jacobians};

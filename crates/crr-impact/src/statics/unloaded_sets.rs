@@ -41,7 +41,7 @@ use super::{
     Collapse, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted, moving_points,
     physical, solve_program,
 };
-use crr_kinematics::{ContactFace, Model, Parent};
+use crr_kinematics::{ContactFace, DisjointSets, Model, Parent};
 
 /// The interfaces that may be unloaded in a collapse state: on a loop of the graph of bodies
 /// and interfaces (not a bridge, whose removal leaves a body unsupported) and not pins (a pin
@@ -94,16 +94,9 @@ fn lifters(model: &Model, faces: &[ContactFace]) -> Vec<Vec<usize>> {
 
 /// Whether every body is joined to the ground through the interfaces not `removed`.
 pub(super) fn supported(model: &Model, removed: &[bool]) -> bool {
-    // Union–find over the bodies and the ground (index n).
+    // The bodies and the ground (index n).
     let n = model.bodies.len();
-    let mut root: Vec<usize> = (0..=n).collect();
-    fn find(root: &mut [usize], mut a: usize) -> usize {
-        while root[a] != a {
-            root[a] = root[root[a]];
-            a = root[a];
-        }
-        a
-    }
+    let mut sets = DisjointSets::new(n + 1);
     for (i, interface) in model.interfaces.iter().enumerate() {
         if removed[i] {
             continue;
@@ -112,11 +105,9 @@ pub(super) fn supported(model: &Model, removed: &[bool]) -> bool {
             Parent::Ground => n,
             Parent::Body(b) => b,
         };
-        let (a, b) = (find(&mut root, parent), find(&mut root, interface.child));
-        root[a] = b;
+        sets.union(parent, interface.child);
     }
-    let ground = find(&mut root, n);
-    (0..n).all(|b| find(&mut root, b) == ground)
+    (0..n).all(|b| sets.joined(b, n))
 }
 
 /// The least collapse over every set U that a collapse state may unload, below `best`
