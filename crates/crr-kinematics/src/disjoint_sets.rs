@@ -1,8 +1,9 @@
 //! Disjoint sets (union–find) over the indices 0..n: which bodies a set of interfaces joins.
 //!
-//! Used to tell whether every body keeps a path to the ground through the interfaces kept
-//! (`crr_impact`'s exhaustive pass) and to group bodies into the domains no mechanism separates
-//! (the facade crate's rigid domains).
+//! Used for a structure's independent parts ([`crate::Model::parts`]), the bodies left without a
+//! path to the ground when interfaces open ([`crate::Model::bodies_off_ground`]: the exhaustive
+//! pass's sets and the flights of a run) and the domains no mechanism separates (the facade
+//! crate's rigid domains).
 
 /// A partition of 0..n into sets, each named by its smallest member.
 #[derive(Clone, Debug)]

@@ -6,6 +6,7 @@ use std::ops::Range;
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::disjoint_sets::DisjointSets;
 use crate::error::ModelError;
 use crate::shapes::{MassProperties, Shape};
 use crate::spec::{BodySpec, ImpactLaw, InterfaceSpec, PivotSpec, StructureSpec};
@@ -1038,6 +1039,25 @@ impl Model {
         false
     }
 
+    /// The bodies (indices, in order) with no path to the ground through the interfaces not
+    /// `removed` (each interface joins its parent and its child): those that would fly if the
+    /// removed interfaces opened.
+    pub fn bodies_off_ground(&self, removed: &[bool]) -> Vec<usize> {
+        let n = self.bodies.len();
+        // The ground is index n.
+        let mut sets = DisjointSets::new(n + 1);
+        for (i, interface) in self.interfaces.iter().enumerate() {
+            if !removed[i] {
+                let parent = match interface.parent {
+                    Parent::Ground => n,
+                    Parent::Body(b) => b,
+                };
+                sets.union(parent, interface.child);
+            }
+        }
+        (0..n).filter(|&b| !sets.joined(b, n)).collect()
+    }
+
     /// The partition of the structure into its connected parts: the coordinates joined by
     /// parent links (one tree rooted at the ground each), by loop closures between bodies
     /// (a closure to the ground joins nothing) and by symmetry rows. The equations of motion of
@@ -1045,40 +1065,27 @@ impl Model {
     /// one part), so a quantity of one part depends on that part's state alone.
     pub fn parts(&self) -> Parts {
         let n = self.dof();
-        let mut up: Vec<usize> = (0..n).collect();
-        fn root(up: &mut [usize], mut k: usize) -> usize {
-            while up[k] != k {
-                up[k] = up[up[k]];
-                k = up[k];
-            }
-            k
-        }
-        let mut join = |a: usize, b: usize| {
-            let (ra, rb) = (root(&mut up, a), root(&mut up, b));
-            // The smaller index stays the root, so a part's root is its first coordinate.
-            if ra != rb {
-                up[ra.max(rb)] = ra.min(rb);
-            }
-        };
+        // The smaller index names a set, so a part's root is its first coordinate.
+        let mut sets = DisjointSets::new(n);
         for (k, c) in self.coords.iter().enumerate() {
             if let Some(p) = c.parent {
-                join(p, k);
+                sets.union(p, k);
             }
         }
         for cl in &self.closures {
             let iface = &self.interfaces[cl.interface];
             if let Some(a) = self.frame_of(iface.parent) {
-                join(a, self.body_coord[iface.child]);
+                sets.union(a, self.body_coord[iface.child]);
             }
         }
         for &(a, b, _) in &self.symmetries {
-            join(a, b);
+            sets.union(a, b);
         }
         let mut index = vec![usize::MAX; n];
         let mut of_coord = vec![0; n];
         let mut coords: Vec<Vec<usize>> = Vec::new();
         for k in 0..n {
-            let r = root(&mut up, k);
+            let r = sets.find(k);
             if index[r] == usize::MAX {
                 index[r] = coords.len();
                 coords.push(Vec::new());

@@ -409,41 +409,14 @@ pub(crate) fn flight_words(in_flight: &[String]) -> String {
 /// interface joins its parent and its child), in the model's order: the bodies that would fly
 /// if those interfaces opened.
 pub fn bodies_without_support(model: &Model, lifting: &[String]) -> Vec<String> {
-    let nb = model.bodies.len();
-    let mut supported = vec![false; nb];
-    let kept: Vec<&crr_kinematics::Interface> = model
+    let removed: Vec<bool> = model
         .interfaces
         .iter()
-        .filter(|f| !lifting.contains(&f.name))
+        .map(|f| lifting.contains(&f.name))
         .collect();
-    let parent_of = |f: &crr_kinematics::Interface| match f.parent {
-        crr_kinematics::Parent::Ground => None,
-        crr_kinematics::Parent::Body(b) => Some(b),
-    };
-    // Grow the supported set from the ground until nothing changes (at most one pass per body).
-    loop {
-        let mut changed = false;
-        for f in &kept {
-            let (a, b) = (parent_of(f), f.child);
-            let a_supported = a.is_none_or(|a| supported[a]);
-            if a_supported && !supported[b] {
-                supported[b] = true;
-                changed = true;
-            }
-            if let Some(a) = a
-                && supported[b]
-                && !supported[a]
-            {
-                supported[a] = true;
-                changed = true;
-            }
-        }
-        if !changed {
-            break;
-        }
-    }
-    (0..nb)
-        .filter(|&b| !supported[b])
+    model
+        .bodies_off_ground(&removed)
+        .into_iter()
         .map(|b| model.bodies[b].name.clone())
         .collect()
 }

@@ -41,7 +41,7 @@ use super::{
     Collapse, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted, moving_points,
     physical, solve_program,
 };
-use crr_kinematics::{ContactFace, DisjointSets, Model, Parent};
+use crr_kinematics::{ContactFace, Model, Parent};
 
 /// The interfaces that may be unloaded in a collapse state: on a loop of the graph of bodies
 /// and interfaces (not a bridge, whose removal leaves a body unsupported) and not pins (a pin
@@ -94,20 +94,7 @@ fn lifters(model: &Model, faces: &[ContactFace]) -> Vec<Vec<usize>> {
 
 /// Whether every body is joined to the ground through the interfaces not `removed`.
 pub(super) fn supported(model: &Model, removed: &[bool]) -> bool {
-    // The bodies and the ground (index n).
-    let n = model.bodies.len();
-    let mut sets = DisjointSets::new(n + 1);
-    for (i, interface) in model.interfaces.iter().enumerate() {
-        if removed[i] {
-            continue;
-        }
-        let parent = match interface.parent {
-            Parent::Ground => n,
-            Parent::Body(b) => b,
-        };
-        sets.union(parent, interface.child);
-    }
-    (0..n).all(|b| sets.joined(b, n))
+    model.bodies_off_ground(removed).is_empty()
 }
 
 /// The least collapse over every set U that a collapse state may unload, below `best`
