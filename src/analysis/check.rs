@@ -18,7 +18,7 @@ use crr_impact::simulation::{Parameters, Simulation, StopReason};
 use crr_kinematics::{ActivePivots, Data, Model, Side};
 
 use crate::analysis::static_multiplier::{
-    StaticMultiplier, horizontal_directions, static_multiplier_with,
+    MultiplierOptions, StaticMultiplier, horizontal_directions, static_multiplier_with,
 };
 
 /// One line of the frequency table.
@@ -107,6 +107,9 @@ pub struct CheckReport {
     pub static_multipliers: Vec<StaticMultiplier>,
     /// Why `static_multipliers` is empty, else `None`.
     pub static_multipliers_note: Option<String>,
+    /// The most sets of joints that may open and slide the exhaustive pass tried per direction
+    /// (`crr check --exhaustive-sets`, default [`crr_impact::statics::EXHAUSTIVE_SETS`]).
+    pub exhaustive_sets: usize,
     /// What to know before trusting the report (a planar model whose hinge axis is not
     /// horizontal, [`crate::analysis::static_multiplier::gravity_along_axis_warning`]).
     pub warnings: Vec<String>,
@@ -237,16 +240,19 @@ pub const FINITE_STEP: f64 = 0.01;
 
 /// Builds the report, with the static multipliers along ±x and ±y without sliding.
 pub fn check(model: &Model) -> CheckReport {
-    check_with(model, &horizontal_directions(), None)
+    check_with(
+        model,
+        &horizontal_directions(),
+        &MultiplierOptions::default(),
+    )
 }
 
 /// Builds the report, with the static multipliers along `directions` (unit or not; the ground
-/// accelerating along each) and Coulomb friction μ = `friction` at the contacts (`None`: no
-/// sliding).
+/// accelerating along each), asked with `asked` (friction, the exhaustive pass's budget).
 pub fn check_with(
     model: &Model,
     directions: &[Vector3<f64>],
-    friction: Option<f64>,
+    asked: &MultiplierOptions,
 ) -> CheckReport {
     let zero = DVector::zeros(model.dof());
     let mob = mobility(model, &zero, &ActivePivots::uniform(model, Side::Positive));
@@ -287,7 +293,7 @@ pub fn check_with(
     let statics = std::thread::scope(|scope| {
         let handles: Vec<_> = directions
             .iter()
-            .map(|&d| scope.spawn(move || static_multiplier_with(model, d, friction)))
+            .map(|&d| scope.spawn(move || static_multiplier_with(model, d, asked)))
             .collect();
         handles
             .into_iter()
@@ -314,6 +320,7 @@ pub fn check_with(
         note,
         static_multipliers: statics,
         static_multipliers_note: statics_note,
+        exhaustive_sets: asked.exhaustive_sets,
         warnings: crate::analysis::static_multiplier::gravity_along_axis_warning(model)
             .into_iter()
             .chain(crate::analysis::contact_geometry::contact_geometry_warnings(model))
@@ -323,17 +330,22 @@ pub fn check_with(
 
 /// The lines of a multiplier's report on joints that open and slide: where λ comes from them,
 /// and whether every set of them was tried (docs/simulation.md, "Joints that open may slide").
-fn sliding_note(m: &crate::analysis::static_multiplier::StaticMultiplier) -> String {
+fn sliding_note(m: &crate::analysis::static_multiplier::StaticMultiplier, budget: usize) -> String {
     let see = "(docs/simulation.md, \"Joints that open may slide\")";
     let without = crate::analysis::static_multiplier::without_sliding(m.convex_lambda);
     let why = match &m.not_exhaustive_because {
         Some(crr_impact::statics::Unexhausted::SolverFailed(status)) => format!(
             "a program of the pass over the sets of joints that may open and slide did not solve ({status}), so not every set was tried"
         ),
-        _ => format!(
-            "the structure's loops give more sets of joints that may open and slide than the statics try ({})",
-            crr_impact::statics::EXHAUSTIVE_SETS
-        ),
+        _ => match m.exhaustive_sets_needed {
+            Some(needed) => format!(
+                "the structure's loops give {needed} sets of joints that may open and slide, more than the statics try ({budget}): `crr check --exhaustive-sets {needed}` tries them all, at one to three linear programs a set"
+            ),
+            None => format!(
+                "the structure's loops give more than {} sets of joints that may open and slide, and the statics try {budget}",
+                crr_impact::statics::COUNTED_SETS
+            ),
+        },
     };
     match (m.from_sliding_search, m.exhaustive) {
         (true, true) => format!(
@@ -461,7 +473,7 @@ pub fn to_text(r: &CheckReport) -> String {
                             lifting.join(", ")
                         );
                     }
-                    s += &sliding_note(m);
+                    s += &sliding_note(m, r.exhaustive_sets);
                     let sliding = with(crr_impact::statics::Motion::Slides);
                     if !sliding.is_empty() {
                         s += &format!(
@@ -475,7 +487,7 @@ pub fn to_text(r: &CheckReport) -> String {
                         "  d = {dir}: holds up to λ = {}\n",
                         crate::analysis::static_multiplier::LAMBDA_MAX
                     );
-                    s += &sliding_note(m);
+                    s += &sliding_note(m, r.exhaustive_sets);
                 }
             }
             if !m.hinges_out_of_plane.is_empty() {

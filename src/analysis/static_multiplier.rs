@@ -17,8 +17,9 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crr_impact::statics::{
-    Collapse, Friction, Motion, StaticsError, StaticsOptions, collapse_multiplier,
-    hinges_out_of_plane, required_friction, state_friction,
+    COUNTED_SETS, Collapse, Friction, Motion, StaticsError, StaticsOptions, Unexhausted,
+    collapse_multiplier, exhaustive_sets_needed, hinges_out_of_plane, required_friction,
+    state_friction,
 };
 use crr_kinematics::{Model, Side};
 
@@ -94,6 +95,33 @@ pub struct StaticMultiplier {
     /// than the statics try, [`crr_impact::statics::EXHAUSTIVE_SETS`]) or `{"solver_failed":
     /// status}` (a program of the exhaustive pass did not solve); `None` where it is true.
     pub not_exhaustive_because: Option<crr_impact::statics::Unexhausted>,
+    /// Where `not_exhaustive_because` is `too_many_sets`: how many sets the exhaustive pass
+    /// would try along this direction (counted without a program,
+    /// [`crr_impact::statics::exhaustive_sets_needed`]), the `exhaustive_sets` that makes the
+    /// answer exhaustive; `None` beyond [`crr_impact::statics::COUNTED_SETS`] and wherever
+    /// there is no such reason.
+    pub exhaustive_sets_needed: Option<usize>,
+}
+
+/// What the static multipliers are asked with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MultiplierOptions {
+    /// Coulomb friction μ at every contact point (a pyramid on each tangent, exact for planar
+    /// loads); `None`: no sliding, and the report gives the friction each multiplier needs.
+    pub friction: Option<f64>,
+    /// The most sets of joints that may open and slide the exhaustive pass tries per direction
+    /// ([`crr_impact::statics::StaticsOptions::exhaustive_sets`]); beyond them λ is the
+    /// search's answer, an upper bound.
+    pub exhaustive_sets: usize,
+}
+
+impl Default for MultiplierOptions {
+    fn default() -> Self {
+        MultiplierOptions {
+            friction: None,
+            exhaustive_sets: crr_impact::statics::EXHAUSTIVE_SETS,
+        }
+    }
 }
 
 /// What the program without sliding answered, for the reports of an answer the search for
@@ -119,19 +147,21 @@ pub fn static_multiplier(
     model: &Model,
     direction: Vector3<f64>,
 ) -> Result<StaticMultiplier, String> {
-    static_multiplier_with(model, direction, None)
+    static_multiplier_with(model, direction, &MultiplierOptions::default())
 }
 
-/// [`static_multiplier`] with Coulomb friction `friction` = μ at every contact point (a pyramid
-/// on each tangent, exact for planar loads) instead of no sliding; `required_friction` is then
-/// `None`.
+/// [`static_multiplier`] with the options `asked`: Coulomb friction μ at every contact point
+/// instead of no sliding (`required_friction` is then `None`), and the budget of the exhaustive
+/// pass.
 pub fn static_multiplier_with(
     model: &Model,
     direction: Vector3<f64>,
-    friction: Option<f64>,
+    asked: &MultiplierOptions,
 ) -> Result<StaticMultiplier, String> {
+    let friction = asked.friction;
     let options = StaticsOptions {
         friction: friction.map_or(Friction::NoSliding, Friction::Pyramid),
+        exhaustive_sets: asked.exhaustive_sets,
         ..StaticsOptions::default()
     };
     let along_axis = out_of_plane(model, &direction);
@@ -160,6 +190,7 @@ pub fn static_multiplier_with(
             from_sliding_search: false,
             exhaustive: true,
             not_exhaustive_because: None,
+            exhaustive_sets_needed: None,
         });
     }
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
@@ -176,6 +207,9 @@ pub fn static_multiplier_with(
         _ => None,
     };
     let mut report = report(model, &collapse, required);
+    if collapse.unexhausted == Some(Unexhausted::TooManySets) {
+        report.exhaustive_sets_needed = exhaustive_sets_needed(model, &collapse, COUNTED_SETS);
+    }
     // A planar model's out-of-plane part is `out_of_plane`; elsewhere the hinges that every
     // distribution at λ loads out of their plane (at λ_max where it holds).
     if model.planar_axis().is_none() {
@@ -336,5 +370,6 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         from_sliding_search: collapse.from_sliding_search(),
         exhaustive: collapse.exhaustive,
         not_exhaustive_because: collapse.unexhausted.clone(),
+        exhaustive_sets_needed: None,
     }
 }

@@ -329,3 +329,82 @@ fn directions_of_any_scale_give_the_same_multiplier() {
     assert_eq!(report("1e-300,0,1e-300"), diagonal);
     assert_eq!(report("1e300,0,1e300"), diagonal);
 }
+
+/// `--exhaustive-sets N` is the exhaustive pass's budget. A wall of three courses
+/// ([0.53 | 0.18 | 0.29], [0.29 | 0.39 | 0.32], [1], 0.5 m high, every contact a joint) has more
+/// sets of joints that may open and slide than the default 4096: along −x the report gives the
+/// search's upper bound 2/3, `too_many_sets` and the number of sets; asked with that budget it
+/// tries them all and answers the least collapse, 0.328658189978, the value the independent
+/// enumeration of `tests/statics/exhaustive.rs` finds (1e-7 there;
+/// `a_budget_of_the_counted_sets_makes_a_larger_wall_exhaustive`). A budget that is no count is
+/// refused, naming the option.
+#[test]
+fn a_larger_budget_of_sets_makes_the_answer_exhaustive() {
+    let dir = crate::common::scratch("check_exhaustive_sets");
+    let mut assembly = String::from("name = \"budget_wall\"\ngravity = 9.81\n");
+    let courses: [&[f64]; 3] = [&[0.53, 0.18, 0.29], &[0.29, 0.39, 0.32], &[1.0]];
+    for (c, lengths) in courses.iter().enumerate() {
+        let mut x = 0.0;
+        for (k, len) in lengths.iter().enumerate() {
+            assembly += &format!(
+                "\n[[body]]\nname = \"c{c}_b{k}\"\ndensity = 2000.0\nbox = {{ center = [{}, 0.0, {}], size = [{len}, 0.5, 0.5] }}\n",
+                x + len / 2.0,
+                0.5 * c as f64 + 0.25
+            );
+            x += len;
+        }
+    }
+    let (blocks, model) = (dir.join("blocks.toml"), dir.join("model.toml"));
+    std::fs::write(&blocks, assembly).unwrap();
+    let (blocks, model) = (blocks.to_str().unwrap(), model.to_str().unwrap());
+    let o = crate::common::crr(&[
+        "assemble",
+        blocks,
+        "--all-contacts",
+        "--planar",
+        "--out",
+        model,
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let along_minus_x = |extra: &[&str]| {
+        let mut args = vec!["check", model, "--json", "--direction", "-x"];
+        args.extend_from_slice(extra);
+        let o = crate::common::crr(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        r["static_multipliers"][0].clone()
+    };
+    let default = along_minus_x(&[]);
+    assert_eq!(default["exhaustive"], false, "{default}");
+    assert_eq!(default["not_exhaustive_because"], "too_many_sets");
+    assert!(
+        (default["lambda"].as_f64().unwrap() - 2.0 / 3.0).abs() < 1e-9,
+        "{default}"
+    );
+    let needed = default["exhaustive_sets_needed"].as_u64().expect("a count");
+    assert!(needed > 4096, "{needed}");
+    let budget = needed.to_string();
+    let full = along_minus_x(&["--exhaustive-sets", &budget]);
+    assert_eq!(full["exhaustive"], true, "{full}");
+    assert_eq!(full["not_exhaustive_because"], serde_json::Value::Null);
+    let lambda = full["lambda"].as_f64().unwrap();
+    assert!((lambda - 0.328658189978).abs() < 1e-9, "{full}");
+    // The text says how many sets there are and how to try them all.
+    let o = crate::common::crr(&["check", model, "--direction", "-x"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains(&format!(
+            "`crr check --exhaustive-sets {needed}` tries them all"
+        )),
+        "{text}"
+    );
+    for bad in ["-1", "many", "1.5"] {
+        let o = crate::common::crr(&["check", model, "--exhaustive-sets", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        let said = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            said.contains(&format!("invalid value '{bad}' for '--exhaustive-sets")),
+            "{said}"
+        );
+    }
+}

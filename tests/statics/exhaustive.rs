@@ -29,7 +29,10 @@
 use nalgebra::Vector3;
 
 use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
-use crr::impact::statics::{StaticsOptions, Unexhausted, collapse_multiplier};
+use crr::impact::statics::{
+    COUNTED_SETS, EXHAUSTIVE_SETS, StaticsOptions, Unexhausted, collapse_multiplier,
+    exhaustive_sets_needed,
+};
 use crr::kinematics::Model;
 
 use super::independent::Lp;
@@ -427,4 +430,45 @@ fn the_exhaustive_pass_finds_the_least_collapse_of_small_walls() {
             }
         }
     }
+}
+
+/// A wall whose sets of joints that may open and slide outnumber the default budget
+/// (`EXHAUSTIVE_SETS`): [0.53 | 0.18 | 0.29] under [0.29 | 0.39 | 0.32] under [1], every contact
+/// a joint, along −x, where the search alone answered 0.666667 and the least collapse opens at
+/// 0.328658 (module docs). With the default budget the answer is the search's, marked
+/// `TooManySets`, and `exhaustive_sets_needed` counts the sets the pass would try; with exactly
+/// that budget the pass runs and gives the enumeration's least collapse (1e-7), and with one
+/// set less it still does not (the count is the pass's own).
+#[test]
+fn a_budget_of_the_counted_sets_makes_a_larger_wall_exhaustive() {
+    let courses: &[&[f64]] = &[&[0.53, 0.18, 0.29], &[0.29, 0.39, 0.32], &[1.0]];
+    let blocks = blocks(courses);
+    let joints = joints(&blocks, true);
+    let model = engine_model("exhaustive_budget_wall", &blocks, true);
+    let d = Vector3::new(-1.0, 0.0, 0.0);
+    let expected = least_collapse(&blocks, &joints, -1.0);
+    let default = collapse_multiplier(&model, d, &StaticsOptions::default()).unwrap();
+    assert_eq!(default.unexhausted, Some(Unexhausted::TooManySets));
+    let searched = default.lambda.expect("the search has an answer");
+    assert!(
+        searched > expected * (1.0 + 1e-6),
+        "the search alone gives {searched}, not above the least collapse {expected}"
+    );
+    let needed = exhaustive_sets_needed(&model, &default, COUNTED_SETS)
+        .expect("fewer sets than COUNTED_SETS");
+    assert!(needed > EXHAUSTIVE_SETS, "{needed} sets");
+    let budget = |sets: usize| StaticsOptions {
+        exhaustive_sets: sets,
+        ..StaticsOptions::default()
+    };
+    let short = collapse_multiplier(&model, d, &budget(needed - 1)).unwrap();
+    assert_eq!(short.unexhausted, Some(Unexhausted::TooManySets));
+    let full = collapse_multiplier(&model, d, &budget(needed)).unwrap();
+    assert!(full.exhaustive, "{:?}", full.unexhausted);
+    let got = full.lambda.expect("a multiplier");
+    println!("{needed} sets: search {searched:.9}, pass {got:.12}, enumeration {expected:.12}");
+    assert!(
+        (got - expected).abs() <= RTOL * expected,
+        "engine {got} against the enumeration's {expected}"
+    );
 }

@@ -41,6 +41,12 @@ pub(crate) struct Args {
     /// sliding, and the report gives the μ each multiplier needs).
     #[arg(long, value_name = "MU")]
     pub(crate) friction: Option<f64>,
+    /// The most sets of joints that may open and slide the exhaustive pass tries per direction
+    /// (each one to three linear programs); where a structure has more, λ is an upper bound and
+    /// the report says how many it has (up to 100 000)
+    #[arg(long, value_name = "N", allow_hyphen_values = true,
+          default_value_t = crr::impact::statics::EXHAUSTIVE_SETS)]
+    pub(crate) exhaustive_sets: usize,
     /// Replace the plots of an earlier `crr check --plot` in DIR.
     #[arg(long)]
     pub(crate) force: bool,
@@ -96,13 +102,17 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
             earlier.display()
         ))));
     }
+    let asked = crr::analysis::static_multiplier::MultiplierOptions {
+        friction,
+        exhaustive_sets: a.exhaustive_sets,
+    };
     let loaded = paths
         .iter()
         .map(|p| load_model(p))
         .collect::<Result<Vec<_>, _>>()?;
     let reports: Vec<_> = loaded
         .iter()
-        .map(|(_, m)| crr::analysis::check::check_with(m, &directions, friction))
+        .map(|(_, m)| crr::analysis::check::check_with(m, &directions, &asked))
         .collect();
     // The sweep needs a one-DOF mechanism; its failure is reported after the reports.
     let mut sweeps: Vec<Option<crr::analysis::size_sweep::SizeSweep>> = vec![None; reports.len()];

@@ -121,26 +121,28 @@ pub(super) fn least_collapse(
     best: Collapse,
     best_lambda: f64,
 ) -> Result<Collapse, Unexhausted> {
-    // The net load on every body points down for every λ below the best where gravity wins
-    // over the load's vertical part: (1 + λ d_z) > 0 (the inertial load is −λ g d).
-    let downward = 1.0 + best_lambda * d.z.min(0.0) > 0.0;
-    let mut pass = Pass {
-        model,
-        faces,
-        d,
-        options,
-        candidates,
-        depth: loops(model),
-        lifters: downward.then(|| lifters(model, faces)),
-        best,
-        best_lambda,
-    };
+    let mut pass = Pass::new(model, faces, candidates, d, options, best, best_lambda);
     pass.count_sets(options.exhaustive_sets)
         .ok_or(Unexhausted::TooManySets)?;
     if pass.below_best(candidates)? {
         pass.children(&[], 0)?;
     }
     Ok(pass.best)
+}
+
+/// How many sets [`least_collapse`] would try below `best` (λ = `best_lambda`), counted
+/// without a program; None beyond `most`.
+pub(super) fn count(
+    model: &Model,
+    faces: &[ContactFace],
+    candidates: &[usize],
+    d: Vector3<f64>,
+    best: Collapse,
+    best_lambda: f64,
+    most: usize,
+) -> Option<usize> {
+    let options = StaticsOptions::default();
+    Pass::new(model, faces, candidates, d, &options, best, best_lambda).count_sets(most)
 }
 
 /// The state of [`least_collapse`]'s depth-first walk.
@@ -159,7 +161,32 @@ struct Pass<'a> {
     best_lambda: f64,
 }
 
-impl Pass<'_> {
+impl<'a> Pass<'a> {
+    fn new(
+        model: &'a Model,
+        faces: &'a [ContactFace],
+        candidates: &'a [usize],
+        d: Vector3<f64>,
+        options: &'a StaticsOptions,
+        best: Collapse,
+        best_lambda: f64,
+    ) -> Self {
+        // The net load on every body points down for every λ below the best where gravity
+        // wins over the load's vertical part: (1 + λ d_z) > 0 (the inertial load is −λ g d).
+        let downward = 1.0 + best_lambda * d.z.min(0.0) > 0.0;
+        Pass {
+            model,
+            faces,
+            d,
+            options,
+            candidates,
+            depth: loops(model),
+            lifters: downward.then(|| lifters(model, faces)),
+            best,
+            best_lambda,
+        }
+    }
+
     fn lowers(&self, lambda: f64) -> bool {
         lambda < self.best_lambda * (1.0 - 1e-9)
     }
