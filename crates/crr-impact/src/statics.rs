@@ -1088,6 +1088,9 @@ struct ZeroForces<'a> {
     unloaded: &'a [(usize, usize)],
     /// Every point unloaded (not a pin): the face has opened.
     opened: bool,
+    /// A hinge that has not opened: an unloaded line of it keeps its shear (only its normal
+    /// force goes).
+    keeps_a_line: bool,
 }
 
 impl<'a> ZeroForces<'a> {
@@ -1097,10 +1100,12 @@ impl<'a> ZeroForces<'a> {
             freed: free[face.interface] && !face.pin,
             unloaded,
             opened: false,
+            keeps_a_line: false,
         };
         zero.opened = !face.pin
             && !face.points.is_empty()
             && (0..face.points.len()).all(|p| zero.unloaded_point(p));
+        zero.keeps_a_line = !face.bilateral_couples.is_empty() && !zero.opened;
         zero
     }
 
@@ -1110,9 +1115,8 @@ impl<'a> ZeroForces<'a> {
 
     /// Whether component k (0: normal, 1: t₁, 2: t₂) of point p's force is zero.
     fn is_zero(&self, p: usize, k: usize) -> bool {
-        let keeps_a_line = !self.face.bilateral_couples.is_empty() && !self.opened;
         match (self.unloaded_point(p), self.freed) {
-            (true, _) if keeps_a_line => k == 0,
+            (true, _) if self.keeps_a_line => k == 0,
             (true, _) => true,
             (false, true) => (1..=self.face.friction_tangents).contains(&k),
             (false, false) => false,
@@ -1161,8 +1165,8 @@ struct LumpedShear {
 struct Program {
     /// Columns 1.. (column 0 is λ).
     unknowns: Vec<Unknown>,
-    /// Per interface, per point, the columns of (fₙ, f₁, f₂) ([`NO_COLUMN`] for the tangents of
-    /// a lumped face).
+    /// Per interface, per point, the columns of (fₙ, f₁, f₂): [`NO_COLUMN`] for the tangents of
+    /// a lumped face and for every force the program holds at zero ([`ZeroForces`]).
     point_columns: Vec<Vec<[usize; 3]>>,
     /// Per interface, its lumped shear ([`LumpedShear`]) where it is lumped.
     shears: Vec<Option<LumpedShear>>,
