@@ -92,7 +92,7 @@ pub struct StaticMultiplier {
     /// with `--friction`.
     pub exhaustive: bool,
     /// Why `exhaustive` is false: `too_many_sets` (more sets of joints that may open and slide
-    /// than the statics try, [`crr_impact::statics::EXHAUSTIVE_SETS`]) or `{"solver_failed":
+    /// than the budget, [`MultiplierOptions::exhaustive_sets`]) or `{"solver_failed":
     /// status}` (a program of the exhaustive pass did not solve); `None` where it is true.
     pub not_exhaustive_because: Option<crr_impact::statics::Unexhausted>,
     /// Where `not_exhaustive_because` is `too_many_sets`: how many sets the exhaustive pass

@@ -333,7 +333,8 @@ fn directions_of_any_scale_give_the_same_multiplier() {
 /// `--exhaustive-sets N` is the exhaustive pass's budget. A wall of three courses
 /// ([0.53 | 0.18 | 0.29], [0.29 | 0.39 | 0.32], [1], 0.5 m high, every contact a joint) has more
 /// sets of joints that may open and slide than the default 4096: along −x the report gives the
-/// search's upper bound 2/3, `too_many_sets` and the number of sets; asked with that budget it
+/// search's upper bound, the whole wall (1 m × 1.5 m) overturning about its outer foot at
+/// λ = (1/2)/(1.5/2) = 2/3, with `too_many_sets` and the number of sets; asked with that budget it
 /// tries them all and answers the least collapse, 0.328658189978, the value the independent
 /// enumeration of `tests/statics/exhaustive.rs` finds (1e-7 there;
 /// `a_budget_of_the_counted_sets_makes_a_larger_wall_exhaustive`). A budget that is no count is
