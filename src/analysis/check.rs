@@ -447,10 +447,10 @@ pub fn to_text(r: &CheckReport) -> String {
                 Some(l) => {
                     let joints: Vec<String> =
                         m.opening.iter().map(|(k, v)| format!("{k} {v}")).collect();
-                    let friction = match m.required_friction {
-                        Some(mu) if mu.is_finite() => format!(" (μ ≥ {mu:.4})"),
-                        Some(_) => " (needs μ > 1000)".to_string(),
-                        None => String::new(),
+                    let friction = match (m.required_friction, m.friction_unbounded) {
+                        (_, true) => " (needs μ > 1000)".to_string(),
+                        (Some(mu), false) => format!(" (μ ≥ {mu:.4})"),
+                        (None, false) => String::new(),
                     };
                     // A mechanism of lift-offs alone opens no CRR angle (the lines below say).
                     let opening = if joints.is_empty() {

@@ -58,8 +58,14 @@ pub struct StaticMultiplier {
     /// The smallest Coulomb friction coefficient with which λ is reached (the no-sliding answer
     /// relies on it); for an answer of the search for joints that open and slide, the one its
     /// collapse state needs at the points it keeps in contact
-    /// ([`crr_impact::statics::state_friction`]); `None` when `lambda` is.
+    /// ([`crr_impact::statics::state_friction`]); `None` when `lambda` is, with `--friction`,
+    /// and where no μ up to 1000 reaches λ (`friction_unbounded`).
     pub required_friction: Option<f64>,
+    /// Whether no Coulomb μ up to 1000 brings the multiplier within 1e-6 of λ: the answer rests
+    /// on shear across a joint whose compression vanishes at λ (a closure limit, approached only
+    /// as μ grows without bound) or on a friction beyond any masonry's, so with real friction
+    /// the structure slides or opens first (`crr check --friction μ` gives that multiplier).
+    pub friction_unbounded: bool,
     /// For a planar model (every interface a hinge about one common unit axis a,
     /// [`Model::planar_axis`]): |d·a|, the part of the load along a, which the hinges carry
     /// bilaterally; `None` for any other model. Above 0, λ answers for the load's part in the
@@ -184,6 +190,7 @@ pub fn static_multiplier_with(
             opening: BTreeMap::new(),
             mechanism: Vec::new(),
             required_friction: None,
+            friction_unbounded: false,
             out_of_plane: along_axis,
             hinges_out_of_plane: Vec::new(),
             convex_lambda: None,
@@ -326,7 +333,7 @@ pub fn gravity_along_axis_warning(model: &Model) -> Option<String> {
     ))
 }
 
-/// The report of one collapse.
+/// The report of one collapse; `friction` is the μ it relies on, infinite beyond 1000.
 fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMultiplier {
     let moving = || {
         collapse
@@ -360,7 +367,9 @@ fn report(model: &Model, collapse: &Collapse, friction: Option<f64>) -> StaticMu
         lambda: collapse.lambda,
         opening,
         mechanism,
-        required_friction: friction,
+        // JSON has no infinity (serde writes null): the unbounded case is a flag of its own.
+        required_friction: friction.filter(|mu| mu.is_finite()),
+        friction_unbounded: friction.is_some_and(f64::is_infinite),
         out_of_plane: out_of_plane(model, &Vector3::from(collapse.direction)),
         hinges_out_of_plane: Vec::new(),
         convex_lambda: collapse

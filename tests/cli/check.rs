@@ -409,3 +409,56 @@ fn a_larger_budget_of_sets_makes_the_answer_exhaustive() {
         );
     }
 }
+
+/// A wall of beds only whose answer without sliding rests on shear across a joint whose
+/// compression vanishes ([0.301 | 0.699] under [0.585 | 0.415], courses 0.5 m, along −x; the
+/// independent LP of `tests/statics/independent.rs` finds λ(1000) 2.5e-5 of λ short): the line
+/// says "needs μ > 1000" and the JSON `friction_unbounded`, with no μ; with `--friction 0.7`
+/// the multiplier is lower, the one a real wall has.
+#[test]
+fn a_multiplier_that_needs_unbounded_friction_says_so() {
+    let dir = crate::common::scratch("check_unbounded_friction");
+    let mut assembly = String::from("name = \"closure_limit\"\ngravity = 9.81\n");
+    let courses: [&[f64]; 2] = [&[0.301, 0.699], &[0.585, 0.415]];
+    for (c, lengths) in courses.iter().enumerate() {
+        let mut x = 0.0;
+        for (k, len) in lengths.iter().enumerate() {
+            assembly += &format!(
+                "\n[[body]]\nname = \"c{c}_b{k}\"\ndensity = 2000.0\nbox = {{ center = [{}, 0.0, {}], size = [{len}, 0.5, 0.5] }}\n",
+                x + len / 2.0,
+                0.5 * c as f64 + 0.25
+            );
+            x += len;
+        }
+    }
+    let (blocks, model) = (dir.join("blocks.toml"), dir.join("model.toml"));
+    std::fs::write(&blocks, assembly).unwrap();
+    let (blocks, model) = (blocks.to_str().unwrap(), model.to_str().unwrap());
+    let o = crate::common::crr(&["assemble", blocks, "--planar", "--out", model]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let along_minus_x = |extra: &[&str]| {
+        let mut args = vec!["check", model, "--json", "--direction", "-x"];
+        args.extend_from_slice(extra);
+        let o = crate::common::crr(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        r["static_multipliers"][0].clone()
+    };
+    let m = along_minus_x(&[]);
+    assert_eq!(m["friction_unbounded"], true, "{m}");
+    assert!(m["required_friction"].is_null(), "{m}");
+    let lambda = m["lambda"].as_f64().unwrap();
+    let real = along_minus_x(&["--friction", "0.7"]);
+    assert_eq!(real["friction_unbounded"], false, "{real}");
+    let with_friction = real["lambda"].as_f64().unwrap();
+    assert!(
+        with_friction < lambda * (1.0 - 1e-3),
+        "{with_friction} {lambda}"
+    );
+    let o = crate::common::crr(&["check", model, "--direction", "-x"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains(&format!("λ = {lambda:.6} (needs μ > 1000)")),
+        "{text}"
+    );
+}

@@ -1304,3 +1304,127 @@ fn an_arch_of_200_voussoirs_near_its_minimum_thickness_has_its_multiplier() {
         assert!(mu > 0.0 && mu.is_finite(), "μ = {mu}");
     }
 }
+
+/// The static theorem for a wall of [`cut_wall`]'s boxes (one density, areas as weights),
+/// written from the boxes: the largest λ (≤ [`LAMBDA_CAP`]) for which every block is in
+/// equilibrium under its weight and the horizontal load −λ W dx at its centre, with a normal
+/// force fₙ ≥ 0 and a tangential force f_t at both ends of every bed-joint overlap (with the
+/// block below or the ground), |f_t| ≤ μ fₙ (Coulomb; exact in the plane) or free without μ.
+fn cut_wall_lp(blocks: &[WallBlock], dx: f64, mu: Option<f64>) -> f64 {
+    // Contact points: (block above, block below or None, x, z).
+    let mut points: Vec<(usize, Option<usize>, f64, f64)> = Vec::new();
+    for (a, above) in blocks.iter().enumerate() {
+        let z = above.z[0];
+        let supports: Vec<(Option<usize>, [f64; 2])> = if z == 0.0 {
+            vec![(None, above.x)]
+        } else {
+            blocks
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| (b.z[1] - z).abs() < 1e-12)
+                .map(|(j, b)| (Some(j), [b.x[0].max(above.x[0]), b.x[1].min(above.x[1])]))
+                .filter(|(_, x)| x[1] - x[0] > 1e-9)
+                .collect()
+        };
+        for (below, x) in supports {
+            points.push((a, below, x[0], z));
+            points.push((a, below, x[1], z));
+        }
+    }
+    // Variables: λ, then (fₙ, f_t) per point.
+    let mut lp = Lp::new(1 + 2 * points.len());
+    lp.cost[0] = -1.0;
+    let mut eqs: Vec<[Vec<(usize, f64)>; 3]> = vec![Default::default(); blocks.len()];
+    let mut rhs = vec![[0.0; 3]; blocks.len()];
+    for (k, b) in blocks.iter().enumerate() {
+        let w = (b.x[1] - b.x[0]) * (b.z[1] - b.z[0]);
+        // Σf_x − λ W dx = 0, Σf_z − W = 0, Σ moments about the centre = 0.
+        eqs[k][0].push((0, -w * dx));
+        rhs[k][1] = w;
+    }
+    for (p, &(above, below, x, z)) in points.iter().enumerate() {
+        let (vn, vt) = (1 + 2 * p, 2 + 2 * p);
+        for (body, sign) in [(Some(above), 1.0), (below, -1.0)] {
+            let Some(k) = body else { continue };
+            let b = &blocks[k];
+            let r = [x - (b.x[0] + b.x[1]) / 2.0, z - (b.z[0] + b.z[1]) / 2.0];
+            // Force on this body: sign·(f_t, fₙ); its moment r_z f_x − r_x f_z.
+            eqs[k][0].push((vt, sign));
+            eqs[k][1].push((vn, sign));
+            eqs[k][2].push((vt, sign * r[1]));
+            eqs[k][2].push((vn, -sign * r[0]));
+        }
+        lp.le.push((vec![(vn, -1.0)], 0.0));
+        if let Some(mu) = mu {
+            lp.le.push((vec![(vt, 1.0), (vn, -mu)], 0.0));
+            lp.le.push((vec![(vt, -1.0), (vn, -mu)], 0.0));
+        }
+    }
+    for (e, r) in eqs.into_iter().zip(rhs) {
+        for (row, b) in e.into_iter().zip(r) {
+            lp.eq.push((row, b));
+        }
+    }
+    lp.le.push((vec![(0, 1.0)], LAMBDA_CAP));
+    let sol = lp
+        .solve()
+        .unwrap_or_else(|s| panic!("cut wall LP (μ {mu:?}): {s:?}"));
+    sol.x[0]
+}
+
+/// The friction a multiplier relies on, against this file's LP of the blocks with Coulomb
+/// friction ([`cut_wall_lp`]), on two walls of beds only whose answers need more friction than
+/// any masonry has.
+///
+/// [0.3 | 0.7] under one block, courses 0.25 m, along +x: the report's μ (about 110) reaches
+/// λ to 1e-6 in the independent LP, and 1e-3 less does not (the report's bracket is 1e-4 of μ).
+///
+/// [0.301 | 0.699] under [0.585 | 0.415], courses 0.5 m, along −x: the upper left block lifts
+/// off the lower in the mechanism, and the equilibrium at λ still carries shear across that
+/// joint as its compression vanishes, so λ(μ) only approaches λ as μ grows (the independent LP at
+/// μ = 1000 is 2.5e-5 of λ short, 25 times the 1e-6 asked). The report has no μ there and says
+/// `friction_unbounded`, in the JSON too: until 2026-12-06 it wrote the infinite μ, which JSON
+/// cannot hold, as `null`, the value it gives where no friction is asked at all.
+#[test]
+fn the_friction_a_multiplier_needs_matches_the_block_lp_and_unbounded_friction_is_said() {
+    let (blocks, spec) = cut_wall(&[&[0.3, 0.7], &[1.0]], 0.25, false);
+    let lambda = cut_wall_lp(&blocks, 1.0, None);
+    let report = static_multiplier(&model(&spec), Vector3::x()).unwrap();
+    assert_close("[0.3 | 0.7] under [1]", report.lambda, lambda, RTOL);
+    assert!(!report.friction_unbounded);
+    let mu = report.required_friction.expect("a finite μ");
+    let target = lambda * (1.0 - 1e-6);
+    let (at, below) = (
+        cut_wall_lp(&blocks, 1.0, Some(mu)),
+        cut_wall_lp(&blocks, 1.0, Some(mu * (1.0 - 1e-3))),
+    );
+    println!("λ = {lambda}, μ = {mu}: λ(μ) − target = {:e}", at - target);
+    assert!(mu > 50.0 && mu < 200.0, "{mu}");
+    assert!(at >= target - 1e-9, "λ({mu}) = {at} < {target}");
+    assert!(below < target, "λ just below {mu}: {below}");
+
+    let (blocks, spec) = cut_wall(&[&[0.301, 0.699], &[0.585, 0.415]], 0.5, false);
+    let lambda = cut_wall_lp(&blocks, -1.0, None);
+    let report = static_multiplier(&model(&spec), -Vector3::x()).unwrap();
+    assert_close(
+        "[0.301 | 0.699] under [0.585 | 0.415]",
+        report.lambda,
+        lambda,
+        RTOL,
+    );
+    let at_1000 = cut_wall_lp(&blocks, -1.0, Some(1000.0));
+    println!("λ = {lambda}, λ(1000) = {at_1000}");
+    assert!(at_1000 < lambda * (1.0 - 1e-5), "{at_1000}");
+    assert!(report.friction_unbounded);
+    assert_eq!(report.required_friction, None);
+    assert!(
+        report
+            .mechanism
+            .iter()
+            .any(|j| j.interface == "c1_b0_on_c0_b0"
+                && j.motion == crr::impact::statics::Motion::LiftsOff)
+    );
+    let json = serde_json::to_value(&report).unwrap();
+    assert_eq!(json["friction_unbounded"], serde_json::Value::Bool(true));
+    assert!(json["required_friction"].is_null());
+}
