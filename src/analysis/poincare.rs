@@ -694,6 +694,14 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, Error> {
     }
     let (file, model) = load_model(path)?;
     let here = |m: String| Error::Argument(format!("{}: {m}", path.display()));
+    let forced = opts.amplitude > 0.0
+        || matches!(opts.sweep, Sweep::Amplitudes(r) if r.start > 0.0 || r.end > 0.0);
+    if forced
+        && let Some(why) =
+            crate::analysis::simulation::component_along_the_hinges(&model, opts.axis)
+    {
+        return Err(here(format!("--component {}: {why}", opts.axis)));
+    }
     if model.dof() == 0 {
         return Err(here(
             "the model has no coordinate: there is nothing to section".into(),

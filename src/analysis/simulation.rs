@@ -735,6 +735,32 @@ fn out_of_plane_ground_motion(model: &Model, ground: &GroundMotion) -> Option<St
     })
 }
 
+/// Why a planar model (every interface a hinge about one common axis a,
+/// [`Model::planar_axis`]) cannot be driven along the ground-motion component `axis` alone: a
+/// lies along it (within 1e-9 rad, as `crr check` answers nothing there), so its hinges carry
+/// the whole load bilaterally and every run stays at rest, an answer about the model, not the
+/// structure. `crr study` and `crr poincare` refuse such a component (a sweep or a map of "no
+/// motion" would read as safety); `crr simulate`, whose record may have other components, warns
+/// (its summary's warning on the part along the axis). None where `axis` has a part in the
+/// plane of motion.
+pub fn component_along_the_hinges(model: &Model, axis: Axis) -> Option<String> {
+    let mut d = Vector3::zeros();
+    d[axis.index()] = 1.0;
+    let a = model.planar_axis()?;
+    (crate::analysis::static_multiplier::out_of_plane(model, &d) == Some(1.0)).then(|| {
+        format!(
+            "the ground motion along {axis} lies along the hinges' common axis ({:.3}, {:.3}, \
+             {:.3}) of this planar model, whose hinges carry it bilaterally: every run would \
+             stay at rest, which says nothing of the structure (out-of-plane rocking, \
+             overturning or sliding is outside a planar model); drive a component in its plane, \
+             or model the structure in 3D with rocking bases",
+            a.x + 0.0,
+            a.y + 0.0,
+            a.z + 0.0
+        )
+    })
+}
+
 /// The warning for hinges in a model that is not planar: a hinge is a line, which holds any
 /// couple out of its plane and any force along its axis, so the run excludes tipping out of
 /// the hinges' planes at those joints (`crr check` names them where λ uses that,

@@ -112,8 +112,9 @@ pub struct StaticMultiplier {
 /// What the static multipliers are asked with.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MultiplierOptions {
-    /// Coulomb friction μ at every contact point (a pyramid on each tangent, exact for planar
-    /// loads); `None`: no sliding, and the report gives the friction each multiplier needs.
+    /// Coulomb friction μ at every contact point (the exact cone ‖(f₁, f₂)‖ ≤ μ fₙ; a hinge's
+    /// in its plane); `None`: no sliding, and the report gives the friction each multiplier
+    /// needs.
     pub friction: Option<f64>,
     /// The most sets of joints that may open and slide the exhaustive pass tries per direction
     /// ([`crr_impact::statics::StaticsOptions::exhaustive_sets`]); beyond them λ is the
@@ -166,7 +167,7 @@ pub fn static_multiplier_with(
 ) -> Result<StaticMultiplier, String> {
     let friction = asked.friction;
     let options = StaticsOptions {
-        friction: friction.map_or(Friction::NoSliding, Friction::Pyramid),
+        friction: friction.map_or(Friction::NoSliding, Friction::Cone),
         exhaustive_sets: asked.exhaustive_sets,
         ..StaticsOptions::default()
     };

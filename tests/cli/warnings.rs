@@ -394,3 +394,82 @@ fn a_ground_motion_along_the_hinges_axis_is_warned_with_its_peak() {
     let (summary, _) = run("in_plane", &text, &["--duration", "1", "--quiet"]);
     assert!(along(&summary).is_none(), "{summary}");
 }
+
+/// A planar model driven along its hinges' common axis alone stays at rest whatever the load:
+/// its hinges carry it bilaterally. `crr study` and `crr poincare` refuse such a component,
+/// naming it and the axis, where they used to print "no motion" for every case with no word (an
+/// independent review, 2026-12-06: Housner's block, λ = 0.2 across its width, under one-sine
+/// pulses of 4 and 10 m/s² along y: "collapse 0, impacts 0, peak 0" in every row). The same
+/// study along x runs, and so does a section with no forcing along y (free rocking).
+#[test]
+fn a_study_or_section_driven_along_the_hinges_axis_is_refused() {
+    let dir = common::scratch("along_axis_study");
+    std::fs::write(dir.join("block.toml"), bundled_text("single_block")).unwrap();
+    let study = |component: &str| {
+        let path = dir.join(format!("study_{component}.toml"));
+        std::fs::write(
+            &path,
+            format!(
+                "name = \"along\"\nmodel = \"block.toml\"\nduration = 2.0\ncomponent = \"{component}\"\n\
+                 [pulses]\nkind = \"one_sine_pulse\"\namplitudes = [4.0, 10.0]\nperiods = [1.0]\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.join(format!("out_{component}"));
+        common::crr(&[
+            "study",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let refused = study("y");
+    assert_eq!(refused.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("study_y.toml: component: model block.toml: the ground motion along y lies along the hinges' common axis (0.000, 1.000, 0.000)"),
+        "{stderr}"
+    );
+    let runs = study("x");
+    assert!(
+        runs.status.success(),
+        "{}",
+        String::from_utf8_lossy(&runs.stderr)
+    );
+    let model = dir.join("block.toml");
+    let section = |component: &str, amplitude: &str| {
+        let out = dir.join(format!("section_{component}_{amplitude}"));
+        common::crr(&[
+            "poincare",
+            model.to_str().unwrap(),
+            "--amplitude",
+            amplitude,
+            "--frequency",
+            "1",
+            "--component",
+            component,
+            "--periods",
+            "2",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let refused = section("y", "10");
+    assert_eq!(refused.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains(
+            "--component y: the ground motion along y lies along the hinges' common axis"
+        ),
+        "{stderr}"
+    );
+    for (component, amplitude) in [("x", "1"), ("y", "0")] {
+        let o = section(component, amplitude);
+        assert!(
+            o.status.success(),
+            "{component} {amplitude}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}

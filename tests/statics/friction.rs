@@ -70,3 +70,68 @@ fn the_multiplier_grows_with_the_friction_coefficient() {
     eprintln!("{strictly} pairs grow strictly; the largest relative fall {worst_fall:.1e}");
     assert!(strictly >= 5, "{strictly} pairs grow strictly");
 }
+
+/// A column of two square blocks (0.4 × 0.4 m, 2 m and 0.5 m high, so the centre of mass
+/// stands h = 1.25 m high over the half-width b = 0.2 m) turned about the vertical by φ = 0°,
+/// 17°, 30° and 45°, loaded along ±x and +y. By hand:
+/// - it overturns about the edge of its base whose normal lies nearest the load (φ from it):
+///   virtual work λ W h cos φ = W b, so λ = b / (h cos φ) (a line through one corner, normal
+///   along the load, lies b(cos φ + sin φ) from the centre: higher);
+/// - at rest under λ the whole column needs |Σf_t| = λ W over Σfₙ = W at its base (and the top
+///   block the same ratio on its bed), and the forces may all be parallel: Coulomb's cone holds
+///   them from μ = λ on, whatever φ;
+/// - with μ below λ it slides as one: λ(μ) = μ.
+///
+/// Until 2026-12-06 the friction was a pyramid on the faces' own tangents, which admits μ√2
+/// along a diagonal: the column turned by 30° needed "μ ≥ 0.1600" for λ = 0.1848, and with
+/// μ = 0.17 it held up to 0.1848, where `crr simulate`'s monitor (the exact cone) said it slides
+/// (an independent review).
+#[test]
+fn friction_is_the_same_cone_whichever_way_the_column_is_turned() {
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    use crr::analysis::static_multiplier::{MultiplierOptions, static_multiplier_with};
+    let dir = crate::common::scratch("statics_turned_column");
+    let (b, h) = (0.2, 1.25);
+    for degrees in [0.0f64, 17.0, 30.0, 45.0] {
+        let phi = degrees.to_radians();
+        let text = format!(
+            "name = \"turned\"\n\n[[body]]\nname = \"block\"\ndensity = 2500.0\n\
+             box = {{ center = [0.0, 0.0, 1.0], size = [0.4, 0.4, 2.0], rotation = [0.0, 0.0, {phi}] }}\n\n\
+             [[body]]\nname = \"top\"\ndensity = 2500.0\n\
+             box = {{ center = [0.0, 0.0, 2.25], size = [0.4, 0.4, 0.5], rotation = [0.0, 0.0, {phi}] }}\n"
+        );
+        let path = dir.join(format!("turned_{degrees}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let file = read_assembly(&path).unwrap();
+        let model = assemble(&path, &file, &AssemblyOptions::default())
+            .unwrap()
+            .model;
+        let by_hand = b / (h * phi.cos());
+        for d in [Vector3::x(), -Vector3::x(), Vector3::y()] {
+            let what = format!("φ = {degrees}° along {d:?}");
+            let report = static_multiplier_with(&model, d, &MultiplierOptions::default())
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            let lambda = report.lambda.expect("a multiplier");
+            assert!(
+                (lambda - by_hand).abs() < 1e-7 * by_hand,
+                "{what}: {lambda}"
+            );
+            // The friction's bracket is 1e-4 of μ, its upper end reported.
+            let mu = report.required_friction.expect("a finite μ");
+            assert!(
+                mu >= by_hand * (1.0 - 1e-6) && mu <= by_hand * (1.0 + 2e-4),
+                "{what}: μ ≥ {mu} where λ = {by_hand}"
+            );
+            let asked = MultiplierOptions {
+                friction: Some(0.9 * by_hand),
+                ..MultiplierOptions::default()
+            };
+            let sliding = static_multiplier_with(&model, d, &asked).unwrap();
+            let lambda = sliding.lambda.expect("a multiplier");
+            assert!(
+                (lambda - 0.9 * by_hand).abs() < 1e-7 * by_hand,
+                "{what}: with μ = 0.9 λ it holds to {lambda}"
+            );
+        }
+    }
+}

@@ -881,10 +881,12 @@ fn twist_reactions(faces: &[ContactFace], collapse: &Collapse, size: f64) -> Vec
         .collect()
 }
 
-/// The smallest Coulomb friction coefficient (pyramid on each tangent, exact for planar loads)
-/// at which the collapse multiplier along `direction` reaches (1 − 1e-6) of `lambda`, its value
-/// without sliding ([`collapse_multiplier`]'s answer, which the caller has): the friction the
-/// no-sliding answer relies on. 0 when it needs none, infinity beyond μ = 1000.
+/// The smallest Coulomb friction coefficient (the exact cone, [`Friction::Cone`]) at which the
+/// collapse multiplier along `direction` reaches (1 − 1e-6) of `lambda`, its value without
+/// sliding ([`collapse_multiplier`]'s answer, which the caller has): the friction the no-sliding
+/// answer relies on. 0 when it needs none, infinity beyond μ = 1000. The cone, not the pyramid:
+/// a pyramid on a face's own tangents admits μ√2 along its diagonals, so a block turned about
+/// the vertical would need less friction than the same block square to the load.
 pub fn required_friction(
     model: &Model,
     direction: Vector3<f64>,
@@ -894,7 +896,7 @@ pub fn required_friction(
     let target = lambda - 1e-6 * lambda.abs();
     smallest_friction(|mu: f64| -> Result<Option<f64>, StaticsError> {
         let options = StaticsOptions {
-            friction: Friction::Pyramid(mu),
+            friction: Friction::Cone(mu),
             lambda_max,
             sliding_lift_off: false,
             exhaustive_sets: 0,
@@ -907,7 +909,7 @@ pub fn required_friction(
     })
 }
 
-/// The smallest Coulomb friction coefficient (pyramid on each tangent) with which the collapse
+/// The smallest Coulomb friction coefficient (the exact cone) with which the collapse
 /// state `collapse` (an answer of [`collapse_multiplier`] with its λ) has an equilibrium at
 /// (1 − 1e-6) of its λ with forces only at the points its mechanism keeps in contact without
 /// sliding: the friction that state relies on. For an answer of the search for joints that open
@@ -937,7 +939,7 @@ pub fn state_friction(
     let mut failure = None;
     let mu = smallest_friction(|mu: f64| -> Result<Option<f64>, StaticsError> {
         let options = StaticsOptions {
-            friction: Friction::Pyramid(mu),
+            friction: Friction::Cone(mu),
             lambda_max,
             sliding_lift_off: false,
             exhaustive_sets: 0,

@@ -275,6 +275,12 @@ impl Study {
         });
         let (file, structure, model) = study_model(&spec, base, path)?;
         let axis = study_axis(&spec, path)?;
+        if let Some(why) = crate::analysis::simulation::component_along_the_hinges(&model, axis) {
+            return Err(bad(
+                path,
+                format!("component: model {}: {why}", spec.model.display()),
+            ));
+        }
         let initial_spec = match spec.start {
             Start::Rest => Default::default(),
             Start::Model => file.initial.clone().unwrap_or_default(),
