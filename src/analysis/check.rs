@@ -324,6 +324,7 @@ pub fn check_with(
         warnings: crate::analysis::static_multiplier::gravity_along_axis_warning(model)
             .into_iter()
             .chain(crate::analysis::contact_geometry::contact_geometry_warnings(model))
+            .chain(crate::analysis::contact_geometry::bodies_held_by_shear_alone(model))
             .collect(),
     }
 }

@@ -16,7 +16,7 @@
 
 use crr_kinematics::interpenetration::{distance_to_surface, interpenetration};
 use crr_kinematics::shapes::Surface;
-use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent};
+use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent, contact_faces};
 use nalgebra::Vector3;
 
 /// How far (a fraction of the model size) a pivot may lie from a body's surface, and two bodies
@@ -89,6 +89,54 @@ pub fn contact_geometry_warnings(model: &Model) -> Vec<String> {
         }
     }
     out
+}
+
+/// Largest upward part n·ẑ of a contact's normal (into the body it carries) that still counts as
+/// a vertical face: round-off of a face built vertical, far below any wedge a mason cuts.
+pub const VERTICAL_FACE: f64 = 1e-9;
+
+/// The warnings for the bodies of `model` that no contact carries from below: every face they
+/// touch is vertical (its normal into the body has no upward part above [`VERTICAL_FACE`]), and
+/// no pin holds them. Their weight then rests on shear across those faces alone, which the
+/// statics without sliding grants with no compression at all, and a clamping force between
+/// the faces (a self-stress the rigid blocks never supply at rest) grants with any friction:
+/// `crr check` would say such a stone "holds" where a dry-stone one falls. (A stone between two
+/// piers with vertical faces and nothing under it, written with `crr assemble --all-contacts`:
+/// an independent review, 2026-12-06.)
+pub fn bodies_held_by_shear_alone(model: &Model) -> Vec<String> {
+    let mut carried = vec![false; model.bodies.len()];
+    for face in contact_faces(model) {
+        let iface = &model.interfaces[face.interface];
+        let parent = match iface.parent {
+            Parent::Body(b) => Some(b),
+            Parent::Ground => None,
+        };
+        // The normal points into the child; into the parent it is −n.
+        if face.pin || face.normal.z > VERTICAL_FACE {
+            carried[iface.child] = true;
+        }
+        if let Some(b) = parent
+            && (face.pin || -face.normal.z > VERTICAL_FACE)
+        {
+            carried[b] = true;
+        }
+    }
+    model
+        .bodies
+        .iter()
+        .zip(carried)
+        .filter(|(_, carried)| !carried)
+        .map(|(body, _)| {
+            format!(
+                "body \"{}\": every contact it has is a vertical face (no support under it): its \
+                 weight rests on shear across those faces alone, which the statics grant without \
+                 sliding, or with friction by a clamping force the blocks at rest do not supply; \
+                 a dry-stone block so placed falls, so its multipliers and its rest are those of \
+                 a block glued or wedged in place",
+                body.name
+            )
+        })
+        .collect()
 }
 
 /// The pivots of an interface to find on a body whose centre of mass is `com`, each as the

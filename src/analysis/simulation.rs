@@ -901,6 +901,7 @@ fn warnings(
         out.push(tilt);
     }
     out.extend(crate::analysis::contact_geometry::contact_geometry_warnings(&p.model));
+    out.extend(crate::analysis::contact_geometry::bodies_held_by_shear_alone(&p.model));
     let analysis = p.file.analysis.clone().unwrap_or_default();
     if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)
         && analysis.rtol > crr_dynamics::analysis::RTOL_WARNING

@@ -258,6 +258,10 @@ pub fn parse_direction(text: &str) -> Result<Vector3<f64>, String> {
             .trim()
             .parse::<f64>()
             .map_err(|_| format!("'{}' in '{text}' is not a number", p.trim()))?;
+        // Rust reads "nan" and "inf" as numbers; a direction has neither.
+        if !d[k].is_finite() {
+            return Err(format!("'{}' in '{text}' is not a finite number", p.trim()));
+        }
     }
     // Only the direction counts: scaled by its largest component, a vector of tiny or huge
     // components (1e-300, 1e300) is one, whose norm alone would underflow or overflow.

@@ -462,3 +462,90 @@ fn a_multiplier_that_needs_unbounded_friction_says_so() {
         "{text}"
     );
 }
+
+/// A stone between two fixed piers, touching only their vertical faces, with nothing under it
+/// (`crr assemble --all-contacts`, planar and 3D): its weight rests on shear alone, which the
+/// statics grant without sliding (and with friction by a clamping the blocks at rest do not
+/// supply), so `crr check` says it holds up to 10 g. Both `crr check` and `crr simulate` warn,
+/// naming the stone; the bundled arch, whose voussoirs meet on inclined joints, gets no such
+/// warning.
+#[test]
+fn a_stone_held_by_vertical_faces_alone_is_warned() {
+    let dir = crate::common::scratch("check_shear_alone");
+    let blocks = dir.join("wedged.toml");
+    std::fs::write(
+        &blocks,
+        "name = \"wedged\"\nfixed = [\"pL\", \"pR\"]\n\
+         [[body]]\nname = \"pL\"\ndensity = 2500.0\nbox = { center = [-0.5, 0.0, 1.0], size = [0.6, 0.6, 2.0] }\n\
+         [[body]]\nname = \"pR\"\ndensity = 2500.0\nbox = { center = [0.5, 0.0, 1.0], size = [0.6, 0.6, 2.0] }\n\
+         [[body]]\nname = \"stone\"\ndensity = 2500.0\nbox = { center = [0.0, 0.0, 1.5], size = [0.4, 0.6, 0.4] }\n",
+    )
+    .unwrap();
+    let blocks = blocks.to_str().unwrap();
+    for planar in [true, false] {
+        let model = dir.join(format!("model_{planar}.toml"));
+        let model = model.to_str().unwrap();
+        let mut args = vec!["assemble", blocks, "--all-contacts", "--out", model];
+        if planar {
+            args.push("--planar");
+        }
+        let o = crate::common::crr(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let o = crate::common::crr(&["check", model, "--json"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let warned = r["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|w| w.as_str())
+            .filter(|w| w.starts_with("body \"stone\": every contact it has is a vertical face"))
+            .count();
+        assert_eq!(warned, 1, "planar {planar}: {r}");
+        let out = dir.join(format!("run_{planar}"));
+        let o = crate::common::crr(&[
+            "simulate",
+            model,
+            "--duration",
+            "0.1",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            stderr.contains("body \"stone\": every contact it has is a vertical face"),
+            "planar {planar}: {stderr}"
+        );
+    }
+    let arch = crate::common::bundled_path("arch");
+    let o = crate::common::crr(&["check", arch.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&o.stdout).contains("vertical face"));
+}
+
+/// A direction that is not one is refused with exit code 2, naming the option and the part that
+/// is wrong: Rust reads "nan" and "inf" as numbers, and `--direction nan,1,0` used to be taken,
+/// its report saying only that the statics had no direction, with exit code 0 (an independent
+/// review, 2026-12-06).
+#[test]
+fn a_direction_with_a_part_that_is_no_finite_number_is_refused() {
+    for (direction, part) in [
+        ("nan,1,0", "'nan'"),
+        ("1,inf,0", "'inf'"),
+        ("0,0,0", "not a non-zero finite vector"),
+        ("1,x,0", "'x'"),
+    ] {
+        let o = crate::common::crr(&[
+            "check",
+            "examples/models/single_block.toml",
+            "--direction",
+            direction,
+        ]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{direction}: {stderr}");
+        assert!(
+            stderr.contains("--direction") && stderr.contains(part),
+            "{direction}: {stderr}"
+        );
+    }
+}

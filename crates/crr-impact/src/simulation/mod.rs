@@ -741,8 +741,8 @@ pub fn check_physical_bounds(model: &Model, params: &Parameters) -> Result<(), S
     if params.duration.is_nan() || params.duration > LONGEST_DURATION * time_scale {
         return Err(SimulationError::Parameter(format!(
             "duration = {:e} s is more than {LONGEST_DURATION:e} times the structure's time scale \
-             √(L/g) = {time_scale:.4} s (the ground motion's end, where [analysis] gives no \
-             duration): an instant t is located to 1e-13 t, beyond that coarser than the \
+             √(L/g) = {time_scale:.4} s (the duration is `[analysis] duration`, or the ground \
+             motion's end where that gives none): an instant t is located to 1e-13 t, beyond that coarser than the \
              impacts' own spacing near rest (min_impact_interval, default 1e-6 s); a record \
              whose time step or times are in the wrong unit gives such a duration",
             params.duration
