@@ -444,15 +444,15 @@ pub fn to_text(r: &CheckReport) -> String {
                 );
                 continue;
             }
+            let friction = match (m.required_friction, m.friction_unbounded) {
+                (_, true) => " (needs μ > 1000)".to_string(),
+                (Some(mu), false) => format!(" (μ ≥ {mu:.4})"),
+                (None, false) => String::new(),
+            };
             match m.lambda {
                 Some(l) => {
                     let joints: Vec<String> =
                         m.opening.iter().map(|(k, v)| format!("{k} {v}")).collect();
-                    let friction = match (m.required_friction, m.friction_unbounded) {
-                        (_, true) => " (needs μ > 1000)".to_string(),
-                        (Some(mu), false) => format!(" (μ ≥ {mu:.4})"),
-                        (None, false) => String::new(),
-                    };
                     // A mechanism of lift-offs alone opens no CRR angle (the lines below say).
                     let opening = if joints.is_empty() {
                         String::new()
@@ -485,7 +485,7 @@ pub fn to_text(r: &CheckReport) -> String {
                 }
                 None => {
                     s += &format!(
-                        "  d = {dir}: holds up to λ = {}\n",
+                        "  d = {dir}: holds up to λ = {}{friction}\n",
                         crate::analysis::static_multiplier::LAMBDA_MAX
                     );
                     s += &sliding_note(m, r.exhaustive_sets);

@@ -56,10 +56,10 @@ pub struct StaticMultiplier {
     /// Every interface that moves in the mechanism.
     pub mechanism: Vec<MechanismJoint>,
     /// The smallest Coulomb friction coefficient with which λ is reached (the no-sliding answer
-    /// relies on it); for an answer of the search for joints that open and slide, the one its
+    /// relies on it), or where it holds up to [`LAMBDA_MAX`], with which it holds that far; for an answer of the search for joints that open and slide, the one its
     /// collapse state needs at the points it keeps in contact
-    /// ([`crr_impact::statics::state_friction`]); `None` when `lambda` is, with `--friction`,
-    /// and where no μ up to 1000 reaches λ (`friction_unbounded`).
+    /// ([`crr_impact::statics::state_friction`]); `None` with `--friction`, along a planar
+    /// model's hinge axis, and where no μ up to 1000 reaches λ (`friction_unbounded`).
     pub required_friction: Option<f64>,
     /// Whether no Coulomb μ up to 1000 brings the multiplier within 1e-6 of λ: the answer rests
     /// on shear across a joint whose compression vanishes at λ (a closure limit, approached only
@@ -210,6 +210,12 @@ pub fn static_multiplier_with(
         }
         (Some(lambda), None) => Some(
             required_friction(model, direction, options.lambda_max, lambda)
+                .map_err(|e| e.to_string())?,
+        ),
+        // Holding up to the cap without sliding relies on friction too (a slab ten times as
+        // wide as it is high holds to 10 g only with μ ≥ 10).
+        (None, None) => Some(
+            required_friction(model, direction, options.lambda_max, options.lambda_max)
                 .map_err(|e| e.to_string())?,
         ),
         _ => None,

@@ -135,3 +135,42 @@ fn friction_is_the_same_cone_whichever_way_the_column_is_turned() {
         }
     }
 }
+
+/// A slab 3 m × 3 m × 0.1 m on the ground (b/h = 15) holds without sliding beyond the cap of
+/// 10 g along ±x and ±y, and the report says what that relies on: to hold λ W along the ground
+/// on W of compression it needs μ ≥ λ, so μ ≥ 10 to hold up to the cap (its bracket 1e-4 of μ).
+/// With μ = 9 it slides at λ = 9. Until 2026-12-06 the line said "holds up to λ = 10" and no
+/// friction at all.
+#[test]
+fn holding_up_to_the_cap_says_the_friction_it_needs() {
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    use crr::analysis::static_multiplier::{LAMBDA_MAX, MultiplierOptions, static_multiplier_with};
+    let dir = crate::common::scratch("statics_slab_holds");
+    let path = dir.join("slab.toml");
+    std::fs::write(
+        &path,
+        "name = \"slab\"\n[[body]]\nname = \"slab\"\ndensity = 2500.0\n\
+         box = { center = [0.0, 0.0, 0.05], size = [3.0, 3.0, 0.1] }\n",
+    )
+    .unwrap();
+    let file = read_assembly(&path).unwrap();
+    let model = assemble(&path, &file, &AssemblyOptions::default())
+        .unwrap()
+        .model;
+    for d in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()] {
+        let report = static_multiplier_with(&model, d, &MultiplierOptions::default()).unwrap();
+        assert_eq!(report.lambda, None, "{d:?}");
+        let mu = report.required_friction.expect("a finite μ");
+        assert!(
+            (LAMBDA_MAX * (1.0 - 1e-6)..=LAMBDA_MAX * (1.0 + 2e-4)).contains(&mu),
+            "{d:?}: μ ≥ {mu}"
+        );
+        let asked = MultiplierOptions {
+            friction: Some(9.0),
+            ..MultiplierOptions::default()
+        };
+        let sliding = static_multiplier_with(&model, d, &asked).unwrap();
+        let lambda = sliding.lambda.expect("it slides");
+        assert!((lambda - 9.0).abs() < 1e-7 * 9.0, "{d:?}: {lambda}");
+    }
+}
