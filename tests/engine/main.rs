@@ -10,6 +10,7 @@ mod certificate_audit;
 mod collapse;
 mod far_from_origin;
 mod free_fall;
+mod friction_on_loops;
 mod impact_laws_on_chains;
 mod impulse_tension;
 mod initial_state_paths;

@@ -112,6 +112,93 @@ pub fn most_compressive(
     Some(program.answer(&x, Some(&z)))
 }
 
+/// What Coulomb friction the contact forces of a hyperstatic structure need at one state
+/// ([`least_friction`]): their resultants are not fixed by the motion, so the friction demand
+/// |F_t|/N of one distribution (the least-norm one) says nothing of whether some other holds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FrictionNeed {
+    /// Some distribution in equilibrium with the motion presses at every touching point (to
+    /// −tolerance/2, per edge) and keeps every contact's resultant within Coulomb's cone of the
+    /// μ asked, |F_t| ≤ μ N + tolerance.
+    Holds,
+    /// None does: the least μ for which one does (to [`FRICTION_DIGITS`] of it; infinite
+    /// beyond [`MOST_FRICTION`]), and in the distribution found there the interface whose
+    /// resultant asks the most of it, with its normal force (N) and |F_t|/N.
+    Slides {
+        /// The least μ some compressive distribution needs.
+        least: f64,
+        /// The interface with the largest |F_t|/N in that distribution.
+        interface: usize,
+        /// Its normal force (N).
+        normal: f64,
+        /// Its |F_t|/N.
+        demand: f64,
+    },
+}
+
+/// Relative width of the bracket of [`least_friction`]'s μ.
+pub const FRICTION_DIGITS: f64 = 1e-3;
+
+/// Largest μ [`least_friction`] tries: beyond it the contacts need a friction no joint has.
+pub const MOST_FRICTION: f64 = 1e3;
+
+/// Whether the contact forces at the state solved in `dynamics` (the bodies' accelerations in
+/// `work`, [`crate::monitor::contact_forces_into`]) can keep every contact within Coulomb's
+/// cone of `mu`: one second-order cone program on the faces, the monitor's
+/// ([`most_compressive`]: max s with w fₙ ≥ s at every touching point, measured per edge) with,
+/// for every interface that touches, its resultant's tangential part within μ N plus a share of
+/// `tolerance` (the resultant over its touching points, as the monitor's sliding test reads
+/// it; the shares add up to the `tolerance` one contact of a tree is allowed). Where it
+/// does not, the least μ that does, by bisection on the same program. None when a program does
+/// not solve (the caller keeps the demand of the forces it has).
+pub fn least_friction(
+    model: &Model,
+    dynamics: &Dynamics,
+    work: &ForceWork,
+    mu: f64,
+    tolerance: f64,
+) -> Option<FrictionNeed> {
+    let program = FaceProgram::build(model, dynamics).per_edge();
+    let loads = program.loads(model, dynamics, work)?;
+    // The verdict allows the structure the tangential slack a single contact of a tree has
+    // (`tolerance`), shared among its contacts (each one's would add up over a colonnade's);
+    // the least μ is sought without it, so that it lies above the μ that fails.
+    let touching = program.touching_interfaces().max(1);
+    let slack = tolerance / (program.weight * touching as f64);
+    // Compressive to −tolerance/2 within the cones of μ: the distribution, or None.
+    let holding = |mu: f64, slack: f64| -> Option<Option<Vec<f64>>> {
+        // No distribution within the cones at all (the program infeasible) does not hold.
+        let x = program.solve_within_cones(&loads, mu, slack)?;
+        Some(x.filter(|x| x[0] * program.weight >= -0.5 * tolerance))
+    };
+    if holding(mu, slack)?.is_some() {
+        return Some(FrictionNeed::Holds);
+    }
+    let holding = |mu: f64| holding(mu, 0.0);
+    let (mut low, mut high) = (mu, (2.0 * mu).max(0.01));
+    let mut found = loop {
+        if let Some(x) = holding(high)? {
+            break x;
+        }
+        if high > MOST_FRICTION {
+            return Some(program.slides_at(f64::INFINITY, None));
+        }
+        low = high;
+        high *= 2.0;
+    };
+    while high - low > FRICTION_DIGITS * high {
+        let mid = 0.5 * (low + high);
+        match holding(mid)? {
+            Some(x) => {
+                high = mid;
+                found = x;
+            }
+            None => low = mid,
+        }
+    }
+    Some(program.slides_at(high, Some(&found)))
+}
+
 /// The most compressive distribution of contact impulses that changes each body's momentum by
 /// `momentum_change[b]` = (m_b Δċ_b, I_b Δω_b) (N s; N m s about its centre of mass: the impulse
 /// body b needs from its contacts in an instant, where gravity and the ground's motion give
@@ -360,6 +447,133 @@ impl FaceProgram {
         ];
         let solution = solve_clarabel(&p, &q, &a, &b, &cones)?;
         Some((solution.x, solution.z[equilibrium..].to_vec()))
+    }
+
+    /// [`Self::solve`] with s ≤ 0 and, for every interface with a unilateral point, the
+    /// resultant of its touching points' forces within Coulomb's cone: ‖(T₁, T₂)‖ ≤ μ N + `slack`
+    /// (W), N the sum of its normal forces and Tₖ of its forces along tangent k. The primal x;
+    /// Some(None) where no distribution meets the cones (the solver finds the program
+    /// infeasible), None where the solver fails otherwise.
+    fn solve_within_cones(&self, loads: &[f64], mu: f64, slack: f64) -> Option<Option<Vec<f64>>> {
+        let equilibrium = 6 * self.bodies;
+        let (mut ri, mut ci, mut vi) = self.triplets();
+        let mut b = loads.to_vec();
+        let mut row = equilibrium;
+        for (&c, &w) in self.unilateral.iter().zip(&self.unilateral_weight) {
+            ri.extend([row, row]);
+            ci.extend([0, c]);
+            vi.extend([1.0, -w]);
+            b.push(0.0);
+            row += 1;
+        }
+        ri.push(row);
+        ci.push(0);
+        vi.push(1.0);
+        b.push(0.0);
+        row += 1;
+        let nonnegative = row - equilibrium;
+        let mut cones = vec![
+            SupportedConeT::ZeroConeT(equilibrium),
+            SupportedConeT::NonnegativeConeT(nonnegative),
+        ];
+        // (μ N + slack, T₁, T₂) in the second-order cone: s = b − A x.
+        for interface in 0..self.interfaces {
+            let columns: Vec<(usize, usize)> = self
+                .unknowns
+                .iter()
+                .enumerate()
+                .filter(|(_, u)| u.interface == interface && u.point.is_some())
+                .map(|(j, u)| (1 + j, u.key.along))
+                .collect();
+            if !columns.iter().any(|&(c, _)| self.unilateral.contains(&c)) {
+                continue;
+            }
+            for &(c, along) in &columns {
+                let value = if along == 0 { -mu } else { -1.0 };
+                ri.push(row + along);
+                ci.push(c);
+                vi.push(value);
+            }
+            b.extend([slack, 0.0, 0.0]);
+            row += 3;
+            cones.push(SupportedConeT::SecondOrderConeT(3));
+        }
+        let columns = 1 + self.unknowns.len();
+        let a = CscMatrix::new_from_triplets(row, columns, ri, ci, vi);
+        let p = CscMatrix::new_from_triplets(
+            columns,
+            columns,
+            (1..columns).collect(),
+            (1..columns).collect(),
+            vec![PROXIMAL; columns - 1],
+        );
+        let mut q = vec![0.0; columns];
+        q[0] = -1.0;
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .max_iter(200)
+            .iterative_refinement_max_iter(REFINEMENT_STEPS)
+            .build()
+            .ok()?;
+        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
+        solver.solve();
+        match solver.solution.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => Some(Some(solver.solution.x)),
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Some(None),
+            _ => None,
+        }
+    }
+
+    /// [`FrictionNeed::Slides`] at the least μ `least`, read from the distribution `x` found
+    /// there (None beyond [`MOST_FRICTION`]: no distribution, no interface read; the first with
+    /// a touching point is named).
+    fn slides_at(&self, least: f64, x: Option<&[f64]>) -> FrictionNeed {
+        let mut resultant = vec![[0.0; 3]; self.interfaces];
+        let mut touches = vec![false; self.interfaces];
+        for (j, u) in self.unknowns.iter().enumerate() {
+            if u.point.is_some() {
+                if u.unilateral {
+                    touches[u.interface] = true;
+                }
+                if let Some(x) = x {
+                    resultant[u.interface][u.key.along] += x[1 + j];
+                }
+            }
+        }
+        let demand = |r: &[f64; 3]| {
+            if r[0] > 0.0 {
+                r[1].hypot(r[2]) / r[0]
+            } else {
+                f64::INFINITY
+            }
+        };
+        // The largest demand; the lowest index among equals.
+        let interface = (0..self.interfaces)
+            .filter(|&i| touches[i])
+            .fold(None, |best: Option<usize>, i| match best {
+                Some(b) if demand(&resultant[b]) >= demand(&resultant[i]) => Some(b),
+                _ => Some(i),
+            })
+            .unwrap_or(0);
+        FrictionNeed::Slides {
+            least,
+            interface,
+            normal: resultant[interface][0] * self.weight,
+            demand: if x.is_some() {
+                demand(&resultant[interface])
+            } else {
+                f64::INFINITY
+            },
+        }
+    }
+
+    /// How many interfaces have a unilateral touching point (the contacts a cone bounds).
+    fn touching_interfaces(&self) -> usize {
+        let mut touches = vec![false; self.interfaces];
+        for &c in &self.unilateral {
+            touches[self.unknowns[c - 1].interface] = true;
+        }
+        touches.iter().filter(|&&t| t).count()
     }
 
     /// A distribution in equilibrium with `loads`, the least-norm one (min ½‖f‖² subject to the

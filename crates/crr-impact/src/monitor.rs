@@ -716,6 +716,47 @@ fn judge_distribution(
     judge(model, forces, edges, &values, t, friction, tolerance)
 }
 
+/// A `"sliding"` verdict of [`check`] or [`check_distribution_at`] on a structure with loops,
+/// settled: there the contact forces are not fixed by the motion, and the verdict read the
+/// tangential forces of one distribution (the least-norm one) against the normal forces of
+/// another, so it may report a slide that another distribution does not need (an independent
+/// review, 2026-12-06: the bundled baldachin at rest with μ = 0.1, "needs friction |F_t|/N =
+/// 0.0395 above μ"). One cone program decides ([`crate::face_forces::least_friction`]): None
+/// where some compressive distribution keeps every contact within the cone of μ; otherwise the
+/// slide at the contact that the least-friction distribution loads most, its `friction_demand`
+/// the least μ any distribution needs. Other verdicts, a tree's (its contacts' resultants are
+/// the subtrees' own) and a verdict whose program does not solve pass unchanged.
+pub fn settle_sliding(
+    model: &Model,
+    dynamics: &Dynamics,
+    work: &ForceWork,
+    found: Option<Violation>,
+    friction: Option<f64>,
+    tolerance: f64,
+) -> Option<Violation> {
+    let (Some(v), Some(mu)) = (found.as_ref(), friction) else {
+        return found;
+    };
+    if v.kind != "sliding" || model.constraint_rows == 0 {
+        return found;
+    }
+    match crate::face_forces::least_friction(model, dynamics, work, mu, tolerance) {
+        Some(crate::face_forces::FrictionNeed::Holds) => None,
+        Some(crate::face_forces::FrictionNeed::Slides {
+            least,
+            interface,
+            normal,
+            ..
+        }) => Some(Violation {
+            interface: model.interfaces[interface].name.clone(),
+            normal,
+            friction_demand: least,
+            ..v.clone()
+        }),
+        None => found,
+    }
+}
+
 /// The gravest violation among the forces and edges, read from `values` where it has them (every
 /// interface's normal force, then (far, near) of each edge split: a distribution other than the
 /// given one), from the given forces otherwise. Each contact's own failure is its tension, else

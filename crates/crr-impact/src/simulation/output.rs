@@ -105,6 +105,14 @@ impl Simulation<'_> {
                         tol,
                     )
                 };
+                found = crate::monitor::settle_sliding(
+                    &self.model,
+                    d,
+                    work,
+                    found,
+                    self.params.friction,
+                    tol,
+                );
                 let snaps = super::SnapsAndLosses {
                     t,
                     snaps: self.energy_at_snaps,
@@ -129,6 +137,14 @@ impl Simulation<'_> {
                         &work.edges,
                         None,
                         t,
+                        self.params.friction,
+                        tol,
+                    );
+                    found = crate::monitor::settle_sliding(
+                        &self.model,
+                        &self.spare.monitor,
+                        work,
+                        found,
                         self.params.friction,
                         tol,
                     );
