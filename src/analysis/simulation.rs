@@ -981,10 +981,16 @@ fn warnings(
              structure may move from here (docs/simulation.md, \"Joints that open may slide\")"
                 .to_string()
         } else {
-            format!(
-                "needs friction |F_t|/N = {:.4} above μ: it slides",
-                v.friction_demand
-            )
+            if v.friction_demand.is_finite() {
+                format!(
+                    "needs friction |F_t|/N = {:.4} above μ: it slides",
+                    v.friction_demand
+                )
+            } else {
+                "needs a friction coefficient above 1000, or holds only by a contact that \
+                 carries nothing: it slides"
+                    .to_string()
+            }
         };
         out.push(format!(
             "the rigid-contact hypotheses fail at t = {} s: interface \"{}\" {what}; the results \

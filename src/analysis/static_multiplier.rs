@@ -214,10 +214,11 @@ pub fn static_multiplier_with(
         ),
         // Holding up to the cap without sliding relies on friction too (a slab ten times as
         // wide as it is high holds to 10 g only with μ ≥ 10).
-        (None, None) => Some(
-            required_friction(model, direction, options.lambda_max, options.lambda_max)
-                .map_err(|e| e.to_string())?,
-        ),
+        // A solver's trouble with this secondary answer leaves it out rather than the
+        // multiplier.
+        (None, None) => {
+            required_friction(model, direction, options.lambda_max, options.lambda_max).ok()
+        }
         _ => None,
     };
     let mut report = report(model, &collapse, required);

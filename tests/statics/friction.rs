@@ -136,7 +136,7 @@ fn friction_is_the_same_cone_whichever_way_the_column_is_turned() {
     }
 }
 
-/// A slab 3 m × 3 m × 0.1 m on the ground (b/h = 15) holds without sliding beyond the cap of
+/// A slab 3 m × 3 m × 0.1 m on the ground (b/h = 30) holds without sliding beyond the cap of
 /// 10 g along ±x and ±y, and the report says what that relies on: to hold λ W along the ground
 /// on W of compression it needs μ ≥ λ, so μ ≥ 10 to hold up to the cap (its bracket 1e-4 of μ).
 /// With μ = 9 it slides at λ = 9. Until 2026-12-06 the line said "holds up to λ = 10" and no

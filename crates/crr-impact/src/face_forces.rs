@@ -119,20 +119,17 @@ pub fn most_compressive(
 pub enum FrictionNeed {
     /// Some distribution in equilibrium with the motion presses at every touching point (to
     /// −tolerance/2, per edge) and keeps every contact's resultant within Coulomb's cone of the
-    /// μ asked, |F_t| ≤ μ N + tolerance.
+    /// μ asked, |F_t| ≤ μ N plus its share of the tolerance.
     Holds,
     /// None does: the least μ for which one does (to [`FRICTION_DIGITS`] of it; infinite
-    /// beyond [`MOST_FRICTION`]), and in the distribution found there the interface whose
-    /// resultant asks the most of it, with its normal force (N) and |F_t|/N.
+    /// beyond [`MOST_FRICTION`]), and, where it is finite, in the distribution found there the
+    /// contact whose resultant asks the most of it with a normal force above the tolerance.
     Slides {
         /// The least μ some compressive distribution needs.
         least: f64,
-        /// The interface with the largest |F_t|/N in that distribution.
-        interface: usize,
-        /// Its normal force (N).
-        normal: f64,
-        /// Its |F_t|/N.
-        demand: f64,
+        /// That contact (None beyond [`MOST_FRICTION`], or where none carries more than the
+        /// tolerance): its interface, its normal force (N) and its |F_t|/N.
+        limiting: Option<(usize, f64, f64)>,
     },
 }
 
@@ -142,15 +139,22 @@ pub const FRICTION_DIGITS: f64 = 1e-3;
 /// Largest μ [`least_friction`] tries: beyond it the contacts need a friction no joint has.
 pub const MOST_FRICTION: f64 = 1e3;
 
+/// The excess τ (W) over every cone below which a distribution counts as within the cones of a
+/// μ in [`least_friction`]'s bisection: the interior point's accuracy on forces of order one.
+const WITHIN_CONES: f64 = 1e-7;
+
 /// Whether the contact forces at the state solved in `dynamics` (the bodies' accelerations in
 /// `work`, [`crate::monitor::contact_forces_into`]) can keep every contact within Coulomb's
-/// cone of `mu`: one second-order cone program on the faces, the monitor's
-/// ([`most_compressive`]: max s with w fₙ ≥ s at every touching point, measured per edge) with,
-/// for every interface that touches, its resultant's tangential part within μ N plus a share of
-/// `tolerance` (the resultant over its touching points, as the monitor's sliding test reads
-/// it; the shares add up to the `tolerance` one contact of a tree is allowed). Where it
-/// does not, the least μ that does, by bisection on the same program. None when a program does
-/// not solve (the caller keeps the demand of the forces it has).
+/// cone of `mu`: one second-order cone program on the faces, min τ ≥ 0 over the distributions
+/// in equilibrium with the motion whose touching points press to −tolerance/2 (measured per
+/// edge, as the monitor's program [`most_compressive`]) and whose contacts' resultants (over
+/// their touching points, as the monitor's sliding test reads them) keep |F_t| ≤ μ N + τ. It
+/// holds where τ* is within a share of `tolerance` (the shares add up to the `tolerance` one
+/// contact of a tree is allowed). Where it does not, the least μ with τ* = 0, by bisection on
+/// the same program. The program is feasible wherever a compressive distribution exists (τ is
+/// free), so an infeasibility is no verdict: None then, and where the solver fails on the μ
+/// asked (the caller keeps its own verdict); a failure inside the bisection counts as not
+/// holding, which can only raise the least μ.
 pub fn least_friction(
     model: &Model,
     dynamics: &Dynamics,
@@ -160,35 +164,36 @@ pub fn least_friction(
 ) -> Option<FrictionNeed> {
     let program = FaceProgram::build(model, dynamics).per_edge();
     let loads = program.loads(model, dynamics, work)?;
-    // The verdict allows the structure the tangential slack a single contact of a tree has
-    // (`tolerance`), shared among its contacts (each one's would add up over a colonnade's);
-    // the least μ is sought without it, so that it lies above the μ that fails.
+    let floor = 0.5 * tolerance / program.weight;
     let touching = program.touching_interfaces().max(1);
-    let slack = tolerance / (program.weight * touching as f64);
-    // Compressive to −tolerance/2 within the cones of μ: the distribution, or None.
-    let holding = |mu: f64, slack: f64| -> Option<Option<Vec<f64>>> {
-        // No distribution within the cones at all (the program infeasible) does not hold.
-        let x = program.solve_within_cones(&loads, mu, slack)?;
-        Some(x.filter(|x| x[0] * program.weight >= -0.5 * tolerance))
-    };
-    if holding(mu, slack)?.is_some() {
+    let share = tolerance / (program.weight * touching as f64);
+    let (tau, _) = program.least_cone_excess(&loads, mu, floor)?;
+    if tau <= share {
         return Some(FrictionNeed::Holds);
     }
-    let holding = |mu: f64| holding(mu, 0.0);
+    let within = |mu: f64| {
+        program
+            .least_cone_excess(&loads, mu, floor)
+            .filter(|(tau, _)| *tau <= WITHIN_CONES)
+            .map(|(_, x)| x)
+    };
     let (mut low, mut high) = (mu, (2.0 * mu).max(0.01));
     let mut found = loop {
-        if let Some(x) = holding(high)? {
+        if let Some(x) = within(high) {
             break x;
         }
         if high > MOST_FRICTION {
-            return Some(program.slides_at(f64::INFINITY, None));
+            return Some(FrictionNeed::Slides {
+                least: f64::INFINITY,
+                limiting: None,
+            });
         }
         low = high;
         high *= 2.0;
     };
     while high - low > FRICTION_DIGITS * high {
         let mid = 0.5 * (low + high);
-        match holding(mid)? {
+        match within(mid) {
             Some(x) => {
                 high = mid;
                 found = x;
@@ -196,7 +201,10 @@ pub fn least_friction(
             None => low = mid,
         }
     }
-    Some(program.slides_at(high, Some(&found)))
+    Some(FrictionNeed::Slides {
+        least: high,
+        limiting: program.most_demanding(&found, tolerance),
+    })
 }
 
 /// The most compressive distribution of contact impulses that changes each body's momentum by
@@ -449,34 +457,35 @@ impl FaceProgram {
         Some((solution.x, solution.z[equilibrium..].to_vec()))
     }
 
-    /// [`Self::solve`] with s ≤ 0 and, for every interface with a unilateral point, the
-    /// resultant of its touching points' forces within Coulomb's cone: ‖(T₁, T₂)‖ ≤ μ N + `slack`
-    /// (W), N the sum of its normal forces and Tₖ of its forces along tangent k. The primal x;
-    /// Some(None) where no distribution meets the cones (the solver finds the program
-    /// infeasible), None where the solver fails otherwise.
-    fn solve_within_cones(&self, loads: &[f64], mu: f64, slack: f64) -> Option<Option<Vec<f64>>> {
+    /// min τ + the proximal term over the distributions in equilibrium with `loads` whose
+    /// unilateral points press to −`floor` (W, each times its weight) and whose every interface
+    /// with a unilateral point keeps its resultant within Coulomb's cone widened by τ ≥ 0:
+    /// ‖(T₁, T₂)‖ ≤ μ N + τ (W), N the sum of its normal forces and Tₖ of its forces along
+    /// tangent k. (τ*, the primal x); None where the solver does not solve (after the retry
+    /// with looser settings), or finds no such distribution at all.
+    fn least_cone_excess(&self, loads: &[f64], mu: f64, floor: f64) -> Option<(f64, Vec<f64>)> {
         let equilibrium = 6 * self.bodies;
         let (mut ri, mut ci, mut vi) = self.triplets();
         let mut b = loads.to_vec();
         let mut row = equilibrium;
+        // −w fₙ ≤ floor at every unilateral point, −τ ≤ 0.
         for (&c, &w) in self.unilateral.iter().zip(&self.unilateral_weight) {
-            ri.extend([row, row]);
-            ci.extend([0, c]);
-            vi.extend([1.0, -w]);
-            b.push(0.0);
+            ri.push(row);
+            ci.push(c);
+            vi.push(-w);
+            b.push(floor);
             row += 1;
         }
         ri.push(row);
         ci.push(0);
-        vi.push(1.0);
+        vi.push(-1.0);
         b.push(0.0);
         row += 1;
-        let nonnegative = row - equilibrium;
         let mut cones = vec![
             SupportedConeT::ZeroConeT(equilibrium),
-            SupportedConeT::NonnegativeConeT(nonnegative),
+            SupportedConeT::NonnegativeConeT(row - equilibrium),
         ];
-        // (μ N + slack, T₁, T₂) in the second-order cone: s = b − A x.
+        // (μ N + τ, T₁, T₂) in the second-order cone, t first: s = b − A x.
         for interface in 0..self.interfaces {
             let columns: Vec<(usize, usize)> = self
                 .unknowns
@@ -488,13 +497,15 @@ impl FaceProgram {
             if !columns.iter().any(|&(c, _)| self.unilateral.contains(&c)) {
                 continue;
             }
+            ri.push(row);
+            ci.push(0);
+            vi.push(-1.0);
             for &(c, along) in &columns {
-                let value = if along == 0 { -mu } else { -1.0 };
                 ri.push(row + along);
                 ci.push(c);
-                vi.push(value);
+                vi.push(if along == 0 { -mu } else { -1.0 });
             }
-            b.extend([slack, 0.0, 0.0]);
+            b.extend([0.0, 0.0, 0.0]);
             row += 3;
             cones.push(SupportedConeT::SecondOrderConeT(3));
         }
@@ -508,63 +519,53 @@ impl FaceProgram {
             vec![PROXIMAL; columns - 1],
         );
         let mut q = vec![0.0; columns];
-        q[0] = -1.0;
-        let settings = DefaultSettingsBuilder::default()
-            .verbose(false)
-            .max_iter(200)
-            .iterative_refinement_max_iter(REFINEMENT_STEPS)
-            .build()
-            .ok()?;
-        let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
-        solver.solve();
-        match solver.solution.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => Some(Some(solver.solution.x)),
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Some(None),
-            _ => None,
-        }
+        q[0] = 1.0;
+        let solved = solve_clarabel(&p, &q, &a, &b, &cones).or_else(|| {
+            let settings = DefaultSettingsBuilder::default()
+                .verbose(false)
+                .max_iter(1000)
+                .tol_gap_abs(1e-7)
+                .tol_gap_rel(1e-7)
+                .tol_feas(1e-7)
+                .iterative_refinement_max_iter(50)
+                .build()
+                .ok()?;
+            let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
+            solver.solve();
+            matches!(
+                solver.solution.status,
+                SolverStatus::Solved | SolverStatus::AlmostSolved
+            )
+            .then(|| solver.solution)
+        })?;
+        Some((solved.x[0].max(0.0), solved.x))
     }
 
-    /// [`FrictionNeed::Slides`] at the least μ `least`, read from the distribution `x` found
-    /// there (None beyond [`MOST_FRICTION`]: no distribution, no interface read; the first with
-    /// a touching point is named).
-    fn slides_at(&self, least: f64, x: Option<&[f64]>) -> FrictionNeed {
+    /// The contact of the distribution `x` whose resultant has the largest |F_t|/N among those
+    /// whose normal force N exceeds `tolerance` (N; a contact that carries next to nothing
+    /// would turn round-off into a ratio): its interface, N and |F_t|/N; the lowest index among
+    /// equals. None when no contact carries more.
+    fn most_demanding(&self, x: &[f64], tolerance: f64) -> Option<(usize, f64, f64)> {
         let mut resultant = vec![[0.0; 3]; self.interfaces];
         let mut touches = vec![false; self.interfaces];
         for (j, u) in self.unknowns.iter().enumerate() {
             if u.point.is_some() {
-                if u.unilateral {
-                    touches[u.interface] = true;
-                }
-                if let Some(x) = x {
-                    resultant[u.interface][u.key.along] += x[1 + j];
-                }
+                touches[u.interface] |= u.unilateral;
+                resultant[u.interface][u.key.along] += x[1 + j];
             }
         }
-        let demand = |r: &[f64; 3]| {
-            if r[0] > 0.0 {
-                r[1].hypot(r[2]) / r[0]
-            } else {
-                f64::INFINITY
+        let mut best: Option<(usize, f64, f64)> = None;
+        for (i, r) in resultant.iter().enumerate() {
+            let normal = r[0] * self.weight;
+            if !touches[i] || normal <= tolerance {
+                continue;
             }
-        };
-        // The largest demand; the lowest index among equals.
-        let interface = (0..self.interfaces)
-            .filter(|&i| touches[i])
-            .fold(None, |best: Option<usize>, i| match best {
-                Some(b) if demand(&resultant[b]) >= demand(&resultant[i]) => Some(b),
-                _ => Some(i),
-            })
-            .unwrap_or(0);
-        FrictionNeed::Slides {
-            least,
-            interface,
-            normal: resultant[interface][0] * self.weight,
-            demand: if x.is_some() {
-                demand(&resultant[interface])
-            } else {
-                f64::INFINITY
-            },
+            let demand = r[1].hypot(r[2]) / r[0];
+            if best.is_none_or(|(_, _, d)| demand > d) {
+                best = Some((i, normal, demand));
+            }
         }
+        best
     }
 
     /// How many interfaces have a unilateral touching point (the contacts a cone bounds).

@@ -742,17 +742,21 @@ pub fn settle_sliding(
     }
     match crate::face_forces::least_friction(model, dynamics, work, mu, tolerance) {
         Some(crate::face_forces::FrictionNeed::Holds) => None,
-        Some(crate::face_forces::FrictionNeed::Slides {
-            least,
-            interface,
-            normal,
-            ..
-        }) => Some(Violation {
-            interface: model.interfaces[interface].name.clone(),
-            normal,
-            friction_demand: least,
-            ..v.clone()
-        }),
+        // The contact the least-friction distribution loads most; the first verdict's where
+        // none is read (no μ up to the largest tried, or no contact carrying more than the
+        // tolerance).
+        Some(crate::face_forces::FrictionNeed::Slides { least, limiting }) => {
+            let (interface, normal) = limiting.map_or_else(
+                || (v.interface.clone(), v.normal),
+                |(i, normal, _)| (model.interfaces[i].name.clone(), normal),
+            );
+            Some(Violation {
+                interface,
+                normal,
+                friction_demand: least,
+                ..v.clone()
+            })
+        }
         None => found,
     }
 }
@@ -797,12 +801,19 @@ pub(crate) fn judge(
         } else {
             continue;
         };
+        // A slide's demand is the ratio its test read: the given tangential force over the
+        // normal force of the distribution judged (above μ by the test).
+        let friction_demand = if kind == "sliding" && normal > 0.0 {
+            f.tangential / normal
+        } else {
+            f.friction_demand()
+        };
         let v = Violation {
             t,
             interface: model.interfaces[i].name.clone(),
             kind: kind.into(),
             normal: reported,
-            friction_demand: f.friction_demand(),
+            friction_demand,
             hop: None,
         };
         if gravest.as_ref().is_none_or(|g| v.graver_than(g)) {

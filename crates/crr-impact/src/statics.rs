@@ -982,6 +982,9 @@ fn moving_points(faces: &[ContactFace], collapse: &Collapse) -> Vec<(usize, usiz
 /// Relative width of μ's last bracket in [`smallest_friction`] (four significant digits).
 const FRICTION_DIGITS: f64 = 1e-4;
 
+/// The μ below which [`smallest_friction`] stops: no joint's friction is measured finer.
+const SMALLEST_FRICTION: f64 = 1e-6;
+
 /// The smallest μ ≥ 0 whose multiplier reaches a target, to [`FRICTION_DIGITS`]: 0 where μ = 0
 /// reaches, infinity beyond 1000. `excess(μ)` is λ(μ) − target (monotone in μ; it reaches where
 /// ≥ 0), or None where the program has no λ (it does not hold, or the solver stopped): that μ
@@ -1020,7 +1023,9 @@ fn smallest_friction(
     let mut aim_below = false;
     let mut stalled = 0;
     let mut halved_at = high - low;
-    while high - low > FRICTION_DIGITS * high {
+    // (Above an absolute floor: an answer that holds with any friction, by a clamping that
+    // the rigid blocks grant, would chase μ down to round-off.)
+    while high - low > FRICTION_DIGITS * high && high > SMALLEST_FRICTION {
         let margin = 0.3 * FRICTION_DIGITS * high;
         let estimate = match short[..] {
             [.., (m1, e1), (m2, e2)] if stalled < 2 && e2 > e1 => {
