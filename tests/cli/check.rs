@@ -330,20 +330,12 @@ fn directions_of_any_scale_give_the_same_multiplier() {
     assert_eq!(report("1e300,0,1e300"), diagonal);
 }
 
-/// `--exhaustive-sets N` is the exhaustive pass's budget. A wall of three courses
-/// ([0.53 | 0.18 | 0.29], [0.29 | 0.39 | 0.32], [1], 0.5 m high, every contact a joint) has more
-/// sets of joints that may open and slide than the default 4096: along −x the report gives the
-/// search's upper bound, the whole wall (1 m × 1.5 m) overturning about its outer foot at
-/// λ = (1/2)/(1.5/2) = 2/3, with `too_many_sets` and the number of sets; asked with that budget it
-/// tries them all and answers the least collapse, 0.328658189978, the value the independent
-/// enumeration of `tests/statics/exhaustive.rs` finds (1e-7 there;
-/// `a_budget_of_the_counted_sets_makes_a_larger_wall_exhaustive`). A budget that is no count is
-/// refused, naming the option.
-#[test]
-fn a_larger_budget_of_sets_makes_the_answer_exhaustive() {
-    let dir = crate::common::scratch("check_exhaustive_sets");
-    let mut assembly = String::from("name = \"budget_wall\"\ngravity = 9.81\n");
-    let courses: [&[f64]; 3] = [&[0.53, 0.18, 0.29], &[0.29, 0.39, 0.32], &[1.0]];
+/// A planar wall of 0.5 m courses of boxes 0.5 m thick cut at the lengths `courses` (from
+/// x = 0), written as blocks in the scratch folder `tag` and assembled with `crr assemble
+/// --planar` (and `--all-contacts` where asked); the model file's path.
+fn assembled_planar_wall(tag: &str, courses: &[&[f64]], all_contacts: bool) -> String {
+    let dir = crate::common::scratch(tag);
+    let mut assembly = format!("name = \"{tag}\"\ngravity = 9.81\n");
     for (c, lengths) in courses.iter().enumerate() {
         let mut x = 0.0;
         for (k, len) in lengths.iter().enumerate() {
@@ -358,23 +350,40 @@ fn a_larger_budget_of_sets_makes_the_answer_exhaustive() {
     let (blocks, model) = (dir.join("blocks.toml"), dir.join("model.toml"));
     std::fs::write(&blocks, assembly).unwrap();
     let (blocks, model) = (blocks.to_str().unwrap(), model.to_str().unwrap());
-    let o = crate::common::crr(&[
-        "assemble",
-        blocks,
-        "--all-contacts",
-        "--planar",
-        "--out",
-        model,
-    ]);
+    let mut args = vec!["assemble", blocks, "--planar", "--out", model];
+    if all_contacts {
+        args.push("--all-contacts");
+    }
+    let o = crate::common::crr(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let along_minus_x = |extra: &[&str]| {
-        let mut args = vec!["check", model, "--json", "--direction", "-x"];
-        args.extend_from_slice(extra);
-        let o = crate::common::crr(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        r["static_multipliers"][0].clone()
-    };
+    model.to_string()
+}
+
+/// The JSON report of `crr check MODEL --json --direction -x` with the options `extra`: its one
+/// static multiplier.
+fn multiplier_along_minus_x(model: &str, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["check", model, "--json", "--direction", "-x"];
+    args.extend_from_slice(extra);
+    let o = crate::common::crr(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    r["static_multipliers"][0].clone()
+}
+
+/// `--exhaustive-sets N` is the exhaustive pass's budget. A wall of three courses
+/// ([0.53 | 0.18 | 0.29], [0.29 | 0.39 | 0.32], [1], 0.5 m high, every contact a joint) has more
+/// sets of joints that may open and slide than the default 4096: along −x the report gives the
+/// search's upper bound, the whole wall (1 m × 1.5 m) overturning about its outer foot at
+/// λ = (1/2)/(1.5/2) = 2/3, with `too_many_sets` and the number of sets; asked with that budget it
+/// tries them all and answers the least collapse, 0.328658189978, the value the independent
+/// enumeration of `tests/statics/exhaustive.rs` finds (1e-7 there;
+/// `a_budget_of_the_counted_sets_makes_a_larger_wall_exhaustive`). A budget that is no count is
+/// refused, naming the option.
+#[test]
+fn a_larger_budget_of_sets_makes_the_answer_exhaustive() {
+    let courses: [&[f64]; 3] = [&[0.53, 0.18, 0.29], &[0.29, 0.39, 0.32], &[1.0]];
+    let model = &assembled_planar_wall("check_exhaustive_sets", &courses, true);
+    let along_minus_x = |extra: &[&str]| multiplier_along_minus_x(model, extra);
     let default = along_minus_x(&[]);
     assert_eq!(default["exhaustive"], false, "{default}");
     assert_eq!(default["not_exhaustive_because"], "too_many_sets");
@@ -417,33 +426,9 @@ fn a_larger_budget_of_sets_makes_the_answer_exhaustive() {
 /// the multiplier is lower, the one a real wall has.
 #[test]
 fn a_multiplier_that_needs_unbounded_friction_says_so() {
-    let dir = crate::common::scratch("check_unbounded_friction");
-    let mut assembly = String::from("name = \"closure_limit\"\ngravity = 9.81\n");
     let courses: [&[f64]; 2] = [&[0.301, 0.699], &[0.585, 0.415]];
-    for (c, lengths) in courses.iter().enumerate() {
-        let mut x = 0.0;
-        for (k, len) in lengths.iter().enumerate() {
-            assembly += &format!(
-                "\n[[body]]\nname = \"c{c}_b{k}\"\ndensity = 2000.0\nbox = {{ center = [{}, 0.0, {}], size = [{len}, 0.5, 0.5] }}\n",
-                x + len / 2.0,
-                0.5 * c as f64 + 0.25
-            );
-            x += len;
-        }
-    }
-    let (blocks, model) = (dir.join("blocks.toml"), dir.join("model.toml"));
-    std::fs::write(&blocks, assembly).unwrap();
-    let (blocks, model) = (blocks.to_str().unwrap(), model.to_str().unwrap());
-    let o = crate::common::crr(&["assemble", blocks, "--planar", "--out", model]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let along_minus_x = |extra: &[&str]| {
-        let mut args = vec!["check", model, "--json", "--direction", "-x"];
-        args.extend_from_slice(extra);
-        let o = crate::common::crr(&args);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        r["static_multipliers"][0].clone()
-    };
+    let model = &assembled_planar_wall("check_unbounded_friction", &courses, false);
+    let along_minus_x = |extra: &[&str]| multiplier_along_minus_x(model, extra);
     let m = along_minus_x(&[]);
     assert_eq!(m["friction_unbounded"], true, "{m}");
     assert!(m["required_friction"].is_null(), "{m}");

@@ -415,40 +415,8 @@ fn wall_lp(
             }
         }
     }
-    // Variables: λ, then (fₙ, f_t) per point.
-    let mut lp = Lp::new(1 + 2 * points.len());
-    lp.cost[0] = -1.0;
-    let unit = l * hb;
-    let mut eqs: Vec<[Vec<(usize, f64)>; 3]> = vec![Default::default(); list.len()];
-    let mut rhs: Vec<[f64; 3]> = vec![[0.0; 3]; list.len()];
-    for (k, (_, (x, z))) in list.iter().enumerate() {
-        let w = (x[1] - x[0]) * (z[1] - z[0]) / unit;
-        // Σf_x − λ W dx = 0, Σf_z − W = 0, Σ moments = 0.
-        eqs[k][0].push((0, -w * dx));
-        rhs[k][1] = w;
-    }
-    for (p, &(above, below, x, z)) in points.iter().enumerate() {
-        let (vn, vt) = (1 + 2 * p, 2 + 2 * p);
-        for (body, sign) in [(Some(above), 1.0), (below, -1.0)] {
-            let Some(k) = body else { continue };
-            let (bx, bz) = list[k].1;
-            let c = [(bx[0] + bx[1]) / 2.0, (bz[0] + bz[1]) / 2.0];
-            let r = [x - c[0], z - c[1]];
-            // Force on this body: sign·(f_t, fₙ); its moment r_z f_x − r_x f_z.
-            eqs[k][0].push((vt, sign));
-            eqs[k][1].push((vn, sign));
-            eqs[k][2].push((vt, sign * r[1]));
-            eqs[k][2].push((vn, -sign * r[0]));
-        }
-        lp.le.push((vec![(vn, -1.0)], 0.0));
-    }
-    for (e, r) in eqs.into_iter().zip(rhs) {
-        for (row, b) in e.into_iter().zip(r) {
-            lp.eq.push((row, b));
-        }
-    }
-    lp.le.push((vec![(0, 1.0)], LAMBDA_CAP));
-    let sol = lp
+    let boxes: Vec<Block> = list.iter().map(|(_, b)| *b).collect();
+    let sol = bed_joint_lp(&boxes, l * hb, &points, dx, None)
         .solve()
         .unwrap_or_else(|s| panic!("wall LP {courses}×{blocks}: {s:?}"));
     assert!(
@@ -468,6 +436,56 @@ fn wall_lp(
         })
         .collect();
     (sol.x[0], modes)
+}
+
+/// The static theorem's LP for boxes (x and z extents, one density, weights their areas over
+/// `unit`) with a normal force fₙ ≥ 0 and a tangential force f_t at each of `points` (block
+/// above, block below or None for the ground, x, z), |f_t| ≤ μ fₙ (Coulomb; exact in the plane)
+/// or free without μ: max λ ≤ [`LAMBDA_CAP`] with every box in equilibrium under its weight W and
+/// the horizontal load −λ W dx at its centre. Variables λ, then (fₙ, f_t) per point; three
+/// equality rows per box (Σf_x, Σf_z, the moment about its centre), in box order.
+fn bed_joint_lp(
+    boxes: &[Block],
+    unit: f64,
+    points: &[(usize, Option<usize>, f64, f64)],
+    dx: f64,
+    mu: Option<f64>,
+) -> Lp {
+    let mut lp = Lp::new(1 + 2 * points.len());
+    lp.cost[0] = -1.0;
+    let mut eqs: Vec<[Vec<(usize, f64)>; 3]> = vec![Default::default(); boxes.len()];
+    let mut rhs: Vec<[f64; 3]> = vec![[0.0; 3]; boxes.len()];
+    for (k, (x, z)) in boxes.iter().enumerate() {
+        let w = (x[1] - x[0]) * (z[1] - z[0]) / unit;
+        // Σf_x − λ W dx = 0, Σf_z − W = 0, Σ moments = 0.
+        eqs[k][0].push((0, -w * dx));
+        rhs[k][1] = w;
+    }
+    for (p, &(above, below, x, z)) in points.iter().enumerate() {
+        let (vn, vt) = (1 + 2 * p, 2 + 2 * p);
+        for (body, sign) in [(Some(above), 1.0), (below, -1.0)] {
+            let Some(k) = body else { continue };
+            let (bx, bz) = boxes[k];
+            let r = [x - (bx[0] + bx[1]) / 2.0, z - (bz[0] + bz[1]) / 2.0];
+            // Force on this body: sign·(f_t, fₙ); its moment r_z f_x − r_x f_z.
+            eqs[k][0].push((vt, sign));
+            eqs[k][1].push((vn, sign));
+            eqs[k][2].push((vt, sign * r[1]));
+            eqs[k][2].push((vn, -sign * r[0]));
+        }
+        lp.le.push((vec![(vn, -1.0)], 0.0));
+        if let Some(mu) = mu {
+            lp.le.push((vec![(vt, 1.0), (vn, -mu)], 0.0));
+            lp.le.push((vec![(vt, -1.0), (vn, -mu)], 0.0));
+        }
+    }
+    for (e, r) in eqs.into_iter().zip(rhs) {
+        for (row, b) in e.into_iter().zip(r) {
+            lp.eq.push((row, b));
+        }
+    }
+    lp.le.push((vec![(0, 1.0)], LAMBDA_CAP));
+    lp
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -1081,23 +1099,9 @@ fn cut_wall(cuts: &[&[f64]], h: f64, mirror: bool) -> (Vec<WallBlock>, Structure
         })
         .collect();
     let mut interface = Vec::new();
-    for above in &blocks {
-        let supports: Vec<(&str, [f64; 2])> = if above.z[0] == 0.0 {
-            vec![("ground", above.x)]
-        } else {
-            blocks
-                .iter()
-                .filter(|b| (b.z[1] - above.z[0]).abs() < 1e-12)
-                .map(|b| {
-                    (
-                        b.name.as_str(),
-                        [b.x[0].max(above.x[0]), b.x[1].min(above.x[1])],
-                    )
-                })
-                .filter(|(_, x)| x[1] - x[0] > 1e-9)
-                .collect()
-        };
-        for (below, x) in supports {
+    for (a, above) in blocks.iter().enumerate() {
+        for (below, x) in bed_supports(&blocks, a) {
+            let below = below.map_or("ground", |j| blocks[j].name.as_str());
             let z = above.z[0];
             interface.push(hinge(
                 &format!("{}_on_{below}", above.name),
@@ -1161,18 +1165,7 @@ fn wedge_multiplier(blocks: &[WallBlock], motion: &[PlanarMotion], dx: f64) -> f
     let tol = 1e-12;
     let at = |i: Option<usize>, x: f64, z: f64| i.map_or([0.0, 0.0], |i| motion[i].velocity(x, z));
     for (a, above) in blocks.iter().enumerate() {
-        let supports: Vec<(Option<usize>, [f64; 2])> = if above.z[0] == 0.0 {
-            vec![(None, above.x)]
-        } else {
-            blocks
-                .iter()
-                .enumerate()
-                .filter(|(_, b)| (b.z[1] - above.z[0]).abs() < 1e-12)
-                .map(|(j, b)| (Some(j), [b.x[0].max(above.x[0]), b.x[1].min(above.x[1])]))
-                .filter(|(_, x)| x[1] - x[0] > 1e-9)
-                .collect()
-        };
-        for (below, x) in supports {
+        for (below, x) in bed_supports(blocks, a) {
             let z = above.z[0];
             let rel: Vec<[f64; 2]> = x
                 .iter()
@@ -1311,65 +1304,36 @@ fn an_arch_of_200_voussoirs_near_its_minimum_thickness_has_its_multiplier() {
 /// force fₙ ≥ 0 and a tangential force f_t at both ends of every bed-joint overlap (with the
 /// block below or the ground), |f_t| ≤ μ fₙ (Coulomb; exact in the plane) or free without μ.
 fn cut_wall_lp(blocks: &[WallBlock], dx: f64, mu: Option<f64>) -> f64 {
-    // Contact points: (block above, block below or None, x, z).
+    // Contact points: (block above, block below or None, x, z) at both ends of every overlap.
     let mut points: Vec<(usize, Option<usize>, f64, f64)> = Vec::new();
     for (a, above) in blocks.iter().enumerate() {
-        let z = above.z[0];
-        let supports: Vec<(Option<usize>, [f64; 2])> = if z == 0.0 {
-            vec![(None, above.x)]
-        } else {
-            blocks
-                .iter()
-                .enumerate()
-                .filter(|(_, b)| (b.z[1] - z).abs() < 1e-12)
-                .map(|(j, b)| (Some(j), [b.x[0].max(above.x[0]), b.x[1].min(above.x[1])]))
-                .filter(|(_, x)| x[1] - x[0] > 1e-9)
-                .collect()
-        };
-        for (below, x) in supports {
-            points.push((a, below, x[0], z));
-            points.push((a, below, x[1], z));
+        for (below, x) in bed_supports(blocks, a) {
+            points.push((a, below, x[0], above.z[0]));
+            points.push((a, below, x[1], above.z[0]));
         }
     }
-    // Variables: λ, then (fₙ, f_t) per point.
-    let mut lp = Lp::new(1 + 2 * points.len());
-    lp.cost[0] = -1.0;
-    let mut eqs: Vec<[Vec<(usize, f64)>; 3]> = vec![Default::default(); blocks.len()];
-    let mut rhs = vec![[0.0; 3]; blocks.len()];
-    for (k, b) in blocks.iter().enumerate() {
-        let w = (b.x[1] - b.x[0]) * (b.z[1] - b.z[0]);
-        // Σf_x − λ W dx = 0, Σf_z − W = 0, Σ moments about the centre = 0.
-        eqs[k][0].push((0, -w * dx));
-        rhs[k][1] = w;
-    }
-    for (p, &(above, below, x, z)) in points.iter().enumerate() {
-        let (vn, vt) = (1 + 2 * p, 2 + 2 * p);
-        for (body, sign) in [(Some(above), 1.0), (below, -1.0)] {
-            let Some(k) = body else { continue };
-            let b = &blocks[k];
-            let r = [x - (b.x[0] + b.x[1]) / 2.0, z - (b.z[0] + b.z[1]) / 2.0];
-            // Force on this body: sign·(f_t, fₙ); its moment r_z f_x − r_x f_z.
-            eqs[k][0].push((vt, sign));
-            eqs[k][1].push((vn, sign));
-            eqs[k][2].push((vt, sign * r[1]));
-            eqs[k][2].push((vn, -sign * r[0]));
-        }
-        lp.le.push((vec![(vn, -1.0)], 0.0));
-        if let Some(mu) = mu {
-            lp.le.push((vec![(vt, 1.0), (vn, -mu)], 0.0));
-            lp.le.push((vec![(vt, -1.0), (vn, -mu)], 0.0));
-        }
-    }
-    for (e, r) in eqs.into_iter().zip(rhs) {
-        for (row, b) in e.into_iter().zip(r) {
-            lp.eq.push((row, b));
-        }
-    }
-    lp.le.push((vec![(0, 1.0)], LAMBDA_CAP));
-    let sol = lp
+    let boxes: Vec<Block> = blocks.iter().map(|b| (b.x, b.z)).collect();
+    let sol = bed_joint_lp(&boxes, 1.0, &points, dx, mu)
         .solve()
         .unwrap_or_else(|s| panic!("cut wall LP (μ {mu:?}): {s:?}"));
     sol.x[0]
+}
+
+/// The bed joints of block `a` of a wall of [`cut_wall`]'s boxes: the ground (None) under a
+/// block on z = 0, else each block whose top is its bottom, with the x extent of their overlap
+/// (overlaps shorter than 1e-9 m left out).
+fn bed_supports(blocks: &[WallBlock], a: usize) -> Vec<(Option<usize>, [f64; 2])> {
+    let above = &blocks[a];
+    if above.z[0] == 0.0 {
+        return vec![(None, above.x)];
+    }
+    blocks
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| (b.z[1] - above.z[0]).abs() < 1e-12)
+        .map(|(j, b)| (Some(j), [b.x[0].max(above.x[0]), b.x[1].min(above.x[1])]))
+        .filter(|(_, x)| x[1] - x[0] > 1e-9)
+        .collect()
 }
 
 /// The friction a multiplier relies on, against this file's LP of the blocks with Coulomb

@@ -165,15 +165,15 @@ pub fn least_friction(
     let program = FaceProgram::build(model, dynamics).per_edge();
     let loads = program.loads(model, dynamics, work)?;
     let floor = 0.5 * tolerance / program.weight;
-    let touching = program.touching_interfaces().max(1);
-    let share = tolerance / (program.weight * touching as f64);
-    let (tau, _) = program.least_cone_excess(&loads, mu, floor)?;
+    let cones = program.cone_columns();
+    let share = tolerance / (program.weight * cones.len().max(1) as f64);
+    let (tau, _) = program.least_cone_excess(&loads, &cones, mu, floor)?;
     if tau <= share {
         return Some(FrictionNeed::Holds);
     }
     let within = |mu: f64| {
         program
-            .least_cone_excess(&loads, mu, floor)
+            .least_cone_excess(&loads, &cones, mu, floor)
             .filter(|(tau, _)| *tau <= WITHIN_CONES)
             .map(|(_, x)| x)
     };
@@ -203,7 +203,7 @@ pub fn least_friction(
     }
     Some(FrictionNeed::Slides {
         least: high,
-        limiting: program.most_demanding(&found, tolerance),
+        limiting: program.most_demanding(&found, tolerance, &model.interfaces),
     })
 }
 
@@ -440,13 +440,7 @@ impl FaceProgram {
         row += 1;
         let columns = 1 + self.unknowns.len();
         let a = CscMatrix::new_from_triplets(row, columns, ri, ci, vi);
-        let p = CscMatrix::new_from_triplets(
-            columns,
-            columns,
-            (1..columns).collect(),
-            (1..columns).collect(),
-            vec![PROXIMAL; columns - 1],
-        );
+        let p = self.proximal();
         let mut q = vec![0.0; columns];
         q[0] = -1.0;
         let cones = [
@@ -458,12 +452,18 @@ impl FaceProgram {
     }
 
     /// min τ + the proximal term over the distributions in equilibrium with `loads` whose
-    /// unilateral points press to −`floor` (W, each times its weight) and whose every interface
-    /// with a unilateral point keeps its resultant within Coulomb's cone widened by τ ≥ 0:
-    /// ‖(T₁, T₂)‖ ≤ μ N + τ (W), N the sum of its normal forces and Tₖ of its forces along
+    /// unilateral points press to −`floor` (W, each times its weight) and whose every contact of
+    /// `cones` ([`Self::cone_columns`]) keeps its resultant within Coulomb's cone widened by
+    /// τ ≥ 0: ‖(T₁, T₂)‖ ≤ μ N + τ (W), N the sum of its normal forces and Tₖ of its forces along
     /// tangent k. (τ*, the primal x); None where the solver does not solve (after the retry
     /// with looser settings), or finds no such distribution at all.
-    fn least_cone_excess(&self, loads: &[f64], mu: f64, floor: f64) -> Option<(f64, Vec<f64>)> {
+    fn least_cone_excess(
+        &self,
+        loads: &[f64],
+        cones_of: &[Vec<(usize, usize)>],
+        mu: f64,
+        floor: f64,
+    ) -> Option<(f64, Vec<f64>)> {
         let equilibrium = 6 * self.bodies;
         let (mut ri, mut ci, mut vi) = self.triplets();
         let mut b = loads.to_vec();
@@ -486,21 +486,11 @@ impl FaceProgram {
             SupportedConeT::NonnegativeConeT(row - equilibrium),
         ];
         // (μ N + τ, T₁, T₂) in the second-order cone, t first: s = b − A x.
-        for interface in 0..self.interfaces {
-            let columns: Vec<(usize, usize)> = self
-                .unknowns
-                .iter()
-                .enumerate()
-                .filter(|(_, u)| u.interface == interface && u.point.is_some())
-                .map(|(j, u)| (1 + j, u.key.along))
-                .collect();
-            if !columns.iter().any(|&(c, _)| self.unilateral.contains(&c)) {
-                continue;
-            }
+        for columns in cones_of {
             ri.push(row);
             ci.push(0);
             vi.push(-1.0);
-            for &(c, along) in &columns {
+            for &(c, along) in columns {
                 ri.push(row + along);
                 ci.push(c);
                 vi.push(if along == 0 { -mu } else { -1.0 });
@@ -511,41 +501,67 @@ impl FaceProgram {
         }
         let columns = 1 + self.unknowns.len();
         let a = CscMatrix::new_from_triplets(row, columns, ri, ci, vi);
-        let p = CscMatrix::new_from_triplets(
+        let p = self.proximal();
+        let mut q = vec![0.0; columns];
+        q[0] = 1.0;
+        let loose = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .max_iter(1000)
+            .tol_gap_abs(1e-7)
+            .tol_gap_rel(1e-7)
+            .tol_feas(1e-7)
+            .iterative_refinement_max_iter(50)
+            .build()
+            .ok()?;
+        let solved = solve_clarabel(&p, &q, &a, &b, &cones)
+            .or_else(|| solve_clarabel_with(&p, &q, &a, &b, &cones, loose))?;
+        Some((solved.x[0].max(0.0), solved.x))
+    }
+
+    /// Per contact that touches (an interface with a unilateral point), the columns of its
+    /// touching points' forces with their place along (n, t₁, t₂): the contacts whose
+    /// resultants a friction cone bounds.
+    fn cone_columns(&self) -> Vec<Vec<(usize, usize)>> {
+        let mut per_interface: Vec<Vec<(usize, usize)>> = vec![Vec::new(); self.interfaces];
+        let mut touches = vec![false; self.interfaces];
+        for (j, u) in self.unknowns.iter().enumerate() {
+            if u.point.is_some() {
+                per_interface[u.interface].push((1 + j, u.key.along));
+                touches[u.interface] |= u.unilateral;
+            }
+        }
+        per_interface
+            .into_iter()
+            .zip(touches)
+            .filter_map(|(columns, touches)| touches.then_some(columns))
+            .collect()
+    }
+
+    /// The proximal term ½ε‖f‖² of the programs ([`PROXIMAL`]; column 0, s or τ, left out).
+    fn proximal(&self) -> CscMatrix<f64> {
+        let columns = 1 + self.unknowns.len();
+        CscMatrix::new_from_triplets(
             columns,
             columns,
             (1..columns).collect(),
             (1..columns).collect(),
             vec![PROXIMAL; columns - 1],
-        );
-        let mut q = vec![0.0; columns];
-        q[0] = 1.0;
-        let solved = solve_clarabel(&p, &q, &a, &b, &cones).or_else(|| {
-            let settings = DefaultSettingsBuilder::default()
-                .verbose(false)
-                .max_iter(1000)
-                .tol_gap_abs(1e-7)
-                .tol_gap_rel(1e-7)
-                .tol_feas(1e-7)
-                .iterative_refinement_max_iter(50)
-                .build()
-                .ok()?;
-            let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).ok()?;
-            solver.solve();
-            matches!(
-                solver.solution.status,
-                SolverStatus::Solved | SolverStatus::AlmostSolved
-            )
-            .then(|| solver.solution)
-        })?;
-        Some((solved.x[0].max(0.0), solved.x))
+        )
     }
 
     /// The contact of the distribution `x` whose resultant has the largest |F_t|/N among those
     /// whose normal force N exceeds `tolerance` (N; a contact that carries next to nothing
-    /// would turn round-off into a ratio): its interface, N and |F_t|/N; the lowest index among
-    /// equals. None when no contact carries more.
-    fn most_demanding(&self, x: &[f64], tolerance: f64) -> Option<(usize, f64, f64)> {
+    /// would turn round-off into a ratio): its interface, N and |F_t|/N. The least-friction
+    /// distribution loads many contacts to the same ratio, which the interior point leaves
+    /// equal only to its accuracy: of the contacts within [`FRICTION_DIGITS`] of the largest,
+    /// the one whose name (of `interfaces`) sorts first, whatever order the file lists them in.
+    /// None when no contact carries more.
+    fn most_demanding(
+        &self,
+        x: &[f64],
+        tolerance: f64,
+        interfaces: &[crr_kinematics::Interface],
+    ) -> Option<(usize, f64, f64)> {
         let mut resultant = vec![[0.0; 3]; self.interfaces];
         let mut touches = vec![false; self.interfaces];
         for (j, u) in self.unknowns.iter().enumerate() {
@@ -554,27 +570,17 @@ impl FaceProgram {
                 resultant[u.interface][u.key.along] += x[1 + j];
             }
         }
-        let mut best: Option<(usize, f64, f64)> = None;
-        for (i, r) in resultant.iter().enumerate() {
-            let normal = r[0] * self.weight;
-            if !touches[i] || normal <= tolerance {
-                continue;
-            }
-            let demand = r[1].hypot(r[2]) / r[0];
-            if best.is_none_or(|(_, _, d)| demand > d) {
-                best = Some((i, normal, demand));
-            }
-        }
-        best
-    }
-
-    /// How many interfaces have a unilateral touching point (the contacts a cone bounds).
-    fn touching_interfaces(&self) -> usize {
-        let mut touches = vec![false; self.interfaces];
-        for &c in &self.unilateral {
-            touches[self.unknowns[c - 1].interface] = true;
-        }
-        touches.iter().filter(|&&t| t).count()
+        let loaded: Vec<(usize, f64, f64)> = resultant
+            .iter()
+            .enumerate()
+            .filter(|&(i, r)| touches[i] && r[0] * self.weight > tolerance)
+            .map(|(i, r)| (i, r[0] * self.weight, r[1].hypot(r[2]) / r[0]))
+            .collect();
+        let largest = loaded.iter().map(|l| l.2).fold(f64::NEG_INFINITY, f64::max);
+        loaded
+            .into_iter()
+            .filter(|l| l.2 >= largest * (1.0 - FRICTION_DIGITS))
+            .min_by(|a, b| interfaces[a.0].name.cmp(&interfaces[b.0].name))
     }
 
     /// A distribution in equilibrium with `loads`, the least-norm one (min ½‖f‖² subject to the
@@ -771,6 +777,18 @@ fn solve_clarabel(
         .iterative_refinement_max_iter(REFINEMENT_STEPS)
         .build()
         .ok()?;
+    solve_clarabel_with(p, q, a, b, cones, settings)
+}
+
+/// [`solve_clarabel`] with the given settings.
+fn solve_clarabel_with(
+    p: &CscMatrix<f64>,
+    q: &[f64],
+    a: &CscMatrix<f64>,
+    b: &[f64],
+    cones: &[SupportedConeT<f64>],
+    settings: clarabel::solver::DefaultSettings<f64>,
+) -> Option<clarabel::solver::DefaultSolution<f64>> {
     let mut solver = DefaultSolver::new(p, q, a, b, cones, settings).ok()?;
     solver.solve();
     matches!(

@@ -140,14 +140,7 @@ impl Simulation<'_> {
                         self.params.friction,
                         tol,
                     );
-                    found = crate::monitor::settle_sliding(
-                        &self.model,
-                        &self.spare.monitor,
-                        work,
-                        found,
-                        self.params.friction,
-                        tol,
-                    );
+                    // (Hops are deferred on trees only, whose slides need no settling.)
                 }
             }
         }
