@@ -151,6 +151,42 @@ pub struct Section {
     pub violation: Option<crr_impact::monitor::Violation>,
 }
 
+/// The model's settings and the length of each run the section takes are input errors found
+/// before any run (a run of 5e6 s failed as a run stopping early, with exit 1, blaming
+/// `[analysis] duration`): the longest is (transient + periods)/F for a stroboscopic section and
+/// `--duration` (or its default) for a crossing one, at most `LONGEST_DURATION` times the
+/// structure's time scale √(L/g).
+fn check_run_length(
+    model: &Model,
+    params: &Parameters,
+    kind: SectionKind,
+    section_time: f64,
+    opts: &PoincareOptions,
+) -> Result<(), String> {
+    let mut settings = params.clone();
+    settings.duration = 0.0;
+    crr_impact::simulation::check_physical_bounds(model, &settings).map_err(|e| e.to_string())?;
+    let (longest, what) = match kind {
+        SectionKind::Stroboscopic => (section_time, "(transient + periods) / F"),
+        _ => (
+            opts.duration.unwrap_or(DEFAULT_CROSSING_DURATION),
+            "--duration, or its default",
+        ),
+    };
+    let time_scale = (model.size / model.gravity).sqrt();
+    let bound = crr_impact::simulation::LONGEST_DURATION * time_scale;
+    if longest.is_nan() || longest > bound {
+        return Err(format!(
+            "each run would last {longest:e} s ({what}): more than {:e} times the structure's \
+             time scale √(L/g) = {time_scale:.4} s, beyond which an instant is located more \
+             coarsely than the impacts' own spacing near rest; lower --periods, --transient or \
+             --duration",
+            crr_impact::simulation::LONGEST_DURATION
+        ));
+    }
+    Ok(())
+}
+
 /// Runs one section of `model` from `initial`; `params` gives the solver settings (its duration
 /// and output interval are replaced). Never panics on a failing run: the error is in
 /// [`Section::error`] with the points computed until then.
@@ -775,6 +811,7 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, Error> {
     check_initial_state(&model, &initial).map_err(here)?;
     let analysis = file.analysis.clone().unwrap_or_default();
     let params = Parameters::from_analysis(&analysis, 1.0).map_err(here)?;
+    check_run_length(&model, &params, kind, section_time, opts).map_err(here)?;
     let settings = SectionSettings {
         forcing: Forcing {
             amplitude: opts.amplitude,

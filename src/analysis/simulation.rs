@@ -220,6 +220,16 @@ pub fn prepare(input: &ModelInput, options: &RunOptions) -> Result<Prepared, Err
     // is written (not a failed run with partial results).
     crr_impact::simulation::check_physical_bounds(&input.model, &params)
         .map_err(|e| here(e.to_string()))?;
+    let rows = (params.duration / params.output_interval).floor() + 1.0;
+    if rows.is_nan() || rows > MAX_HISTORY_ROWS {
+        return Err(here(format!(
+            "output_interval = {} s over the duration {} s makes {rows:.3e} history rows, more \
+             than {MAX_HISTORY_ROWS:e} (tens of gigabytes; 1e-300 s wrote 880 MB in 10 s and \
+             would never end): raise output_interval",
+            num(params.output_interval),
+            params.duration
+        )));
+    }
     Ok(Prepared {
         path: path.clone(),
         file,
@@ -443,6 +453,10 @@ pub const RK4_STEP_WARNING: f64 = 0.05;
 
 /// A simultaneity tolerance larger than this fraction of the smallest slenderness α is a warning.
 pub const SIMULTANEITY_WARNING: f64 = 1e-2;
+
+/// The most rows a run's history may have (one per output interval): beyond, the run is
+/// refused before it starts, as a history of tens of gigabytes fills a disk and never ends.
+pub const MAX_HISTORY_ROWS: f64 = 1e9;
 
 /// A history expected to exceed this size (bytes of `history.csv`, or of memory held by a run
 /// that keeps its samples: both are about the same) is a warning, given before the run starts.

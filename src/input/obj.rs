@@ -71,6 +71,9 @@ pub struct ObjSpec {
     pub up: ObjUp,
 }
 
+/// The largest OBJ file read (bytes): a mesh of a few hundred blocks takes a few megabytes.
+pub const OBJ_FILE_LIMIT: u64 = 256 << 20;
+
 /// The bodies of the OBJ file of `spec` (its path relative to `folder`), one per object.
 pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error> {
     let path = folder.join(&spec.file);
@@ -86,7 +89,14 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
         single_index: false,
         ..Default::default()
     };
-    let (models, _) = tobj::load_obj(&path, &options).map_err(|e| here(format!("{e}")))?;
+    // A regular file of bounded size, like every other input (a FIFO hung the reader, and
+    // /dev/zero exhausted the memory); materials are not read (only the geometry is used).
+    let bytes = crr_dynamics::input::read_regular_file(&path, OBJ_FILE_LIMIT)
+        .map_err(|e| here(e.to_string()))?;
+    let (models, _) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| here(format!("{e}")))?;
     if models.is_empty() {
         return Err(here("no object in the file".into()));
     }

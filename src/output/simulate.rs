@@ -11,7 +11,9 @@ use super::folder_lock::FolderLock;
 use super::history::{
     OPENINGS_HEADER, history_header, hops_csv, impacts_csv, push_history_row, push_openings_rows,
 };
-use super::results_folder::{check_out_dir, default_out_dir, partial_name, write_outputs_with};
+use super::results_folder::{
+    RESULT_FILES, check_out_dir, default_out_dir, partial_name, write_outputs_with,
+};
 use crate::Error;
 use crate::analysis::simulation::{Prepared, RunOptions, prepare};
 use crate::analysis::summary::Summary;
@@ -81,6 +83,7 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
         .map_err(output_error)?;
     let (mut rows, mut opening_rows) = (String::new(), String::new());
     let mut row = 0;
+    let mut sink_failed = false;
     let sink = |samples: &Samples| -> std::io::Result<()> {
         rows.clear();
         opening_rows.clear();
@@ -89,16 +92,13 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
             push_history_row(&mut rows, &p.model, &x);
             push_openings_rows(&mut opening_rows, &p.model, row, &x);
         }
-        history.write_all(rows.as_bytes())?;
-        openings.write_all(opening_rows.as_bytes())
+        let written = history
+            .write_all(rows.as_bytes())
+            .and_then(|()| openings.write_all(opening_rows.as_bytes()));
+        sink_failed |= written.is_err();
+        written
     };
     let run = p.run_streaming(sink);
-    for writer in [history, openings] {
-        let file = writer
-            .into_inner()
-            .map_err(|e| output_error(e.into_error()))?;
-        file.sync_all().map_err(output_error)?;
-    }
     let files = [
         ("impacts.csv", impacts_csv(&p.model, &run.trajectory)),
         (
@@ -107,9 +107,155 @@ pub fn write_run(p: &Prepared, out: &Path) -> Result<SimulateResult, Error> {
         ),
         ("summary.json", run.summary.to_json()),
     ];
-    write_outputs_with(out, &["history.csv", "openings.csv"], &files).map_err(output_error)?;
+    let flushed = [history, openings]
+        .into_iter()
+        .try_for_each(|writer| writer.into_inner().map_err(|e| e.into_error())?.sync_all());
+    if sink_failed || flushed.is_err() {
+        // A write cut short (a full disk, a file size limit) may have left half a row.
+        for streamed in [&history_tmp, &openings_tmp] {
+            let _ = truncate_to_last_line(streamed);
+        }
+    }
+    let written =
+        flushed.and_then(|()| write_outputs_with(out, &["history.csv", "openings.csv"], &files));
+    if let Err(source) = written {
+        return keep_what_was_written(out, source, &run.summary);
+    }
     Ok(match run.summary.error.clone() {
         None => SimulateResult::Done(out.to_path_buf(), Box::new(run.summary)),
         Some(e) => SimulateResult::Failed(out.to_path_buf(), e),
     })
+}
+
+/// The results could not all be written (a full disk, a file size limit): the rows already
+/// streamed are results the run computed, so they are kept under their own names rather than
+/// left hidden, with summary.json (marked as not completed) where it can still be written, and
+/// the run counts as failed part-way. Where not even the history is left, the error stands.
+fn keep_what_was_written(
+    out: &Path,
+    source: std::io::Error,
+    summary: &Summary,
+) -> Result<SimulateResult, Error> {
+    // An earlier run's files would mix with this one's (and removing them frees space).
+    for stale in RESULT_FILES {
+        let _ = std::fs::remove_file(out.join(stale));
+    }
+    let kept: Vec<&str> = ["history.csv", "openings.csv", "impacts.csv", "hops.csv"]
+        .into_iter()
+        .filter(|name| std::fs::rename(partial_name(out, name), out.join(name)).is_ok())
+        .collect();
+    // A write cut short may have left half a row: the files end at their last whole line.
+    for name in &kept {
+        let _ = truncate_to_last_line(&out.join(name));
+    }
+    if !kept.contains(&"history.csv") {
+        return Err(Error::Output {
+            dir: out.to_path_buf(),
+            source,
+        });
+    }
+    let why = format!(
+        "the results could not all be written ({source}): the rows written before are kept in {}",
+        kept.join(", ")
+    );
+    let mut marked = summary.clone();
+    marked.completed = false;
+    marked.error = Some(match &summary.error {
+        Some(e) => format!("{e}; {why}"),
+        None => why.clone(),
+    });
+    // Not through write_outputs_with, which clears the folder's result files first.
+    let summary_tmp = partial_name(out, "summary.json");
+    let summary_written = std::fs::write(&summary_tmp, marked.to_json())
+        .and_then(|()| std::fs::rename(&summary_tmp, out.join("summary.json")));
+    if summary_written.is_err() {
+        let _ = std::fs::remove_file(&summary_tmp);
+    }
+    let said = match summary_written {
+        Ok(()) => format!("{why} and summary.json"),
+        Err(e) => format!("{why} (summary.json could not be written either: {e})"),
+    };
+    Ok(SimulateResult::Failed(out.to_path_buf(), said))
+}
+
+/// Cuts the file at `path` after its last line break (a row written in part goes).
+fn truncate_to_last_line(path: &Path) -> std::io::Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)?;
+    let len = file.metadata()?.len();
+    // Rows are far shorter than this: the last line break is within the tail.
+    let tail = len.min(1 << 20);
+    file.seek(SeekFrom::Start(len - tail))?;
+    let mut bytes = Vec::with_capacity(tail as usize);
+    file.read_to_end(&mut bytes)?;
+    let keep = match bytes.iter().rposition(|&b| b == b'\n') {
+        Some(i) => len - tail + i as u64 + 1,
+        None if tail == len => 0,
+        None => return Ok(()),
+    };
+    file.set_len(keep)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The writes cut short by a full disk: the streamed rows are renamed into place, cut at
+    /// their last whole line, an earlier run's files go, and summary.json says the run did not
+    /// complete and why; with no history left the error stands.
+    #[test]
+    fn what_was_written_before_a_write_failed_is_kept() {
+        let out = std::env::temp_dir().join(format!("crr_keep_written_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        std::fs::create_dir_all(&out).unwrap();
+        std::fs::write(
+            partial_name(&out, "history.csv"),
+            "t,base\n0e0,1e-1\n1e-2,9.9e-",
+        )
+        .unwrap();
+        std::fs::write(partial_name(&out, "openings.csv"), "row,t\n").unwrap();
+        std::fs::write(out.join("energy.png"), "an earlier run's plot").unwrap();
+        let block = ModelInput::read(Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/examples/models/single_block.toml"
+        )))
+        .unwrap();
+        let options = RunOptions {
+            duration: Some(0.05),
+            ..Default::default()
+        };
+        let summary = prepare(&block, &options).unwrap().run().summary;
+        let full = || std::io::Error::other("No space left on device");
+        let SimulateResult::Failed(_, said) =
+            keep_what_was_written(&out, full(), &summary).expect("the history is kept")
+        else {
+            panic!("a failed run");
+        };
+        assert!(
+            said.contains("No space left on device")
+                && said.contains("kept in history.csv, openings.csv and summary.json"),
+            "{said}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(out.join("history.csv")).unwrap(),
+            "t,base\n0e0,1e-1\n"
+        );
+        assert!(!out.join("energy.png").exists());
+        let kept: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(kept["completed"], false);
+        assert!(kept["error"].as_str().unwrap().contains("No space left"));
+        // Nothing streamed left: the error stands.
+        let empty = out.join("empty");
+        std::fs::create_dir_all(&empty).unwrap();
+        assert!(matches!(
+            keep_what_was_written(&empty, full(), &summary),
+            Err(Error::Output { .. })
+        ));
+        std::fs::remove_dir_all(&out).unwrap();
+    }
 }

@@ -105,10 +105,37 @@ fn rows_that_are_not_the_studys_are_refused_with_their_line() {
             "appears a second time",
         ),
     ];
-    for (tag, text, needle) in cases {
+    // Values crr study never writes in their columns, each in the second row (they were
+    // resumed and plotted as they were).
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let edited = |column: &str, value: &str| {
+        let k = header.iter().position(|h| *h == column).unwrap();
+        let mut row: Vec<&str> = lines[2].split(',').collect();
+        row[k] = value;
+        format!("{}\n{}\n{}\n", lines[0], lines[1], row.join(","))
+    };
+    let mut cases: Vec<(String, String, String)> = cases
+        .into_iter()
+        .map(|(tag, text, needle)| (tag.to_string(), text, needle.to_string()))
+        .collect();
+    for (column, value) in [
+        ("status", "banana"),
+        ("collapse", "7"),
+        ("impacts", "-3"),
+        ("amplitude_m_s2", "inf"),
+        ("residual_rad", "NaN"),
+    ] {
+        cases.push((
+            format!("edited_{column}"),
+            edited(column, value),
+            format!("line 3: `{column}` holds `{value}`"),
+        ));
+    }
+    for (tag, text, needle) in &cases {
+        let (tag, needle) = (tag.as_str(), needle.as_str());
         let out = dir.join(tag);
         std::fs::create_dir_all(&out).unwrap();
-        std::fs::write(out.join("cases.csv"), &text).unwrap();
+        std::fs::write(out.join("cases.csv"), text).unwrap();
         std::fs::copy(
             full.join("study.fingerprint"),
             out.join("study.fingerprint"),
@@ -120,9 +147,17 @@ fn rows_that_are_not_the_studys_are_refused_with_their_line() {
         );
         assert_eq!(
             read(&out.join("cases.csv")),
-            text,
+            *text,
             "{tag}: the file is left as it was"
         );
+        // `crr plot` reads the same rows: the edited values are refused there too.
+        if tag.starts_with("edited_") {
+            std::fs::copy(full.join("study.json"), out.join("study.json")).unwrap();
+            let o = crr(&["plot", out.to_str().unwrap()]);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{tag}: {err}");
+            assert!(err.contains(&needle["line 3: ".len()..]), "{tag}: {err}");
+        }
     }
 }
 
@@ -170,6 +205,17 @@ fn a_merge_needs_every_shard_finished_and_of_one_study() {
     );
     run_ok(&["study", "merge", o1, o2, "--out", m]);
     assert_eq!(read(&merged.join("cases.csv")).lines().count(), 7);
+    // Merging into one of the shards (also written another way) would turn it into a merge:
+    // refused, the shard left as it was.
+    let shard_rows = read(&one.join("cases.csv"));
+    let one_again = format!("{}/../one", two.display());
+    for target in [o1, one_again.as_str()] {
+        refused(
+            &["study", "merge", o1, o2, "--out", target],
+            "it is one of the shards being merged",
+        );
+    }
+    assert_eq!(read(&one.join("cases.csv")), shard_rows);
     // A shard left out.
     refused(
         &[

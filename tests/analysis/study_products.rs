@@ -822,3 +822,49 @@ fn a_study_s_stop_at_violation_ends_each_case_at_its_first_violation() {
     assert!(number(&rows[1][0]) < number(&rows[0][0]), "{rows:?}");
     study_refused(&dir, &text("\"yes\""), "stop_at_violation");
 }
+
+/// What every case of a study shares is checked before any case runs: a study duration beyond
+/// the model's time scales, a model setting that would change the physics, and an initial state
+/// through its support are refused (status 2, naming the file and the item, no cases.csv), where
+/// each failed every case alike (16 error rows, exit 0).
+#[test]
+fn a_study_whose_every_case_would_fail_alike_is_refused_before_any_runs() {
+    let dir = scratch("study_shared_checks");
+    let block = std::fs::read_to_string(models().join("single_block.toml")).unwrap();
+    let seat = write(
+        &dir,
+        "seat.toml",
+        &format!("{block}\n[analysis]\nseat_rate = 100.0\n"),
+    );
+    let tilted = write(
+        &dir,
+        "tilted.toml",
+        &block.replace("angles = { base = 0.1 }", "angles = { base = 7.0 }"),
+    );
+    let plain = models().join("single_block.toml");
+    let study = |model: &Path, extra: &str| {
+        format!(
+            "model = \"{}\"\n{extra}\n[pulses]\nkind = \"one_sine_pulse\"\n\
+             amplitudes = [2.0, 3.0]\nperiods = [0.5, 1.0]\n",
+            model.display()
+        )
+    };
+    for (text, key) in [
+        (
+            study(&plain, "duration = 1e300"),
+            "duration = 1e300 s is more than",
+        ),
+        (study(&seat, ""), "seat_rate = 100 rad/s is not small"),
+        (
+            study(&tilted, "start = \"model\""),
+            "the initial angle of base is 7e0 rad",
+        ),
+    ] {
+        study_refused(&dir, &text, key);
+        assert!(!dir.join("bad").join("cases.csv").exists(), "no case ran");
+    }
+    // The same study from rest with a sound duration runs its four cases.
+    let (out, _) = study_quietly(&dir, "sound", &study(&plain, "duration = 3.0"));
+    let cases = std::fs::read_to_string(out.join("cases.csv")).unwrap();
+    assert_eq!(cases.lines().count(), 5, "{cases}");
+}

@@ -534,3 +534,29 @@ fn a_direction_with_a_part_that_is_no_finite_number_is_refused() {
         );
     }
 }
+
+/// `--friction` is a coefficient from 0 to 1000 (1e300 ended in the statics' solver failing
+/// with exit 0; the largest need the statics report is 1000): outside, refused naming it.
+#[test]
+fn a_friction_outside_zero_to_a_thousand_is_refused() {
+    for mu in ["-0.1", "nan", "inf", "1000.5", "1e300"] {
+        crate::common::refused(
+            &[
+                "check",
+                "examples/models/single_block.toml",
+                &format!("--friction={mu}"),
+            ],
+            &format!(
+                "--friction must be a number from 0 to 1000 (no masonry joint needs more to hold), got {}",
+                mu.parse::<f64>().unwrap()
+            ),
+        );
+    }
+    let o = crate::common::crr(&[
+        "check",
+        "examples/models/single_block.toml",
+        "--friction",
+        "1000",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -252,3 +252,136 @@ fn a_fifo_in_place_of_an_output_file_is_replaced() {
     assert!(run(&["plot", results.to_str().unwrap()]).success());
     assert!(std::fs::metadata(results.join("energy.png")).unwrap().len() > 10_000);
 }
+
+/// A record column at the top of the integers is an error naming the record's line, not an
+/// index overflow (it panicked with exit 101).
+#[test]
+fn a_record_column_beyond_any_line_is_an_error() {
+    let dir = scratch("column");
+    let csv = dir.join("a.csv");
+    std::fs::write(&csv, "time,accel\n0.0,0.0\n0.1,5.0\n0.2,0\n").unwrap();
+    let block =
+        common::bundled_text("single_block").replace("[initial]\nangles = { base = 0.1 }\n", "");
+    for key in ["accel_column", "time_column"] {
+        let model = dir.join(format!("{key}.toml"));
+        std::fs::write(
+            &model,
+            format!(
+                "{block}\n[ground_motion]\nx = {{ record = {{ file = \"a.csv\", format = \"csv\", \
+                 units = \"g\", {key} = 18446744073709551615 }} }}\n[analysis]\nduration = 1.0\n"
+            ),
+        )
+        .unwrap();
+        refused(
+            &[
+                "simulate",
+                model.to_str().unwrap(),
+                "--out",
+                dir.join("out").to_str().unwrap(),
+                "--force",
+            ],
+            "a.csv:2: expected at least 18446744073709551615 columns, found 2",
+        );
+    }
+}
+
+/// An assembly's OBJ file is read like every other input: a device, a folder or a FIFO is
+/// refused (`/dev/zero` exhausted the memory, a FIFO hung `crr assemble`).
+#[cfg(unix)]
+#[test]
+fn an_obj_file_that_is_not_a_regular_file_is_refused() {
+    let dir = scratch("obj_special");
+    let fifo = dir.join("blocks_fifo.obj");
+    let _ = std::fs::remove_file(&fifo);
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut files = vec!["/dev/zero".to_string(), dir.to_str().unwrap().to_string()];
+    if made {
+        files.push(fifo.to_str().unwrap().to_string());
+    }
+    for (k, file) in files.iter().enumerate() {
+        let assembly = dir.join(format!("assembly_{k}.toml"));
+        std::fs::write(
+            &assembly,
+            format!("name = \"a\"\n[[obj]]\nfile = \"{file}\"\ndensity = 2000.0\n"),
+        )
+        .unwrap();
+        refused(
+            &[
+                "assemble",
+                assembly.to_str().unwrap(),
+                "--out",
+                dir.join(format!("model_{k}.toml")).to_str().unwrap(),
+            ],
+            &format!("{file}: not a regular file"),
+        );
+    }
+}
+
+/// A write that fails during a run (here a file size limit, with SIGXFSZ ignored so that writes
+/// past it fail) ends the run; the rows written before are kept under their own names, cut at
+/// their last whole line (a row written in part was left), with a summary.json that says the
+/// run did not complete, and the exit status is a run's failure (1). The kept folder is a
+/// results folder: `crr plot` draws it.
+#[cfg(unix)]
+#[test]
+fn results_written_before_the_disk_fills_are_kept() {
+    let dir = scratch("disk_full");
+    let out = dir.join("out");
+    let model = common::bundled_path("single_block");
+    let script = "trap '' XFSZ; ulimit -f 400; exec \"$0\" simulate \"$1\" --out \"$2\" \
+                  --duration 100000 --force --quiet";
+    let o = Command::new("sh")
+        .args([
+            "-c",
+            script,
+            env!("CARGO_BIN_EXE_crr"),
+            model.to_str().unwrap(),
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    // A size limit per file: the run stops on the history's write, and the small files after
+    // it are written (a disk with no room left at all is `keep_what_was_written`'s, whose unit
+    // test cuts every write).
+    assert!(
+        err.contains("cannot write the history: File too large")
+            && err.contains("partial results written to"),
+        "{err}"
+    );
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert!(history.ends_with('\n'), "cut at a whole line");
+    let width = history.lines().next().unwrap().split(',').count();
+    let rows: Vec<&str> = history.lines().skip(1).collect();
+    assert!(rows.len() > 100, "{} rows kept", rows.len());
+    for row in &rows {
+        assert_eq!(row.split(',').count(), width, "{row}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["completed"], false);
+    assert!(
+        summary["error"]
+            .as_str()
+            .unwrap()
+            .contains("cannot write the history"),
+        "{summary}"
+    );
+    let hidden: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".partial."))
+        .map(|e| e.file_name())
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+    let plotted = crr(&["plot", out.to_str().unwrap()]);
+    assert!(
+        plotted.status.success(),
+        "{}",
+        String::from_utf8_lossy(&plotted.stderr)
+    );
+}

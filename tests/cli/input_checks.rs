@@ -135,3 +135,220 @@ fn sizes_that_overflow_the_mass_properties_are_named_as_such() {
         "body \"block\": its mass properties are not finite",
     );
 }
+
+/// Names whose output columns collide are refused, naming both interfaces (a hinge `x.1` beside
+/// a rocking base `x` gave two coordinates `x.1`, `[initial]` took the first silently, and
+/// interfaces named `t`, `kinetic`, `base_rate` or `base_state` doubled history.csv's columns).
+#[test]
+fn names_whose_output_columns_collide_are_refused() {
+    let block = bundled("single_block");
+    for (name, needle) in [
+        (
+            "t",
+            "its output column \"t\" is also a column of the history of its own",
+        ),
+        ("kinetic", "its output column \"kinetic\" is also a column"),
+        ("dissipated_rate", "\"dissipated_rate\""),
+    ] {
+        let p = write(
+            &format!("collide_{name}.toml"),
+            &block
+                .replace("name = \"base\"", &format!("name = \"{name}\""))
+                .replace(
+                    "angles = { base = 0.1 }",
+                    &format!("angles = {{ {name} = 0.1 }}"),
+                ),
+        );
+        let o = crr(&["inspect", p.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        if name == "dissipated_rate" {
+            // No fixed column is `dissipated_rate`: the name is free.
+            assert!(o.status.success(), "{err}");
+            continue;
+        }
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(needle), "{name}: {err}");
+    }
+    // Two blocks: a hinge `x.1` under a rocking base `x` (whose tilts are `x.1`, `x.2`), and a
+    // hinge `base_rate` over a hinge `base` (`base`'s rate column is `base_rate`).
+    let stack = |lower: &str, upper: &str, upper_kind: &str| {
+        format!(
+            "name = \"stack\"\ngravity = 9.81\n\
+             [[body]]\nname = \"a\"\ndensity = 2500.0\nbox = {{ center = [0.0, 0.0, 0.5], size = [0.4, 0.4, 1.0] }}\n\
+             [[body]]\nname = \"b\"\ndensity = 2500.0\nbox = {{ center = [0.0, 0.0, 1.5], size = [0.4, 0.4, 1.0] }}\n\
+             [[interface]]\nname = \"{lower}\"\nparent = \"ground\"\nchild = \"a\"\naxis = [0.0, 1.0, 0.0]\n\
+             pivot_positive = [0.2, 0.0, 0.0]\npivot_negative = [-0.2, 0.0, 0.0]\n\
+             [[interface]]\nname = \"{upper}\"\nparent = \"a\"\nchild = \"b\"\n{upper_kind}\n"
+        )
+    };
+    let hinge = "axis = [0.0, 1.0, 0.0]\npivot_positive = [0.2, 0.0, 1.0]\npivot_negative = [-0.2, 0.0, 1.0]";
+    let base = "rocking_base = { corners = [[0.2, -0.2, 1.0], [0.2, 0.2, 1.0], [-0.2, 0.2, 1.0], [-0.2, -0.2, 1.0]] }";
+    for (tag, text, needle) in [
+        (
+            "dot",
+            stack("x.1", "x", base),
+            "interface \"x\": its output column \"x.1\" is also interface \"x.1\"'s",
+        ),
+        (
+            "rate",
+            stack("base", "base_rate", hinge),
+            "interface \"base_rate\": its output column \"base_rate\" is also interface \"base\"'s",
+        ),
+        (
+            "state",
+            stack("base", "base_state", hinge),
+            "interface \"base_state\": its output column \"base_state\" is also interface \"base\"'s",
+        ),
+    ] {
+        let p = write(&format!("collide_{tag}.toml"), &text);
+        refused(&["inspect", p.to_str().unwrap()], needle);
+    }
+    // The same stack with names that do not collide is a valid model.
+    let p = write("collide_none.toml", &stack("x", "y", base));
+    assert!(crr(&["inspect", p.to_str().unwrap()]).status.success());
+}
+
+/// Densities and gravities far outside any material's and planet's are refused naming the item:
+/// the mass was a finite number but the weight overflowed (1e308 kg/m³ wrote U = NaN into the
+/// history and `crr check` printed p = inf with exit 0), or the tolerances derived from √(L/g)
+/// blamed a setting the user never gave (gravity 1e-6 m/s² blamed `seat_rate`).
+#[test]
+fn densities_and_gravities_outside_any_material_or_planet_are_refused() {
+    let block = bundled("single_block");
+    for (tag, text, needle) in [
+        (
+            "dense",
+            block.replace("density = 2500.0", "density = 1e308"),
+            "body \"block\": its density 1e308 kg/m³ is outside 1e-12…1e9 kg/m³",
+        ),
+        (
+            "light",
+            block.replace("density = 2500.0", "density = 1e-320"),
+            "body \"block\": its density",
+        ),
+        (
+            "mass",
+            block.replace("density = 2500.0", "mass = 1e306"),
+            "body \"block\": its density (its mass over its volume)",
+        ),
+        (
+            "weak",
+            block.replace("gravity = 9.81", "gravity = 1e-6"),
+            "gravity: 1e-6 m/s² is outside 1e-2…1e3 m/s²",
+        ),
+        (
+            "strong",
+            block.replace("gravity = 9.81", "gravity = 1e300"),
+            "gravity: 1e300 m/s² is outside",
+        ),
+    ] {
+        let p = write(&format!("range_{tag}.toml"), &text);
+        for command in ["inspect", "check"] {
+            refused(&[command, p.to_str().unwrap()], needle);
+        }
+    }
+    // Either end of the ranges is a model (osmium is 22 590 kg/m³, the Moon's gravity 1.62).
+    for (tag, text) in [
+        (
+            "osmium",
+            block.replace("density = 2500.0", "density = 22590.0"),
+        ),
+        ("moon", block.replace("gravity = 9.81", "gravity = 1.62")),
+    ] {
+        let p = write(&format!("range_{tag}.toml"), &text);
+        assert!(
+            crr(&["inspect", p.to_str().unwrap()]).status.success(),
+            "{tag}"
+        );
+    }
+}
+
+/// A hinge axis is a direction whatever its length: [0, 1e160, 0] (whose norm overflows) and
+/// [0, 1e-200, 0] (whose norm underflows) give the same model as [0, 1, 0] (inspect's report,
+/// M(q) and U included, identical but for the name), where they gave a NaN axis and "the zero
+/// vector".
+#[test]
+fn a_hinge_axis_of_any_length_is_its_direction() {
+    let block = bundled("single_block");
+    let report = |text: &str, tag: &str| {
+        let p = write(&format!("axis_{tag}.toml"), text);
+        let o = crr(&["inspect", p.to_str().unwrap(), "--json", "--q", "base=0.1"]);
+        assert!(
+            o.status.success(),
+            "{tag}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let unit = report(&block, "unit");
+    for (tag, axis) in [
+        ("long", "[0.0, 1e160, 0.0]"),
+        ("short", "[0.0, 1e-200, 0.0]"),
+    ] {
+        let scaled = report(
+            &block.replace("axis = [0.0, 1.0, 0.0]", &format!("axis = {axis}")),
+            tag,
+        );
+        assert_eq!(scaled, unit, "{tag}");
+    }
+}
+
+/// Initial rates so large that the kinetic energy overflows are refused naming them (a rate of
+/// 1e200 rad/s wrote kinetic = inf into history.csv with exit 0).
+#[test]
+fn initial_rates_whose_energy_overflows_are_refused() {
+    let block = bundled("single_block");
+    let p = write(
+        "rate_huge.toml",
+        &block.replace(
+            "angles = { base = 0.1 }",
+            "angles = { base = 0.1 }\nrates = { base = 1e200 }",
+        ),
+    );
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/rate_out");
+    refused(
+        &[
+            "simulate",
+            p.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ],
+        "initial.rates: the kinetic energy of the initial state is inf J",
+    );
+}
+
+/// Ground accelerations beyond any ground motion are refused naming the component: a constant
+/// 1e308 m/s² (finite) made every force infinite and the block stayed at rest with exit 0, as
+/// did a rectangular pulse of that amplitude and a record scaled by 1e308.
+#[test]
+fn ground_accelerations_beyond_any_ground_motion_are_refused() {
+    let block = bundled("single_block").replace("[initial]\nangles = { base = 0.1 }\n", "");
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/accel_out");
+    for (tag, component) in [
+        ("constant", "x = { constant = { value = 1e308 } }"),
+        (
+            "pulse",
+            "x = { rectangular_pulse = { amplitude = -1e308, duration = 0.1, start = 0.5 } }",
+        ),
+        (
+            "scaled",
+            "x = { sine = { amplitude = 1e300, period = 0.5 }, scale = 1e300 }",
+        ),
+    ] {
+        let p = write(
+            &format!("accel_{tag}.toml"),
+            &format!("{block}\n[ground_motion]\n{component}\n[analysis]\nduration = 1.0\n"),
+        );
+        refused(
+            &[
+                "simulate",
+                p.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--force",
+            ],
+            "ground_motion.x: its peak acceleration",
+        );
+    }
+}

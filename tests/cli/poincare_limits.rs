@@ -49,6 +49,30 @@ fn sizes_beyond_the_limits_are_refused_before_running() {
             ],
             ["100000 case(s) × --periods 1000", "10000000"],
         ),
+        (
+            // 10⁷ periods at 2 Hz: 5e6 s per run, beyond 1e7 times the block's time scale
+            // √(L/g) = 0.3193 s (it failed as a run stopping early, exit 1).
+            vec![
+                "--periods",
+                "9999999",
+                "--frequency",
+                "2",
+                "--amplitude",
+                "3",
+            ],
+            ["each run would last 5", "(transient + periods) / F"],
+        ),
+        (
+            vec![
+                "--section",
+                "base",
+                "--duration",
+                "1e300",
+                "--amplitude",
+                "0",
+            ],
+            ["each run would last 1e300 s", "--duration"],
+        ),
     ] {
         let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("poincare_limits");
         let mut a = vec!["poincare", "examples/models/single_block.toml", "--out"];

@@ -304,11 +304,11 @@ fn settings_beyond_the_physics_are_refused_and_a_loose_rtol_warns() {
 fn a_history_of_gigabytes_is_announced_before_the_run() {
     use std::io::{BufRead, BufReader};
     use std::process::{Command, Stdio};
-    // output_interval = 1e-9 s over 10 s: 1e10 rows of about 0.3 kB. The warning must come
+    // output_interval = 2e-8 s over 10 s: 5e8 rows of about 0.2 kB. The warning must come
     // before the run writes them, so the user can stop it; the run is killed after it.
     let dir = scratch("gigabytes");
     let model = dir.join("model.toml");
-    std::fs::write(&model, single_block_with("output_interval = 1e-9")).unwrap();
+    std::fs::write(&model, single_block_with("output_interval = 2e-8")).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_crr"))
         .args(["simulate", model.to_str().unwrap(), "--quiet", "--out"])
         .arg(dir.join("out"))
@@ -330,10 +330,28 @@ fn a_history_of_gigabytes_is_announced_before_the_run() {
     child.wait().unwrap();
     let line = line.expect("crr printed nothing on stderr within the hang guard");
     assert!(
-        line.starts_with("crr: warning: the history will hold about 1.000e10 rows")
+        line.starts_with("crr: warning: the history will hold about 5.000e8 rows")
             && line.contains("raise output_interval"),
         "{line}"
     );
+    // Beyond 1e9 rows the run is refused before it starts (1e-300 s wrote 880 MB in 10 s).
+    for interval in ["1e-9", "1e-300"] {
+        let model = dir.join(format!("refused_{interval}.toml"));
+        std::fs::write(
+            &model,
+            single_block_with(&format!("output_interval = {interval}")),
+        )
+        .unwrap();
+        common::refused(
+            &[
+                "simulate",
+                model.to_str().unwrap(),
+                "--out",
+                dir.join("refused").to_str().unwrap(),
+            ],
+            &format!("output_interval = {interval} s over the duration 10 s makes"),
+        );
+    }
     // The size is that of the file such a run writes: the bundled block's history at 0.01 s.
     let (summary, err) = run("history_size", &single_block_with(""), &["--quiet"]);
     assert!(!err.contains("the history will hold"), "{err}");

@@ -796,6 +796,19 @@ pub fn solve_initial(model: &Model, spec: &InitialSpec) -> Result<InitialState, 
             )));
         }
     }
+    // Rates so large that T overflows (1e155 rad/s on a 2 m block) would write an infinite
+    // energy into the results: refused here, naming the rates.
+    let energy = crate::energy::energies(model, &mut kin, &q, &qdot, &pivots, 0.0);
+    if !(energy.kinetic.is_finite() && energy.potential.is_finite()) {
+        let (what, energy) = if energy.kinetic.is_finite() {
+            ("initial.angles: the potential energy", energy.potential)
+        } else {
+            ("initial.rates: the kinetic energy", energy.kinetic)
+        };
+        return Err(DynamicsError::Initial(format!(
+            "{what} of the initial state is {energy} J, not a finite number"
+        )));
+    }
     Ok(InitialState { q, qdot, pivots })
 }
 

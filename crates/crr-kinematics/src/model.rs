@@ -404,6 +404,25 @@ fn build_body(spec: &BodySpec) -> Result<Body, ModelError> {
             }
         });
     }
+    let (low, high) = DENSITY_RANGE;
+    for (k, d) in densities.iter().enumerate() {
+        if !(low..=high).contains(d) {
+            let which = if spec.is_compound() {
+                format!("block {}'s density", k + 1)
+            } else if spec.mass.is_some() {
+                "density (its mass over its volume)".to_string()
+            } else {
+                "density".to_string()
+            };
+            return Err(ModelError::new(
+                item,
+                format!(
+                    "its {which} {d:e} kg/m³ is outside {low:e}…{high:e} kg/m³ (stone is about \
+                     2500; check the units: kg, m, kg/m³)"
+                ),
+            ));
+        }
+    }
     // Sums over the parts (parallel-axis theorem): m = Σ ρₖVₖ, c = Σ ρₖVₖcₖ / m,
     // S = Σ ρₖ (Sₖ + Vₖ (cₖ − c)(cₖ − c)ᵀ).
     let mass: f64 = parts
@@ -562,14 +581,16 @@ fn hinge_kind(
         .axis
         .ok_or_else(|| ModelError::new(item, "a hinge needs an axis (or give a rocking_base)"))?;
     let axis = finite3(&axis, item, "axis")?;
-    let n = axis.norm();
-    if n == 0.0 {
+    // Divided by its largest component first: the norm of [0, 1e160, 0] overflows and that of
+    // [0, 1e-200, 0] underflows, while any non-zero length is a direction.
+    let largest = axis.amax();
+    if largest == 0.0 {
         return Err(ModelError::new(
             format!("{item} (axis)"),
             "the axis is the zero vector",
         ));
     }
-    let axis = axis / n;
+    let axis = (axis / largest).normalize();
     let pp = spec
         .pivot_positive
         .as_ref()
@@ -1179,6 +1200,18 @@ fn check_impact_law(law: &ImpactLaw, item: &str) -> Result<(), ModelError> {
     }
 }
 
+/// Gravities a model may have, m/s²: every planet's and moon's surface gravity with margin on
+/// both sides. Far outside, the run's tolerances, set against the time scale √(L/g), blame
+/// settings the user never gave (1e-6 m/s² was reported as a `seat_rate` too large).
+pub const GRAVITY_RANGE: (f64, f64) = (1e-2, 1e3);
+
+/// Densities a body or block may have, kg/m³: far beyond every material on both sides (osmium
+/// is 22 590; a nearly massless member, as in a test of a limit, stays allowed), while the
+/// weight, the inertia and their products stay far from overflow and underflow in the equations
+/// of motion (1e308 kg/m³ gave U = inf where the mass was still a finite number, and 1e-320 a
+/// NaN frequency).
+pub const DENSITY_RANGE: (f64, f64) = (1e-12, 1e9);
+
 /// An interface's two ends and its kind, before the chain is built.
 type InterfaceEnds = (Parent, usize, InterfaceKind);
 
@@ -1188,6 +1221,17 @@ fn check_structure(spec: &StructureSpec) -> Result<(), ModelError> {
         return Err(ModelError::new(
             "gravity",
             format!("must be a positive number of m/s², got {}", spec.gravity),
+        ));
+    }
+    let (low, high) = GRAVITY_RANGE;
+    if !(low..=high).contains(&spec.gravity) {
+        return Err(ModelError::new(
+            "gravity",
+            format!(
+                "{:e} m/s² is outside {low:e}…{high:e} m/s² (Earth's is 9.81; check the units: \
+                 m/s²)",
+                spec.gravity
+            ),
         ));
     }
     if spec.body.is_empty() {
@@ -1366,8 +1410,52 @@ fn build_interfaces(
         check_impact_law(&i.impact, &item)?;
         ends.push((parent, child, kind));
     }
-
+    check_history_columns(spec, &ends)?;
     Ok(ends)
+}
+
+/// The columns of the history (docs/outputs.md) besides the interfaces' own.
+const FIXED_COLUMNS: [&str; 5] = ["t", "kinetic", "potential", "work_in", "dissipated"];
+
+/// The history's columns must be distinct: each interface takes its coordinates (its name, or
+/// `<name>.1` and `<name>.2`), their rates `<coordinate>_rate` and its state `<name>_state`
+/// (whether it closes a loop or not, so that no choice of the chain makes two columns one).
+/// Names that collide (a hinge `x.1` beside a rocking base `x`, an interface `kinetic`, or
+/// `base_rate` beside `base`) would make two coordinates one name for `[initial]` and two
+/// columns one for whatever reads the file.
+fn check_history_columns(spec: &StructureSpec, ends: &[InterfaceEnds]) -> Result<(), ModelError> {
+    let mut owner: HashMap<String, Option<usize>> = FIXED_COLUMNS
+        .iter()
+        .map(|c| (c.to_string(), None))
+        .collect();
+    for (k, (i, (_, _, kind))) in spec.interface.iter().zip(ends).enumerate() {
+        let count = kind.angle_count();
+        let coordinates: Vec<String> = (0..count)
+            .map(|comp| coordinate_name(&i.name, count, comp))
+            .collect();
+        let columns = coordinates
+            .iter()
+            .cloned()
+            .chain(coordinates.iter().map(|c| format!("{c}_rate")))
+            .chain(std::iter::once(format!("{}_state", i.name)));
+        for column in columns {
+            if let Some(previous) = owner.insert(column.clone(), Some(k)) {
+                let other = match previous {
+                    Some(j) => format!("interface \"{}\"'s", spec.interface[j].name),
+                    None => "a column of the history of its own".to_string(),
+                };
+                return Err(ModelError::new(
+                    quoted("interface", &i.name),
+                    format!(
+                        "its output column \"{column}\" is also {other}: rename one (the \
+                         history's columns are t, each coordinate, its _rate, kinetic, potential, \
+                         work_in, dissipated and each interface's _state)"
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The spanning tree, breadth first from the ground along parent → child: the tree interfaces

@@ -314,6 +314,7 @@ impl Study {
             &initial_spec,
             axis,
         )?;
+        check_what_every_case_shares(&spec, path, &params, &variants)?;
         let sized = spec.scales.is_some();
         let mut study = Study {
             spec: spec.clone(),
@@ -634,6 +635,34 @@ fn mechanism_scales(model: &Model, axis: Axis) -> Option<(f64, f64, f64)> {
 }
 
 /// The model at every scale of the study (one variant, the model itself, without `scales`).
+/// What every case shares is checked once, before any case runs or a file is written: the
+/// initial state of each model variant and the settings against its scales (the study's own
+/// duration where it gives one). Each used to fail every case alike, one error row per case and
+/// exit 0 (a study duration of 1e300 s, a model's seat_rate of 100 rad/s, an initial angle of
+/// 7 rad).
+fn check_what_every_case_shares(
+    spec: &StudySpec,
+    path: &Path,
+    params: &Parameters,
+    variants: &[Variant],
+) -> Result<(), Error> {
+    let mut shared = params.clone();
+    // Without the study's duration each case's comes from its ground motion (checked there).
+    shared.duration = spec.duration.unwrap_or(0.0);
+    for v in variants {
+        let which = if spec.scales.is_some() {
+            format!("model {} scaled by {}", spec.model.display(), v.scale)
+        } else {
+            format!("model {}", spec.model.display())
+        };
+        crr_impact::simulation::check_initial_state(&v.model, &v.initial)
+            .map_err(|e| bad(path, format!("{which}: {e}")))?;
+        crr_impact::simulation::check_physical_bounds(&v.model, &shared)
+            .map_err(|e| bad(path, format!("{which}: {e}")))?;
+    }
+    Ok(())
+}
+
 fn variants(
     spec: &StudySpec,
     path: &Path,

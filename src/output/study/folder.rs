@@ -375,9 +375,10 @@ fn checked_row<'a>(
     path: &Path,
     number: usize,
     body: &'a str,
-    fields: usize,
+    header: &str,
     seen: impl Fn(&str) -> bool,
 ) -> Result<&'a str, Error> {
+    let fields = field_count(header);
     let bad = |what: String| {
         Error::Argument(format!(
             "{}: line {number}: {what}; the file is damaged or was written by another program \
@@ -393,7 +394,32 @@ fn checked_row<'a>(
     if seen(id) {
         return Err(bad(format!("case {id} appears a second time")));
     }
+    let columns = super::products::split_csv(header);
+    let values = super::products::split_csv(body);
+    if let Some(why) = columns
+        .iter()
+        .zip(&values)
+        .find_map(|(column, value)| invalid_field(column, value))
+    {
+        return Err(bad(why));
+    }
     Ok(id)
+}
+
+/// Why `value` cannot be in the column `column` of a `cases.csv` as `crr study` writes it, if it
+/// cannot: `status` is `ok` or `error`, `collapse` 0 or 1 (or empty), `impacts` a count, and
+/// every other column but the id and the texts (`record`, `violation`, `violation_interface`,
+/// `error`) empty or a finite number. (A row edited to `status = banana`, `collapse = 7`, a NaN
+/// peak or an infinite amplitude was resumed and plotted as it was.)
+pub(crate) fn invalid_field(column: &str, value: &str) -> Option<String> {
+    let valid = match column {
+        "id" | "record" | "violation" | "violation_interface" | "error" => true,
+        "status" => matches!(value, "ok" | "error"),
+        "collapse" => matches!(value, "" | "0" | "1"),
+        "impacts" => value.is_empty() || value.parse::<u64>().is_ok(),
+        _ => value.is_empty() || value.parse::<f64>().is_ok_and(f64::is_finite),
+    };
+    (!valid).then(|| format!("`{column}` holds `{value}`, which crr study does not write there"))
 }
 
 /// The ids of the complete rows of an existing `cases.csv` (a row is complete when its line ends
@@ -431,9 +457,7 @@ fn done_rows(path: &Path, header: &str) -> Result<(BTreeMap<String, String>, u64
             }
             first = false;
         } else {
-            let id = checked_row(path, number + 1, body, field_count(header), |id| {
-                rows.contains_key(id)
-            })?;
+            let id = checked_row(path, number + 1, body, header, |id| rows.contains_key(id))?;
             rows.insert(id.to_string(), body.to_string());
         }
         complete += line.len() as u64;
@@ -667,6 +691,20 @@ fn is_case_id(id: &str, total: usize) -> bool {
 /// `crr study merge`: joins the `cases.csv` of shard folders into `out` (rows by id; the same id
 /// twice must be the same row), checking that they come from the same study.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
+    // The merged folder replaces its files: merging into one of the shards would turn that
+    // shard into a merge, and a later merge of the shards would no longer find it.
+    let same_folder =
+        |a: &Path, b: &Path| match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => a == b,
+        };
+    if let Some(shard) = dirs.iter().find(|d| same_folder(d, out)) {
+        return Err(Error::Argument(format!(
+            "--out {}: it is one of the shards being merged ({}); merge into another folder",
+            out.display(),
+            shard.display()
+        )));
+    }
     let mut header: Option<String> = None;
     let mut study: Option<serde_json::Value> = None;
     let mut first_json: Option<serde_json::Value> = None;
@@ -723,7 +761,6 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
         shards.push(shard_of(&json, &json_path)?);
         let mut lines = text.lines();
         let h = lines.next().unwrap_or_default().to_string();
-        let fields = field_count(&h);
         match &header {
             None => header = Some(h),
             Some(x) if *x != h => {
@@ -738,7 +775,8 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
         let in_study = json["cases_in_study"].as_u64().map(|n| n as usize);
         let mut in_file = std::collections::BTreeSet::new();
         for (number, line) in lines.enumerate() {
-            let id = checked_row(&csv, number + 2, line, fields, |id| in_file.contains(id))?;
+            let columns = header.as_deref().expect("set by the first folder");
+            let id = checked_row(&csv, number + 2, line, columns, |id| in_file.contains(id))?;
             if let Some(total) = in_study
                 && !is_case_id(id, total)
             {

@@ -163,6 +163,13 @@ impl StudyResults {
                     header.len()
                 )));
             }
+            if let Some(why) = header
+                .iter()
+                .zip(&f)
+                .find_map(|(column, value)| super::folder::invalid_field(column, value))
+            {
+                return Err(bad(format!("row {}: {why}", n + 2)));
+            }
             let num = |i: Option<usize>| i.and_then(|i| f[i].parse::<f64>().ok());
             if f[status] != "ok" {
                 errors += 1;

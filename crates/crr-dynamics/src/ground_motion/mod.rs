@@ -139,6 +139,28 @@ fn finite(context: &str, field: &str, value: f64) -> Result<f64, GroundMotionErr
     }
 }
 
+/// Largest peak ground acceleration a component may have, m/s² (about 1e5 g, five orders
+/// above the strongest records): finite accelerations beyond it overflow the forces they drive
+/// (a constant 1e308 m/s² made every generalized force infinite, and the uplift test, comparing
+/// NaN, left the block at rest).
+pub const MAX_GROUND_ACCELERATION: f64 = 1e6;
+
+/// The component `signal` × `scale`, refused where its peak is not finite or beyond
+/// [`MAX_GROUND_ACCELERATION`].
+fn bounded(context: &str, signal: Signal, scale: f64) -> Result<Component, GroundMotionError> {
+    let peak = scale.abs() * signal.peak();
+    if peak.is_nan() || peak > MAX_GROUND_ACCELERATION {
+        return Err(spec_error(
+            context,
+            format!(
+                "its peak acceleration |scale| × peak = {peak:e} m/s² is beyond any ground motion \
+                 (at most {MAX_GROUND_ACCELERATION:e} m/s², about 1e5 g)"
+            ),
+        ));
+    }
+    Ok(Component::new(signal, scale))
+}
+
 fn positive(context: &str, field: &str, value: f64) -> Result<f64, GroundMotionError> {
     let value = finite(context, field, value)?;
     if value > 0.0 {
@@ -336,7 +358,7 @@ impl GroundMotion {
                 error: Box::new(other),
             },
         })?;
-        self.components[axis.index()] = Some(Component::new(signal, scale));
+        self.components[axis.index()] = Some(bounded(&component_ctx, signal, scale)?);
         Ok(self)
     }
 
@@ -353,8 +375,9 @@ impl GroundMotion {
         record: Record,
         scale: f64,
     ) -> Result<Self, GroundMotionError> {
-        finite(&format!("ground_motion.{axis}"), "scale", scale)?;
-        self.components[axis.index()] = Some(Component::new(Signal::Record(record), scale));
+        let context = format!("ground_motion.{axis}");
+        finite(&context, "scale", scale)?;
+        self.components[axis.index()] = Some(bounded(&context, Signal::Record(record), scale)?);
         Ok(self)
     }
 

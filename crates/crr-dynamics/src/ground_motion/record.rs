@@ -561,7 +561,12 @@ pub fn parse_table(
             ),
         });
     }
-    let needed = options.time_column.max(options.accel_column) + 1;
+    // Saturating: a column index of usize::MAX asks for more columns than any line has (the
+    // error below), not for an overflow.
+    let needed = options
+        .time_column
+        .max(options.accel_column)
+        .saturating_add(1);
     let mut times: Vec<f64> = Vec::new();
     let mut accel: Vec<f64> = Vec::new();
     let mut previous_line = 0usize;

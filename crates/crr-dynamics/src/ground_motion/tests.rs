@@ -227,6 +227,30 @@ fn a_byte_order_mark_keeps_the_first_sample() {
     assert_eq!(marked.times().collect::<Vec<_>>(), vec![0.0, 0.01, 0.02]);
 }
 
+/// A column index at the top of the integers (a typo or a script's -1) is an error naming the
+/// line, not an overflow: for each of the time and acceleration columns, in CSV and text.
+#[test]
+fn a_column_beyond_any_line_is_an_error() {
+    for format in [RecordFormat::Csv, RecordFormat::Text] {
+        for time_column in [true, false] {
+            let mut opts = TableOptions::new(format, Units::MetersPerSecondSquared);
+            if time_column {
+                opts.time_column = usize::MAX;
+            } else {
+                opts.accel_column = usize::MAX;
+            }
+            let text = match format {
+                RecordFormat::Csv => "0,1\n0.1,2\n",
+                _ => "0 1\n0.1 2\n",
+            };
+            assert_eq!(
+                err_string(parse_table(text, "a.csv", &opts)),
+                format!("a.csv:1: expected at least {} columns, found 2", usize::MAX)
+            );
+        }
+    }
+}
+
 #[test]
 fn table_errors() {
     let opts = TableOptions::new(RecordFormat::Csv, Units::MetersPerSecondSquared);
@@ -648,6 +672,48 @@ fn invalid_parameters_name_component_and_field() {
     assert_eq!(
         err_string(GroundMotion::none().with_component(Axis::X, &scaled, base)),
         "ground_motion.x: scale must be finite, got inf"
+    );
+}
+
+/// Accelerations whose peak overflows, or is finite but beyond any ground motion, are refused
+/// naming the component (a constant 1e308 m/s² used to leave a block at rest: its forces were
+/// infinite and the uplift test compared NaN); the bound itself is accepted, and a record's
+/// peak counts with its scale.
+#[test]
+fn accelerations_beyond_any_ground_motion_are_refused() {
+    let base = Path::new(".");
+    let build = |signal: SignalSpec, scale: f64| {
+        GroundMotion::none().with_component(Axis::X, &ComponentSpec { signal, scale }, base)
+    };
+    let constant = |value: f64| SignalSpec::Constant(ConstantSpec { value });
+    let pulse = SignalSpec::RectangularPulse(RectangularPulseSpec {
+        amplitude: -1e308,
+        duration: 0.1,
+        start: 0.5,
+    });
+    for (signal, scale) in [
+        (constant(1e308), 1.0),
+        (pulse, 1.0),
+        (sine(1e300, 0.5, 0.0, None, 0.0), 1e300),
+        (constant(1.0), 1.000001e6),
+    ] {
+        let e = err_string(build(signal, scale));
+        assert!(
+            e.starts_with("ground_motion.x: its peak acceleration") && e.contains("at most 1e6"),
+            "{e}"
+        );
+    }
+    let at_bound = build(constant(-1.0), MAX_GROUND_ACCELERATION).expect("the bound is allowed");
+    assert_eq!(at_bound.pga().x, MAX_GROUND_ACCELERATION);
+    let record = read_table(
+        &data("accel_cm.csv"),
+        &TableOptions::new(RecordFormat::Csv, Units::CentimetersPerSecondSquared),
+    )
+    .expect("the test record");
+    let e = err_string(GroundMotion::from_record(Axis::Y, record, 1e308));
+    assert!(
+        e.starts_with("ground_motion.y: its peak acceleration"),
+        "{e}"
     );
 }
 
