@@ -220,6 +220,20 @@ pub fn prepare(input: &ModelInput, options: &RunOptions) -> Result<Prepared, Err
     // is written (not a failed run with partial results).
     crr_impact::simulation::check_physical_bounds(&input.model, &params)
         .map_err(|e| here(e.to_string()))?;
+    if let Some(time_scale) = ground.time_scale() {
+        let cycles = params.duration / time_scale;
+        if cycles.is_nan() || cycles > MAX_GROUND_CYCLES {
+            return Err(here(format!(
+                "ground motion: its shortest time scale {time_scale:e} s (a period, or 1/f of a \
+                 Ricker wavelet) fits {cycles:.3e} times in the run's {} s, more than \
+                 {MAX_GROUND_CYCLES:e}: the uplift test samples each {} times while joints are \
+                 seated (a 1e9 Hz sine would take hours for 2 s); lower the frequency or the \
+                 duration",
+                params.duration,
+                crr_impact::simulation::SEATED_SAMPLES_PER_PERIOD
+            )));
+        }
+    }
     let rows = (params.duration / params.output_interval).floor() + 1.0;
     if rows.is_nan() || rows > MAX_HISTORY_ROWS {
         return Err(here(format!(
@@ -453,6 +467,11 @@ pub const RK4_STEP_WARNING: f64 = 0.05;
 
 /// A simultaneity tolerance larger than this fraction of the smallest slenderness α is a warning.
 pub const SIMULTANEITY_WARNING: f64 = 1e-2;
+
+/// The most periods of its ground motion's shortest time scale a run may span (a period, or
+/// 1/f of a Ricker wavelet): the seated test samples each 32 times, so 1e6 of them are some
+/// 3e7 tests (a sine of 1e5 Hz for 2 s, 2e5 periods, runs in about 3 s).
+pub const MAX_GROUND_CYCLES: f64 = 1e6;
 
 /// The most rows a run's history may have (one per output interval): beyond, the run is
 /// refused before it starts, as a history of tens of gigabytes fills a disk and never ends.

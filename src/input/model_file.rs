@@ -155,6 +155,9 @@ fn array_length_error(v: &serde_json::Value, at: &str) -> Option<String> {
                 ("coordinates", Some(a)) if at.starts_with("symmetry") && a.len() != 2 => {
                     bad(&here, a.len(), "2")
                 }
+                // An empty list of points is left to the shape's or face's own check, which
+                // says how many points it needs (it read as a vector of 0 values, "3 expected").
+                ("corners" | "vertices" | "polygon", Some(a)) if a.is_empty() => None,
                 (key, Some(a)) if VECTOR_KEYS.contains(&key) => {
                     if is_vector(x) {
                         (a.len() != 3).then(|| bad(&here, a.len(), "3")).flatten()

@@ -868,3 +868,25 @@ fn a_study_whose_every_case_would_fail_alike_is_refused_before_any_runs() {
     let cases = std::fs::read_to_string(out.join("cases.csv")).unwrap();
     assert_eq!(cases.lines().count(), 5, "{cases}");
 }
+
+/// Sa(T₁) is taken at periods from 1e-3 to 1e3 s: outside, refused naming the key before any
+/// case (a period of 1e-300 s hung before the first case).
+#[test]
+fn a_spectral_period_outside_any_use_is_refused() {
+    let dir = scratch("study_sa_period");
+    let model = models().join("single_block.toml");
+    let record = models().join("../records/synthetic.AT2");
+    for period in ["1e-300", "1e-4", "1e4"] {
+        let text = format!(
+            "model = \"{}\"\n[records]\nfiles = [\"{}\"]\nformat = \"peer-at2\"\n\
+             [intensity]\nsa = {{ period = {period}, levels = [0.2] }}\n",
+            model.display(),
+            record.display()
+        );
+        study_refused(
+            &dir,
+            &text,
+            "intensity.sa.period must be from 0.001 to 1000 s",
+        );
+    }
+}

@@ -352,3 +352,75 @@ fn ground_accelerations_beyond_any_ground_motion_are_refused() {
         );
     }
 }
+
+/// A ground motion whose period (or a Ricker wavelet's 1/f) fits more than 1e6 times in the run
+/// is refused before it starts, naming it: the uplift test samples each period 32 times while
+/// joints are seated, and a 1e9 Hz sine over 2 s took hours (a Ricker of 1e10 Hz did not pass
+/// 2e-4 s in 30 s).
+#[test]
+fn a_ground_motion_faster_than_any_run_can_sample_is_refused() {
+    let block = bundled("single_block").replace("[initial]\nangles = { base = 0.1 }\n", "");
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/cycles_out");
+    for (tag, component, fits) in [
+        (
+            "sine",
+            "x = { sine = { amplitude = 1.0, frequency = 1e9 } }",
+            "2.000e9",
+        ),
+        (
+            "ricker",
+            "x = { ricker = { amplitude = 5.0, frequency = 1e10, center = 1.0 } }",
+            "2.000e10",
+        ),
+    ] {
+        let p = write(
+            &format!("cycles_{tag}.toml"),
+            &format!("{block}\n[ground_motion]\n{component}\n[analysis]\nduration = 2.0\n"),
+        );
+        refused(
+            &[
+                "simulate",
+                p.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--force",
+            ],
+            &format!("fits {fits} times in the run's 2 s, more than 1e6"),
+        );
+    }
+}
+
+/// A pivot that is neither a point nor an edge says what a pivot is, at its line (it said "data
+/// did not match any variant of untagged enum PivotSpec").
+#[test]
+fn a_pivot_that_is_no_point_or_edge_says_what_a_pivot_is() {
+    let block = bundled("single_block");
+    for pivot in ["[0.2, 0.0, 0.0, 1.0]", "[[0.2, -0.2, 0.0]]", "[]"] {
+        let p = write(
+            "pivot_shape.toml",
+            &block.replace(
+                "pivot_positive = [[0.2, -0.2, 0.0], [0.2, 0.2, 0.0]]",
+                &format!("pivot_positive = {pivot}"),
+            ),
+        );
+        refused(
+            &["inspect", p.to_str().unwrap()],
+            "expected a point [x, y, z] or an edge of two points [[x, y, z], [x, y, z]] (m)",
+        );
+    }
+}
+
+/// An empty list of points gets the count its shape or face needs (`corners = []` said "0
+/// values, 3 expected", as if it were one point).
+#[test]
+fn an_empty_list_of_points_gets_the_count_it_needs() {
+    let base = bundled("baldachin").replace(
+        "rocking_base = { corners = [[-1.4, -1.4, 0.0], [-1.0, -1.4, 0.0], [-1.0, -1.0, 0.0], [-1.4, -1.0, 0.0]] }",
+        "rocking_base = { corners = [] }",
+    );
+    let p = write("empty_corners.toml", &base);
+    refused(
+        &["inspect", p.to_str().unwrap()],
+        "(rocking_base.corners): needs exactly 4 corners, got 0",
+    );
+}

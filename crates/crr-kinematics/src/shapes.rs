@@ -93,6 +93,10 @@ impl MassProperties {
     }
 }
 
+/// The largest angle a box's `rotation` may have, rad (about 16 turns): a turn is 2π, so this
+/// admits any orientation written with a few turns to spare.
+pub const MAX_ROTATION_ANGLE: f64 = 100.0;
+
 /// Invalid shape input. Messages are meant for the structural engineer who
 /// wrote the model file.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -105,6 +109,15 @@ pub enum ShapeError {
     NonFinite {
         /// Name of the offending field.
         field: &'static str,
+    },
+    /// A box rotation of more turns than any model needs.
+    #[error(
+        "rotation is {angle:e} rad about its axis, more than {MAX_ROTATION_ANGLE} rad (the \
+         axis-angle vector's length is the angle in radians: degrees given for radians?)"
+    )]
+    RotationAngle {
+        /// The rotation's angle, the vector's length (rad).
+        angle: f64,
     },
     /// A box side is zero or negative.
     #[error(
@@ -294,6 +307,19 @@ impl BoxShape {
         check_finite(&self.size, "size")?;
         if let Some(r) = &self.rotation {
             check_finite(r, "rotation")?;
+            // An angle of many turns is a typo (degrees for radians, a stray exponent); beyond
+            // about 1e16 rad it has no digits left, and 1e300 made the inertia NaN.
+            let v = v3(r);
+            let largest = v.amax();
+            // Scaled by its largest component: the squares of 1e300 overflow.
+            let angle = if largest > 0.0 {
+                largest * (v / largest).norm()
+            } else {
+                0.0
+            };
+            if angle.is_nan() || angle > MAX_ROTATION_ANGLE {
+                return Err(ShapeError::RotationAngle { angle });
+            }
         }
         if self.size.iter().any(|&s| s <= 0.0) {
             return Err(ShapeError::BoxSize { size: self.size });

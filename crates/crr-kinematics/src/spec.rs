@@ -238,7 +238,10 @@ impl BlockSpec {
 
 /// A pivot line, given by one point on it or by two points of the contact edge.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a point [x, y, z] or an edge of two points [[x, y, z], [x, y, z]] (m)"
+)]
 pub enum PivotSpec {
     /// A point on the pivot line (m); the line runs along the interface axis.
     Point([f64; 3]),

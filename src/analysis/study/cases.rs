@@ -757,6 +757,9 @@ fn synthetic_seeds(r: &RecordsSpec, path: &Path) -> Result<Vec<u64>, Error> {
     Ok(seeds)
 }
 
+/// The oscillator periods Sa(T₁) may be taken at, s.
+pub const SA_PERIOD_RANGE: (f64, f64) = (1e-3, 1e3);
+
 /// The intensity measure and its levels (`[intensity]`; without it the records run as given).
 fn intensity_levels(spec: &StudySpec, path: &Path) -> Result<(IntensityMeasure, Vec<f64>), Error> {
     Ok(match &spec.intensity {
@@ -764,10 +767,17 @@ fn intensity_levels(spec: &StudySpec, path: &Path) -> Result<(IntensityMeasure, 
         Some(i) => {
             let sa = match &i.sa {
                 Some(sa) => {
-                    if !(sa.period.is_finite() && sa.period > 0.0) {
+                    // Spectral periods of engineering use are 0.01 to 10 s; far outside, the
+                    // oscillator's exact step exponentiates w²h beyond any float (1e-300 s
+                    // hung before the first case, 1e-8 s took 16 s on a 5-sample record).
+                    let (low, high) = SA_PERIOD_RANGE;
+                    if !(sa.period.is_finite() && (low..=high).contains(&sa.period)) {
                         return Err(bad(
                             path,
-                            format!("intensity.sa.period must be > 0 s, got {}", sa.period),
+                            format!(
+                                "intensity.sa.period must be from {low} to {high} s, got {}",
+                                sa.period
+                            ),
                         ));
                     }
                     if !(sa.damping.is_finite() && (0.0..1.0).contains(&sa.damping)) {

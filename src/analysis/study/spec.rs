@@ -31,7 +31,10 @@ pub enum Values {
 /// [`Values`] as written, with any number as the count, so that a count that is not a whole
 /// number ≥ 1 gets its own error instead of serde's "did not match any variant".
 #[derive(Deserialize)]
-#[serde(untagged)]
+#[serde(
+    untagged,
+    expecting = "expected a list of numbers [a, b, …] or a range { from = a, to = b, count = n }"
+)]
 enum RawValues {
     List(Vec<f64>),
     Range { from: f64, to: f64, count: f64 },

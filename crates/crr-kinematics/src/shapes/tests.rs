@@ -703,6 +703,21 @@ fn box_errors() {
     let m =
         err_msg(box_shape([0.0; 3], [1.0; 3], Some([f64::INFINITY, 0.0, 0.0])).mass_properties());
     assert_eq!(m, "non-finite number in rotation");
+    // An angle of many turns is refused (1e300 rad made the inertia NaN, reported as mass
+    // properties that are not finite); 100 rad is allowed and is the rotation by 100 − 30π rad.
+    let m = err_msg(box_shape([0.0; 3], [1.0; 3], Some([0.0, 0.0, 1e300])).mass_properties());
+    assert!(
+        m.starts_with("rotation is 1e300 rad about its axis, more than 100 rad"),
+        "{m}"
+    );
+    let turned = |angle: f64| {
+        box_shape([0.0; 3], [1.0, 2.0, 3.0], Some([0.0, 0.0, angle]))
+            .mass_properties()
+            .expect("a valid box")
+            .second_moment
+    };
+    let (many, few) = (turned(100.0), turned(100.0 - 30.0 * std::f64::consts::PI));
+    assert!((many - few).amax() < 1e-12 * many.amax(), "{many} vs {few}");
 }
 
 #[test]
