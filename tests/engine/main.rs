@@ -25,6 +25,7 @@ mod stop_at_violation;
 mod streaming;
 mod temple;
 mod twist_closure;
+mod unheld_seat;
 mod uplift_at_a_jump;
 mod uplift_at_multiplier;
 mod uplift_fast_signals;

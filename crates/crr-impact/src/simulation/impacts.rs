@@ -4,6 +4,11 @@
 
 use super::*;
 
+/// Rate a joint seated at an impact may keep after the plastic impulse, as a fraction of
+/// `seat_rate`: the impulse holds the rows it acts on to round-off (1e-12 of the rates or
+/// better), so a joint left turning faster had its row dropped as dependent on the loops'.
+const UNSTOPPED_RATE: f64 = 1e-3;
+
 /// Regularised Dirac-delta laws acting as a continuous generalized force.
 pub(super) struct Regularised {
     pub(super) slots: Vec<RegularisedSlot>,
@@ -410,6 +415,18 @@ impl Simulation<'_> {
                         || after.sides[s].sign() * rates[s] < 0.0)
             }));
             to_seat.extend_from_slice(&pending);
+        }
+        // The plastic impulse holds every seated row it can act on to round-off: a seat left
+        // turning is one whose row the loops make dependent (`SimulationError::UnheldSeat`).
+        if let Some(&s) = to_seat
+            .iter()
+            .find(|&&s| rates[s].abs() > UNSTOPPED_RATE * self.params.seat_rate)
+        {
+            return Err(SimulationError::UnheldSeat {
+                t,
+                interface: model.interfaces[slot_interface(model, s)].name.clone(),
+                rate: rates[s],
+            });
         }
         // Every tree joint seated after the impact goes to exactly 0 (the joints seated with the
         // impacting ones had residual angles within `simultaneity`) and the loops close again,

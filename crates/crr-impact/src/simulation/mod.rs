@@ -309,6 +309,24 @@ pub enum SimulationError {
         /// The interfaces they involve.
         interfaces: Vec<String>,
     },
+    /// A joint an impact seats keeps turning after the plastic impulse that seats it: its rate
+    /// row is dependent on the loops' (and the other seated joints') within the rank threshold,
+    /// so the impulse cannot act on it alone. The loop is near a singular configuration of its
+    /// angles (pivots nearly in line, as two columns rocking about collinear edges under one
+    /// beam), where holding the seat would take an impulse beyond the rigid model's resolution;
+    /// left seated, the joint reopened on the side the contacts chose while it still turned the
+    /// other way, and re-impacted at once (a 3D trilithon: 200 impacts within 7e-7 s).
+    #[error(
+        "at t = {t} s the seat of {interface} cannot be held: the plastic impulse that seats it leaves it turning at {rate:.3e} rad/s, its rate dependent on the loops' within the rank threshold (a loop near a singular configuration, e.g. pivots nearly in line); outside what the chain's angles resolve (docs/simulation.md, \"Limitations\")"
+    )]
+    UnheldSeat {
+        /// Time (s).
+        t: f64,
+        /// The interface whose seat cannot be held.
+        interface: String,
+        /// Its rate after the seating impulse (rad/s).
+        rate: f64,
+    },
     /// The uplift test keeps finding that the seated state cannot hold while no release is
     /// confirmed: [`UNDECIDED_UPLIFTS`] uplift events in a row released nothing, each within
     /// [`UNDECIDED_GAP`] of the one before (a step of round-off length, with no release or impact
