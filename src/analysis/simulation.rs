@@ -220,16 +220,15 @@ pub fn prepare(input: &ModelInput, options: &RunOptions) -> Result<Prepared, Err
     // is written (not a failed run with partial results).
     crr_impact::simulation::check_physical_bounds(&input.model, &params)
         .map_err(|e| here(e.to_string()))?;
-    if let Some(time_scale) = ground.time_scale() {
-        let cycles = params.duration / time_scale;
-        if cycles.is_nan() || cycles > MAX_GROUND_CYCLES {
+    if let Some(period) = ground.time_scale() {
+        let structure = (input.model.size / input.model.gravity).sqrt();
+        if period.is_nan() || period < SHORTEST_GROUND_PERIOD * structure {
             return Err(here(format!(
-                "ground motion: its shortest time scale {time_scale:e} s (a period, or 1/f of a \
-                 Ricker wavelet) fits {cycles:.3e} times in the run's {} s, more than \
-                 {MAX_GROUND_CYCLES:e}: the uplift test samples each {} times while joints are \
-                 seated (a 1e9 Hz sine would take hours for 2 s); lower the frequency or the \
-                 duration",
-                params.duration,
+                "ground motion: its shortest time scale {period:e} s (a period, or 1/f of a \
+                 Ricker wavelet) is below {SHORTEST_GROUND_PERIOD:e} of the structure's time \
+                 scale √(L/g) = {structure:.4} s: no ground motion is that fast against a \
+                 structure, and the uplift test samples each period {} times while joints are \
+                 seated (a 1e9 Hz sine over 2 s would take hours)",
                 crr_impact::simulation::SEATED_SAMPLES_PER_PERIOD
             )));
         }
@@ -468,10 +467,12 @@ pub const RK4_STEP_WARNING: f64 = 0.05;
 /// A simultaneity tolerance larger than this fraction of the smallest slenderness α is a warning.
 pub const SIMULTANEITY_WARNING: f64 = 1e-2;
 
-/// The most periods of its ground motion's shortest time scale a run may span (a period, or
-/// 1/f of a Ricker wavelet): the seated test samples each 32 times, so 1e6 of them are some
-/// 3e7 tests (a sine of 1e5 Hz for 2 s, 2e5 periods, runs in about 3 s).
-pub const MAX_GROUND_CYCLES: f64 = 1e6;
+/// The shortest time scale a ground motion may have (a period, or 1/f of a Ricker wavelet), as
+/// a fraction of the structure's √(L/g): earthquakes are slower than their structures' rocking
+/// by far (the bundled block: √(L/g) = 0.3255 s, so at most 31 kHz). The seated uplift test
+/// samples each period 32 times, and the run's duration is bounded by `LONGEST_DURATION`
+/// √(L/g), so the tests a run can take are bounded too.
+pub const SHORTEST_GROUND_PERIOD: f64 = 1e-4;
 
 /// The most rows a run's history may have (one per output interval): beyond, the run is
 /// refused before it starts, as a history of tens of gigabytes fills a disk and never ends.
