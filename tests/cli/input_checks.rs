@@ -145,7 +145,12 @@ fn names_whose_output_columns_collide_are_refused() {
     for (name, needle) in [
         (
             "t",
-            "its output column \"t\" is also a column of the history of its own",
+            "its output column \"t\" is also a column of the outputs of their own",
+        ),
+        // A Poincaré section's column (poincare.csv: k, t, the coordinates…).
+        (
+            "k",
+            "its output column \"k\" is also a column of the outputs of their own",
         ),
         ("kinetic", "its output column \"kinetic\" is also a column"),
         ("dissipated_rate", "\"dissipated_rate\""),

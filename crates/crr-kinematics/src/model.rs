@@ -1414,8 +1414,19 @@ fn build_interfaces(
     Ok(ends)
 }
 
-/// The columns of the history (docs/outputs.md) besides the interfaces' own.
-const FIXED_COLUMNS: [&str; 5] = ["t", "kinetic", "potential", "work_in", "dissipated"];
+/// The columns of the history (docs/outputs.md) and of the Poincaré sections and sweeps
+/// (docs/poincare.md) besides the interfaces' own.
+const FIXED_COLUMNS: [&str; 9] = [
+    "t",
+    "kinetic",
+    "potential",
+    "work_in",
+    "dissipated",
+    "k",
+    "case",
+    "amplitude",
+    "frequency",
+];
 
 /// The history's columns must be distinct: each interface takes its coordinates (its name, or
 /// `<name>.1` and `<name>.2`), their rates `<coordinate>_rate` and its state `<name>_state`
@@ -1442,14 +1453,15 @@ fn check_history_columns(spec: &StructureSpec, ends: &[InterfaceEnds]) -> Result
             if let Some(previous) = owner.insert(column.clone(), Some(k)) {
                 let other = match previous {
                     Some(j) => format!("interface \"{}\"'s", spec.interface[j].name),
-                    None => "a column of the history of its own".to_string(),
+                    None => "a column of the outputs of their own".to_string(),
                 };
                 return Err(ModelError::new(
                     quoted("interface", &i.name),
                     format!(
                         "its output column \"{column}\" is also {other}: rename one (the \
                          history's columns are t, each coordinate, its _rate, kinetic, potential, \
-                         work_in, dissipated and each interface's _state)"
+                         work_in, dissipated and each interface's _state; the Poincaré sections' \
+                         add k, case, amplitude and frequency)"
                     ),
                 ));
             }
