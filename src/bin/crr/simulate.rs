@@ -143,7 +143,17 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         let dir = match &result {
             SimulateResult::Done(dir, _) | SimulateResult::Failed(dir, _) => dir,
         };
-        plot_results(dir)?;
+        // After a failed run the failure is the news: a plot that cannot be drawn from the
+        // partial results (a folder kept after failed writes may lack impacts.csv) is a
+        // warning, not the error that would hide it.
+        match (plot_results(dir), &result) {
+            (Err(e), SimulateResult::Failed(..)) => {
+                eprintln!("crr: warning: the partial results could not be plotted: {e}");
+            }
+            (plotted, _) => {
+                plotted?;
+            }
+        }
     }
     if animate {
         let dir = match &result {
