@@ -12,6 +12,27 @@ fn write(name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// The bundled block at rest under `component` (a `[ground_motion]` line) for `duration` s.
+fn block_under(component: &str, duration: f64) -> String {
+    let block = bundled("single_block").replace("[initial]\nangles = { base = 0.1 }\n", "");
+    format!("{block}\n[ground_motion]\n{component}\n[analysis]\nduration = {duration}\n")
+}
+
+/// `crr simulate model` into a scratch folder is refused (exit 2) with `needle`.
+fn simulate_refused(model: &Path, needle: &str) {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/refused_out");
+    refused(
+        &[
+            "simulate",
+            model.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ],
+        needle,
+    );
+}
+
 #[test]
 fn arrays_of_the_wrong_length_are_refused() {
     let block = bundled("single_block");
@@ -310,15 +331,8 @@ fn initial_rates_whose_energy_overflows_are_refused() {
             "angles = { base = 0.1 }\nrates = { base = 1e200 }",
         ),
     );
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/rate_out");
-    refused(
-        &[
-            "simulate",
-            p.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--force",
-        ],
+    simulate_refused(
+        &p,
         "initial.rates: the kinetic energy of the initial state is inf J",
     );
 }
@@ -328,8 +342,6 @@ fn initial_rates_whose_energy_overflows_are_refused() {
 /// did a rectangular pulse of that amplitude and a record scaled by 1e308.
 #[test]
 fn ground_accelerations_beyond_any_ground_motion_are_refused() {
-    let block = bundled("single_block").replace("[initial]\nangles = { base = 0.1 }\n", "");
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/accel_out");
     for (tag, component) in [
         ("constant", "x = { constant = { value = 1e308 } }"),
         (
@@ -341,20 +353,8 @@ fn ground_accelerations_beyond_any_ground_motion_are_refused() {
             "x = { sine = { amplitude = 1e300, period = 0.5 }, scale = 1e300 }",
         ),
     ] {
-        let p = write(
-            &format!("accel_{tag}.toml"),
-            &format!("{block}\n[ground_motion]\n{component}\n[analysis]\nduration = 1.0\n"),
-        );
-        refused(
-            &[
-                "simulate",
-                p.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-                "--force",
-            ],
-            "ground_motion.x: its peak acceleration",
-        );
+        let p = write(&format!("accel_{tag}.toml"), &block_under(component, 1.0));
+        simulate_refused(&p, "ground_motion.x: its peak acceleration");
     }
 }
 
@@ -364,24 +364,6 @@ fn ground_accelerations_beyond_any_ground_motion_are_refused() {
 /// did not pass 2e-4 s in 30 s). The bundled block's √(L/g) is 0.3255 s: 1e4 Hz runs.
 #[test]
 fn a_ground_motion_faster_than_any_run_can_sample_is_refused() {
-    let block = bundled("single_block").replace("[initial]\nangles = { base = 0.1 }\n", "");
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/cycles_out");
-    let model = |tag: &str, component: &str, duration: f64| {
-        write(
-            &format!("cycles_{tag}.toml"),
-            &format!("{block}\n[ground_motion]\n{component}\n[analysis]\nduration = {duration}\n"),
-        )
-    };
-    let simulate = |p: &Path| {
-        vec![
-            "simulate".to_string(),
-            p.to_str().unwrap().to_string(),
-            "--out".to_string(),
-            out.to_str().unwrap().to_string(),
-            "--force".to_string(),
-            "--quiet".to_string(),
-        ]
-    };
     for (tag, component, period) in [
         (
             "sine",
@@ -394,10 +376,9 @@ fn a_ground_motion_faster_than_any_run_can_sample_is_refused() {
             "1e-10",
         ),
     ] {
-        let args = simulate(&model(tag, component, 2.0));
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        refused(
-            &args,
+        let p = write(&format!("cycles_{tag}.toml"), &block_under(component, 2.0));
+        simulate_refused(
+            &p,
             &format!(
                 "its shortest time scale {period} s (a period, or 1/f of a Ricker wavelet) is \
                  below 1e-4 of the structure's time scale √(L/g) = 0.3255 s"
@@ -405,13 +386,19 @@ fn a_ground_motion_faster_than_any_run_can_sample_is_refused() {
         );
     }
     // Slower than the bound, a run is accepted (0.05 s of a 1e4 Hz sine).
-    let args = simulate(&model(
-        "valid",
-        "x = { sine = { amplitude = 1.0, frequency = 1e4 } }",
-        0.05,
-    ));
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let o = crr(&args);
+    let p = write(
+        "cycles_valid.toml",
+        &block_under("x = { sine = { amplitude = 1.0, frequency = 1e4 } }", 0.05),
+    );
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("input_checks/cycles_out");
+    let o = crr(&[
+        "simulate",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+        "--quiet",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
