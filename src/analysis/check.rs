@@ -10,8 +10,8 @@ use serde::Serialize;
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::mechanism::reduce_at;
 use crr_dynamics::{
-    FiniteMobility, InitialSpec, LagrangianParameters, Mobility, equivalent_block,
-    lagrangian_parameters, mobility, mobility_after_step, solve_initial,
+    FiniteMobility, InitialSpec, LagrangianParameters, Mobility, lagrangian_parameters_on_side,
+    mobility, mobility_after_step, reported_side, solve_initial,
 };
 use crr_impact::laws::momentum_law;
 use crr_impact::simulation::{Parameters, Simulation, StopReason};
@@ -26,7 +26,7 @@ use crate::analysis::static_multiplier::{
 pub struct FrequencyRow {
     /// θ_m/α_eq.
     pub amplitude_ratio: f64,
-    /// θ_m (rad): the released angle of the mechanism coordinate.
+    /// θ_m (rad): the released angle of the mechanism coordinate (negative on the side `-`).
     pub theta_m: f64,
     /// F_H = √χ / (4 arccosh(1/(1 − εθ_m))), χ = p_eq², ε = 1/α_eq (Hz).
     pub housner_hz: f64,
@@ -42,10 +42,15 @@ pub struct FrequencyRow {
 pub struct MechanismReport {
     /// The mechanism coordinate θ (the first coordinate).
     pub coordinate: String,
+    /// The side the mechanism opens on, `+` (θ > 0) or `-` (θ < 0): the one that opens under
+    /// its own weight, else the smaller λ, else (equal λ) the larger α_eq, else `+`
+    /// ([`crr_dynamics::reported_side`]). Every quantity below is read in the opening angle
+    /// |θ| of that side.
+    pub side: String,
     /// Unit horizontal direction of the ground acceleration used for λ (perpendicular to the
     /// coordinate's axis).
     pub direction: [f64; 3],
-    /// Pivot side of every angle slot in the opening state θ > 0 (`+` or `-`), by interface name
+    /// Pivot side of every angle slot in the opening state of `side` (`+` or `-`), by interface name
     /// (joined by `/` for a rocking base).
     pub pivots: BTreeMap<String, String>,
     /// λ: activating ground acceleration in g (limit-analysis collapse multiplier).
@@ -163,20 +168,18 @@ fn slot_codes(model: &Model, pivots: &ActivePivots) -> BTreeMap<String, String> 
 
 fn mechanism(model: &Model) -> Result<MechanismReport, String> {
     let name = model.coords[0].name.clone();
-    let opening = InitialSpec {
-        angles: [(name.clone(), 0.01)].into_iter().collect(),
-        rates: BTreeMap::new(),
-    };
-    let open = solve_initial(model, &opening).map_err(|e| e.to_string())?;
-    let pivots = open.pivots;
     let u = model.coords[0].axis;
     let mut d = u.cross(&Vector3::z());
     if d.norm() < 1e-9 {
         d = Vector3::x();
     }
     let d = d.normalize();
-    let eq = equivalent_block(model, &pivots, 0, &d).map_err(|e| e.to_string())?;
-    let lagrangian = lagrangian_parameters(model, &pivots, 0, &d).map_err(|e| e.to_string())?;
+    // The side the mechanism is reported on follows from its physics, not from the sense the
+    // file gives the coordinate (reported_side).
+    let (side, pivots, eq) = reported_side(model, 0, &d).map_err(|e| e.to_string())?;
+    let sigma = side.sign();
+    let lagrangian =
+        lagrangian_parameters_on_side(model, &pivots, 0, &d, side).map_err(|e| e.to_string())?;
     // r from the momentum law: closing velocity on the opening pivots, after the flip.
     let zero = DVector::zeros(model.dof());
     let b = reduce_at(model, &zero, &pivots, 0, &d)
@@ -186,7 +189,8 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
     let after = ActivePivots {
         sides: before.sides.iter().map(|s| s.flipped()).collect(),
     };
-    let qd = -&b;
+    // Closing: the coordinate turns back towards 0 from the side it opened on.
+    let qd = &b * -sigma;
     let mut kin = Data::new(model);
     let res = momentum_law(model, &mut kin, &zero, &qd, &before, &after)
         .map_err(|e| format!("momentum law: {e}"))?;
@@ -197,9 +201,10 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
     let frequencies = (1..=9)
         .map(|k| {
             let ratio = k as f64 / 10.0;
-            let theta_m = ratio * alpha;
-            let fh = housner_frequency(p, alpha, theta_m);
+            let amplitude = ratio * alpha;
+            let fh = housner_frequency(p, alpha, amplitude);
             let limit = 2.0 / fh + 1.0;
+            let theta_m = sigma * amplitude;
             let engine = first_fall_time(model, &name, theta_m, limit).map(|tau| 1.0 / (4.0 * tau));
             FrequencyRow {
                 amplitude_ratio: ratio,
@@ -212,6 +217,7 @@ fn mechanism(model: &Model) -> Result<MechanismReport, String> {
         .collect();
     Ok(MechanismReport {
         coordinate: name,
+        side: if sigma > 0.0 { "+" } else { "-" }.to_string(),
         direction: [d.x, d.y, d.z],
         pivots: slot_codes(model, &pivots),
         lambda: eq.lambda,
@@ -527,8 +533,9 @@ pub fn to_text(r: &CheckReport) -> String {
     }
     if let Some(k) = &r.mechanism {
         s += &format!(
-            "\none-DOF mechanism, coordinate {} > 0 opening on pivots:",
-            k.coordinate
+            "\none-DOF mechanism, coordinate {} {} 0 opening on pivots:",
+            k.coordinate,
+            if k.side == "-" { "<" } else { ">" }
         );
         for (name, code) in &k.pivots {
             s += &format!(" {name} {code}");

@@ -16,8 +16,8 @@ use crr_dynamics::ground_motion::{
 };
 use crr_dynamics::{AnalysisSpec, InitialSpec, InitialState, solve_initial};
 use crr_impact::simulation::{
-    ImpactRecord, Parameters, Samples, Simulation, SimulationError, StopReason, Trajectory,
-    check_initial_state,
+    ImpactRecord, Parameters, Samples, Simulation, SimulationError, SlotState, StopReason,
+    Trajectory, check_initial_state,
 };
 use crr_kinematics::{InterfaceKind, Model};
 
@@ -325,7 +325,7 @@ impl Prepared {
     }
 
     fn run_with(&self, mut sink: impl FnMut(&Samples) -> std::io::Result<()>, stream: bool) -> Run {
-        let mut stats = SampleStats::default();
+        let mut stats = SampleStats::watching_corners_of(&self.model);
         let mut counted = |samples: &Samples| {
             stats.add(samples);
             sink(samples)
@@ -424,18 +424,40 @@ pub fn coordinate_alpha(model: &Model, coordinate: usize) -> Option<f64> {
 
 /// What the streamed samples leave for the summary: how many were written, and the run's energy
 /// scale (the largest T, |U|, |W| and D met).
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct SampleStats {
     /// Rows of history.csv.
     pub rows: usize,
     /// The largest of T, |U|, |W| and D over the samples (J).
     pub energy_scale: f64,
+    /// The rocking bases without twist (their interfaces and first slots) whose corner rocking
+    /// is watched ([`Self::watching_corners_of`]), and the first sample (s) at which each had
+    /// both tilts turned.
+    pub corners: Vec<(usize, usize, Option<f64>)>,
 }
 
 impl SampleStats {
+    /// Stats that also watch `model`'s rocking bases (not those that may twist) for a sample on
+    /// a corner (both tilts turned), for the warning of docs/model-format.md, "Rocking bases: the
+    /// order of the two tilts".
+    pub fn watching_corners_of(model: &Model) -> Self {
+        let corners = model
+            .interfaces
+            .iter()
+            .enumerate()
+            .filter(|(_, i)| matches!(i.kind, InterfaceKind::RockingBase { twist: false, .. }))
+            .map(|(k, i)| (k, i.slots.start, None))
+            .collect();
+        SampleStats {
+            corners,
+            ..SampleStats::default()
+        }
+    }
+
     /// Counts `samples` in.
     pub fn add(&mut self, samples: &Samples) {
         self.rows += samples.len();
+        let turned = |s: SlotState| matches!(s, SlotState::Positive | SlotState::Negative);
         for s in samples {
             let e = s
                 .kinetic
@@ -443,6 +465,14 @@ impl SampleStats {
                 .max(s.work_in.abs())
                 .max(s.dissipated);
             self.energy_scale = self.energy_scale.max(e);
+            for (_, slot, first) in self.corners.iter_mut().filter(|c| c.2.is_none()) {
+                if s.states.len() > *slot + 1
+                    && turned(s.states[*slot])
+                    && turned(s.states[*slot + 1])
+                {
+                    *first = Some(s.t);
+                }
+            }
         }
     }
 }
@@ -824,6 +854,41 @@ fn num(x: f64) -> String {
     format!("{x:e}")
 }
 
+/// The rocking bases that rocked on a corner (both tilts turned) at some output sample, with the
+/// first such time. Their two tilts are applied in series, `.1` about the edge corner 0 →
+/// corner 1 and then `.2`, with no twist about the face normal: R(e₁, φ₁)R(e₂, φ₂) and
+/// R(e₂, φ₂)R(e₁, φ₁) differ by a twist of order φ₁φ₂, so on a corner the motion depends at
+/// second order on the corner a face's list starts from (a 0.4 × 0.6 × 2 m block under two
+/// sines overturned with one order and rocked on with the other, both without a warning until
+/// this one). A seat that may twist (`twist = true`) has no such constraint and is left out.
+fn rocking_on_a_corner(model: &Model, stats: &SampleStats) -> Option<String> {
+    let first: Vec<(f64, &str)> = stats
+        .corners
+        .iter()
+        .filter_map(|&(k, _, t)| Some((t?, model.interfaces[k].name.as_str())))
+        .collect();
+    let (t0, _) = *first.iter().min_by(|x, y| x.0.total_cmp(&y.0))?;
+    let mut names: Vec<&str> = first.iter().map(|(_, n)| *n).collect();
+    let more = names.len().saturating_sub(3);
+    names.truncate(3);
+    Some(format!(
+        "from t = {} s {}{} rocked on a corner (both tilts turned): a rocking base's two tilts \
+         turn in series, .1 about the edge from its corner 0 to corner 1 and then .2, with no \
+         twist about the face normal, and the two orders differ at second order (φ₁φ₂), so from \
+         there the motion depends on the corner the face's list starts from; near a threshold \
+         (overturning, the timing of an impact) the response may change: run the model with the \
+         corners listed from the next corner to see how much (docs/model-format.md, \
+         \"Rocking bases: the order of the two tilts\")",
+        num(t0),
+        names.join(", "),
+        if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        }
+    ))
+}
+
 /// What a user must know before trusting the results (`warnings` in summary.json, also printed
 /// on stderr by `crr simulate`).
 fn warnings(
@@ -924,6 +989,9 @@ fn warnings(
             d.z + 0.0,
             crr_impact::statics::EXHAUSTIVE_SETS,
         ));
+    }
+    if let Some(corners) = rocking_on_a_corner(&p.model, stats) {
+        out.push(corners);
     }
     if let Some(part) = out_of_plane_ground_motion(&p.model, &p.ground) {
         out.push(part);

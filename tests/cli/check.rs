@@ -560,3 +560,126 @@ fn a_friction_outside_zero_to_a_thousand_is_refused() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// The mechanism `crr check` reports follows from the structure, not from the sense a file gives
+/// its coordinate: a hinge written with its axis reversed and its pivots exchanged (the same
+/// joint) gives the same report. `mechanism` is read as JSON for both writings of one model.
+fn mechanism_of(tag: &str, text: &str) -> serde_json::Value {
+    let path = crate::common::write_model(tag, text);
+    check(path.to_str().unwrap())["mechanism"].clone()
+}
+
+/// Every number of two mechanism reports agrees within `tol` relative (the frequency table's
+/// released angles in magnitude: they carry the side's sign).
+fn assert_same_mechanism(a: &serde_json::Value, b: &serde_json::Value, tol: f64) {
+    let close = |x: f64, y: f64| (x - y).abs() <= tol * x.abs().max(y.abs()).max(1e-12);
+    for key in [
+        "lambda",
+        "mass",
+        "potential_slope",
+        "potential_curvature",
+        "alpha_eq",
+        "p_eq",
+        "r",
+        "energy_ratio",
+    ] {
+        let (x, y) = (a[key].as_f64().unwrap(), b[key].as_f64().unwrap());
+        assert!(close(x, y), "{key}: {x} vs {y}");
+    }
+    for key in ["nu", "xi", "eta", "chi"] {
+        let (x, y) = (
+            a["lagrangian"][key].as_f64().unwrap(),
+            b["lagrangian"][key].as_f64().unwrap(),
+        );
+        assert!(close(x, y), "lagrangian.{key}: {x} vs {y}");
+    }
+    let rows = |m: &serde_json::Value| m["frequencies"].as_array().unwrap().clone();
+    for (x, y) in rows(a).iter().zip(&rows(b)) {
+        let m = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap();
+        assert!(
+            close(m(x, "theta_m").abs(), m(y, "theta_m").abs()),
+            "{x} vs {y}"
+        );
+        assert!(close(m(x, "housner_hz"), m(y, "housner_hz")), "{x} vs {y}");
+    }
+}
+
+/// A block on a parallelogram section (base x ∈ [−0.2, 0.2], top shifted 0.1 m along +x, 2 m
+/// high): its centroid lies at x = 0.05, 1 m up, so it tips about its +x edge at λ = 0.15/1 and
+/// about its −x edge at 0.25/1 (Housner's tan α of each side, α the angle of the centroid from
+/// the vertical through the pivot). The report gives the side a growing load opens first,
+/// λ = 0.15 with α_eq = atan 0.15, however the hinge is written.
+#[test]
+fn the_mechanism_reported_is_the_side_that_opens_first_in_any_sense_of_its_coordinate() {
+    let block = |axis: f64, plus: f64, minus: f64| {
+        format!(
+            "name = \"leaning\"\n[[body]]\nname = \"block\"\ndensity = 2000.0\n\
+             prism = {{ polygon = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.3, -0.2, 2.0], \
+             [-0.1, -0.2, 2.0]], extrude = [0.0, 0.4, 0.0] }}\n[[interface]]\nname = \"base\"\n\
+             parent = \"ground\"\nchild = \"block\"\naxis = [0.0, {axis}, 0.0]\n\
+             pivot_positive = [{plus}, 0.0, 0.0]\npivot_negative = [{minus}, 0.0, 0.0]\n"
+        )
+    };
+    let written = mechanism_of("leaning_plus", &block(1.0, 0.2, -0.2));
+    let reversed = mechanism_of("leaning_minus", &block(-1.0, -0.2, 0.2));
+    assert_eq!(
+        (written["side"].as_str(), reversed["side"].as_str()),
+        (Some("+"), Some("-"))
+    );
+    for m in [&written, &reversed] {
+        assert!((m["lambda"].as_f64().unwrap() - 0.15).abs() < 1e-9, "{m}");
+        assert!(
+            (m["alpha_eq"].as_f64().unwrap() - 0.15f64.atan()).abs() < 1e-6,
+            "{m}"
+        );
+        assert_eq!(
+            m["pivots"]["base"],
+            "+".replace('+', m["side"].as_str().unwrap())
+        );
+    }
+    assert_same_mechanism(&written, &reversed, 1e-9);
+}
+
+/// The bundled four-hinge arch is symmetric: its two sides are mirror images, equal in λ, read
+/// in one coordinate (the right springing's angle) with two different α_eq. Written with that
+/// springing's axis reversed and its pivots exchanged it used to report the other side (α_eq
+/// 0.107 instead of 0.302, r 1.20 instead of 0.47); both writings now report the same block.
+#[test]
+fn the_arch_written_with_a_reversed_springing_reports_the_same_block() {
+    let text = crate::common::bundled_text("arch");
+    let flipped = text
+        .replacen(
+            "axis = [0.0, 1.0, 0.0]\npivot_positive = [2.5, 0.0, 0.0]\npivot_negative = [2.0, 0.0, 0.0]",
+            "axis = [0.0, -1.0, 0.0]\npivot_positive = [2.0, 0.0, 0.0]\npivot_negative = [2.5, 0.0, 0.0]",
+            1,
+        )
+        .replace(
+            "angles = { springing_right = 0.03 }",
+            "angles = { springing_right = -0.03 }",
+        );
+    assert_ne!(flipped, text);
+    let written = mechanism_of("arch_as_bundled", &text);
+    let reversed = mechanism_of("arch_springing_reversed", &flipped);
+    assert_eq!(
+        (written["side"].as_str(), reversed["side"].as_str()),
+        (Some("+"), Some("-"))
+    );
+    // The frequency table's engine runs are the same runs mirrored in the coordinate's sign.
+    assert_same_mechanism(&written, &reversed, 1e-9);
+    let engine = |m: &serde_json::Value| -> Vec<Option<f64>> {
+        m["frequencies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["engine_hz"].as_f64())
+            .collect()
+    };
+    for (x, y) in engine(&written).iter().zip(engine(&reversed)) {
+        match (x, y) {
+            (Some(x), Some(y)) => assert!((x - y).abs() < 1e-6 * x, "{x} vs {y}"),
+            (x, y) => assert_eq!(*x, y),
+        }
+    }
+    // The side reported is the larger α_eq of the two (equal λ): θ > 0 as bundled.
+    assert!((written["alpha_eq"].as_f64().unwrap() - 0.301858).abs() < 1e-6);
+}

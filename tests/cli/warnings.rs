@@ -165,7 +165,9 @@ fn a_pulse_that_lifts_a_joint_off_is_a_warning() {
     assert!(v["normal_force"].as_f64().unwrap() < 0.0);
 }
 
-/// Every bundled model runs without a warning except two that report a flight: the drum
+/// The three 3D models whose rocking bases reach a corner (the baldachin, the 3D arch, the
+/// temple) are warned that the order of those faces' corners counts there, and no other.
+/// Every bundled model runs without another warning except two that report a flight: the drum
 /// column's (its monitor, after an impact that opens seated joints which would otherwise pull:
 /// docs/simulation.md, "Impulses at landings and impacts") and the temple's (its monitor). The
 /// two-block stack used to be flagged too, its impact at 1.80 s holding the base seated with an
@@ -206,9 +208,40 @@ fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
         } else {
             assert!(o.status.success(), "{stem}: {err}");
         }
-        let s: serde_json::Value =
+        let mut s: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
+        // The 3D models whose rocking bases reach a corner (both tilts turned) are warned that
+        // the order of those faces' corners counts there (docs/model-format.md): the baldachin's
+        // eight bases from 0.1 s, the 3D arch's springings from 2.42 s, the temple's beds and
+        // necks from 2.04 s. No other model has a base on a corner.
+        let corner = match stem.as_str() {
+            "baldachin" => {
+                Some("from t = 1e-1 s base_1, base_2, base_3 and 5 more rocked on a corner")
+            }
+            "arch_3d" => {
+                Some("from t = 2.42e0 s springing_right, springing_left rocked on a corner")
+            }
+            "temple" => Some("from t = 2.04e0 s "),
+            _ => None,
+        };
+        let listed = s["warnings"].as_array_mut().unwrap();
+        let on_corner: Vec<usize> = (0..listed.len())
+            .filter(|&i| {
+                listed[i]
+                    .as_str()
+                    .unwrap()
+                    .contains("rocked on a corner (both tilts turned)")
+            })
+            .collect();
+        match corner {
+            Some(words) => {
+                assert_eq!(on_corner.len(), 1, "{stem}: {listed:?}");
+                let w = listed.remove(on_corner[0]);
+                assert!(w.as_str().unwrap().starts_with(words), "{stem}: {w}");
+            }
+            None => assert!(on_corner.is_empty(), "{stem}: {listed:?}"),
+        }
         // The drum column's impact at 0.402 s, whose seated joints would pull, opens them
         // (Moreau's impact), and at 0.5028 s the force under the seventh drum pulls: the drums
         // above hop, outside crr's model, and the run says so. (The two-block stack's impact at
@@ -241,7 +274,9 @@ fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
             continue;
         }
         assert!(warnings(&s).is_empty(), "{stem}: {s}");
-        assert!(!err.contains("warning"), "{stem}: {err}");
+        if corner.is_none() {
+            assert!(!err.contains("warning"), "{stem}: {err}");
+        }
     }
 }
 

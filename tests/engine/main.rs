@@ -8,6 +8,7 @@ mod common;
 mod arch_3d;
 mod certificate_audit;
 mod collapse;
+mod corner_order;
 mod far_from_origin;
 mod free_fall;
 mod friction_on_loops;

@@ -6,7 +6,7 @@
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use crr_kinematics::{
-    ActivePivots, Data, Model, constraint_jacobian, forward_kinematics, generalized_gravity,
+    ActivePivots, Data, Model, Side, constraint_jacobian, forward_kinematics, generalized_gravity,
     mass_matrix,
 };
 
@@ -101,6 +101,56 @@ pub fn configuration(
     Ok(q)
 }
 
+/// Angle (rad) of the coordinate at which [`reported_side`] reads each side's pivots: the
+/// pivots a state opened that far settles on.
+pub const SIDE_PROBE_ANGLE: f64 = 0.01;
+
+/// Relative difference below which the two sides' multipliers (or slendernesses) count as equal.
+pub const SIDE_TIE: f64 = 1e-9;
+
+/// The side of `coordinate` on which a one-DOF mechanism is reported, with its pivots and its
+/// equivalent block: decided by the physics of the two sides, not by the sense the file gives
+/// the coordinate (a hinge written with its axis and pivots exchanged gives the same report).
+/// A side that opens under its own weight (α_eq < 0) first; else the side with the smaller
+/// activation multiplier λ (the mechanism that opens first under a growing horizontal load);
+/// on equal λ (within [`SIDE_TIE`], as for a symmetric arch, whose two sides are mirror images
+/// read in one coordinate) the larger α_eq; on equal α_eq too, θ > 0. A side whose state cannot
+/// be solved is skipped; both failing is the error of θ > 0.
+pub fn reported_side(
+    model: &Model,
+    coordinate: usize,
+    direction: &Vector3<f64>,
+) -> Result<(Side, ActivePivots, EquivalentBlock), DynamicsError> {
+    let name = &model.coords[coordinate].name;
+    let side = |side: Side| -> Result<(Side, ActivePivots, EquivalentBlock), DynamicsError> {
+        let spec = crate::InitialSpec {
+            angles: [(name.clone(), side.sign() * SIDE_PROBE_ANGLE)]
+                .into_iter()
+                .collect(),
+            rates: Default::default(),
+        };
+        let pivots = crate::solve_initial(model, &spec)?.pivots;
+        let eq = equivalent_block_on_side(model, &pivots, coordinate, direction, side)?;
+        Ok((side, pivots, eq))
+    };
+    let (plus, minus) = (side(Side::Positive), side(Side::Negative));
+    let (a, b) = match (plus, minus) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Ok(a), Err(_)) => return Ok(a),
+        (Err(_), Ok(b)) => return Ok(b),
+        (Err(e), Err(_)) => return Err(e),
+    };
+    let tie = |x: f64, y: f64| (x - y).abs() <= SIDE_TIE * x.abs().max(y.abs());
+    let take_b = if a.2.alpha < 0.0 || b.2.alpha < 0.0 {
+        b.2.alpha < a.2.alpha
+    } else if !tie(a.2.lambda, b.2.lambda) {
+        b.2.lambda < a.2.lambda
+    } else {
+        !tie(a.2.alpha, b.2.alpha) && b.2.alpha > a.2.alpha
+    };
+    Ok(if take_b { b } else { a })
+}
+
 /// A one-DOF mechanism at rest seen as a single rocking block.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct EquivalentBlock {
@@ -127,30 +177,48 @@ pub struct EquivalentBlock {
 }
 
 /// Reduces a one-DOF mechanism at rest (q = 0, the given pivots) to its equivalent block, driven
-/// by a horizontal ground acceleration along `direction` (unit).
+/// by a horizontal ground acceleration along `direction` (unit). The mechanism opens with the
+/// coordinate increasing (θ > 0); [`equivalent_block_on_side`] for either side.
 pub fn equivalent_block(
     model: &Model,
     pivots: &ActivePivots,
     coordinate: usize,
     direction: &Vector3<f64>,
 ) -> Result<EquivalentBlock, DynamicsError> {
+    equivalent_block_on_side(model, pivots, coordinate, direction, Side::Positive)
+}
+
+/// [`equivalent_block`] of the mechanism opening on `side` of the coordinate (θ > 0 or θ < 0),
+/// `pivots` those of that side. It is read in the opening angle s = σθ (σ = ±1), so that a
+/// mechanism written with its coordinate's sense reversed (axis and pivots exchanged) gives the
+/// same block: U′ and the generalized force change sign with σ, M and U″ do not.
+pub fn equivalent_block_on_side(
+    model: &Model,
+    pivots: &ActivePivots,
+    coordinate: usize,
+    direction: &Vector3<f64>,
+    side: Side,
+) -> Result<EquivalentBlock, DynamicsError> {
+    let sigma = side.sign();
     let zero = DVector::zeros(model.dof());
-    let at = |theta: f64| -> Result<ReducedPoint, DynamicsError> {
-        let q = configuration(model, &zero, pivots, coordinate, theta)?;
+    let at = |s: f64| -> Result<ReducedPoint, DynamicsError> {
+        let q = configuration(model, &zero, pivots, coordinate, sigma * s)?;
         reduce_at(model, &q, pivots, coordinate, direction)
     };
     let r0 = at(0.0)?;
     // U″ by central differences along the mechanism: h = 1e-5 rad, truncation h²U⁗ ~ 1e-10 relative.
+    // d²U/ds² = d²U/dθ², and dU/ds = σ dU/dθ at both ends.
     let h = 1e-5;
-    let curvature = (at(h)?.potential_slope - at(-h)?.potential_slope) / (2.0 * h);
-    let u1 = r0.potential_slope;
+    let curvature = sigma * (at(h)?.potential_slope - at(-h)?.potential_slope) / (2.0 * h);
+    let u1 = sigma * r0.potential_slope;
     Ok(EquivalentBlock {
         coordinate: model.coords[coordinate].name.clone(),
         mass: r0.mass,
         potential_slope: u1,
         potential_curvature: curvature,
         lambda: u1.abs() / r0.horizontal_force.abs(),
-        lambda_sign: -(u1 * r0.horizontal_force).signum(),
+        // σU′ · σQ_h: the activating direction does not depend on the side's sign.
+        lambda_sign: -(r0.potential_slope * r0.horizontal_force).signum(),
         alpha: u1.atan2(-curvature),
         p_squared: u1.hypot(curvature) / r0.mass,
         p_squared_linearised: -curvature / r0.mass,
@@ -199,10 +267,23 @@ pub fn lagrangian_parameters(
     coordinate: usize,
     direction: &Vector3<f64>,
 ) -> Result<LagrangianParameters, DynamicsError> {
-    let eq = equivalent_block(model, pivots, coordinate, direction)?;
+    lagrangian_parameters_on_side(model, pivots, coordinate, direction, Side::Positive)
+}
+
+/// [`lagrangian_parameters`] of the mechanism opening on `side`, read in the opening angle
+/// s = σθ as [`equivalent_block_on_side`] (ν = M′(0)/M(0) changes sign with σ, ξ does not).
+pub fn lagrangian_parameters_on_side(
+    model: &Model,
+    pivots: &ActivePivots,
+    coordinate: usize,
+    direction: &Vector3<f64>,
+    side: Side,
+) -> Result<LagrangianParameters, DynamicsError> {
+    let eq = equivalent_block_on_side(model, pivots, coordinate, direction, side)?;
+    let sigma = side.sign();
     let zero = DVector::zeros(model.dof());
-    let mass_at = |theta: f64| -> Result<f64, DynamicsError> {
-        let q = configuration(model, &zero, pivots, coordinate, theta)?;
+    let mass_at = |s: f64| -> Result<f64, DynamicsError> {
+        let q = configuration(model, &zero, pivots, coordinate, sigma * s)?;
         Ok(reduce_at(model, &q, pivots, coordinate, direction)?.mass)
     };
     // M′ with h = 1e-4 rad: truncation h²M‴/6 ~ 1e-9 M, round-off ~1e-16 M/h ~ 1e-12 M. M″ with

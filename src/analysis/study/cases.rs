@@ -12,7 +12,7 @@ use crr_dynamics::ground_motion::{
     Axis, ComponentSpec, GroundMotion, GroundMotionSpec, PulseSpec, Record, RickerSpec,
     STANDARD_GRAVITY, SignalSpec, read_record,
 };
-use crr_dynamics::{InitialSpec, InitialState, equivalent_block, solve_initial};
+use crr_dynamics::{InitialSpec, InitialState, reported_side, solve_initial};
 use crr_impact::Parameters;
 use crr_kinematics::{Model, StructureSpec};
 
@@ -619,17 +619,13 @@ fn pulse_axis(
 
 /// λ, p_eq and α_eq of the model's one-DOF mechanism opening under the driven axis, if it has one.
 fn mechanism_scales(model: &Model, axis: Axis) -> Option<(f64, f64, f64)> {
-    let name = model.coords.first()?.name.clone();
-    let opening = crr_dynamics::InitialSpec {
-        angles: [(name, 0.01)].into_iter().collect(),
-        rates: Default::default(),
-    };
-    let open = solve_initial(model, &opening).ok()?;
+    model.coords.first()?;
     let d = match axis {
         Axis::Y => Vector3::y(),
         _ => Vector3::x(),
     };
-    let eq = equivalent_block(model, &open.pivots, 0, &d).ok()?;
+    // The side `crr check` reports (reported_side): the same λ, p_eq and α_eq.
+    let (_, _, eq) = reported_side(model, 0, &d).ok()?;
     (eq.lambda.is_finite() && eq.p_squared > 0.0)
         .then(|| (eq.lambda, eq.p_squared.sqrt(), eq.alpha))
 }
