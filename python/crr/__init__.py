@@ -75,9 +75,12 @@ def _fspath(p: PathLike) -> str:
     return os.fspath(p)
 
 
-def _json(value: Any) -> str:
+def _json(value: Any, where: str) -> str:
     """JSON of a model, study or table given as Python values, numpy scalars and arrays
-    included (as the numbers and lists they hold)."""
+    included (as the numbers and lists they hold). A number that is not finite (NaN, ±inf) is an
+    :class:`InputError` naming its place (``where``, then the keys and indices down to it): JSON
+    has no such numbers, and the parser would only report a position in a text the user never
+    wrote."""
 
     def plain(o: Any) -> Any:
         if isinstance(o, np.generic):
@@ -86,7 +89,44 @@ def _json(value: Any) -> str:
             return o.tolist()
         raise TypeError(f"{type(o).__name__} is not a number, string, list or mapping")
 
+    def check_finite(o: Any, path: str) -> None:
+        if isinstance(o, (float, np.floating)) and not np.isfinite(o):
+            raise InputError(f"{path}: {float(o)} is not a finite number")
+        if isinstance(o, np.ndarray) and o.dtype.kind in "fc" and not np.all(np.isfinite(o)):
+            i = int(np.flatnonzero(~np.isfinite(o.ravel()))[0])
+            raise InputError(f"{path}[{i}]: {o.ravel()[i]} is not a finite number")
+        if isinstance(o, Mapping):
+            for k, v in o.items():
+                check_finite(v, f"{path}.{k}")
+        elif isinstance(o, (list, tuple)):
+            for i, v in enumerate(o):
+                check_finite(v, f"{path}[{i}]")
+
+    check_finite(value, where)
     return json.dumps(value, default=plain)
+
+
+def _is_one_direction(d: Any) -> bool:
+    """A single direction (a name or three numbers), not a list of them."""
+    if isinstance(d, str):
+        return True
+    items = list(np.asarray(d, dtype=object).ravel()) if not isinstance(d, Mapping) else []
+    return len(items) == 3 and all(
+        isinstance(x, (int, float, np.integer, np.floating)) for x in items
+    )
+
+
+def _direction_text(d: Any) -> str:
+    """A direction as ``crr check --direction`` takes it."""
+    if isinstance(d, str):
+        return d
+    try:
+        values = list(np.asarray(d, dtype=float).ravel())
+    except (TypeError, ValueError):
+        values = []
+    if len(values) != 3:
+        raise InputError(f"direction: expected a name such as '+x' or three numbers, got {d!r}")
+    return ",".join(repr(float(v)) for v in values)
 
 
 def _memory_available() -> Optional[float]:
@@ -211,7 +251,7 @@ class Model:
         """A model from a mapping with the keys of a model file (``name``, ``body``,
         ``interface``, ``ground_motion``, …), e.g. the output of :meth:`to_dict`."""
         base = _fspath(base_dir) if base_dir is not None else "."
-        return cls(_crr.Model.parse(_json(d), True, label, base))
+        return cls(_crr.Model.parse(_json(d, label), True, label, base))
 
     @property
     def name(self) -> str:
@@ -237,12 +277,37 @@ class Model:
         """The model file as a dict (every table, defaults filled in)."""
         return json.loads(self._native.to_json())
 
-    def check(self) -> Dict[str, Any]:
-        """The mobility report of ``crr check --json``: DOF, closures, and for a one-DOF
-        mechanism the activation multiplier λ, the equivalent block, r and the free-rocking
-        frequencies (keys and units in ``docs/outputs.md``). Its ``warnings`` (a planar
-        model whose hinge axis is not horizontal) are also issued as :class:`CrrWarning`."""
-        report = json.loads(self._native.check_json())
+    def check(
+        self,
+        direction: Union[None, str, Sequence[Any]] = None,
+        friction: Optional[float] = None,
+        exhaustive_sets: Optional[int] = None,
+    ) -> Dict[str, Any]:
+        """The report of ``crr check --json``: DOF, closures, the static multipliers, and for a
+        one-DOF mechanism the activation multiplier λ, the equivalent block, r and the
+        free-rocking frequencies (keys and units in ``docs/outputs.md``). Its ``warnings`` (a
+        planar model whose hinge axis is not horizontal) are also issued as
+        :class:`CrrWarning`.
+
+        Args:
+            direction: the directions of the ground acceleration for the static multipliers,
+                as ``--direction`` (default ±x and ±y): one direction or a list of them, each
+                ``"+x"``, ``"-y"``, … or three numbers (a string ``"1,1,0"`` or a sequence
+                ``(1, 1, 0)``; any length, it may have a vertical part).
+            friction: Coulomb μ at every contact (0 to 1000), as ``--friction``; default no
+                sliding, and the report gives the μ each multiplier needs.
+            exhaustive_sets: the most sets of joints that may open and slide the exhaustive
+                pass tries per direction, as ``--exhaustive-sets`` (default 4096).
+        """
+        directions: Optional[List[str]] = None
+        if direction is not None:
+            given = [direction] if _is_one_direction(direction) else list(direction)
+            directions = [_direction_text(d) for d in given]
+        mu = None if friction is None else float(friction)
+        sets = None if exhaustive_sets is None else _positive_count("exhaustive_sets", exhaustive_sets)
+        report = json.loads(
+            self._native.check_json(directions=directions, friction=mu, exhaustive_sets=sets)
+        )
         for message in report.get("warnings") or []:
             warnings.warn(CrrWarning(message), stacklevel=2)
         return report
@@ -658,7 +723,7 @@ def simulate(
     if ground_motion is None:
         pass
     elif isinstance(ground_motion, Mapping):
-        gm_json = _json(ground_motion)
+        gm_json = _json(ground_motion, "ground_motion")
     else:
         if isinstance(ground_motion, Record):
             records: List[Record] = [ground_motion]
@@ -670,9 +735,17 @@ def simulate(
             records = [Record.from_arrays(ground_motion[0], ground_motion[1])]
         else:
             records = list(ground_motion)  # type: ignore[arg-type]
+        driven: Dict[str, Record] = {}
         for r in records:
             if not isinstance(r, Record):
                 raise TypeError(f"ground_motion: expected crr.Record items, got {type(r).__name__}")
+            if r.component in driven:
+                # Each replaces its component: a second one would silently win.
+                raise InputError(
+                    f"ground_motion: two records drive component {r.component!r} "
+                    "(each record replaces its component; give one per component)"
+                )
+            driven[r.component] = r
             if r.path is not None:
                 if record_file is not None:
                     raise InputError("ground_motion: at most one record file per run")
@@ -684,7 +757,7 @@ def simulate(
                 arrays.append(
                     (r.component, r.t.tolist(), r.a.tolist(), r.units or "m/s2", r.scale)
                 )
-    init_json = _json(initial) if initial is not None else None
+    init_json = _json(initial, "initial") if initial is not None else None
     unknown = sorted(set(analysis) - set(_crr.ANALYSIS_KEYS))
     if unknown:
         raise TypeError(
@@ -701,7 +774,7 @@ def simulate(
     if analysis:
         table = dict(model.to_dict().get("analysis") or {})
         table.update(analysis)
-        analysis_json = _json(table)
+        analysis_json = _json(table, "analysis")
     try:
         run = _crr.simulate(
             native,
@@ -759,7 +832,7 @@ class Study:
     def from_dict(cls, d: Mapping[str, Any], base_dir: Optional[PathLike] = None) -> "Study":
         """A study from a mapping with the keys of a study file, read as :meth:`from_toml`."""
         label = os.path.join(_fspath(base_dir) if base_dir is not None else ".", "study.toml")
-        text = _json(d)
+        text = _json(d, label)
         return cls(_crr.Study.parse(text, True, label), ("json", text, label))
 
     @property
@@ -882,17 +955,28 @@ def _pandas(what: str) -> Any:
     return pandas
 
 
+#: The text columns of ``cases.csv``: read as text whatever they hold, so that a study whose
+#: cases all ran cleanly (``violation``, ``violation_interface`` and ``error`` all empty) still
+#: takes ``frame["error"].str`` (read alone, an all-empty column is a float64 of NaN).
+CASES_TEXT_COLUMNS = ("id", "record", "status", "violation", "violation_interface", "error")
+
+
 def cases_frame(text: str) -> "pandas.DataFrame":
     """The text of a ``cases.csv`` as a pandas DataFrame, every number read back exactly; the
-    empty cells are NaN."""
+    empty cells are NaN. The text columns (:data:`CASES_TEXT_COLUMNS`) are text (``object``)
+    whatever their values, ``collapse`` is a nullable integer (``Int64``: empty for a case
+    stopped by an error before it could tell)."""
     pd = _pandas("a study's DataFrame")
-
+    header = text.split("\n", 1)[0].split(",")
+    dtype: Dict[str, Any] = {c: object for c in CASES_TEXT_COLUMNS if c in header}
+    if "collapse" in header:
+        dtype["collapse"] = "Int64"
     # pandas < 3 reads floats exactly only with the round-trip converter; pandas 3 always does
     # (and deprecates the option).
     if int(pd.__version__.split(".")[0]) >= 3:
-        frame = pd.read_csv(io.StringIO(text))
+        frame = pd.read_csv(io.StringIO(text), dtype=dtype)
     else:  # pragma: no cover
-        frame = pd.read_csv(io.StringIO(text), float_precision="round_trip")
+        frame = pd.read_csv(io.StringIO(text), dtype=dtype, float_precision="round_trip")
     frame.attrs["cases_csv"] = text
     return frame
 

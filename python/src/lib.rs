@@ -198,10 +198,46 @@ impl PyModel {
         serde_json::to_string(&self.file).expect("a model file serialises")
     }
 
-    /// `crr check --json` of this model.
-    fn check_json(&self, py: Python<'_>) -> String {
-        let report = py.detach(|| crr::analysis::check::check(&self.structure));
-        serde_json::to_string(&report).expect("the report serialises")
+    /// `crr check --json` of this model, with `--direction D…` (`directions`, each as the
+    /// command line takes it), `--friction MU` and `--exhaustive-sets N`.
+    #[pyo3(signature = (directions=None, friction=None, exhaustive_sets=None))]
+    fn check_json(
+        &self,
+        py: Python<'_>,
+        directions: Option<Vec<String>>,
+        friction: Option<f64>,
+        exhaustive_sets: Option<usize>,
+    ) -> PyResult<String> {
+        use crr::analysis::static_multiplier::{
+            MultiplierOptions, check_friction, horizontal_directions, parse_direction,
+        };
+        let directions = match directions {
+            None => horizontal_directions(),
+            Some(list) if list.is_empty() => {
+                return Err(argument(
+                    py,
+                    "direction: give at least one direction".into(),
+                ));
+            }
+            Some(list) => list
+                .iter()
+                .map(|d| parse_direction(d))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| argument(py, format!("direction: {e}")))?,
+        };
+        if let Some(mu) = friction {
+            check_friction(mu).map_err(|e| argument(py, format!("friction {e}")))?;
+        }
+        let mut asked = MultiplierOptions {
+            friction,
+            ..MultiplierOptions::default()
+        };
+        if let Some(n) = exhaustive_sets {
+            asked.exhaustive_sets = n;
+        }
+        let report =
+            py.detach(|| crr::analysis::check::check_with(&self.structure, &directions, &asked));
+        Ok(serde_json::to_string(&report).expect("the report serialises"))
     }
 
     /// `crr inspect --json` at q: `settings` as `--q NAME=VALUE` (others 0), or every

@@ -387,3 +387,33 @@ def test_an_assembly_is_the_model_the_command_line_writes(cli, in_root, tmp_path
         crr.Model.from_assembly(wrong, planar=True, all_contacts=True)
     assert str(error.value) == p.stderr.strip().removeprefix("crr: error: ")
     assert 'fixed: no block is named "skewback_west"' in str(error.value)
+
+
+def test_check_takes_the_command_line_s_options(cli, in_root):
+    """``Model.check(direction=…, friction=…, exhaustive_sets=…)`` is ``crr check --json
+    --direction … --friction … --exhaustive-sets …``. The bundled trilithon is planar (hinges
+    about y): along d = (1, 1, 0)/√2 its multiplier is the in-plane one over the in-plane part
+    of d, λ_x/cos 45° = 0.125 √2 (docs/outputs.md, ``out_of_plane``)."""
+    path = "examples/models/trilithon.toml"
+    model = crr.Model.from_file(path)
+    for kwargs, args in [
+        ({"direction": "1,1,0"}, ["--direction", "1,1,0"]),
+        ({"direction": (1, 1, 0)}, ["--direction", "1,1,0"]),
+        ({"direction": ["+x", "-y"], "exhaustive_sets": 16}, ["--direction", "+x", "--direction", "-y", "--exhaustive-sets", "16"]),
+        ({"friction": 0.6}, ["--friction", "0.6"]),
+    ]:
+        printed = json.loads(run_cli(cli, ["check", path, "--json", *args]).stdout)
+        assert model.check(**kwargs) == printed, kwargs
+    along = model.check(direction=np.array([1.0, 1.0, 0.0]))["static_multipliers"]
+    assert len(along) == 1
+    assert along[0]["lambda"] == pytest.approx(0.125 * np.sqrt(2.0), rel=1e-9)
+    for bad, message in [
+        ({"friction": 1e300}, r"^friction must be a number from 0 to 1000"),
+        ({"friction": float("nan")}, r"^friction must be a number from 0 to 1000"),
+        ({"direction": "0,0,0"}, r"^direction: "),
+        ({"direction": "up"}, r"^direction: 'up' is neither"),
+        ({"direction": [1, 2]}, r"^direction: expected a name such as '\+x' or three numbers"),
+        ({"exhaustive_sets": 0}, r"exhaustive_sets must be a positive integer"),
+    ]:
+        with pytest.raises(crr.InputError, match=message):
+            model.check(**bad)

@@ -156,3 +156,39 @@ def test_record_argument_errors_name_the_python_arguments() -> None:
     for record, message in cases:
         with pytest.raises(crr.InputError, match=message):
             crr.simulate(BLOCK, ground_motion=record, duration=1.0)
+
+
+def test_numbers_that_are_not_finite_are_named_where_they_are() -> None:
+    """JSON has no NaN or infinity: a Python value holding one is refused naming its place, where
+    the engine's parser would report a position in a text the user never wrote."""
+    nan = float("nan")
+    with pytest.raises(crr.InputError, match=r"^analysis\.rtol: nan is not a finite number$"):
+        crr.simulate(BLOCK, rtol=nan, duration=1.0)
+    with pytest.raises(crr.InputError, match=r"^initial\.angles\.base: inf is not a finite number$"):
+        crr.simulate(BLOCK, initial={"angles": {"base": float("inf")}}, duration=1.0)
+    d = crr.Model.from_file(BLOCK).to_dict()
+    d["body"][0]["density"] = np.float64(nan)
+    with pytest.raises(crr.InputError, match=r"^<dict>\.body\[0\]\.density: nan is not a finite number$"):
+        crr.Model.from_dict(d)
+    d = crr.Model.from_file(BLOCK).to_dict()
+    d["body"][0]["box"]["size"] = np.array([0.4, nan, 2.0])
+    with pytest.raises(crr.InputError, match=r"^<dict>\.body\[0\]\.box\.size\[1\]: nan is not a finite number$"):
+        crr.Model.from_dict(d)
+    with pytest.raises(crr.InputError, match=r"^ground_motion\.x\.sine\.amplitude: nan"):
+        crr.simulate(BLOCK, ground_motion={"x": {"sine": {"amplitude": nan, "period": 1.0}}}, duration=1.0)
+
+
+def test_two_records_for_one_component_are_refused() -> None:
+    """Each record replaces its component of the ground motion: a second record for the same
+    component would silently replace the first (two files were already refused)."""
+    t = np.linspace(0.0, 1.0, 101)
+    a = np.sin(2.0 * np.pi * t)
+    x1 = crr.Record.from_arrays(t, a, units="g")
+    x2 = crr.Record.from_arrays(t, 2.0 * a, units="g")
+    with pytest.raises(crr.InputError, match=r"^ground_motion: two records drive component 'x'"):
+        crr.simulate(BLOCK, ground_motion=[x1, x2], duration=1.0)
+    y = crr.Record.from_arrays(t, a, units="g", component="y")
+    # The block is planar (hinge about y): the y record is carried bilaterally, and said so.
+    with pytest.warns(crr.CrrWarning, match="part along the hinges' common axis"):
+        both = crr.simulate(BLOCK, ground_motion=[x1, y], duration=1.0)
+    assert both.summary["ground_motion"]["pga"][:2] == pytest.approx([9.80665, 9.80665], rel=1e-3)

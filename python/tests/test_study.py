@@ -57,6 +57,12 @@ def test_a_study_equals_the_command_lines_cases_csv(cli, tmp_path):
     assert len(frame) == 36
     assert set(frame["status"]) == {"ok"}
     assert frame["collapse"].sum() > 0 and (frame["collapse"] == 0).sum() > 0
+    # Its text columns are text though every case ran cleanly (all empty: read alone, a float64
+    # of NaN that refuses `.str`), and `collapse` a nullable integer.
+    assert frame["error"].isna().all() and frame["violation_interface"].isna().all()
+    assert not frame["error"].str.contains("failed").fillna(False).any()
+    assert frame["error"].dtype == object and frame["violation"].dtype == object
+    assert str(frame["collapse"].dtype) == "Int64"
     # The DataFrame holds the file's numbers exactly.
     again = crr.cases_frame((tmp_path / "cli" / "cases.csv").read_text())
     for column in ("amplitude_m_s2", "peak_base_rad", "dissipated_j"):

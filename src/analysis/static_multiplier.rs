@@ -238,6 +238,22 @@ pub fn static_multiplier_with(
     Ok(report)
 }
 
+/// The largest Coulomb friction coefficient the statics take (`crr check --friction`, Python's
+/// `Model.check(friction=…)`): above it their programs lose their accuracy (1e300 ended in a
+/// solver's NumericalError), and it is also the largest need for friction they report.
+pub const MAX_FRICTION: f64 = 1e3;
+
+/// μ as the statics take it: a number from 0 to [`MAX_FRICTION`], else why not.
+pub fn check_friction(mu: f64) -> Result<f64, String> {
+    if mu.is_finite() && (0.0..=MAX_FRICTION).contains(&mu) {
+        Ok(mu)
+    } else {
+        Err(format!(
+            "must be a number from 0 to 1000 (no masonry joint needs more to hold), got {mu}"
+        ))
+    }
+}
+
 /// A direction of the ground acceleration from the command line: `+x`, `-x`, `+y`, `-y`, `+z`,
 /// `-z` (or without the `+`), or three numbers `X,Y,Z`, not all zero.
 pub fn parse_direction(text: &str) -> Result<Vector3<f64>, String> {

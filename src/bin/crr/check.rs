@@ -85,15 +85,9 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| Failure::Input(Error::Argument(format!("--direction: {e}"))))?
     };
-    // Above 1000 the statics' programs lose their accuracy (1e300 ended in a solver's
-    // NumericalError with exit 0); it is also the largest friction they report a need for.
-    if let Some(mu) = friction
-        && !(mu.is_finite() && (0.0..=1e3).contains(&mu))
-    {
-        return Err(Failure::Input(Error::Argument(format!(
-            "--friction must be a number from 0 to 1000 (no masonry joint needs more to hold), \
-             got {mu}"
-        ))));
+    if let Some(mu) = friction {
+        crr::analysis::static_multiplier::check_friction(mu)
+            .map_err(|e| Failure::Input(Error::Argument(format!("--friction {e}"))))?;
     }
     if let Some(dir) = plot
         && !force
