@@ -618,7 +618,7 @@ class Result:
             ("impacts.csv", self.impacts_csv()),
             ("hops.csv", self.hops_csv()),
             ("openings.csv", self.openings_csv()),
-            ("summary.json", json.dumps(self.summary, indent=2, ensure_ascii=False) + "\n"),
+            ("summary.json", self._run.summary_json),
         ):
             with open(d / name, "w", newline="", encoding="utf-8") as f:
                 f.write(text)
@@ -634,13 +634,14 @@ class Result:
             self._run.impacts_csv(),
             self._run.openings_csv(),
             self._run.hops_csv(),
+            self._run.summary_json,
         )
         return state
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
-        history, impacts, openings, hops = state.pop("_csv")
+        history, impacts, openings, hops, summary = state.pop("_csv")
         self.__dict__.update(state)
-        self._run = _CsvTexts(history, impacts, openings, hops)
+        self._run = _CsvTexts(history, impacts, openings, hops, summary)
 
     def __repr__(self) -> str:
         s = self.summary
@@ -651,15 +652,17 @@ class Result:
 
 
 class _CsvTexts:
-    """What an unpickled :class:`Result` keeps of its native run: the texts of its CSV files."""
+    """What an unpickled :class:`Result` keeps of its native run: the texts of its CSV files and
+    of its summary.json."""
 
-    __slots__ = ("_history", "_impacts", "_openings", "_hops")
+    __slots__ = ("_history", "_impacts", "_openings", "_hops", "summary_json")
 
-    def __init__(self, history: str, impacts: str, openings: str, hops: str) -> None:
+    def __init__(self, history: str, impacts: str, openings: str, hops: str, summary: str) -> None:
         self._history = history
         self._impacts = impacts
         self._openings = openings
         self._hops = hops
+        self.summary_json = summary
 
     def history_csv(self) -> str:
         return self._history
@@ -875,6 +878,8 @@ class Study:
         self, jobs: Optional[int], out: Optional[PathLike], progress: bool
     ) -> "pandas.DataFrame":
         """:meth:`run` without its warning."""
+        # Before any case runs: without pandas the rows would be computed and then lost.
+        _pandas("a study's DataFrame")
         if out is not None:
             self._native.run_into(_fspath(out), _jobs(jobs), progress)
             text = (Path(out) / "cases.csv").read_text()

@@ -544,9 +544,9 @@ fn simulate(
     let cancel = crr::Cancel::new();
     options.cancel = Some(cancel.clone());
     let to_py = |run: crr::Run| {
-        let summary = serde_json::to_value(&run.summary).expect("the summary serialises");
         PyRun {
-            summary: serde_json::to_string(&summary).expect("a JSON value prints"),
+            // The text `crr simulate` writes, so that Result.write writes the same bytes.
+            summary: run.summary.to_json(),
             error: run.summary.error,
             hop_tolerance: run.summary.solver.hop_tolerance,
             structure: run.model,

@@ -29,6 +29,8 @@ def _same_result(a: crr.Result, b: crr.Result) -> None:
     assert a.impacts_csv() == b.impacts_csv()
     assert a.openings_csv() == b.openings_csv()
     assert a.hops_csv() == b.hops_csv()
+    # Result.write's summary.json text survives the round trip too.
+    assert a._run.summary_json == b._run.summary_json
 
 
 def _simulate(duration: float) -> crr.Result:

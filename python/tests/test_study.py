@@ -188,3 +188,25 @@ def test_without_pandas_the_frames_say_which_extra_installs_it(monkeypatch, tmp_
     ):
         with pytest.raises(ImportError, match=f"{what} needs pandas.*crr-rocking\\[pandas\\]"):
             call()
+
+
+def test_a_study_without_pandas_is_refused_before_any_case_runs(monkeypatch, tmp_path):
+    """``crr.study`` returns a DataFrame: without pandas it used to run every case and then raise
+    ImportError, losing the rows. Now it raises before any runs (the rows without pandas are
+    :meth:`Study.run_rows`)."""
+    import builtins
+
+    study = crr.Study.from_file(small_map(tmp_path))
+    real_import = builtins.__import__
+
+    def no_pandas(name, *args, **kwargs):
+        if name == "pandas" or name.startswith("pandas."):
+            raise ImportError("No module named 'pandas'")
+        return real_import(name, *args, **kwargs)
+
+    ran = []
+    monkeypatch.setattr(type(study), "run_rows", lambda self, *a, **k: ran.append(1) or [])
+    monkeypatch.setattr(builtins, "__import__", no_pandas)
+    with pytest.raises(ImportError, match="needs pandas"):
+        crr.study(study)
+    assert ran == []
