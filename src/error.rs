@@ -18,6 +18,19 @@ pub enum Error {
         /// The operating system's reason.
         source: std::io::Error,
     },
+    /// A file that an input names (a model's record, say) could not be read: the input and the
+    /// item that names it are given.
+    #[error("{input}: {item}: {file}: cannot read file: {source}")]
+    NamedFile {
+        /// The input (model or study file) that names it.
+        input: PathBuf,
+        /// The item naming it, e.g. `ground_motion.x.record`.
+        item: String,
+        /// The file as named (joined with the input's folder).
+        file: PathBuf,
+        /// The operating system's reason.
+        source: std::io::Error,
+    },
     /// The text is not valid TOML/JSON or does not fit the model format (line and column given).
     #[error("{file}: {message}")]
     Parse {

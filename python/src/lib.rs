@@ -46,6 +46,7 @@ fn input_error(py: Python<'_>, e: Error) -> PyErr {
     let message = e.to_string();
     let (file, source) = match &e {
         Error::Io { file, source } => (file, source),
+        Error::NamedFile { file, source, .. } => (file, source),
         Error::Output { dir, source } => (dir, source),
         _ => return raise(py, "InputError", message),
     };

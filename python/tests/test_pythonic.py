@@ -70,6 +70,16 @@ def test_a_missing_file_is_a_file_not_found_error_with_its_name() -> None:
     with pytest.raises(FileNotFoundError) as model:
         crr.Model.from_file("no/such.toml")
     assert model.value.filename == "no/such.toml"
+    # A record the model names, missing where its folder puts it: the same kind of error, with
+    # the model and the item in its message (as `crr simulate` prints it).
+    text = (ROOT / "examples" / "models" / "block_record.toml").read_text()
+    named = crr.Model.from_toml(text, base_dir=ROOT / "no" / "folder", label="block_record.toml")
+    with pytest.raises(FileNotFoundError) as info:
+        crr.simulate(named)
+    e = info.value
+    assert isinstance(e, crr.MissingFileError) and e.errno == errno.ENOENT
+    assert Path(e.filename) == ROOT / "no" / "folder" / ".." / "records" / "synthetic.AT2"
+    assert str(e).startswith("block_record.toml: ground_motion.x.record: ")
 
 
 def test_a_run_that_cannot_fit_in_memory_is_refused_before_it_starts() -> None:

@@ -265,8 +265,20 @@ fn ground_motion(
     options: &RunOptions,
 ) -> Result<GroundMotion, Error> {
     let mut ground = match &file.ground_motion {
-        Some(spec) => GroundMotion::from_spec(spec, &input.base_dir)
-            .map_err(|e| Error::Argument(format!("{}: {e}", input.path.display())))?,
+        Some(spec) => GroundMotion::from_spec(spec, &input.base_dir).map_err(|e| match e {
+            // A record file the model names that cannot be read is a file error (Python:
+            // crr.MissingFileError when it does not exist), named with the item.
+            GroundMotionError::InComponent { context, error } => match *error {
+                GroundMotionError::Io { path, error } => Error::NamedFile {
+                    input: input.path.clone(),
+                    item: context,
+                    file: path.into(),
+                    source: error,
+                },
+                other => Error::Argument(format!("{}: {context}: {other}", input.path.display())),
+            },
+            e => Error::Argument(format!("{}: {e}", input.path.display())),
+        })?,
         None => GroundMotion::none(),
     };
     if let Some(r) = &options.record_file {
