@@ -75,12 +75,12 @@ def _fspath(p: PathLike) -> str:
     return os.fspath(p)
 
 
-def _json(value: Any, where: str) -> str:
+def _json(value: Any, path: str = "", label: Optional[str] = None) -> str:
     """JSON of a model, study or table given as Python values, numpy scalars and arrays
     included (as the numbers and lists they hold). A number that is not finite (NaN, ±inf) is an
-    :class:`InputError` naming its place (``where``, then the keys and indices down to it): JSON
-    has no such numbers, and the parser would only report a position in a text the user never
-    wrote."""
+    :class:`InputError` naming its place (``label: `` when given, then ``path`` and the keys and
+    indices down to it, as the parser names a key): JSON has no such numbers, and the parser
+    would only report a position in a text the user never wrote."""
 
     def plain(o: Any) -> Any:
         if isinstance(o, np.generic):
@@ -89,20 +89,28 @@ def _json(value: Any, where: str) -> str:
             return o.tolist()
         raise TypeError(f"{type(o).__name__} is not a number, string, list or mapping")
 
-    def check_finite(o: Any, path: str) -> None:
+    def refuse(at: str, x: Any) -> None:
+        raise InputError(f"{label + ': ' if label else ''}{at}: {float(x)} is not a finite number")
+
+    def check_finite(o: Any, at: str) -> None:
         if isinstance(o, (float, np.floating)) and not np.isfinite(o):
-            raise InputError(f"{path}: {float(o)} is not a finite number")
-        if isinstance(o, np.ndarray) and o.dtype.kind in "fc" and not np.all(np.isfinite(o)):
-            i = int(np.flatnonzero(~np.isfinite(o.ravel()))[0])
-            raise InputError(f"{path}[{i}]: {o.ravel()[i]} is not a finite number")
-        if isinstance(o, Mapping):
+            refuse(at, o)
+        if isinstance(o, np.ndarray):
+            if o.dtype.kind in "fc":
+                bad = np.argwhere(~np.isfinite(o))
+                if len(bad):
+                    index = tuple(int(i) for i in bad[0])
+                    refuse(at + "".join(f"[{i}]" for i in index), o[index])
+            elif o.dtype.kind == "O":
+                check_finite(o.tolist(), at)
+        elif isinstance(o, Mapping):
             for k, v in o.items():
-                check_finite(v, f"{path}.{k}")
+                check_finite(v, f"{at}.{k}" if at else str(k))
         elif isinstance(o, (list, tuple)):
             for i, v in enumerate(o):
-                check_finite(v, f"{path}[{i}]")
+                check_finite(v, f"{at}[{i}]")
 
-    check_finite(value, where)
+    check_finite(value, path)
     return json.dumps(value, default=plain)
 
 
@@ -251,7 +259,7 @@ class Model:
         """A model from a mapping with the keys of a model file (``name``, ``body``,
         ``interface``, ``ground_motion``, …), e.g. the output of :meth:`to_dict`."""
         base = _fspath(base_dir) if base_dir is not None else "."
-        return cls(_crr.Model.parse(_json(d, label), True, label, base))
+        return cls(_crr.Model.parse(_json(d, label=label), True, label, base))
 
     @property
     def name(self) -> str:
@@ -835,7 +843,7 @@ class Study:
     def from_dict(cls, d: Mapping[str, Any], base_dir: Optional[PathLike] = None) -> "Study":
         """A study from a mapping with the keys of a study file, read as :meth:`from_toml`."""
         label = os.path.join(_fspath(base_dir) if base_dir is not None else ".", "study.toml")
-        text = _json(d, label)
+        text = _json(d, label=label)
         return cls(_crr.Study.parse(text, True, label), ("json", text, label))
 
     @property

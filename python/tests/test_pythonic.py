@@ -178,12 +178,22 @@ def test_numbers_that_are_not_finite_are_named_where_they_are() -> None:
         crr.simulate(BLOCK, initial={"angles": {"base": float("inf")}}, duration=1.0)
     d = crr.Model.from_file(BLOCK).to_dict()
     d["body"][0]["density"] = np.float64(nan)
-    with pytest.raises(crr.InputError, match=r"^<dict>\.body\[0\]\.density: nan is not a finite number$"):
+    with pytest.raises(crr.InputError, match=r"^<dict>: body\[0\]\.density: nan is not a finite number$"):
         crr.Model.from_dict(d)
     d = crr.Model.from_file(BLOCK).to_dict()
     d["body"][0]["box"]["size"] = np.array([0.4, nan, 2.0])
-    with pytest.raises(crr.InputError, match=r"^<dict>\.body\[0\]\.box\.size\[1\]: nan is not a finite number$"):
+    with pytest.raises(crr.InputError, match=r"^<dict>: body\[0\]\.box\.size\[1\]: nan is not a finite number$"):
         crr.Model.from_dict(d)
+    # A 2-D array by its row and column; an array of Python objects as the lists it holds.
+    polygon = np.array([[-0.2, 0.0, 0.0], [0.2, 0.0, 0.0], [0.2, 0.0, 2.0], [-0.2, 0.0, nan]])
+    prism = {"name": "p", "body": [{"name": "b", "density": 2000.0,
+                                    "prism": {"polygon": polygon, "extrude": [0.0, 0.4, 0.0]}}],
+             "interface": []}
+    with pytest.raises(crr.InputError, match=r"^<dict>: body\[0\]\.prism\.polygon\[3\]\[2\]: nan"):
+        crr.Model.from_dict(prism)
+    prism["body"][0]["prism"]["polygon"] = polygon.astype(object)
+    with pytest.raises(crr.InputError, match=r"^<dict>: body\[0\]\.prism\.polygon\[3\]\[2\]: nan"):
+        crr.Model.from_dict(prism)
     with pytest.raises(crr.InputError, match=r"^ground_motion\.x\.sine\.amplitude: nan"):
         crr.simulate(BLOCK, ground_motion={"x": {"sine": {"amplitude": nan, "period": 1.0}}}, duration=1.0)
 

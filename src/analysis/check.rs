@@ -10,8 +10,8 @@ use serde::Serialize;
 use crr_dynamics::ground_motion::GroundMotion;
 use crr_dynamics::mechanism::reduce_at;
 use crr_dynamics::{
-    FiniteMobility, InitialSpec, LagrangianParameters, Mobility, lagrangian_parameters_on_side,
-    mobility, mobility_after_step, reported_side, solve_initial,
+    FiniteMobility, InitialSpec, LagrangianParameters, Mobility, horizontal_direction,
+    lagrangian_parameters_on_side, mobility, mobility_after_step, reported_side, solve_initial,
 };
 use crr_impact::laws::momentum_law;
 use crr_impact::simulation::{Parameters, Simulation, StopReason};
@@ -168,12 +168,7 @@ fn slot_codes(model: &Model, pivots: &ActivePivots) -> BTreeMap<String, String> 
 
 fn mechanism(model: &Model) -> Result<MechanismReport, String> {
     let name = model.coords[0].name.clone();
-    let u = model.coords[0].axis;
-    let mut d = u.cross(&Vector3::z());
-    if d.norm() < 1e-9 {
-        d = Vector3::x();
-    }
-    let d = d.normalize();
+    let d = horizontal_direction(model, 0);
     // The side the mechanism is reported on follows from its physics, not from the sense the
     // file gives the coordinate (reported_side).
     let (side, pivots, eq) = reported_side(model, 0, &d).map_err(|e| e.to_string())?;

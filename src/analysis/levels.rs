@@ -123,12 +123,7 @@ fn slot_codes(model: &Model, pivots: &ActivePivots) -> BTreeMap<String, String> 
 
 /// The unit horizontal direction perpendicular to coordinate `c`'s axis (x when it is vertical).
 fn horizontal(model: &Model, c: usize) -> Vector3<f64> {
-    let d = model.coords[c].axis.cross(&Vector3::z());
-    if d.norm() < 1e-9 {
-        Vector3::x()
-    } else {
-        d.normalize()
-    }
+    crr_dynamics::horizontal_direction(model, c)
 }
 
 /// Evaluates the mechanism at θ from the closed configuration `q_prev` (Newton start):

@@ -442,10 +442,20 @@ pub struct SampleStats {
     pub rows: usize,
     /// The largest of T, |U|, |W| and D over the samples (J).
     pub energy_scale: f64,
-    /// The rocking bases without twist (their interfaces and first slots) whose corner rocking
-    /// is watched ([`Self::watching_corners_of`]), and the first sample (s) at which each had
-    /// both tilts turned.
-    pub corners: Vec<(usize, usize, Option<f64>)>,
+    /// The rocking bases without twist watched for a sample on a corner
+    /// ([`Self::watching_corners_of`]; none by default).
+    pub corners: Vec<CornerWatch>,
+}
+
+/// One rocking base watched for a sample on a corner.
+#[derive(Clone, Debug)]
+pub struct CornerWatch {
+    /// Its interface.
+    pub interface: usize,
+    /// Its first slot (`.1`; `.2` follows it).
+    pub first_slot: usize,
+    /// The first sample (s) at which both its tilts were turned.
+    pub first_seen: Option<f64>,
 }
 
 impl SampleStats {
@@ -458,7 +468,11 @@ impl SampleStats {
             .iter()
             .enumerate()
             .filter(|(_, i)| matches!(i.kind, InterfaceKind::RockingBase { twist: false, .. }))
-            .map(|(k, i)| (k, i.slots.start, None))
+            .map(|(k, i)| CornerWatch {
+                interface: k,
+                first_slot: i.slots.start,
+                first_seen: None,
+            })
             .collect();
         SampleStats {
             corners,
@@ -477,12 +491,10 @@ impl SampleStats {
                 .max(s.work_in.abs())
                 .max(s.dissipated);
             self.energy_scale = self.energy_scale.max(e);
-            for (_, slot, first) in self.corners.iter_mut().filter(|c| c.2.is_none()) {
-                if s.states.len() > *slot + 1
-                    && turned(s.states[*slot])
-                    && turned(s.states[*slot + 1])
-                {
-                    *first = Some(s.t);
+            for c in self.corners.iter_mut().filter(|c| c.first_seen.is_none()) {
+                let k = c.first_slot;
+                if s.states.len() > k + 1 && turned(s.states[k]) && turned(s.states[k + 1]) {
+                    c.first_seen = Some(s.t);
                 }
             }
         }
@@ -877,17 +889,18 @@ fn rocking_on_a_corner(model: &Model, stats: &SampleStats) -> Option<String> {
     let first: Vec<(f64, &str)> = stats
         .corners
         .iter()
-        .filter_map(|&(k, _, t)| Some((t?, model.interfaces[k].name.as_str())))
+        .filter_map(|c| Some((c.first_seen?, model.interfaces[c.interface].name.as_str())))
         .collect();
     let (t0, _) = *first.iter().min_by(|x, y| x.0.total_cmp(&y.0))?;
     let mut names: Vec<&str> = first.iter().map(|(_, n)| *n).collect();
     let more = names.len().saturating_sub(3);
     names.truncate(3);
     Some(format!(
-        "from t = {} s {}{} rocked on a corner (both tilts turned): a rocking base's two tilts \
-         turn in series, .1 about the edge from its corner 0 to corner 1 and then .2, with no \
-         twist about the face normal, and the two orders differ at second order (φ₁φ₂), so from \
-         there the motion depends on the corner the face's list starts from; near a threshold \
+        "from t = {} s (an output sample) {}{} rocked on a corner (both tilts turned): a \
+         rocking base's two tilts turn in series, .1 about the edge from its corner 0 to corner \
+         1 and then .2, with no twist about the face normal, and the two orders differ at second \
+         order (φ₁φ₂) on a corner and in the rate at which a base leaves an edge for a corner, \
+         so the motion depends on the corner the face's list starts from; near a threshold \
          (overturning, the timing of an impact) the response may change: run the model with the \
          corners listed from the next corner to see how much (docs/model-format.md, \
          \"Rocking bases: the order of the two tilts\")",

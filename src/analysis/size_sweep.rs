@@ -8,14 +8,13 @@
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use crr_dynamics::equivalent_block;
+use crr_dynamics::{horizontal_direction, reported_side};
 use crr_kinematics::shapes::Shape;
 use crr_kinematics::spec::PivotSpec;
 use crr_kinematics::{Model, StructureSpec};
 
 use crate::Error;
 use crate::analysis::check::{first_fall_time, housner_frequency};
-use crate::analysis::levels::opening_pivots;
 
 /// Largest number of scale factors of a sweep.
 pub const MAX_SIZES: usize = 200;
@@ -251,12 +250,8 @@ pub fn size_sweep(spec: &StructureSpec, scales: &[f64], ratio: f64) -> Result<Si
             .first()
             .map(|c| c.name.clone())
             .unwrap_or_default();
-        let pivots = opening_pivots(&model, 0, 1.0).map_err(|e| format!("{at}: {e}"))?;
-        let mut d = model.coords[0].axis.cross(&Vector3::z());
-        if d.norm() < 1e-9 {
-            d = Vector3::x();
-        }
-        let eq = equivalent_block(&model, &pivots, 0, &d.normalize())
+        // The side `crr check` reports (reported_side), read in its opening angle.
+        let (side, _, eq) = reported_side(&model, 0, &horizontal_direction(&model, 0))
             .map_err(|e| format!("{at}: {e}"))?;
         let (p, alpha) = (eq.p_squared.sqrt(), eq.alpha);
         if !(p.is_finite() && p > 0.0 && alpha.is_finite() && alpha > 0.0) {
@@ -265,8 +260,8 @@ pub fn size_sweep(spec: &StructureSpec, scales: &[f64], ratio: f64) -> Result<Si
                 eq.p_squared
             ));
         }
-        let theta_m = ratio * alpha;
-        let fh = housner_frequency(p, alpha, theta_m);
+        let theta_m = side.sign() * ratio * alpha;
+        let fh = housner_frequency(p, alpha, theta_m.abs());
         let limit = 2.0 / fh + 1.0;
         let engine =
             first_fall_time(&model, &coordinate, theta_m, limit).map(|tau| 1.0 / (4.0 * tau));

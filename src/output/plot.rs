@@ -8,14 +8,13 @@
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
-use nalgebra::Vector3;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use serde_json::Value;
 
-use crr_dynamics::equivalent_block;
+use crr_dynamics::{horizontal_direction, reported_side};
 use crr_kinematics::{ActivePivots, Model, Side};
 
 use crate::analysis::check::{CheckReport, housner_frequency};
@@ -138,13 +137,8 @@ fn free_rocking(summary: &Value) -> Option<FreeRocking> {
     if model.dof() != 1 || !model.closures.is_empty() {
         return None;
     }
-    let pivots = ActivePivots::uniform(&model, Side::Positive);
-    let u = model.coords[0].axis;
-    let mut d = u.cross(&Vector3::z());
-    if d.norm() < 1e-9 {
-        d = Vector3::x();
-    }
-    let eq = equivalent_block(&model, &pivots, 0, &d.normalize()).ok()?;
+    // The side `crr check` reports (reported_side).
+    let (_, _, eq) = reported_side(&model, 0, &horizontal_direction(&model, 0)).ok()?;
     (eq.p_squared > 0.0 && eq.alpha > 0.0).then(|| FreeRocking {
         p: eq.p_squared.sqrt(),
         alpha: eq.alpha,

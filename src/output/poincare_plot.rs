@@ -6,14 +6,13 @@
 use std::ops::Range;
 use std::path::Path;
 
-use nalgebra::Vector3;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
-use crr_dynamics::equivalent_block;
-use crr_kinematics::{ActivePivots, Model, Side};
+use crr_dynamics::{horizontal_direction, reported_side};
+use crr_kinematics::Model;
 
 use crate::analysis::poincare::{Computed, Outcome, Prepared, Section, SectionKind};
 use crate::output::plot::{
@@ -27,13 +26,8 @@ pub fn single_block_levels(model: &Model) -> Option<FreeRocking> {
     if model.dof() != 1 || !model.closures.is_empty() || model.bodies.len() != 1 {
         return None;
     }
-    let pivots = ActivePivots::uniform(model, Side::Positive);
-    let u = model.coords[0].axis;
-    let mut d = u.cross(&Vector3::z());
-    if d.norm() < 1e-9 {
-        d = Vector3::x();
-    }
-    let eq = equivalent_block(model, &pivots, 0, &d.normalize()).ok()?;
+    // The side `crr check` reports (reported_side).
+    let (_, _, eq) = reported_side(model, 0, &horizontal_direction(model, 0)).ok()?;
     (eq.p_squared > 0.0 && eq.alpha > 0.0).then(|| FreeRocking {
         p: eq.p_squared.sqrt(),
         alpha: eq.alpha,

@@ -565,8 +565,12 @@ fn a_friction_outside_zero_to_a_thousand_is_refused() {
 /// its coordinate: a hinge written with its axis reversed and its pivots exchanged (the same
 /// joint) gives the same report. `mechanism` is read as JSON for both writings of one model.
 fn mechanism_of(tag: &str, text: &str) -> serde_json::Value {
+    report_of(tag, text)["mechanism"].clone()
+}
+
+fn report_of(tag: &str, text: &str) -> serde_json::Value {
     let path = crate::common::write_model(tag, text);
-    check(path.to_str().unwrap())["mechanism"].clone()
+    check(path.to_str().unwrap())
 }
 
 /// Every number of two mechanism reports agrees within `tol` relative (the frequency table's
@@ -582,6 +586,7 @@ fn assert_same_mechanism(a: &serde_json::Value, b: &serde_json::Value, tol: f64)
         "p_eq",
         "r",
         "energy_ratio",
+        "mode_change",
     ] {
         let (x, y) = (a[key].as_f64().unwrap(), b[key].as_f64().unwrap());
         assert!(close(x, y), "{key}: {x} vs {y}");
@@ -593,6 +598,18 @@ fn assert_same_mechanism(a: &serde_json::Value, b: &serde_json::Value, tol: f64)
         );
         assert!(close(x, y), "lagrangian.{key}: {x} vs {y}");
     }
+    // The activating ground acceleration is one vector: its direction and sign may both flip.
+    let activating = |m: &serde_json::Value| -> Vec<f64> {
+        let s = m["lambda_sign"].as_f64().unwrap();
+        (0..3)
+            .map(|i| s * m["direction"][i].as_f64().unwrap())
+            .collect()
+    };
+    let (u, v) = (activating(a), activating(b));
+    assert!(
+        u.iter().zip(&v).all(|(x, y)| (x - y).abs() < 1e-12),
+        "{u:?} vs {v:?}"
+    );
     let rows = |m: &serde_json::Value| m["frequencies"].as_array().unwrap().clone();
     for (x, y) in rows(a).iter().zip(&rows(b)) {
         let m = |r: &serde_json::Value, k: &str| r[k].as_f64().unwrap();
@@ -620,7 +637,8 @@ fn the_mechanism_reported_is_the_side_that_opens_first_in_any_sense_of_its_coord
              pivot_positive = [{plus}, 0.0, 0.0]\npivot_negative = [{minus}, 0.0, 0.0]\n"
         )
     };
-    let written = mechanism_of("leaning_plus", &block(1.0, 0.2, -0.2));
+    let report = report_of("leaning_plus", &block(1.0, 0.2, -0.2));
+    let written = report["mechanism"].clone();
     let reversed = mechanism_of("leaning_minus", &block(-1.0, -0.2, 0.2));
     assert_eq!(
         (written["side"].as_str(), reversed["side"].as_str()),
@@ -632,11 +650,21 @@ fn the_mechanism_reported_is_the_side_that_opens_first_in_any_sense_of_its_coord
             (m["alpha_eq"].as_f64().unwrap() - 0.15f64.atan()).abs() < 1e-6,
             "{m}"
         );
-        assert_eq!(
-            m["pivots"]["base"],
-            "+".replace('+', m["side"].as_str().unwrap())
-        );
+        assert_eq!(m["pivots"]["base"], m["side"]);
     }
+    // The statics' linear program, independent of the mechanism's reduction, gives both sides:
+    // 0.15 with the ground accelerating along −x (the block tips over its +x edge), 0.25 along +x.
+    let along = |x: f64| {
+        report["static_multipliers"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["direction"][0].as_f64() == Some(x))
+            .unwrap()["lambda"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((along(-1.0) - 0.15).abs() < 1e-9 && (along(1.0) - 0.25).abs() < 1e-9);
     assert_same_mechanism(&written, &reversed, 1e-9);
 }
 

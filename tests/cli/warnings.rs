@@ -216,13 +216,13 @@ fn the_bundled_models_run_without_warnings_but_the_two_the_monitor_flags() {
         // eight bases from 0.1 s, the 3D arch's springings from 2.42 s, the temple's beds and
         // necks from 2.04 s. No other model has a base on a corner.
         let corner = match stem.as_str() {
-            "baldachin" => {
-                Some("from t = 1e-1 s base_1, base_2, base_3 and 5 more rocked on a corner")
-            }
-            "arch_3d" => {
-                Some("from t = 2.42e0 s springing_right, springing_left rocked on a corner")
-            }
-            "temple" => Some("from t = 2.04e0 s "),
+            "baldachin" => Some(
+                "from t = 1e-1 s (an output sample) base_1, base_2, base_3 and 5 more rocked on a corner",
+            ),
+            "arch_3d" => Some(
+                "from t = 2.42e0 s (an output sample) springing_right, springing_left rocked on a corner",
+            ),
+            "temple" => Some("from t = 2.04e0 s (an output sample) "),
             _ => None,
         };
         let listed = s["warnings"].as_array_mut().unwrap();

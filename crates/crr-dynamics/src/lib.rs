@@ -34,7 +34,7 @@ pub use energy::{Energies, energies};
 pub use eom::{ClosedChainSolve, Dynamics, DynamicsError, ForwardSolver, effective_gravity};
 pub use mechanism::{
     EquivalentBlock, LagrangianParameters, equivalent_block, equivalent_block_on_side,
-    lagrangian_parameters, lagrangian_parameters_on_side, reported_side,
+    horizontal_direction, lagrangian_parameters, lagrangian_parameters_on_side, reported_side,
 };
 pub use run::{Form, Sample, integrate_smooth};
 pub use system::{ConstrainedSystem, ReducedSystem};

@@ -105,8 +105,24 @@ pub fn configuration(
 /// pivots a state opened that far settles on.
 pub const SIDE_PROBE_ANGLE: f64 = 0.01;
 
-/// Relative difference below which the two sides' multipliers (or slendernesses) count as equal.
-pub const SIDE_TIE: f64 = 1e-9;
+/// Relative difference below which the two sides' multipliers (or slendernesses) count as equal:
+/// the geometry and densities of masonry are known to no better than this, so sides whose λ
+/// differ by less are the same to an engineer (a symmetric arch with one voussoir's density off
+/// by 1e-6 has sides 4e-8 apart, and a tolerance of 1e-9 reported its other side, α_eq 0.107
+/// for 0.302).
+pub const SIDE_TIE: f64 = 1e-3;
+
+/// The unit horizontal direction perpendicular to coordinate `coordinate`'s axis (x when the
+/// axis is vertical): the direction of ground acceleration a mechanism of that coordinate is
+/// reported along.
+pub fn horizontal_direction(model: &Model, coordinate: usize) -> Vector3<f64> {
+    let d = model.coords[coordinate].axis.cross(&Vector3::z());
+    if d.norm() < 1e-9 {
+        Vector3::x()
+    } else {
+        d.normalize()
+    }
+}
 
 /// The side of `coordinate` on which a one-DOF mechanism is reported, with its pivots and its
 /// equivalent block: decided by the physics of the two sides, not by the sense the file gives
@@ -114,8 +130,10 @@ pub const SIDE_TIE: f64 = 1e-9;
 /// A side that opens under its own weight (α_eq < 0) first; else the side with the smaller
 /// activation multiplier λ (the mechanism that opens first under a growing horizontal load);
 /// on equal λ (within [`SIDE_TIE`], as for a symmetric arch, whose two sides are mirror images
-/// read in one coordinate) the larger α_eq; on equal α_eq too, θ > 0. A side whose state cannot
-/// be solved is skipped; both failing is the error of θ > 0.
+/// read in one coordinate) the larger α_eq, a choice with no physics behind it but that the
+/// same structure always gets the same one (the two sides are then one motion read in two
+/// coordinates); on equal α_eq too, θ > 0. A side whose state cannot be solved is skipped; both
+/// failing is the error of θ > 0.
 pub fn reported_side(
     model: &Model,
     coordinate: usize,
