@@ -257,7 +257,9 @@ class Model:
         cls, d: Mapping[str, Any], base_dir: Optional[PathLike] = None, label: str = "<dict>"
     ) -> "Model":
         """A model from a mapping with the keys of a model file (``name``, ``body``,
-        ``interface``, ``ground_motion``, …), e.g. the output of :meth:`to_dict`."""
+        ``interface``, ``ground_motion``, …), e.g. the output of :meth:`to_dict`. Relative
+        record paths are read from ``base_dir`` (default: the working folder): to edit a model
+        read from a file, ``Model.from_dict(d, base_dir=model.base_dir)`` keeps its records."""
         base = _fspath(base_dir) if base_dir is not None else "."
         return cls(_crr.Model.parse(_json(d, label=label), True, label, base))
 
@@ -280,6 +282,11 @@ class Model:
     def source(self) -> str:
         """The file the model was read from, or its label."""
         return str(self._native.label)
+
+    @property
+    def base_dir(self) -> Path:
+        """The folder its relative record paths are read from (the model file's folder)."""
+        return Path(self._native.base_dir)
 
     def to_dict(self) -> Dict[str, Any]:
         """The model file as a dict (every table, defaults filled in)."""

@@ -212,3 +212,18 @@ def test_two_records_for_one_component_are_refused() -> None:
     with pytest.warns(crr.CrrWarning, match="part along the hinges' common axis"):
         both = crr.simulate(BLOCK, ground_motion=[x1, y], duration=1.0)
     assert both.summary["ground_motion"]["pga"][:2] == pytest.approx([9.80665, 9.80665], rel=1e-3)
+
+
+def test_a_model_edited_through_its_dict_keeps_its_records() -> None:
+    """``to_dict`` → edit → ``from_dict(d, base_dir=model.base_dir)``: the record the model names
+    by a relative path is still found, and the edit takes effect (a denser block has the same
+    angles under the same record: the rocking equation depends on the shape only)."""
+    model = crr.Model.from_file(ROOT / "examples" / "models" / "block_record.toml")
+    assert model.base_dir == ROOT / "examples" / "models"
+    d = model.to_dict()
+    d["body"][0]["density"] = 2.0 * d["body"][0]["density"]
+    edited = crr.Model.from_dict(d, base_dir=model.base_dir)
+    a = crr.simulate(model, duration=3.0)
+    b = crr.simulate(edited, duration=3.0)
+    np.testing.assert_allclose(b.q, a.q, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(b.kinetic, 2.0 * a.kinetic, rtol=1e-9, atol=1e-9)
