@@ -301,7 +301,13 @@ pub fn mechanism_levels(model: &Model, step: f64) -> Result<MechanismLevels, Str
         .filter(|s| s.end == SideEnd::Overturning)
         .map(|s| s.last().potential)
         .collect();
-    // Levels: U at fractions of the θ > 0 side's reach, below the lowest end energy of both sides.
+    // Levels: U at fractions of the reach of the side `crr check` reports (reported_side: not the
+    // sense the file gives θ), below the lowest end energy of both sides.
+    let reported =
+        match crr_dynamics::reported_side(model, coordinate, &horizontal(model, coordinate)) {
+            Ok((Side::Negative, _, _)) => &negative,
+            _ => &positive,
+        };
     let ceiling = positive.last().potential.min(negative.last().potential);
     // The separatrix closes only if no side locks below it.
     let separatrix = tops
@@ -309,10 +315,10 @@ pub fn mechanism_levels(model: &Model, step: f64) -> Result<MechanismLevels, Str
         .copied()
         .reduce(f64::min)
         .filter(|top| *top <= ceiling);
-    let reach = positive.last().theta;
+    let reach = reported.last().theta;
     let energies = LEVEL_FRACTIONS
         .iter()
-        .map(|f| potential_at(&positive.samples, f * reach))
+        .map(|f| potential_at(&reported.samples, f * reach))
         .filter(|e| *e > 0.0 && *e < ceiling * (1.0 - 1e-9))
         .collect();
     Ok(MechanismLevels {

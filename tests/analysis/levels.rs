@@ -407,3 +407,44 @@ pivot_negative = [-0.1, 0.0, 0.0]
         1e-10,
     );
 }
+
+/// The levels drawn are those of the side `crr check` reports, whatever the sense the file gives
+/// the coordinate: a leaning block (parallelogram section, centroid 0.05 m off its base's centre,
+/// 1 m up: Housner's α = atan 0.15 on its weak side, atan 0.25 on the other) written with its
+/// hinge in both senses has the same level energies, the weak side's U(θm) at θm = 0.25, 0.5 and
+/// 0.75 of its overturning angle atan 0.15: m g R (cos(α − θm) − cos α) with R = √(0.15² + 1).
+#[test]
+fn the_levels_are_those_of_the_reported_side_in_either_sense() {
+    let block = |axis: f64, plus: f64, minus: f64| {
+        format!(
+            "name = \"leaning\"\n[[body]]\nname = \"block\"\ndensity = 2000.0\n\
+             prism = {{ polygon = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.3, -0.2, 2.0], \
+             [-0.1, -0.2, 2.0]], extrude = [0.0, 0.4, 0.0] }}\n[[interface]]\nname = \"base\"\n\
+             parent = \"ground\"\nchild = \"block\"\naxis = [0.0, {axis}, 0.0]\n\
+             pivot_positive = [{plus}, 0.0, 0.0]\npivot_negative = [{minus}, 0.0, 0.0]\n"
+        )
+    };
+    // m = 2000 kg/m³ × (0.4 m × 2 m section) × 0.4 m.
+    let (m, alpha, r) = (2000.0 * 0.8 * 0.4, 0.15f64.atan(), 0.15f64.hypot(1.0));
+    let weak = |f: f64| m * 9.81 * r * ((alpha - f * alpha).cos() - alpha.cos());
+    let mut all = Vec::new();
+    for (tag, text) in [
+        ("levels_leaning_plus", block(1.0, 0.2, -0.2)),
+        ("levels_leaning_minus", block(-1.0, -0.2, 0.2)),
+    ] {
+        let path = crate::common::write_model(tag, &text);
+        let model = load_model(&path).unwrap().1;
+        let levels = mechanism_levels(&model, 1e-3).unwrap();
+        assert_eq!(levels.energies.len(), 3, "{tag}: {:?}", levels.energies);
+        for (e, f) in levels.energies.iter().zip([0.25, 0.5, 0.75]) {
+            // Linear interpolation between samples h = 1e-3 rad apart: within h²/8 max|U″|,
+            // |U″| ≤ m g R.
+            let tol = 1e-6 / 8.0 * m * 9.81 * r;
+            assert!((e - weak(f)).abs() < tol, "{tag}: {e} vs {}", weak(f));
+        }
+        all.push(levels.energies);
+    }
+    for (a, b) in all[0].iter().zip(&all[1]) {
+        assert!((a - b).abs() < 1e-9 * a, "{a} vs {b}");
+    }
+}
