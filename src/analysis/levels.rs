@@ -184,9 +184,12 @@ pub fn evaluate(
 /// The opening pivots of side `sign` (±1) of coordinate `coordinate`, as `crr check` finds them.
 pub fn opening_pivots(model: &Model, coordinate: usize, sign: f64) -> Result<ActivePivots, String> {
     let spec = InitialSpec {
-        angles: [(model.coords[coordinate].name.clone(), 0.01 * sign)]
-            .into_iter()
-            .collect(),
+        angles: [(
+            model.coords[coordinate].name.clone(),
+            crr_dynamics::mechanism::SIDE_PROBE_ANGLE * sign,
+        )]
+        .into_iter()
+        .collect(),
         rates: BTreeMap::new(),
     };
     solve_initial(model, &spec)

@@ -415,15 +415,7 @@ pivot_negative = [-0.1, 0.0, 0.0]
 /// 0.75 of its overturning angle atan 0.15: m g R (cos(α − θm) − cos α) with R = √(0.15² + 1).
 #[test]
 fn the_levels_are_those_of_the_reported_side_in_either_sense() {
-    let block = |axis: f64, plus: f64, minus: f64| {
-        format!(
-            "name = \"leaning\"\n[[body]]\nname = \"block\"\ndensity = 2000.0\n\
-             prism = {{ polygon = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.3, -0.2, 2.0], \
-             [-0.1, -0.2, 2.0]], extrude = [0.0, 0.4, 0.0] }}\n[[interface]]\nname = \"base\"\n\
-             parent = \"ground\"\nchild = \"block\"\naxis = [0.0, {axis}, 0.0]\n\
-             pivot_positive = [{plus}, 0.0, 0.0]\npivot_negative = [{minus}, 0.0, 0.0]\n"
-        )
-    };
+    let block = crate::common::leaning_block;
     // m = 2000 kg/m³ × (0.4 m × 2 m section) × 0.4 m.
     let (m, alpha, r) = (2000.0 * 0.8 * 0.4, 0.15f64.atan(), 0.15f64.hypot(1.0));
     let weak = |f: f64| m * 9.81 * r * ((alpha - f * alpha).cos() - alpha.cos());

@@ -346,15 +346,7 @@ pivot_negative = [-0.3, 0.0, 0.0]
 /// of that row is the same in both (the sweep read the other side, α_eq atan 0.25, in one).
 #[test]
 fn the_sweep_reads_the_side_the_report_gives() {
-    let block = |axis: f64, plus: f64, minus: f64| {
-        format!(
-            "name = \"leaning\"\n[[body]]\nname = \"block\"\ndensity = 2000.0\n\
-             prism = {{ polygon = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.3, -0.2, 2.0], \
-             [-0.1, -0.2, 2.0]], extrude = [0.0, 0.4, 0.0] }}\n[[interface]]\nname = \"base\"\n\
-             parent = \"ground\"\nchild = \"block\"\naxis = [0.0, {axis}, 0.0]\n\
-             pivot_positive = [{plus}, 0.0, 0.0]\npivot_negative = [{minus}, 0.0, 0.0]\n"
-        )
-    };
+    let block = crate::common::leaning_block;
     let mut engine = Vec::new();
     for (tag, text) in [
         ("sweep_leaning_plus", block(1.0, 0.2, -0.2)),

@@ -628,15 +628,7 @@ fn assert_same_mechanism(a: &serde_json::Value, b: &serde_json::Value, tol: f64)
 /// λ = 0.15 with α_eq = atan 0.15, however the hinge is written.
 #[test]
 fn the_mechanism_reported_is_the_side_that_opens_first_in_any_sense_of_its_coordinate() {
-    let block = |axis: f64, plus: f64, minus: f64| {
-        format!(
-            "name = \"leaning\"\n[[body]]\nname = \"block\"\ndensity = 2000.0\n\
-             prism = {{ polygon = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.3, -0.2, 2.0], \
-             [-0.1, -0.2, 2.0]], extrude = [0.0, 0.4, 0.0] }}\n[[interface]]\nname = \"base\"\n\
-             parent = \"ground\"\nchild = \"block\"\naxis = [0.0, {axis}, 0.0]\n\
-             pivot_positive = [{plus}, 0.0, 0.0]\npivot_negative = [{minus}, 0.0, 0.0]\n"
-        )
-    };
+    let block = crate::common::leaning_block;
     let report = report_of("leaning_plus", &block(1.0, 0.2, -0.2));
     let written = report["mechanism"].clone();
     let reversed = mechanism_of("leaning_minus", &block(-1.0, -0.2, 0.2));

@@ -185,6 +185,22 @@ pub fn mirrored_x(
     out
 }
 
+/// A block on a parallelogram section (base x ∈ [−0.2, 0.2], top shifted 0.1 m along +x, 2 m
+/// high, 0.4 m deep, 2000 kg/m³): its centroid lies at x = 0.05, 1 m up, so it tips about its
+/// +x edge at λ = 0.15 and about its −x edge at 0.25 (Housner's tan α of each side). Its hinge
+/// has axis (0, `axis`, 0) and pivots at x = `plus` (P⁺) and `minus` (P⁻): (1, 0.2, −0.2) and
+/// (−1, −0.2, 0.2) are the same joint written in the two senses of its coordinate.
+#[allow(dead_code)]
+pub fn leaning_block(axis: f64, plus: f64, minus: f64) -> String {
+    format!(
+        "name = \"leaning\"\n[[body]]\nname = \"block\"\ndensity = 2000.0\n\
+         prism = {{ polygon = [[-0.2, -0.2, 0.0], [0.2, -0.2, 0.0], [0.3, -0.2, 2.0], \
+         [-0.1, -0.2, 2.0]], extrude = [0.0, 0.4, 0.0] }}\n[[interface]]\nname = \"base\"\n\
+         parent = \"ground\"\nchild = \"block\"\naxis = [0.0, {axis}, 0.0]\n\
+         pivot_positive = [{plus}, 0.0, 0.0]\npivot_negative = [{minus}, 0.0, 0.0]\n"
+    )
+}
+
 /// The bundled single block (2 m tall, 0.4 m wide: b/h = 0.2) turned by θ about x, so that its
 /// hinge axis R_x(θ)ŷ = (0, cos θ, sin θ) rises θ from the horizontal. Written out, pivots and
 /// centre turned by R_x(θ): (x, y, z) ↦ (x, y cos θ − z sin θ, y sin θ + z cos θ).
