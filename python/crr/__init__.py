@@ -53,11 +53,13 @@ __all__ = [
     "MissingFileError",
     "Model",
     "OutOfMemoryError",
+    "Poincare",
     "Record",
     "Result",
     "SimulationError",
     "Study",
     "cases_frame",
+    "poincare",
     "simulate",
     "study",
     "__version__",
@@ -817,6 +819,179 @@ def simulate(
     if run.error is not None:
         raise SimulationError(f"{model.source}: the simulation failed: {run.error}", result)
     return result
+
+
+Range = Union[str, Sequence[Any]]
+
+
+def _range_text(name: str, r: Range, in_g: bool = False) -> str:
+    """A range as the command line takes it, ``START:END:COUNT``, from that text or from a
+    sequence ``(start, end, count)`` (with ``in_g``, its ends may be accelerations in g as
+    ``"0.3g"``)."""
+    if isinstance(r, str):
+        return r
+    items = list(r)
+    if len(items) != 3:
+        raise InputError(f"{name} must be (start, end, count) or 'START:END:COUNT', got {r!r}")
+    start, end, count = items
+    ends = f"{_number_text(name, start, in_g)}:{_number_text(name, end, in_g)}"
+    return f"{ends}:{_positive_count(name + ' count', count)}"
+
+
+def _number_text(name: str, x: Any, in_g: bool = False) -> str:
+    """A number as text for the command line's parser, written exactly (``repr``); with
+    ``in_g`` a string is passed on as given (an acceleration in g, ``"0.3g"``)."""
+    if isinstance(x, str) and in_g:
+        return x
+    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
+        raise InputError(f"{name}: expected a number, got {x!r}")
+    return repr(float(x))
+
+
+class Poincare:
+    """What ``crr poincare`` computes (``docs/poincare.md``): a section, a bifurcation sweep or
+    basins of initial conditions, as the command line's data file and ``poincare.json``.
+
+    Attributes:
+        kind: ``"section"`` (the data file ``poincare.csv``), ``"bifurcation"``
+            (``bifurcation.csv``) or ``"basins"`` (``basins.csv``).
+        csv: the text of that data file, byte for byte what ``crr poincare`` writes.
+        summary: ``poincare.json`` as a dict (the settings, and for a section its points,
+            distinct points, period, overturning, error; for a sweep the same per case).
+    """
+
+    _KINDS = {"poincare.csv": "section", "bifurcation.csv": "bifurcation", "basins.csv": "basins"}
+
+    def __init__(self, texts: Tuple[str, str, str]) -> None:
+        name, csv, summary = texts
+        self._name = name
+        self.kind: str = self._KINDS[name]
+        self.csv: str = csv
+        self._summary_json = summary
+        self.summary: Dict[str, Any] = json.loads(summary)
+
+    def frame(self) -> "pandas.DataFrame":
+        """The data file as a pandas DataFrame: the section's points (``k``, ``t``, every
+        coordinate and ``<coordinate>_rate``, every ``<interface>_state`` as text), the sweep's
+        points (``case``, the parameter, ``k``, ``t``, the coordinate and its rate) or the
+        basins' cases (``angle``, ``rate``, ``outcome`` as text, ``end_time``, ``points``,
+        ``overturn_time``, NaN where the case did not overturn)."""
+        pd = _pandas("Poincare.frame")
+        header = self.csv.split("\n", 1)[0].split(",")
+        text_columns = [c for c in header if c.endswith("_state") or c == "outcome"]
+        return pd.read_csv(
+            io.StringIO(self.csv), dtype={c: object for c in text_columns}, keep_default_na=False,
+            na_values={c: [""] for c in header if c not in text_columns},
+        )
+
+    def write(self, folder: PathLike) -> None:
+        """Writes the data file and ``poincare.json`` into ``folder`` (created if needed), as
+        ``crr poincare --out folder`` names them."""
+        d = Path(folder)
+        d.mkdir(parents=True, exist_ok=True)
+        for name, text in ((self._name, self.csv), ("poincare.json", self._summary_json)):
+            with open(d / name, "w", newline="", encoding="utf-8") as f:
+                f.write(text)
+
+    def __repr__(self) -> str:
+        s = self.summary
+        if s.get("section") is not None:
+            sec = s["section"]
+            return (
+                f"<crr.Poincare section: {sec['points']} point(s), {sec['distinct_points']} "
+                f"distinct, period {sec['period']}, overturned: {sec['overturned']}>"
+            )
+        return f"<crr.Poincare {self.kind}: {len(s.get('cases') or [])} case(s)>"
+
+
+def poincare(
+    model: Union[Model, PathLike],
+    amplitude: Union[float, str] = 0.0,
+    frequency: Optional[float] = None,
+    *,
+    component: str = "x",
+    phase: float = 0.0,
+    periods: int = 100,
+    transient: int = 100,
+    section: Optional[str] = None,
+    coordinate: Optional[str] = None,
+    duration: Optional[float] = None,
+    rest: bool = False,
+    amplitudes: Optional[Range] = None,
+    frequencies: Optional[Range] = None,
+    grid: Optional[Tuple[Range, Range]] = None,
+    jobs: Optional[int] = None,
+) -> Poincare:
+    """Poincaré sections, bifurcation diagrams and basins, as ``crr poincare`` computes them
+    (``docs/poincare.md``; nothing is written: :meth:`Poincare.write` writes its files).
+
+    The model is driven by a_g(t) = A sin(2πF t + φ) on one component, which replaces its own
+    ground motion, and sampled at t = k/F (a stroboscopic section), or where a coordinate crosses
+    0 upward (a crossing section: ``section=NAME``, or ``amplitude=0``).
+
+    Args:
+        model: a :class:`Model`, or the path of a model file.
+        amplitude: A, m/s², or a string in g (``"0.3g"``); 0: no forcing (a crossing section).
+        frequency: F, Hz.
+        component: ``"x"``, ``"y"`` or ``"z"``.
+        phase: φ, rad.
+        periods: N, the points kept; transient: M, the periods (or crossings) dropped first.
+        section: a crossing section of this coordinate.
+        coordinate: the coordinate of a bifurcation diagram and of the basins grid.
+        duration: time limit of a crossing section (s; default 1000).
+        rest: start from rest instead of the model's ``[initial]``.
+        amplitudes, frequencies: a bifurcation sweep, ``(start, end, count)`` or
+            ``"START:END:COUNT"`` (amplitudes in m/s², or strings in g).
+        grid: basins, ``((θ0, θ1, n), (ω0, ω1, m))`` in rad × rad/s, or ``"T0:T1:N,W0:W1:M"``.
+        jobs: worker threads of a sweep (None or -1: one per core); results do not depend on it.
+
+    Raises:
+        InputError: invalid arguments or model, named as here (the command line's checks).
+        KeyboardInterrupt: Ctrl-C stops the cases under way within one integration step; the
+            exception's ``result`` is a :class:`Poincare` of the points computed until then
+            (the cases stopped or not started have an ``error`` in its summary).
+    """
+    if not isinstance(model, Model):
+        model = Model.from_file(model)
+    grid_text: Optional[str] = None
+    if grid is not None:
+        if isinstance(grid, str):
+            grid_text = grid
+        else:
+            parts = list(grid)
+            if len(parts) != 2:
+                raise InputError(
+                    f"grid must be ((θ0, θ1, n), (ω0, ω1, m)) or 'T0:T1:N,W0:W1:M', got {grid!r}"
+                )
+            grid_text = f"{_range_text('grid (angles)', parts[0])},{_range_text('grid (rates)', parts[1])}"
+    counts = {}
+    for name, value, least in (("periods", periods, 1), ("transient", transient, 0)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+            raise InputError(f"{name} must be an integer ≥ {least}, got {value!r}")
+        counts[name] = int(value)
+    try:
+        texts = model._native.poincare(
+            _number_text("amplitude", amplitude, in_g=True),
+            None if frequency is None else float(frequency),
+            str(component),
+            float(phase),
+            counts["periods"],
+            counts["transient"],
+            section,
+            coordinate,
+            None if duration is None else float(duration),
+            bool(rest),
+            None if amplitudes is None else _range_text("amplitudes", amplitudes, in_g=True),
+            None if frequencies is None else _range_text("frequencies", frequencies),
+            grid_text,
+            _jobs(jobs),
+        )
+    except KeyboardInterrupt as interrupt:
+        partial = getattr(interrupt, "poincare", None)
+        if partial is not None:
+            interrupt.result = Poincare(partial)  # type: ignore[attr-defined]
+        raise
+    return Poincare(texts)
 
 
 class Study:

@@ -42,6 +42,23 @@ class Model:
     def inspect_json(
         self, settings: Optional[Sequence[str]] = None, q: Optional[Sequence[float]] = None
     ) -> str: ...
+    def poincare(
+        self,
+        amplitude: str,
+        frequency: Optional[float],
+        component: str,
+        phase: float,
+        periods: int,
+        transient: int,
+        section: Optional[str],
+        coordinate: Optional[str],
+        duration: Optional[float],
+        rest: bool,
+        amplitudes: Optional[str],
+        frequencies: Optional[str],
+        grid: Optional[str],
+        jobs: Optional[int],
+    ) -> Tuple[str, str, str]: ...
 
 class Run:
     @property

@@ -241,6 +241,97 @@ impl PyModel {
         Ok(serde_json::to_string(&report).expect("the report serialises"))
     }
 
+    /// `crr poincare` of this model (nothing written): the options as the command line takes
+    /// them, `amplitude` and the ranges as text (`"0.3g"`, `"1:3:21"`, `"T0:T1:N,W0:W1:M"`).
+    /// Returns the data file's name (`poincare.csv`, `bifurcation.csv` or `basins.csv`), its
+    /// text and the text of `poincare.json`. Ctrl-C stops the cases under way within one
+    /// integration step and raises KeyboardInterrupt with those three texts, of the points
+    /// computed until then, as its `poincare` attribute.
+    #[pyo3(signature = (amplitude, frequency, component, phase, periods, transient, section, coordinate, duration, rest, amplitudes, frequencies, grid, jobs))]
+    #[allow(clippy::too_many_arguments)]
+    fn poincare(
+        &self,
+        py: Python<'_>,
+        amplitude: &str,
+        frequency: Option<f64>,
+        component: &str,
+        phase: f64,
+        periods: usize,
+        transient: usize,
+        section: Option<String>,
+        coordinate: Option<String>,
+        duration: Option<f64>,
+        rest: bool,
+        amplitudes: Option<String>,
+        frequencies: Option<String>,
+        grid: Option<String>,
+        jobs: Option<usize>,
+    ) -> PyResult<(String, String, String)> {
+        use crr::analysis::poincare::{
+            PoincareOptions, compute_until, parse_acceleration, parse_sweep, prepare_model,
+        };
+        use crr::output::poincare::{data_file, summary};
+        let error = |m: String| argument(py, keyword_names(&m));
+        let amplitude = parse_acceleration(amplitude, "--amplitude").map_err(error)?;
+        let axis: Axis = component
+            .parse()
+            .map_err(|e| error(format!("--component: {e}")))?;
+        let sweep = parse_sweep(
+            amplitudes.as_deref(),
+            frequencies.as_deref(),
+            grid.as_deref(),
+        )
+        .map_err(error)?;
+        let opts = PoincareOptions {
+            amplitude,
+            frequency,
+            phase,
+            axis,
+            periods,
+            transient,
+            section,
+            coordinate,
+            duration,
+            rest,
+            sweep,
+            jobs,
+            out: None,
+            force: false,
+            quiet: true,
+        };
+        let prepared = py
+            .detach(|| {
+                prepare_model(
+                    &self.label,
+                    self.file.clone(),
+                    self.structure.clone(),
+                    &opts,
+                )
+            })
+            .map_err(|e| match e {
+                Error::Argument(m) => error(m),
+                e => input_error(py, e),
+            })?;
+        let texts = |computed: &crr::analysis::poincare::Computed| {
+            let (name, text) = data_file(&prepared, computed);
+            let json = summary(&self.label, &prepared, &opts, computed).to_json();
+            (name.to_string(), text, json)
+        };
+        let cancel = crr::Cancel::new();
+        match interruptible(py, &cancel, || {
+            compute_until(&prepared, &opts, false, Some(&cancel))
+        }) {
+            Ok(Ok(computed)) => Ok(texts(&computed)),
+            Ok(Err(e)) => Err(error(e)),
+            Err((interrupt, partial)) => {
+                if let Some(Ok(computed)) = partial {
+                    interrupt.value(py).setattr("poincare", texts(&computed))?;
+                }
+                Err(interrupt)
+            }
+        }
+    }
+
     /// `crr inspect --json` at q: `settings` as `--q NAME=VALUE` (others 0), or every
     /// coordinate's value in `q`.
     #[pyo3(signature = (settings=None, q=None))]
@@ -834,6 +925,28 @@ impl PyStudy {
             self.label.display().to_string()
         )
     }
+}
+
+/// A message of `crr poincare`'s checks with its options named as Python's keyword arguments
+/// (`--periods must be at least 1` → `periods must be at least 1`).
+fn keyword_names(message: &str) -> String {
+    const OPTIONS: [&str; 12] = [
+        "amplitude",
+        "frequenc",
+        "component",
+        "phase",
+        "periods",
+        "transient",
+        "section",
+        "coordinate",
+        "duration",
+        "rest",
+        "grid",
+        "jobs",
+    ];
+    OPTIONS.iter().fold(message.to_string(), |m, name| {
+        m.replace(&format!("--{name}"), name)
+    })
 }
 
 /// The crr library's version.

@@ -101,3 +101,29 @@ def test_ctrl_c_stops_a_study_whose_folder_then_resumes(tmp_path: Path) -> None:
     frame = crr.study(study, jobs=2, out=out)
     assert len(frame) == 3600
     assert frame["id"].is_unique
+
+
+def test_ctrl_c_stops_a_poincare_sweep_and_keeps_the_points_computed() -> None:
+    # 400 sections of 2 100 forcing periods (1 050 s each): some 20 s of work on 2 threads.
+    timer, sent = _interrupt_after(0.5)
+    with pytest.raises(KeyboardInterrupt) as info:
+        crr.poincare(BLOCK, frequency=2.0, amplitudes=(3.5, 4.5, 400), periods=2000, transient=100, jobs=2)
+    caught = time.monotonic()
+    timer.join()
+    assert caught - sent["t"] < STOPPED_WITHIN_S, f"{caught - sent['t']:.3f} s after the signal"
+    result = info.value.result  # type: ignore[attr-defined]
+    assert result.kind == "bifurcation"
+    cases = result.summary["cases"]
+    assert len(cases) == 400
+    errors = [c["error"] for c in cases]
+    # Every case has a section: finished (no error), stopped part-way or never started.
+    assert all(e is None or e.startswith("interrupted") for e in errors)
+    assert sum(e is not None for e in errors) > 0
+    stopped = [c for c in cases if (c["error"] or "").startswith("interrupted at")]
+    for case in stopped:
+        assert 0.0 < case["end_time"] < 1050.0
+        # The points until the interruption are kept: one per period from k = 101 on.
+        assert case["points"] == max(0, int(case["end_time"] * 2.0) - 100)
+    # Python is usable afterwards.
+    again = crr.poincare(BLOCK, 4.0, 2.0, periods=3, transient=1, rest=True)
+    assert again.summary["section"]["points"] == 3

@@ -36,7 +36,7 @@ use crr_impact::simulation::{
 use crr_kinematics::Model;
 
 use crate::Error;
-use crate::analysis::simulation::{Flow, simulate_observed};
+use crate::analysis::simulation::{Cancel, Flow, simulate_observed};
 use crate::input::model_file::{ModelFile, load_model};
 
 /// Two section points are the same point when every angle differs by at most this fraction of the
@@ -196,6 +196,19 @@ pub fn run_section(
     params: &Parameters,
     settings: &SectionSettings,
 ) -> Section {
+    run_section_until(model, initial, params, settings, None)
+}
+
+/// [`run_section`] that `cancel` stops within one integration step: the section keeps the
+/// points until then and its error says where it was interrupted (a section not yet started
+/// when `cancel` was set does not start).
+pub fn run_section_until(
+    model: &Model,
+    initial: &InitialState,
+    params: &Parameters,
+    settings: &SectionSettings,
+    cancel: Option<&Cancel>,
+) -> Section {
     let mut section = Section {
         points: Vec::new(),
         collapse: None,
@@ -204,6 +217,10 @@ pub fn run_section(
         error: None,
         violation: None,
     };
+    if cancel.is_some_and(Cancel::is_cancelled) {
+        section.error = Some(NOT_STARTED.into());
+        return section;
+    }
     let ground = match settings.forcing.ground_motion() {
         Ok(g) => g,
         Err(e) => {
@@ -314,14 +331,21 @@ pub fn run_section(
         }
         Flow::Continue
     };
-    let (trajectory, error) =
-        match simulate_observed(model, &ground, initial, &params, false, None, &mut observe) {
-            Ok(run) => run,
-            Err(e) => {
-                section.error = Some(e.to_string());
-                return section;
-            }
-        };
+    let (trajectory, error) = match simulate_observed(
+        model,
+        &ground,
+        initial,
+        &params,
+        false,
+        cancel,
+        &mut observe,
+    ) {
+        Ok(run) => run,
+        Err(e) => {
+            section.error = Some(e.to_string());
+            return section;
+        }
+    };
     if let Some(e) = error {
         section.error = Some(e.to_string());
     }
@@ -545,6 +569,43 @@ pub fn parse_frequency(text: &str, option: &str) -> Result<f64, String> {
     }
 }
 
+/// The sweep of `--amplitudes A0:A1:N` (m/s², or g as `0.1g`), `--frequencies F0:F1:N` (Hz) or
+/// `--grid T0:T1:N,W0:W1:M` (rad × rad/s), at most one of them given; none: [`Sweep::None`].
+/// Errors name the option.
+pub fn parse_sweep(
+    amplitudes: Option<&str>,
+    frequencies: Option<&str>,
+    grid: Option<&str>,
+) -> Result<Sweep, String> {
+    match (amplitudes, frequencies, grid) {
+        (None, None, None) => Ok(Sweep::None),
+        (Some(r), None, None) => Ok(Sweep::Amplitudes(parse_range(r, "--amplitudes", |v| {
+            parse_acceleration(v, "--amplitudes")
+        })?)),
+        (None, Some(r), None) => Ok(Sweep::Frequencies(parse_range(r, "--frequencies", |v| {
+            parse_frequency(v, "--frequencies")
+        })?)),
+        (None, None, Some(g)) => {
+            let Some((angle, rate)) = g.split_once(',') else {
+                return Err(format!(
+                    "--grid must be T0:T1:N,W0:W1:M (angles in rad, rates in rad/s), got `{g}`"
+                ));
+            };
+            Ok(Sweep::Grid {
+                angle: parse_range(angle, "--grid (angles)", |v| {
+                    parse_finite(v, "--grid (angles)")
+                })?,
+                rate: parse_range(rate, "--grid (rates)", |v| {
+                    parse_finite(v, "--grid (rates)")
+                })?,
+            })
+        }
+        _ => {
+            Err("give one of --amplitudes, --frequencies and --grid: a run sweeps one thing".into())
+        }
+    }
+}
+
 /// A sweep of cases.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Sweep {
@@ -652,7 +713,31 @@ fn coordinate_index(model: &Model, name: &str, option: &str) -> Result<usize, Er
 
 /// Reads and checks everything before any run. Errors name the option or the file.
 pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, Error> {
+    check_options(opts)?;
+    let (file, model) = load_model(path)?;
+    prepare_checked(path, file, model, opts)
+}
+
+/// [`prepare`] for a model already read (`file` and the `model` built from it), named `label`
+/// in the errors: what Python's `Model.poincare` runs.
+pub fn prepare_model(
+    label: &Path,
+    file: ModelFile,
+    model: Model,
+    opts: &PoincareOptions,
+) -> Result<Prepared, Error> {
+    check_options(opts)?;
+    prepare_checked(label, file, model, opts)
+}
+
+/// The checks of the options that need no model.
+fn check_options(opts: &PoincareOptions) -> Result<(), Error> {
     let arg = |m: String| Error::Argument(m);
+    if matches!(opts.sweep, Sweep::Amplitudes(_)) && opts.amplitude != 0.0 {
+        return Err(arg(
+            "--amplitude and --amplitudes cannot be given together".into()
+        ));
+    }
     if !(opts.amplitude.is_finite() && opts.amplitude >= 0.0) {
         return Err(arg(format!(
             "--amplitude must be a finite acceleration ≥ 0 (m/s²), got {}",
@@ -728,7 +813,17 @@ pub fn prepare(path: &Path, opts: &PoincareOptions) -> Result<Prepared, Error> {
         }
         _ => {}
     }
-    let (file, model) = load_model(path)?;
+    Ok(())
+}
+
+/// [`prepare`] after [`check_options`], with the model read.
+fn prepare_checked(
+    path: &Path,
+    file: ModelFile,
+    model: Model,
+    opts: &PoincareOptions,
+) -> Result<Prepared, Error> {
+    let arg = |m: String| Error::Argument(m);
     let here = |m: String| Error::Argument(format!("{}: {m}", path.display()));
     let forced = opts.amplitude > 0.0
         || matches!(opts.sweep, Sweep::Amplitudes(r) if r.start > 0.0 || r.end > 0.0);
@@ -910,10 +1005,27 @@ pub enum Computed {
     Basins(Vec<(f64, f64, Section)>),
 }
 
+/// The error of a case that `cancel` stopped before it started ([`run_section_until`]).
+pub const NOT_STARTED: &str = "interrupted before it started";
+
 /// Runs what the options ask for (one section, or a sweep in parallel).
 pub fn compute(p: &Prepared, opts: &PoincareOptions, progress: bool) -> Result<Computed, String> {
+    compute_until(p, opts, progress, None)
+}
+
+/// [`compute`] that `cancel` stops: the cases under way stop within one integration step with
+/// the points they have, the cases not started are not run (their error [`NOT_STARTED`]).
+pub fn compute_until(
+    p: &Prepared,
+    opts: &PoincareOptions,
+    progress: bool,
+    cancel: Option<&Cancel>,
+) -> Result<Computed, String> {
+    let section = |initial: &InitialState, settings: &SectionSettings| {
+        run_section_until(&p.model, initial, &p.params, settings, cancel)
+    };
     Ok(match opts.sweep {
-        Sweep::None => Computed::Section(run_section(&p.model, &p.initial, &p.params, &p.settings)),
+        Sweep::None => Computed::Section(section(&p.initial, &p.settings)),
         Sweep::Amplitudes(r) | Sweep::Frequencies(r) => {
             let amplitude = matches!(opts.sweep, Sweep::Amplitudes(_));
             let values = r.values();
@@ -924,7 +1036,7 @@ pub fn compute(p: &Prepared, opts: &PoincareOptions, progress: bool) -> Result<C
                 } else {
                     s.forcing.frequency = v;
                 }
-                run_section(&p.model, &p.initial, &p.params, &s)
+                section(&p.initial, &s)
             })?;
             Computed::Bifurcation {
                 parameter: if amplitude { "amplitude" } else { "frequency" },
@@ -939,7 +1051,7 @@ pub fn compute(p: &Prepared, opts: &PoincareOptions, progress: bool) -> Result<C
                 .collect();
             let sections = run_cases(&cases, opts.jobs, progress, |&(a, w)| {
                 match initial_with(&p.model, &p.initial_spec, p.coordinate, a, w) {
-                    Ok(initial) => run_section(&p.model, &initial, &p.params, &p.settings),
+                    Ok(initial) => section(&initial, &p.settings),
                     Err(e) => Section {
                         points: Vec::new(),
                         collapse: None,

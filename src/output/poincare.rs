@@ -376,6 +376,19 @@ pub fn basins_csv(cases: &[(f64, f64, Section)]) -> String {
     s
 }
 
+/// The data file of what was computed: its name (`poincare.csv`, `bifurcation.csv` or
+/// `basins.csv`) and its text.
+pub fn data_file(p: &Prepared, computed: &Computed) -> (&'static str, String) {
+    match computed {
+        Computed::Section(s) => ("poincare.csv", section_csv(&p.model, s)),
+        Computed::Bifurcation { parameter, cases } => (
+            "bifurcation.csv",
+            bifurcation_csv(&p.model, p.coordinate, parameter, cases),
+        ),
+        Computed::Basins(cases) => ("basins.csv", basins_csv(cases)),
+    }
+}
+
 /// The content of poincare.json.
 pub fn summary(
     path: &Path,
@@ -496,16 +509,8 @@ pub fn poincare(path: &Path, opts: &PoincareOptions, plot: bool) -> Result<Poinc
     let _lock = crate::output::folder_lock::FolderLock::acquire(&out)?;
     let computed = compute(&p, opts, progress).map_err(Error::Argument)?;
     let sum = summary(path, &p, opts, &computed);
-    let mut files: Vec<(String, Vec<u8>)> = match &computed {
-        Computed::Section(s) => {
-            vec![("poincare.csv".into(), section_csv(&p.model, s).into_bytes())]
-        }
-        Computed::Bifurcation { parameter, cases } => vec![(
-            "bifurcation.csv".into(),
-            bifurcation_csv(&p.model, p.coordinate, parameter, cases).into_bytes(),
-        )],
-        Computed::Basins(cases) => vec![("basins.csv".into(), basins_csv(cases).into_bytes())],
-    };
+    let (name, text) = data_file(&p, &computed);
+    let mut files: Vec<(String, Vec<u8>)> = vec![(name.into(), text.into_bytes())];
     files.push(("poincare.json".into(), sum.to_json().into_bytes()));
     let output_error = |source| Error::Output {
         dir: out.clone(),

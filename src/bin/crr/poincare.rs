@@ -3,9 +3,7 @@
 use std::path::PathBuf;
 
 use crr::Error;
-use crr::analysis::poincare::{
-    PoincareOptions, Sweep, parse_acceleration, parse_finite, parse_frequency, parse_range,
-};
+use crr::analysis::poincare::{PoincareOptions, parse_acceleration, parse_sweep};
 use crr::dynamics::ground_motion::Axis;
 use crr::output::poincare::{PoincareResult, poincare};
 
@@ -112,40 +110,12 @@ fn poincare_options(a: Args) -> Result<PoincareOptions, Error> {
         .component
         .parse()
         .map_err(|e| arg(format!("--component: {e}")))?;
-    let sweep = if let Some(r) = &a.amplitudes {
-        Sweep::Amplitudes(
-            parse_range(r, "--amplitudes", |v| parse_acceleration(v, "--amplitudes"))
-                .map_err(arg)?,
-        )
-    } else if let Some(r) = &a.frequencies {
-        Sweep::Frequencies(
-            parse_range(r, "--frequencies", |v| parse_frequency(v, "--frequencies"))
-                .map_err(arg)?,
-        )
-    } else if let Some(g) = &a.grid {
-        let Some((angle, rate)) = g.split_once(',') else {
-            return Err(arg(format!(
-                "--grid must be T0:T1:N,W0:W1:M (angles in rad, rates in rad/s), got `{g}`"
-            )));
-        };
-        Sweep::Grid {
-            angle: parse_range(angle, "--grid (angles)", |v| {
-                parse_finite(v, "--grid (angles)")
-            })
-            .map_err(arg)?,
-            rate: parse_range(rate, "--grid (rates)", |v| {
-                parse_finite(v, "--grid (rates)")
-            })
-            .map_err(arg)?,
-        }
-    } else {
-        Sweep::None
-    };
-    if a.amplitudes.is_some() && amplitude != 0.0 {
-        return Err(arg(
-            "--amplitude and --amplitudes cannot be given together".into()
-        ));
-    }
+    let sweep = parse_sweep(
+        a.amplitudes.as_deref(),
+        a.frequencies.as_deref(),
+        a.grid.as_deref(),
+    )
+    .map_err(arg)?;
     Ok(PoincareOptions {
         amplitude,
         frequency: a.frequency,
