@@ -1070,6 +1070,7 @@ class Study:
         """:meth:`run` without its warning."""
         # Before any case runs: without pandas the rows would be computed and then lost.
         _pandas("a study's DataFrame")
+        self._warn_before_running(stacklevel=4)
         if out is not None:
             self._native.run_into(_fspath(out), _jobs(jobs), progress)
             text = (Path(out) / "cases.csv").read_text()
@@ -1078,6 +1079,12 @@ class Study:
         else:
             text = self.csv(self.run_rows(None, jobs))
         return cases_frame(text)
+
+    def _warn_before_running(self, stacklevel: int) -> None:
+        """Issues the study's warnings found before any case runs (a ``duration`` that cuts
+        motions short), as ``crr study`` prints them first."""
+        for message in self._native.warnings:
+            warnings.warn(CrrWarning(message), stacklevel=stacklevel)
 
     def _rows_with_progress(self, jobs: Optional[int]) -> List[str]:
         """Every case's row, run in batches of a few cases per thread, with a tqdm bar when tqdm
@@ -1180,7 +1187,18 @@ def _warn_outside_model(frame: "pandas.DataFrame", stacklevel: int) -> "pandas.D
     """Issues a :class:`CrrWarning`, as ``crr study`` warns on stderr, when some cases' runs left
     crr's model (their ``violation_time_s`` is filled: the rigid-contact hypotheses fail, see
     ``docs/studies.md``); returns ``frame``. ``stacklevel`` counts from the caller of this
-    function, as :func:`warnings.warn`'s does from its own caller."""
+    function, as :func:`warnings.warn`'s does from its own caller. Cases that stopped with an
+    error (``status`` ``error``) are warned about too, as ``crr study`` does."""
+    if "status" in frame.columns:
+        failed = int((frame["status"] == "error").sum())
+        if failed:
+            warnings.warn(
+                CrrWarning(
+                    f"{failed} of the {len(frame)} case(s) stopped with an error (status "
+                    "`error`, the message in column `error`): they have no outcome"
+                ),
+                stacklevel=stacklevel + 1,
+            )
     if "violation_time_s" in frame.columns:
         outside = int(frame["violation_time_s"].notna().sum())
         if outside:
@@ -1219,7 +1237,9 @@ def study(
     Warns:
         CrrWarning: when some cases' runs left crr's model (a hypotheses violation, in their
             ``violation_time_s``, ``violation`` and ``violation_interface`` columns), with the
-            count, as ``crr study`` warns.
+            count, as ``crr study`` warns; and before any case runs, when the study's
+            ``duration`` ends cases before their ground motion does (a collapse after it would
+            not be seen).
     """
     return _warn_outside_model(_as_study(study)._frame(jobs, out, progress), stacklevel=2)
 

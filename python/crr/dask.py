@@ -69,6 +69,7 @@ def run_study(
     if chunk_size < 1:
         raise ValueError(f"chunk_size must be at least 1, got {chunk_size}")
     s = _as_study(study)
+    s._warn_before_running(stacklevel=3)
     ids = s.case_ids
     chunks = [ids[i : i + chunk_size] for i in range(0, len(ids), chunk_size)]
     token = uuid.uuid4().hex[:12]

@@ -851,6 +851,17 @@ impl PyStudy {
         self.study.cases.iter().map(|c| c.id.clone()).collect()
     }
 
+    /// What to know before trusting the results, found before any case runs (a `duration`
+    /// that cuts motions short), as `crr study` warns.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.study
+            .warnings
+            .iter()
+            .map(|w| format!("{}: {w}", self.label.display()))
+            .collect()
+    }
+
     /// The header line of cases.csv (without its newline).
     #[getter]
     fn header(&self) -> String {

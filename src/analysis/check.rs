@@ -326,6 +326,7 @@ pub fn check_with(
             .into_iter()
             .chain(crate::analysis::contact_geometry::contact_geometry_warnings(model))
             .chain(crate::analysis::contact_geometry::bodies_held_by_shear_alone(model))
+            .chain(crate::analysis::body_sizes::bodies_too_large(model))
             .collect(),
     }
 }

@@ -4,6 +4,7 @@
 //! those are the output layer's.
 
 pub mod assemble;
+pub mod body_sizes;
 pub mod check;
 pub mod contact_geometry;
 pub mod inspect;

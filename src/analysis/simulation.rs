@@ -914,6 +914,27 @@ fn rocking_on_a_corner(model: &Model, stats: &SampleStats) -> Option<String> {
     ))
 }
 
+/// A run that ends before its ground motion does, without a collapse: the motion after its
+/// duration is not simulated, so a collapse it would cause is not seen (a 20 s record run for
+/// 5 s wrote `collapse: no` for a block that overturns at 6.9 s, with no warning). An endless
+/// motion (a sine, a constant) has no end to reach: its run ends where the user says. A run
+/// stopped earlier by an error says so in its error.
+fn motion_cut_short(p: &Prepared, t: &Trajectory) -> Option<String> {
+    let motion_end = p.ground.duration();
+    let duration = p.params.duration;
+    let reached = t.end_time >= duration * (1.0 - 1e-12);
+    (reached && t.collapse.is_none() && motion_end.is_finite() && motion_end > duration).then(
+        || {
+            format!(
+                "the run ends at t = {duration} s, before its ground motion does (at t = \
+             {motion_end} s): the motion after {duration} s is not simulated, so a collapse it \
+             would cause is not seen and the run reads as not collapsed; leave the duration out \
+             (it is then the motion's end + 5 s) or make it at least {motion_end} s"
+            )
+        },
+    )
+}
+
 /// What a user must know before trusting the results (`warnings` in summary.json, also printed
 /// on stderr by `crr simulate`).
 fn warnings(
@@ -923,6 +944,9 @@ fn warnings(
     gains: &[&ImpactRecord],
 ) -> Vec<String> {
     let mut out = Vec::new();
+    if let Some(cut) = motion_cut_short(p, t) {
+        out.push(cut);
+    }
     if let Some(worst) = gains
         .iter()
         .min_by(|a, b| a.energy_lost.total_cmp(&b.energy_lost))
@@ -1029,6 +1053,7 @@ fn warnings(
     }
     out.extend(crate::analysis::contact_geometry::contact_geometry_warnings(&p.model));
     out.extend(crate::analysis::contact_geometry::bodies_held_by_shear_alone(&p.model));
+    out.extend(crate::analysis::body_sizes::bodies_too_large(&p.model));
     let analysis = p.file.analysis.clone().unwrap_or_default();
     if !matches!(analysis.method, crr_dynamics::MethodName::Rk4)
         && analysis.rtol > crr_dynamics::analysis::RTOL_WARNING

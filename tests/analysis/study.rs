@@ -247,3 +247,117 @@ fn case_rows_joined_in_any_order_equal_the_command_line_file() {
     let err = case_rows(&study, &cases[..1], Some(0)).unwrap_err();
     assert_eq!(err.to_string(), "--jobs must be at least 1");
 }
+
+/// A study whose `duration` ends its cases before their records do says so before any case
+/// runs (stderr, with `--quiet` too, and `study.json`): 1.5 × the bundled 20 s record overturns
+/// the block at 6.93 s, and a study cut at 5 s wrote `collapse` 0. A `factors` study has one
+/// `factor` column (its level is the factor applied; the header had `factor` twice), and its
+/// failed cases are a warning with `--quiet` too.
+#[test]
+fn a_study_cut_short_warns_and_a_factors_study_has_one_factor_column() {
+    let dir = scratch("study_cut_short");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let study = |name: &str, duration: &str| {
+        let text = format!(
+            "model = \"{}\"\n{duration}\n[records]\nfiles = [\"{}\", \"missing.AT2\"]\nformat = \"peer-at2\"\n\n\
+             [intensity]\nfactors = [1.5]\n",
+            root.join("examples/models/block_record.toml").display(),
+            root.join("examples/records/synthetic.AT2").display()
+        );
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let run = |path: &Path, out: &str| {
+        let out = dir.join(out);
+        let o = crr(&[
+            "study",
+            path.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let json: serde_json::Value = serde_json::from_str(&read(&out.join("study.json"))).unwrap();
+        (
+            read(&out.join("cases.csv")),
+            json,
+            String::from_utf8_lossy(&o.stderr).to_string(),
+        )
+    };
+    let (cut_csv, cut_json, cut_err) = run(&study("cut", "duration = 5.0\n"), "cut");
+    let (full_csv, full_json, full_err) = run(&study("full", ""), "full");
+    let warning = "duration = 5 s ends 1 of the 2 case(s) before their ground motion does (the \
+                   latest ends at t = 20 s)";
+    assert!(
+        cut_err.contains(&format!("crr: warning: {}", dir.join("cut.toml").display())),
+        "{cut_err}"
+    );
+    assert!(cut_err.contains(warning), "{cut_err}");
+    assert_eq!(cut_json["warnings"].as_array().unwrap().len(), 1);
+    assert!(
+        cut_json["warnings"][0]
+            .as_str()
+            .unwrap()
+            .starts_with(warning)
+    );
+    assert!(
+        !full_err.contains("before their ground motion"),
+        "{full_err}"
+    );
+    assert_eq!(full_json["warnings"].as_array().unwrap().len(), 0);
+    // One factor column; the missing record's row keeps its level.
+    for csv in [&cut_csv, &full_csv] {
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        assert_eq!(header[..4], ["id", "record", "factor", "status"]);
+        let rows: Vec<Vec<&str>> = csv
+            .lines()
+            .skip(1)
+            .map(|r| r.split(',').collect())
+            .collect();
+        assert_eq!(rows.len(), 2);
+        assert!(rows.iter().all(|r| r[2] == "1.5"), "{csv}");
+    }
+    // Cut at 5 s the block stands; run to the record's end + 5 s it overturns after 5 s.
+    let collapse = |csv: &str| -> (String, String) {
+        let row: Vec<String> = csv
+            .lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .map(String::from)
+            .collect();
+        (row[3].clone(), row[4].clone()) // status, collapse
+    };
+    assert_eq!(collapse(&cut_csv), ("ok".into(), "0".into()));
+    assert_eq!(collapse(&full_csv), ("ok".into(), "1".into()));
+    let time: f64 = full_csv
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(5)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(time > 5.0 && time < 20.0, "{time}");
+    // The missing record's case failed: said with --quiet.
+    for err in [&cut_err, &full_err] {
+        assert!(
+            err.contains("crr: warning: 1 of the 2 case(s) of this part stopped with an error"),
+            "{err}"
+        );
+    }
+}
+
+/// The bundled studies' durations cover their motions: no warning before they run.
+#[test]
+fn the_bundled_studies_cut_no_motion_short() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["housner_map", "block_spectrum", "drum_fragility"] {
+        let study =
+            crr::analysis::study::Study::load(&root.join(format!("examples/studies/{name}.toml")))
+                .unwrap();
+        assert!(study.warnings.is_empty(), "{name}: {:?}", study.warnings);
+    }
+}

@@ -5,7 +5,7 @@ use crate::common;
 
 use std::path::{Path, PathBuf};
 
-use crate::common::{bundled_text, crr};
+use crate::common::{bundled_text, bundled_text_with_records, crr};
 
 fn scratch(name: &str) -> PathBuf {
     common::scratch(&format!("warnings_{name}"))
@@ -525,4 +525,99 @@ fn a_study_or_section_driven_along_the_hinges_axis_is_refused() {
             String::from_utf8_lossy(&o.stderr)
         );
     }
+}
+
+/// A run whose duration ends before its ground motion reads as "not collapsed" for a structure
+/// that collapses later in the motion: the bundled block under 1.5 × its 20 s record (PGA
+/// 0.375 g) overturns at 6.93 s, and cut at 5 s it stood, with no word. It now says so; a run
+/// as long as its motion, and one under an endless sine, do not.
+#[test]
+fn a_run_cut_before_its_ground_motion_ends_says_so() {
+    let model = bundled_text_with_records("block_record");
+    let scaled = model.replace(
+        "format = \"peer-at2\" } }",
+        "format = \"peer-at2\" }, scale = 1.5 }",
+    );
+    assert_ne!(scaled, model, "the record line was not found");
+    let (full, _) = run("cut_full", &scaled, &[]);
+    let collapse = full["collapse"]["time"].as_f64().expect("a collapse");
+    assert!(collapse > 5.0 && collapse < 20.0, "{collapse}");
+    assert!(warnings(&full).is_empty(), "{:?}", warnings(&full));
+    let (cut, stderr) = run("cut_5s", &scaled, &["--duration", "5"]);
+    assert_eq!(cut["collapse"]["collapsed"], false);
+    assert_reported("cut_5s", &cut, &stderr);
+    let w = warnings(&cut);
+    assert_eq!(w.len(), 1, "{w:?}");
+    // The record's last sample: 2001 samples at 0.01 s (examples/records/synthetic.AT2).
+    assert!(
+        w[0].starts_with("the run ends at t = 5 s, before its ground motion does (at t = 20 s)"),
+        "{}",
+        w[0]
+    );
+    let sine = single_block_with("duration = 3.0").replace(
+        "[analysis]",
+        "[ground_motion]\nx = { sine = { amplitude = 1.0, frequency = 2.0 } }\n\n[analysis]",
+    );
+    let (endless, _) = run("cut_sine", &sine, &[]);
+    assert!(warnings(&endless).is_empty(), "{:?}", warnings(&endless));
+}
+
+/// Lengths in millimetres where crr reads metres: the bundled 2 m block typed in millimetres (a
+/// 2 km block) has the same multiplier, λ = b/h = 0.2, and `crr check` and `crr simulate` say
+/// that it is larger than any stone; a 30 m monolith is not reported.
+#[test]
+fn a_body_kilometres_long_is_a_warning_of_lengths_in_millimetres() {
+    let mm = bundled_text("single_block")
+        .replace(
+            "center = [0.0, 0.0, 1.0], size = [0.4, 0.4, 2.0]",
+            "center = [0.0, 0.0, 1000.0], size = [400.0, 400.0, 2000.0]",
+        )
+        .replace(
+            "0.2, -0.2, 0.0], [0.2, 0.2",
+            "200.0, -200.0, 0.0], [200.0, 200.0",
+        )
+        .replace(
+            "-0.2, -0.2, 0.0], [-0.2, 0.2",
+            "-200.0, -200.0, 0.0], [-200.0, 200.0",
+        )
+        .replace("angles = { base = 0.1 }", "angles = { base = 0.0 }");
+    let check = |tag: &str, text: &str| -> serde_json::Value {
+        let dir = scratch(tag);
+        let model = dir.join("model.toml");
+        std::fs::write(&model, text).unwrap();
+        let o = crr(&["check", model.to_str().unwrap(), "--json"]);
+        assert!(
+            o.status.success(),
+            "{tag}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let report = check("mm_check", &mm);
+    let lambda = report["static_multipliers"][0]["lambda"].as_f64().unwrap();
+    assert!((lambda - 0.2).abs() < 1e-9, "{lambda}");
+    let w = warnings(&report);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with(
+            "body \"block\" spans 2.0000e3 m at rest (its largest extent): larger than any stone"
+        ),
+        "{}",
+        w[0]
+    );
+    let (summary, stderr) = run("mm_simulate", &mm, &["--duration", "1"]);
+    assert!(warnings(&summary).contains(&w[0]), "{stderr}");
+    // A monolith of 30 m (an obelisk's height) is a stone.
+    let obelisk = bundled_text("single_block")
+        .replace(
+            "center = [0.0, 0.0, 1.0], size = [0.4, 0.4, 2.0]",
+            "center = [0.0, 0.0, 15.0], size = [3.0, 3.0, 30.0]",
+        )
+        .replace("0.2, -0.2, 0.0], [0.2, 0.2", "1.5, -1.5, 0.0], [1.5, 1.5")
+        .replace(
+            "-0.2, -0.2, 0.0], [-0.2, 0.2",
+            "-1.5, -1.5, 0.0], [-1.5, 1.5",
+        );
+    let report = check("obelisk_check", &obelisk);
+    assert!(warnings(&report).is_empty(), "{:?}", warnings(&report));
 }

@@ -150,6 +150,10 @@ pub struct Study {
     pub sized: bool,
     /// The cases, in id order.
     pub cases: Vec<Case>,
+    /// What to know before trusting the results, found before any case runs (a `duration`
+    /// that cuts motions short): `crr study` prints them on stderr (with `--quiet` too),
+    /// `study.json` holds them and Python issues them as `crr.CrrWarning`.
+    pub warnings: Vec<String>,
 }
 
 /// Peak ground velocity of a record (m/s): the largest |∫a dt| by the trapezoid rule (the record
@@ -331,6 +335,7 @@ impl Study {
             variants,
             sized,
             cases: Vec::new(),
+            warnings: Vec::new(),
         };
         match (&spec.pulses, &spec.records) {
             (Some(_), Some(_)) | (None, None) => {
@@ -379,7 +384,46 @@ impl Study {
                 study.record_cases(measure, &levels);
             }
         }
+        study.warnings.extend(study.motions_cut_short());
         Ok(study)
+    }
+
+    /// A warning when the study's `duration` ends cases before their ground motion does: each
+    /// is cut there, so that a collapse later in its motion is not seen and the case reads as
+    /// not collapsed (a 20 s record under `duration = 5` wrote `collapse` 0 for a block that
+    /// overturns at 6.9 s). Without a `duration` each case runs to its motion's end + 5 s.
+    fn motions_cut_short(&self) -> Option<String> {
+        let duration = self.spec.duration?;
+        let mut cut = 0usize;
+        let mut latest: f64 = 0.0;
+        for case in &self.cases {
+            // A record's end without copying it into a ground motion (a study may have many
+            // cases of long records); a record that cannot be read fails its cases anyway.
+            let end = match &case.motion {
+                Motion::Record { record, .. } => match &self.records[*record].record {
+                    Ok(r) => r.end_time(),
+                    Err(_) => continue,
+                },
+                Motion::Pulse { .. } => match self.ground_motion(case) {
+                    Ok(g) => g.duration(),
+                    Err(_) => continue,
+                },
+            };
+            if end.is_finite() && end > duration {
+                cut += 1;
+                latest = latest.max(end);
+            }
+        }
+        (cut > 0).then(|| {
+            format!(
+                "duration = {duration} s ends {cut} of the {} case(s) before their ground motion \
+                 does (the latest ends at t = {latest} s): each is cut at {duration} s, so a \
+                 collapse later in its motion is not seen and the case reads as not collapsed \
+                 (`collapse` 0); leave `duration` out (each case then runs to its motion's end \
+                 + 5 s) or make it at least {latest} s",
+                self.cases.len()
+            )
+        })
     }
 
     /// The cases of a pulse family: every amplitude × period of every variant (the grid may be

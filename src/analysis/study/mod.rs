@@ -16,6 +16,6 @@ pub mod measures;
 pub mod spec;
 pub mod zhang_makris;
 
-pub use cases::{Case, Motion, Study};
+pub use cases::{Case, IntensityMeasure, Motion, Study};
 pub use measures::{CaseFailure, Measures, run_case, run_case_cancellable};
 pub use spec::StudySpec;

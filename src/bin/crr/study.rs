@@ -81,6 +81,10 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         None => Shard::ALL,
     };
     let study = Study::load(&path)?;
+    // Before any case runs, so that a study cut short can be stopped; with --quiet too.
+    for w in &study.warnings {
+        eprintln!("crr: warning: {}: {w}", path.display());
+    }
     let out = out.unwrap_or_else(|| PathBuf::from("results").join(&study.name));
     let outcome = run_study(
         &study,
@@ -113,7 +117,17 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
             out.display()
         );
     }
-    // A warning, as `crr simulate`'s: shown with --quiet too.
+    // Warnings, as `crr simulate`'s: shown with --quiet too (a batch script that ran a study
+    // with --quiet was told nothing of its failed cases).
+    if outcome.failed > 0 {
+        eprintln!(
+            "crr: warning: {} of the {} case(s) of this part stopped with an error (status \
+             `error`, the message in column `error` of {}): they have no outcome",
+            outcome.failed,
+            outcome.cases,
+            out.join("cases.csv").display()
+        );
+    }
     if outcome.outside_model > 0 {
         eprintln!(
             "crr: warning: {} of the {} case(s) of this part left crr's model (the rigid-contact \

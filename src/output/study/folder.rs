@@ -18,7 +18,9 @@ use crate::Error;
 use crate::analysis::simulation::Cancel;
 use crate::analysis::simulation::coordinate_alpha;
 use crate::analysis::study::cases::case_id;
-use crate::analysis::study::{Case, CaseFailure, Measures, Motion, Study, run_case_cancellable};
+use crate::analysis::study::{
+    Case, CaseFailure, IntensityMeasure, Measures, Motion, Study, run_case_cancellable,
+};
 use crate::output::replace_file::replace_file;
 
 /// `i/n`: the i-th (1-based) of n disjoint parts of a study; case k belongs to part k mod n + 1.
@@ -123,6 +125,13 @@ fn count_outside_model<'a>(header: &str, rows: impl IntoIterator<Item = &'a Stri
         .count()
 }
 
+/// Whether a records study's rows have a `factor` column besides the level's: not for a
+/// `factors` study, whose level is the factor applied (its header had `factor` twice, which csv
+/// readers keep as one column and pandas renames `factor.1`).
+fn applies_a_factor_of_its_own(study: &Study) -> bool {
+    study.intensity != IntensityMeasure::Factor
+}
+
 /// The header of `cases.csv`.
 pub fn header(study: &Study) -> String {
     let mut cols: Vec<String> = vec!["id".into()];
@@ -140,11 +149,10 @@ pub fn header(study: &Study) -> String {
             .map(String::from),
         );
     } else {
-        cols.extend([
-            "record".into(),
-            study.intensity.name().into(),
-            "factor".into(),
-        ]);
+        cols.extend(["record".into(), study.intensity.name().into()]);
+        if applies_a_factor_of_its_own(study) {
+            cols.push("factor".into());
+        }
     }
     cols.extend(["status", "collapse", "collapse_time_s", "impacts"].map(String::from));
     for c in &study.model.coords {
@@ -200,8 +208,10 @@ pub fn row(study: &Study, case: &Case, result: &Result<Measures, CaseFailure>) -
             cols.extend([
                 quoted(&study.records[*record].file.display().to_string()),
                 num(*level),
-                opt(*factor),
             ]);
+            if applies_a_factor_of_its_own(study) {
+                cols.push(opt(*factor));
+            }
         }
     }
     let n = study.model.dof();
@@ -651,6 +661,7 @@ pub fn run_study(
         cases_run: todo.len(),
         cases_failed: failed,
         cases_outside_model: outside_model,
+        warnings: study.warnings.clone(),
         threads: pool.current_num_threads(),
         wall_time_s: wall,
         lambda: study.lambda_p.map(|x| x.0),

@@ -37,6 +37,10 @@ pub struct StudyInfo {
     /// columns).
     #[serde(default)]
     pub cases_outside_model: usize,
+    /// What to know before trusting the results, found before any case ran
+    /// ([`crate::analysis::study::Study::warnings`]: a `duration` that cuts motions short).
+    #[serde(default)]
+    pub warnings: Vec<String>,
     /// Worker threads.
     pub threads: usize,
     /// Wall-clock time of the run (s).
