@@ -210,3 +210,39 @@ def test_a_study_without_pandas_is_refused_before_any_case_runs(monkeypatch, tmp
     with pytest.raises(ImportError, match="needs pandas"):
         crr.study(study)
     assert ran == []
+
+
+def test_a_study_cut_short_and_its_failed_cases_are_warnings(tmp_path):
+    """A `duration` shorter than a record is warned before any case runs (the case is cut
+    there: 1.5 × the bundled 20 s record overturns the block at 6.93 s, and cut at 5 s it
+    stands), and a case that stopped with an error is warned with the count, as `crr study`
+    prints both on stderr."""
+    study = {
+        "model": (ROOT / "examples/models/block_record.toml").as_posix(),
+        "duration": 5.0,
+        "records": {
+            "files": [(ROOT / "examples/records/synthetic.AT2").as_posix(), "missing.AT2"],
+            "format": "peer-at2",
+        },
+        "intensity": {"factors": [1.5]},
+    }
+    with pytest.warns(crr.CrrWarning) as caught:
+        frame = crr.study(crr.Study.from_dict(study, base_dir=tmp_path))
+    messages = [str(w.message) for w in caught]
+    assert any(
+        "duration = 5 s ends 1 of the 2 case(s) before their ground motion does (the latest ends "
+        "at t = 20 s)" in m
+        for m in messages
+    ), messages
+    assert any("1 of the 2 case(s) stopped with an error" in m for m in messages), messages
+    assert list(frame.columns[:4]) == ["id", "record", "factor", "status"]
+    assert list(frame["status"]) == ["ok", "error"]
+    assert int(frame["collapse"].iloc[0]) == 0
+    study.pop("duration")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        full = crr.study(crr.Study.from_dict(study, base_dir=tmp_path))
+    messages = [str(w.message) for w in caught]
+    assert not any("before their ground motion" in m for m in messages), messages
+    assert int(full["collapse"].iloc[0]) == 1
+    assert 5.0 < float(full["collapse_time_s"].iloc[0]) < 20.0

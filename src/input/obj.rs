@@ -74,6 +74,13 @@ pub struct ObjSpec {
 /// The largest OBJ file read (bytes): a mesh of a few hundred blocks takes a few megabytes.
 pub const OBJ_FILE_LIMIT: u64 = 256 << 20;
 
+/// How far (a fraction of a block's size, its bounding-box diagonal) a vertex may lie outside a
+/// face's plane before the block is refused as not convex: CAD programs write OBJ coordinates
+/// to six decimals (a rounding of up to 0.87e-6 m off a plane), and a 9-voussoir arch turned to
+/// a 30° bearing so written was refused at 1e-9 of its size. 1e-5 of a block (5 µm on 0.5 m)
+/// is far below any concavity a mason cuts; the block is the convex hull of its vertices.
+pub const CONVEX_TOLERANCE: f64 = 1e-5;
+
 /// The bodies of the OBJ file of `spec` (its path relative to `folder`), one per object.
 pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error> {
     let path = folder.join(&spec.file);
@@ -231,7 +238,8 @@ impl Block {
         Ok(())
     }
 
-    /// Every vertex lies on the inner side of every face's plane (to 1e-9 of the block's size),
+    /// Every vertex lies on the inner side of every face's plane (to [`CONVEX_TOLERANCE`] of the
+    /// block's size),
     /// the faces oriented outward by the mesh's sign of volume. Computed with the block moved
     /// near the origin ([`exact_reference`], exact): a face's plane taken at 4.5e6 m would carry
     /// its normal's round-off times that distance, about 1e-9 × 4.5e6 m, and a box turned to a
@@ -269,16 +277,17 @@ impl Block {
                 continue;
             };
             let offset = n.dot(&near[f[0]]);
-            if let Some(v) = self
-                .vertices
-                .iter()
-                .zip(&near)
-                .find_map(|(v, w)| (n.dot(w) - offset > 1e-9 * size).then_some(v))
-            {
+            if let Some(v) = self.vertices.iter().zip(&near).find_map(|(v, w)| {
+                let out = n.dot(w) - offset;
+                (out > CONVEX_TOLERANCE * size).then_some((v, out))
+            }) {
+                let (v, out) = v;
                 return Err(format!(
-                    "the block is not convex: the vertex ({:.6}, {:.6}, {:.6}) m lies outside \
-                     the plane of face {} (a polyhedron body is the convex hull of its vertices: \
-                     cut the block into convex parts)",
+                    "the block is not convex: the vertex ({:.6}, {:.6}, {:.6}) m lies {out:.1e} m \
+                     outside the plane of face {} (more than {CONVEX_TOLERANCE:e} of the block's \
+                     size, {size:.3} m; a polyhedron body is the convex hull of its vertices: cut \
+                     the block into convex parts, or, if its coordinates were rounded, write them \
+                     with more decimals)",
                     v.x,
                     v.y,
                     v.z,

@@ -2,9 +2,12 @@
 //! shapes alone, and the CRR structure whose rocking interfaces they are (documented in
 //! `docs/assembly.md`).
 //!
-//! Two faces touch when they face each other (outward normals opposite, to 1e-9) in one plane
-//! (their distance at most the tolerance); the contact face is the overlap of the two convex
-//! polygons (clipped in the plane, Sutherland–Hodgman). The ground is the horizontal plane at the
+//! Two faces touch when they face each other (outward normals opposite to within
+//! [`MAX_CONTACT_TILT`]) and their overlap lies within the tolerance of both planes; the contact
+//! face is the overlap of the two convex polygons (clipped in the plane of one, Sutherland–
+//! Hodgman). The pieces of a body's face that rounded coordinates split lie in one plane within
+//! the tolerance and are one face (`merge_coplanar_pieces`), and a rectangular contact is written
+//! squared (`squared`). The ground is the horizontal plane at the
 //! ground level (z = 0 unless a site elevation is given): a face lying on it with its outward
 //! normal down rests on the ground whole. A contact whose normal
 //! leans less than 45° from the vertical is a **bed** (the lower body supports the upper one: a
@@ -83,15 +86,24 @@ pub fn body_surface(body: &BodySpec) -> Result<Surface, AssemblyError> {
 }
 
 /// One face of a surface: its polygon, unit outward normal and plane offset n·x.
+#[derive(Clone)]
 struct Face {
     polygon: Vec<Vector3<f64>>,
     normal: Vector3<f64>,
     offset: f64,
+    /// Its area (m²).
+    area: f64,
     /// Whether the polygon is convex (every turn the same way about the normal).
     convex: bool,
 }
 
-fn faces_of(surface: &Surface) -> Vec<Face> {
+/// The faces of a body's surface, pieces of one face in one plane within `tolerance` (m)
+/// merged ([`merge_coplanar_pieces`]).
+fn faces_of(surface: &Surface, tolerance: f64) -> Vec<Face> {
+    merge_coplanar_pieces(surface_faces(surface), tolerance)
+}
+
+fn surface_faces(surface: &Surface) -> Vec<Face> {
     (0..surface.faces.len())
         .filter_map(|f| {
             let polygon: Vec<Vector3<f64>> = surface.faces[f]
@@ -111,11 +123,120 @@ fn faces_of(surface: &Surface) -> Vec<Face> {
                     offset: normal.dot(&polygon[0]),
                     polygon,
                     normal,
+                    area: norm,
                     convex,
                 }
             })
         })
         .collect()
+}
+
+/// The faces of one body that lie in one plane to within `tolerance` (m), as one face each: a
+/// convex block written with rounded coordinates has its faces' vertices off their planes by
+/// up to the rounding (0.87e-6 m at six decimals, as CAD programs export OBJ files), and its
+/// hull then splits such a face into pieces at slightly different angles, so that a block
+/// resting on it met "more than one face" (a 9-voussoir arch turned to a 30° bearing and
+/// exported at six decimals was refused, whatever `--tolerance`). Pieces are merged when every
+/// vertex of each lies within `tolerance` of the other's plane and their normals agree in
+/// sense; the merged face is the convex hull of their vertices in the plane of their summed
+/// area vector, through their mean offset. Only convex faces are merged (a prism's non-convex
+/// caps are whole faces already).
+fn merge_coplanar_pieces(faces: Vec<Face>, tolerance: f64) -> Vec<Face> {
+    let n = faces.len();
+    let on_plane = |a: &Face, b: &Face| {
+        b.polygon
+            .iter()
+            .all(|v| (a.normal.dot(v) - a.offset).abs() <= tolerance)
+    };
+    let mut group: Vec<usize> = (0..n).collect();
+    let root = |group: &[usize], mut i: usize| {
+        while group[i] != i {
+            i = group[i];
+        }
+        i
+    };
+    for i in 0..n {
+        for j in i + 1..n {
+            let (a, b) = (&faces[i], &faces[j]);
+            if a.convex
+                && b.convex
+                && a.normal.dot(&b.normal) > 0.0
+                && on_plane(a, b)
+                && on_plane(b, a)
+            {
+                let (ri, rj) = (root(&group, i), root(&group, j));
+                group[rj.max(ri)] = ri.min(rj);
+            }
+        }
+    }
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for i in 0..n {
+        members[root(&group, i)].push(i);
+    }
+    members
+        .into_iter()
+        .filter(|m| !m.is_empty())
+        .map(|m| {
+            if m.len() == 1 {
+                return faces[m[0]].clone();
+            }
+            let area: Vector3<f64> = m.iter().map(|&i| faces[i].normal * faces[i].area).sum();
+            let normal = area.normalize();
+            let vertices: Vec<Vector3<f64>> = m
+                .iter()
+                .flat_map(|&i| faces[i].polygon.iter().copied())
+                .collect();
+            let offset =
+                vertices.iter().map(|v| normal.dot(v)).sum::<f64>() / vertices.len() as f64;
+            let u = any_perpendicular(&normal);
+            let w = normal.cross(&u);
+            let mut points: Vec<[f64; 2]> = vertices.iter().map(|p| [u.dot(p), w.dot(p)]).collect();
+            let hull = simplified(convex_hull_2d(&mut points), tolerance);
+            Face {
+                polygon: hull
+                    .iter()
+                    .map(|p| u * p[0] + w * p[1] + normal * offset)
+                    .collect(),
+                normal,
+                offset,
+                convex: true,
+                area: area_2d(&hull),
+            }
+        })
+        .collect()
+}
+
+/// The largest angle (rad) between two faces that touch (their outward normals opposite to
+/// within it). Within it the faces touch where their overlap lies within the tolerance of both
+/// planes, so that the tolerance decides: a block seated 0.01° askew on another (1e-4 m of gap
+/// across it), as a survey or a scan gives, touches under `--tolerance 2e-4` and not under the
+/// default 1e-6 m; opposite normals to 1e-9 were required, whatever the tolerance.
+const MAX_CONTACT_TILT: f64 = 1e-2;
+
+/// A contact's four corners as an exact rectangle in the plane normal to `normal`: the same
+/// centre, and edges the means of its opposite edges, the second made normal to the first. A
+/// contact found between faces written with rounded coordinates is a rectangle only to the
+/// rounding (angles of 89.9999° at six decimals), which the model refuses (its corners must
+/// make right angles to 1e-6); squared, it moves by no more than that rounding. Other
+/// polygons are returned as they are.
+fn squared(corners: &[Vector3<f64>], normal: &Vector3<f64>) -> Vec<Vector3<f64>> {
+    let [a, b, c, d] = corners else {
+        return corners.to_vec();
+    };
+    let flat = |v: Vector3<f64>| v - normal * normal.dot(&v);
+    let centre = (a + b + c + d) / 4.0;
+    let first = flat((b - a) + (c - d)) / 2.0;
+    let Some(along) = first.try_normalize(0.0) else {
+        return corners.to_vec();
+    };
+    let second = flat((d - a) + (c - b)) / 2.0;
+    let second = second - along * along.dot(&second);
+    vec![
+        centre - first / 2.0 - second / 2.0,
+        centre + first / 2.0 - second / 2.0,
+        centre + first / 2.0 + second / 2.0,
+        centre - first / 2.0 + second / 2.0,
+    ]
 }
 
 /// Signed area of a 2D polygon (positive counter-clockwise).
@@ -253,7 +374,7 @@ pub fn detect_contacts(
         *v -= reference;
     }
     let ground_near = ground_level - reference.z;
-    let faces: Vec<Vec<Face>> = surfaces.iter().map(faces_of).collect();
+    let faces: Vec<Vec<Face>> = surfaces.iter().map(|s| faces_of(s, tolerance)).collect();
     let boxes: Vec<(Vector3<f64>, Vector3<f64>)> = surfaces
         .iter()
         .map(|s| {
@@ -279,7 +400,7 @@ pub fn detect_contacts(
         &is_fixed,
     )?;
     let min_area = tolerance * size;
-    let facing = 1.0 - 1e-9;
+    let facing = MAX_CONTACT_TILT.cos();
     let mut contacts = Vec::new();
     // On the ground: a face on the ground level whose outward normal is −z rests whole.
     for (b, fs) in faces.iter().enumerate().filter(|&(b, _)| !is_fixed(b)) {
@@ -318,9 +439,7 @@ pub fn detect_contacts(
             }
             for fa in &faces[i] {
                 for fb in &faces[j] {
-                    if fa.normal.dot(&fb.normal) > -facing
-                        || (fa.offset + fb.offset).abs() > tolerance
-                    {
+                    if fa.normal.dot(&fb.normal) > -facing {
                         continue;
                     }
                     // The normal from the lower body into the upper one; a side contact keeps
@@ -335,6 +454,18 @@ pub fn detect_contacts(
                         (j, i, fb.normal)
                     };
                     let (corners, area) = overlap(&fa.polygon, &fb.polygon, &normal, tolerance);
+                    // Within the tolerance of both faces' planes over their whole overlap: two
+                    // faces apart, or tilted against each other by more than the tolerance
+                    // over the overlap, do not touch.
+                    let gap = |f: &Face| {
+                        corners
+                            .iter()
+                            .map(|c| (f.normal.dot(c) - f.offset).abs())
+                            .fold(0.0f64, f64::max)
+                    };
+                    if gap(fa) > tolerance || gap(fb) > tolerance {
+                        continue;
+                    }
                     if area > min_area && !(fa.convex && fb.convex) {
                         let b = if fa.convex { j } else { i };
                         return Err(non_convex(&bodies[b].name));
@@ -722,7 +853,10 @@ pub fn structure_of(
         match style {
             InterfaceStyle::RockingBase => {
                 spec.rocking_base = Some(RockingBaseSpec {
-                    corners: c.corners.iter().map(|p| [p.x, p.y, p.z]).collect(),
+                    corners: squared(&c.corners, &c.normal)
+                        .iter()
+                        .map(|p| [p.x, p.y, p.z])
+                        .collect(),
                     twist: false,
                 });
             }
