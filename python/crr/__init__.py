@@ -233,17 +233,24 @@ class Model:
         rocking base (``planar``: a hinge about y), faces closer than ``tolerance`` (m) touching,
         the ground the plane z = ``ground_level`` (m); with ``inscribed``, a face that is no
         rectangle (a drum's bed) rocks on the largest rectangle of its proportions inside it.
-        Relative record files are read from the assembly's folder. See docs/assembly.md."""
-        return cls(
-            _crr.Model.assemble(
-                _fspath(path),
-                bool(planar),
-                bool(all_contacts),
-                float(tolerance),
-                float(ground_level),
-                bool(inscribed),
-            )
+        Relative record files are read from the assembly's folder. See docs/assembly.md.
+
+        Warns:
+            CrrWarning: blocks whose faces face each other a little farther apart than
+                ``tolerance`` (up to 1 % of the smaller block), which are no contact, with the
+                tolerance that would make them one (as ``crr assemble`` warns).
+        """
+        native, messages = _crr.Model.assemble(
+            _fspath(path),
+            bool(planar),
+            bool(all_contacts),
+            float(tolerance),
+            float(ground_level),
+            bool(inscribed),
         )
+        for message in messages:
+            warnings.warn(CrrWarning(message), stacklevel=2)
+        return cls(native)
 
     @classmethod
     def from_toml(

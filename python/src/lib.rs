@@ -102,6 +102,8 @@ impl PyModel {
     /// ground the plane z = `ground_level` (m) and the blocks the file names `fixed`; with
     /// `inscribed`, a face that is no rectangle rocks on the largest rectangle of its
     /// proportions inside it. Relative record files are read from the assembly's folder.
+    /// Returns the model and the assembly's warnings (blocks a little farther apart than the
+    /// tolerance, which are no contact).
     #[staticmethod]
     fn assemble(
         py: Python<'_>,
@@ -111,7 +113,7 @@ impl PyModel {
         tolerance: f64,
         ground_level: f64,
         inscribed: bool,
-    ) -> PyResult<Self> {
+    ) -> PyResult<(Self, Vec<String>)> {
         use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
         use crr::kinematics::assembly::ContactSet;
         let options = AssemblyOptions {
@@ -128,12 +130,20 @@ impl PyModel {
         let assembled = py
             .detach(|| read_assembly(&path).and_then(|file| assemble(&path, &file, &options)))
             .map_err(|e| input_error(py, e))?;
-        Ok(PyModel {
-            label: path,
-            base_dir: assembled.folder,
-            file: assembled.file,
-            structure: assembled.model,
-        })
+        let warnings = assembled
+            .warnings
+            .iter()
+            .map(|w| format!("{}: {w}", path.display()))
+            .collect();
+        Ok((
+            PyModel {
+                label: path,
+                base_dir: assembled.folder,
+                file: assembled.file,
+                structure: assembled.model,
+            },
+            warnings,
+        ))
     }
 
     /// Parses a model given as text (JSON when `is_json`, else TOML); `label` names it in the

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use crr_kinematics::assembly::{
     ContactFace, ContactSet, InterfaceStyle, detect_contacts, free_blocks, inscribed_rectangle,
-    is_rectangle, structure_of,
+    is_rectangle, near_misses, structure_of,
 };
 use crr_kinematics::{Model, StructureSpec};
 
@@ -148,6 +148,9 @@ pub struct Assembled {
     /// The names of the assembly's blocks, fixed ones included (`ContactFace::support` indexes
     /// them).
     pub assembly_blocks: Vec<String>,
+    /// What to know about the model written: blocks whose faces face each other a little
+    /// farther apart than the tolerance (`near_misses`), which are no contact.
+    pub warnings: Vec<String>,
 }
 
 /// Finds the contacts of the assembly `file` (read from `path`) on the ground of `options` and
@@ -240,5 +243,41 @@ pub fn assemble(
         ground_level,
         fixed: file.fixed.clone(),
         assembly_blocks: file.body.iter().map(|b| b.name.clone()).collect(),
+        warnings: near_miss_warnings(file, &found, &fixed, tolerance),
     })
+}
+
+/// A warning for each pair of blocks with no contact between them whose faces face each other
+/// a little farther apart than the tolerance ([`near_misses`]): a trilithon whose right post
+/// was drawn 0.5 mm short was written with its lintel on the left post alone, without a word
+/// (its multiplier then that of a lintel on one post).
+fn near_miss_warnings(
+    file: &ModelFile,
+    found: &[ContactFace],
+    fixed: &[bool],
+    tolerance: f64,
+) -> Vec<String> {
+    let touching = |i: usize, j: usize| {
+        let ends = |c: &ContactFace| {
+            let lower = c.lower.or(c.support);
+            [(Some(c.upper), lower), (lower, Some(c.upper))]
+        };
+        found.iter().any(|c| ends(c).contains(&(Some(i), Some(j))))
+    };
+    near_misses(&file.body, tolerance, fixed)
+        .into_iter()
+        .filter(|m| !touching(m.bodies.0, m.bodies.1))
+        .map(|m| {
+            format!(
+                "blocks \"{}\" and \"{}\" have faces facing each other {:.3e} m apart, more \
+                 than the tolerance ({tolerance} m): they are no contact, and the model has no \
+                 interface between them; if the gap is the drawing's and not the structure's, \
+                 `--tolerance {:.2e}` makes it one",
+                file.body[m.bodies.0].name,
+                file.body[m.bodies.1].name,
+                m.gap,
+                m.gap * 1.1
+            )
+        })
+        .collect()
 }

@@ -339,5 +339,7 @@ fn merged_model(
         ground_level: all.ground_level,
         fixed: all.fixed.clone(),
         assembly_blocks: all.assembly_blocks.clone(),
+        // The blocks' near misses are those of the assembly of every contact.
+        warnings: all.warnings.clone(),
     })
 }

@@ -1215,3 +1215,66 @@ fn a_stone_seated_askew_touches_within_the_tolerance() {
         assert!((l - 0.3).abs() < 1e-4, "{d:?}: {l}");
     }
 }
+
+/// A drawing's slip: the bundled trilithon of stones with its right column 0.5 mm short
+/// (3.9995 m, centred 0.25 mm lower) is written with the architrave on the left column alone;
+/// `crr assemble` now warns that the architrave's bed faces the column's top 5e-4 m away and
+/// gives the tolerance that joins them, with which the four joints of the frame come back and
+/// no warning. A block resting on nothing is told how far below its bed the nearest face lies.
+#[test]
+fn a_column_drawn_short_is_a_near_miss_with_the_tolerance_that_joins_it() {
+    let source =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assemblies/trilithon.toml");
+    let text = std::fs::read_to_string(source).unwrap();
+    let old = "box = { center = [1.5, 0.0, 2.0], size = [0.5, 0.5, 4.0] }";
+    assert!(text.contains(old));
+    let short = text
+        .replace(
+            old,
+            "box = { center = [1.5, 0.0, 1.99975], size = [0.5, 0.5, 3.9995] }",
+        )
+        .replace("../records/", "/no/records/");
+    let path = common::write_model("assemble_short_column", &short);
+    let run = |extra: &[&str]| {
+        let out = path.with_file_name(format!("model{}.toml", extra.len()));
+        let mut args = vec![
+            "assemble",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = common::crr(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let written = std::fs::read_to_string(&out).unwrap();
+        (
+            String::from_utf8_lossy(&o.stderr).to_string(),
+            written.matches("[[interface]]").count(),
+        )
+    };
+    let (err, interfaces) = run(&[]);
+    assert_eq!(interfaces, 3, "{err}");
+    assert!(
+        err.contains(
+            "blocks \"column_right\" and \"architrave\" have faces facing each other 5.000e-4 m \
+             apart, more than the tolerance (0.000001 m)"
+        ) && err.contains("`--tolerance 5.50e-4` makes it one"),
+        "{err}"
+    );
+    let (err, interfaces) = run(&["--tolerance", "5.5e-4"]);
+    assert_eq!(interfaces, 4, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    // The architrave 1 mm above both columns rests on nothing, 1e-3 m above them.
+    let floating = text.replace("center = [0.0, 0.0, 4.3]", "center = [0.0, 0.0, 4.301]");
+    let path = common::write_model("assemble_floating_architrave", &floating);
+    let o = common::crr(&["assemble", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("body \"architrave\": rests on nothing")
+            && err.contains(
+                "the nearest face under it is 1.000e-3 m below its bed (on \"column_left\")"
+            ),
+        "{err}"
+    );
+}

@@ -74,6 +74,9 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
         return run_mechanism(&a, &file);
     }
     let assembled = assemble(&a.assembly, &file, &options(&a))?;
+    for w in &assembled.warnings {
+        eprintln!("crr: warning: {}: {w}", a.assembly.display());
+    }
     if a.contacts || a.out.is_none() {
         print!("{}", contacts_text(&assembled));
     }
@@ -121,6 +124,9 @@ fn run_mechanism(a: &Args, file: &ModelFile) -> Result<(), Failure> {
             .map_err(|e| Failure::Input(Error::Argument(format!("--direction: {e}"))))?
     };
     let m = mechanism_model(&a.assembly, file, &directions, &options(a))?;
+    for w in &m.all_contacts.warnings {
+        eprintln!("crr: warning: {}: {w}", a.assembly.display());
+    }
     if a.contacts {
         print!("{}", contacts_text(&m.all_contacts));
     }
