@@ -94,10 +94,13 @@ def test_a_study_as_a_dict_and_its_rows_in_chunks(cli, tmp_path):
     # drums above fly): the rows say so, and the frame comes with the command line's warning.
     with pytest.warns(crr.CrrWarning, match="3 of the 6 case\\(s\\) left crr's model") as told:
         frame = crr.study(d)
-    assert [w.filename for w in told] == [__file__], "the warning points at the caller"
+    # With it the warning that duration = 6 s cuts the 20 s records: every one points at the
+    # caller.
+    assert len(told) == 2 and all(w.filename == __file__ for w in told), [str(w.message) for w in told]
+    assert any("before their ground motion does" in str(w.message) for w in told)
     with pytest.warns(crr.CrrWarning) as told:
         s.run()
-    assert [w.filename for w in told] == [__file__]
+    assert told and all(w.filename == __file__ for w in told)
     assert frame.attrs["cases_csv"] == expected
     outside = frame[frame["violation_time_s"].notna()]
     assert sorted(outside["pga_g"].round(9).tolist()) == [0.25, 0.4, 0.4]

@@ -361,3 +361,49 @@ fn the_bundled_studies_cut_no_motion_short() {
         assert!(study.warnings.is_empty(), "{name}: {:?}", study.warnings);
     }
 }
+
+/// The warnings found before a study's cases run stay with its folder through `crr study
+/// merge`: two shards of the study cut at 5 s merge into a study.json that still says so.
+#[test]
+fn a_merged_study_keeps_its_warnings() {
+    let dir = scratch("study_merge_warnings");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = format!(
+        "model = \"{}\"\nduration = 5.0\n[records]\nfiles = [\"{}\"]\nformat = \"peer-at2\"\n\n\
+         [intensity]\nfactors = [0.5, 1.0]\n",
+        root.join("examples/models/block_record.toml").display(),
+        root.join("examples/records/synthetic.AT2").display()
+    );
+    let study = dir.join("cut.toml");
+    std::fs::write(&study, text).unwrap();
+    let s = study.to_str().unwrap();
+    let mut folders = Vec::new();
+    for shard in ["1/2", "2/2"] {
+        let out = dir.join(shard.replace('/', "_of_"));
+        run_ok(&[
+            "study",
+            s,
+            "--shard",
+            shard,
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        folders.push(out);
+    }
+    let merged = dir.join("merged");
+    let mut args = vec!["study", "merge"];
+    args.extend(folders.iter().map(|f| f.to_str().unwrap()));
+    args.extend(["--out", merged.to_str().unwrap()]);
+    run_ok(&args);
+    let json: serde_json::Value = serde_json::from_str(&read(&merged.join("study.json"))).unwrap();
+    let warnings = json["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{json}");
+    assert!(
+        warnings[0]
+            .as_str()
+            .unwrap()
+            .starts_with("duration = 5 s ends 2 of the 2 case(s) before their ground motion does"),
+        "{json}"
+    );
+}

@@ -1242,6 +1242,7 @@ fn a_column_drawn_short_is_a_near_miss_with_the_tolerance_that_joins_it() {
             path.to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
+            "--force",
         ];
         args.extend_from_slice(extra);
         let o = common::crr(&args);
@@ -1277,4 +1278,53 @@ fn a_column_drawn_short_is_a_near_miss_with_the_tolerance_that_joins_it() {
             ),
         "{err}"
     );
+}
+
+/// What squaring and merging must not do (a review of the rounded-geometry change): a stele
+/// whose bed is a trapezoid (1.0 m wide at one end, 0.6 m at the other) is still refused as no
+/// rectangle (squared, it was written as a rectangle reaching 0.2 m beyond its footprint, and
+/// its multiplier along +x was 0.533 where its inscribed rectangle gives 0.454); and a portal
+/// cut from one stone, its legs on two fixed pads and a free sill on the ground flush with them
+/// in the doorway, rests on the pads alone (on the hull of its feet, as a block on two fixed
+/// slabs does) and the sill on the ground: no contact between the portal and the sill (its
+/// legs' feet, in one plane but apart, were merged into one face, and the sill became a
+/// support of the portal where the portal has no stone: a third interface and a loop).
+#[test]
+fn squaring_and_merging_keep_to_pieces_of_one_rectangle() {
+    let trapezoid = "name = \"trap\"\n[[body]]\nname = \"stele\"\ndensity = 2400.0\n\
+        polyhedron = { vertices = [[-0.5, -0.3, 0.0], [0.5, -0.3, 0.0], [0.3, 0.3, 0.0], \
+        [-0.3, 0.3, 0.0], [-0.5, -0.3, 1.5], [0.5, -0.3, 1.5], [0.3, 0.3, 1.5], [-0.3, 0.3, 1.5]] }\n";
+    let path = common::write_model("assemble_trapezoid", trapezoid);
+    let file = read_assembly(&path).unwrap();
+    let err = assemble(&path, &file, &AssemblyOptions::default())
+        .err()
+        .expect("a trapezoid is no rectangle")
+        .to_string();
+    assert!(
+        err.contains("polygon of 4 corners, not a rectangle"),
+        "{err}"
+    );
+    let portal = "name = \"portal\"\nfixed = [\"pad_left\", \"pad_right\"]\n\
+        [[body]]\nname = \"pad_left\"\ndensity = 2400.0\nbox = { center = [-0.8, 0.0, -0.3], size = [0.4, 0.5, 0.6] }\n\
+        [[body]]\nname = \"pad_right\"\ndensity = 2400.0\nbox = { center = [0.8, 0.0, -0.3], size = [0.4, 0.5, 0.6] }\n\
+        [[body]]\nname = \"sill\"\ndensity = 2400.0\nbox = { center = [0.0, 0.0, -0.15], size = [1.2, 0.5, 0.3] }\n\
+        [[body]]\nname = \"portal\"\ndensity = 2400.0\nprism = { polygon = [[-1.0, -0.25, 0.0], \
+        [-0.6, -0.25, 0.0], [-0.6, -0.25, 1.5], [0.6, -0.25, 1.5], [0.6, -0.25, 0.0], \
+        [1.0, -0.25, 0.0], [1.0, -0.25, 2.0], [-1.0, -0.25, 2.0]], extrude = [0.0, 0.5, 0.0] }\n";
+    let path = common::write_model("assemble_portal", portal);
+    let file = read_assembly(&path).unwrap();
+    let options = AssemblyOptions {
+        ground_level: -0.3,
+        ..Default::default()
+    };
+    let a = assemble(&path, &file, &options).unwrap();
+    let mut names: Vec<&str> = a.file.interface.iter().map(|i| i.name.as_str()).collect();
+    names.sort();
+    assert_eq!(names, ["portal_on_ground", "sill_on_ground"]);
+    assert!(a.model.closures.is_empty());
+    let (sill, portal) = (2, 3);
+    let between = |c: &crr::kinematics::assembly::ContactFace| {
+        (c.upper == portal && c.lower == Some(sill)) || (c.upper == sill && c.lower == Some(portal))
+    };
+    assert!(!a.contacts.iter().any(between), "{:?}", a.contacts);
 }

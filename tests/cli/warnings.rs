@@ -621,3 +621,32 @@ fn a_body_kilometres_long_is_a_warning_of_lengths_in_millimetres() {
     let report = check("obelisk_check", &obelisk);
     assert!(warnings(&report).is_empty(), "{:?}", warnings(&report));
 }
+
+/// A run that ends past a joint's slenderness and turning away from rest reads "no collapse"
+/// while the structure is on its way over: the bundled block under one sine cycle of 5 m/s²
+/// and 1 s (the motion over at 1 s), run for 2 s, ends at θ = 1.57 α turning outward; run for
+/// 3 s it overturns after 2 s. Only the first is warned.
+#[test]
+fn a_run_that_ends_on_the_way_over_says_so() {
+    let model = single_block_with("max_step = 0.005")
+        .replace("angles = { base = 0.1 }", "angles = { base = 0.0 }")
+        .replace(
+            "[analysis]",
+            "[ground_motion]\nx = { sine = { amplitude = 5.0, period = 1.0, cycles = 1 } }\n\n[analysis]",
+        );
+    let (cut, stderr) = run("on_the_way_over", &model, &["--duration", "2"]);
+    assert_eq!(cut["collapse"]["collapsed"], false);
+    assert_reported("on_the_way_over", &cut, &stderr);
+    let w = warnings(&cut);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("the run ends at t = 2 s with base at 1.5")
+            && w[0].contains("turning away from rest"),
+        "{}",
+        w[0]
+    );
+    let (full, _) = run("over", &model, &["--duration", "3"]);
+    let t = full["collapse"]["time"].as_f64().expect("a collapse");
+    assert!(t > 2.0 && t < 3.0, "{t}");
+    assert!(warnings(&full).is_empty(), "{:?}", warnings(&full));
+}

@@ -155,12 +155,22 @@ fn merge_coplanar_pieces(faces: Vec<Face>, tolerance: f64) -> Vec<Face> {
         }
         i
     };
+    // Pieces of one face share an edge: two vertices within the tolerance (the separate feet of
+    // a portal cut from one stone lie in one plane and are two faces).
+    let adjacent = |a: &Face, b: &Face| {
+        a.polygon
+            .iter()
+            .filter(|p| b.polygon.iter().any(|q| (*p - q).norm() <= tolerance))
+            .count()
+            >= 2
+    };
     for i in 0..n {
         for j in i + 1..n {
             let (a, b) = (&faces[i], &faces[j]);
             if a.convex
                 && b.convex
                 && a.normal.dot(&b.normal) > 0.0
+                && adjacent(a, b)
                 && on_plane(a, b)
                 && on_plane(b, a)
             {
@@ -176,9 +186,9 @@ fn merge_coplanar_pieces(faces: Vec<Face>, tolerance: f64) -> Vec<Face> {
     members
         .into_iter()
         .filter(|m| !m.is_empty())
-        .map(|m| {
+        .flat_map(|m| {
             if m.len() == 1 {
-                return faces[m[0]].clone();
+                return vec![faces[m[0]].clone()];
             }
             let area: Vector3<f64> = m.iter().map(|&i| faces[i].normal * faces[i].area).sum();
             let normal = area.normalize();
@@ -192,7 +202,23 @@ fn merge_coplanar_pieces(faces: Vec<Face>, tolerance: f64) -> Vec<Face> {
             let w = normal.cross(&u);
             let mut points: Vec<[f64; 2]> = vertices.iter().map(|p| [u.dot(p), w.dot(p)]).collect();
             let hull = simplified(convex_hull_2d(&mut points), tolerance);
-            Face {
+            // One face only if the pieces are flat together (pairs within the tolerance chain
+            // along a faceted camber: 20 facets of a 0.25 mm camber merged into a flat bed
+            // under --tolerance 1e-4) and fill the hull (no gap between them).
+            let flat = vertices
+                .iter()
+                .all(|v| (normal.dot(v) - offset).abs() <= tolerance);
+            let pieces: f64 = m.iter().map(|&i| faces[i].area).sum();
+            let perimeter: f64 = (0..hull.len())
+                .map(|k| {
+                    let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
+                    (a[0] - b[0]).hypot(a[1] - b[1])
+                })
+                .sum();
+            if !flat || (area_2d(&hull) - pieces).abs() > tolerance * perimeter {
+                return m.iter().map(|&i| faces[i].clone()).collect();
+            }
+            vec![Face {
                 polygon: hull
                     .iter()
                     .map(|p| u * p[0] + w * p[1] + normal * offset)
@@ -201,7 +227,7 @@ fn merge_coplanar_pieces(faces: Vec<Face>, tolerance: f64) -> Vec<Face> {
                 offset,
                 convex: true,
                 area: area_2d(&hull),
-            }
+            }]
         })
         .collect()
 }
@@ -217,9 +243,10 @@ pub const MAX_CONTACT_TILT: f64 = 1e-2;
 /// centre, and edges the means of its opposite edges, the second made normal to the first. A
 /// contact found between faces written with rounded coordinates is a rectangle only to the
 /// rounding (angles of 89.9999° at six decimals), which the model refuses (its corners must
-/// make right angles to 1e-6); squared, it moves by no more than that rounding. Other
-/// polygons are returned as they are.
-fn squared(corners: &[Vector3<f64>], normal: &Vector3<f64>) -> Vec<Vector3<f64>> {
+/// make right angles to 1e-6); squared, it moves by no more than that rounding. A contact that
+/// squaring would move by more than `tolerance` (m) at a corner (a rhombus, a trapezoid: not
+/// a rectangle) and other polygons are returned as they are, to be refused as no rectangle.
+fn squared(corners: &[Vector3<f64>], normal: &Vector3<f64>, tolerance: f64) -> Vec<Vector3<f64>> {
     let [a, b, c, d] = corners else {
         return corners.to_vec();
     };
@@ -231,12 +258,21 @@ fn squared(corners: &[Vector3<f64>], normal: &Vector3<f64>) -> Vec<Vector3<f64>>
     };
     let second = flat((d - a) + (c - b)) / 2.0;
     let second = second - along * along.dot(&second);
-    vec![
+    let square = vec![
         centre - first / 2.0 - second / 2.0,
         centre + first / 2.0 - second / 2.0,
         centre + first / 2.0 + second / 2.0,
         centre - first / 2.0 + second / 2.0,
-    ]
+    ];
+    if square
+        .iter()
+        .zip(corners)
+        .all(|(p, q)| (p - q).norm() <= tolerance)
+    {
+        square
+    } else {
+        corners.to_vec()
+    }
 }
 
 /// For a block that rests on nothing: how far below its bed the nearest face under it lies (a
@@ -314,6 +350,9 @@ pub struct NearMiss {
     pub bodies: (usize, usize),
     /// The distance between the faces' planes (m).
     pub gap: f64,
+    /// Whether the faces would make a bed (their normal within 45° of the vertical), the only
+    /// contacts that are interfaces without `--all-contacts`.
+    pub bed: bool,
 }
 
 /// The pairs of blocks of `bodies` with faces facing each other (opposite within
@@ -360,7 +399,7 @@ pub fn near_misses(bodies: &[BodySpec], tolerance: f64, fixed: &[bool]) -> Vec<N
                 faces_of(&moved(si), tolerance),
                 faces_of(&moved(sj), tolerance),
             );
-            let mut smallest: Option<f64> = None;
+            let mut smallest: Option<(f64, bool)> = None;
             for fa in &fi {
                 for fb in &fj {
                     let gap = -(fa.offset + fb.offset);
@@ -368,15 +407,17 @@ pub fn near_misses(bodies: &[BodySpec], tolerance: f64, fixed: &[bool]) -> Vec<N
                         continue;
                     }
                     let (_, area) = overlap(&fa.polygon, &fb.polygon, &fb.normal, tolerance);
-                    if area > tolerance * near / NEAR_MISS && smallest.is_none_or(|g| gap < g) {
-                        smallest = Some(gap);
+                    if area > tolerance * near / NEAR_MISS && smallest.is_none_or(|(g, _)| gap < g)
+                    {
+                        smallest = Some((gap, fa.normal.z.abs() > std::f64::consts::FRAC_1_SQRT_2));
                     }
                 }
             }
-            if let Some(gap) = smallest {
+            if let Some((gap, bed)) = smallest {
                 out.push(NearMiss {
                     bodies: (i, j),
                     gap,
+                    bed,
                 });
             }
         }
@@ -1004,7 +1045,7 @@ pub fn structure_of(
         match style {
             InterfaceStyle::RockingBase => {
                 spec.rocking_base = Some(RockingBaseSpec {
-                    corners: squared(&c.corners, &c.normal)
+                    corners: squared(&c.corners, &c.normal, tolerance)
                         .iter()
                         .map(|p| [p.x, p.y, p.z])
                         .collect(),

@@ -848,6 +848,15 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<usize, Error> {
         merged_from: dirs.iter().map(|d| d.display().to_string()).collect(),
         cases: rows.len(),
         cases_outside_model: count_outside_model(&header, rows.values()),
+        warnings: first_json
+            .as_ref()
+            .and_then(|j| j["warnings"].as_array())
+            .map(|w| {
+                w.iter()
+                    .filter_map(|x| x.as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default(),
         crr_version: env!("CARGO_PKG_VERSION").to_string(),
     };
     replace_file(&out.join("study.json"), to_json(&info)).map_err(out_err)?;

@@ -86,6 +86,10 @@ pub struct MergedStudyInfo {
     /// Of them, those whose run left crr's model (a hypotheses violation).
     #[serde(default)]
     pub cases_outside_model: usize,
+    /// The study's warnings found before its cases ran, as the shards' `study.json` give them
+    /// (one study: the first shard's).
+    #[serde(default)]
+    pub warnings: Vec<String>,
     /// The version of crr that merged them.
     pub crr_version: String,
 }

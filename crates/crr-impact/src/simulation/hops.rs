@@ -532,7 +532,7 @@ impl Simulation<'_> {
                     let snaps = SnapsAndLosses {
                         t,
                         snaps: self.energy_at_snaps,
-                        lost: self.lost_at_impacts(),
+                        lost: self.lost_at_impacts() + self.dissipated_by_forces(),
                     };
                     let side = self.dynamics.pivots.sides[k];
                     let e = Episode::new(k, side, t, r, deferred, snaps);

@@ -116,7 +116,7 @@ impl Simulation<'_> {
                 let snaps = super::SnapsAndLosses {
                     t,
                     snaps: self.energy_at_snaps,
-                    lost: self.lost_at_impacts(),
+                    lost: self.lost_at_impacts() + self.dissipated_by_forces(),
                 };
                 // A pull at a face measured as a hop waits for its episode (module `hops`);
                 // the other contacts are judged without it.

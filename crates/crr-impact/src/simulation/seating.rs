@@ -1764,7 +1764,7 @@ impl Simulation<'_> {
         self.snaps_at_violation = Some(super::SnapsAndLosses {
             t: self.t,
             snaps: self.energy_at_snaps,
-            lost: self.lost_at_impacts(),
+            lost: self.lost_at_impacts() + self.dissipated_by_forces(),
         });
     }
 
