@@ -1297,8 +1297,7 @@ fn squaring_and_merging_keep_to_pieces_of_one_rectangle() {
     let path = common::write_model("assemble_trapezoid", trapezoid);
     let file = read_assembly(&path).unwrap();
     let err = assemble(&path, &file, &AssemblyOptions::default())
-        .err()
-        .expect("a trapezoid is no rectangle")
+        .expect_err("a trapezoid is no rectangle")
         .to_string();
     assert!(
         err.contains("polygon of 4 corners, not a rectangle"),
