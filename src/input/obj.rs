@@ -3,8 +3,8 @@
 //! the model format (a `polyhedron` with the block's vertices, named after its object).
 //!
 //! The mesh is read by `tobj`. Each object's vertices are welded by position (a CAD export often
-//! repeats them per face), its faces must close it (every edge shared by exactly two faces, met
-//! once in each direction) and it must be convex (every vertex on the inner side of every face),
+//! repeats them per face), its faces must close it (every edge shared by exactly two faces; a
+//! face wound the other way from its neighbours is turned to agree) and it must be convex (every vertex on the inner side of every face),
 //! since a `polyhedron` body is the convex hull of its vertices; a block that is not is refused
 //! by name, with the edge or the face concerned.
 
@@ -100,6 +100,7 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
     // /dev/zero exhausted the memory); materials are not read (only the geometry is used).
     let bytes = crr_dynamics::input::read_regular_file(&path, OBJ_FILE_LIMIT)
         .map_err(|e| here(e.to_string()))?;
+    let bytes = groups_inside_objects_dropped(bytes);
     let (models, _) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
@@ -121,6 +122,8 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
         }
         let item = |m: String| here(format!("object \"{name}\": {m}"));
         let block = Block::from_mesh(&m.mesh, spec).map_err(item)?;
+        let mut block = block;
+        block.orient_faces_alike();
         block.check_closed().map_err(item)?;
         block.check_convex().map_err(item)?;
         bodies.push(BodySpec::simple(
@@ -132,6 +135,37 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
         ));
     }
     Ok(bodies)
+}
+
+/// The file's text with its `g` statements made comments when it has `o` statements: a block is
+/// an object, and the groups inside one (a CAD program's material or layer groups: a column's
+/// sides `g stone` and its polished top `g polished`) are parts of its surface. tobj starts a
+/// model at each `o` and each `g` alike, so a column so written was split into two open meshes.
+/// A file without objects keeps its groups as its blocks. The line count is unchanged.
+fn groups_inside_objects_dropped(bytes: Vec<u8>) -> Vec<u8> {
+    let keyword = |line: &[u8]| {
+        let line = line.trim_ascii_start();
+        let end = line
+            .iter()
+            .position(|b| b.is_ascii_whitespace())
+            .unwrap_or(line.len());
+        line[..end].to_vec()
+    };
+    let has_objects = bytes.split(|&b| b == b'\n').any(|l| keyword(l) == b"o");
+    if !has_objects {
+        return bytes;
+    }
+    let mut out = Vec::with_capacity(bytes.len() + 64);
+    for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if k > 0 {
+            out.push(b'\n');
+        }
+        if keyword(line) == b"g" {
+            out.extend_from_slice(b"# ");
+        }
+        out.extend_from_slice(line);
+    }
+    out
 }
 
 /// One object's mesh with its vertices welded (m, z up).
@@ -202,6 +236,57 @@ impl Block {
             let m = f.len();
             (0..m).map(move |i| (f[i], f[(i + 1) % m]))
         })
+    }
+
+    /// Turns faces wound the other way from their neighbours to agree with them, when every
+    /// edge belongs to exactly two faces (a closed surface; otherwise nothing is turned and
+    /// [`Block::check_closed`] names the edge). Exporters write a face reversed now and then,
+    /// and it changes nothing here: the block is the convex hull of its vertices. Each connected
+    /// surface keeps the winding of its first face; the outward side is taken from the sign of
+    /// its volume later.
+    fn orient_faces_alike(&mut self) {
+        let mut sharing: HashMap<(usize, usize), Vec<usize>> = HashMap::new();
+        for (f, face) in self.faces.iter().enumerate() {
+            let m = face.len();
+            for i in 0..m {
+                let (a, b) = (face[i], face[(i + 1) % m]);
+                sharing.entry((a.min(b), a.max(b))).or_default().push(f);
+            }
+        }
+        if sharing.values().any(|faces| faces.len() != 2) {
+            return;
+        }
+        // Whether face f runs along a → b.
+        let runs = |face: &[usize], a: usize, b: usize| {
+            let m = face.len();
+            (0..m).any(|i| face[i] == a && face[(i + 1) % m] == b)
+        };
+        let mut settled = vec![false; self.faces.len()];
+        for start in 0..self.faces.len() {
+            if settled[start] {
+                continue;
+            }
+            settled[start] = true;
+            let mut stack = vec![start];
+            while let Some(f) = stack.pop() {
+                let face = self.faces[f].clone();
+                let m = face.len();
+                for i in 0..m {
+                    let (a, b) = (face[i], face[(i + 1) % m]);
+                    for &g in &sharing[&(a.min(b), a.max(b))] {
+                        if g == f || settled[g] {
+                            continue;
+                        }
+                        // A neighbour agreeing with f runs along the shared edge b → a.
+                        if runs(&self.faces[g], a, b) {
+                            self.faces[g].reverse();
+                        }
+                        settled[g] = true;
+                        stack.push(g);
+                    }
+                }
+            }
+        }
     }
 
     /// Every edge is met once in each direction: two faces share it, oriented alike.

@@ -19,7 +19,7 @@ use clarabel::solver::{
 use nalgebra::Vector3;
 
 use crr::analysis::static_multiplier::static_multiplier;
-use crr::impact::statics::{StaticsOptions, collapse_multiplier};
+use crr::impact::statics::{Friction, StaticsOptions, collapse_multiplier};
 use crr::kinematics::Model;
 use crr::kinematics::fixtures::{
     running_bond_wall, running_bond_wall_3d, stacked_panel, voussoir_arch,
@@ -1391,4 +1391,196 @@ fn the_friction_a_multiplier_needs_matches_the_block_lp_and_unbounded_friction_i
     let json = serde_json::to_value(&report).unwrap();
     assert_eq!(json["friction_unbounded"], serde_json::Value::Bool(true));
     assert!(json["required_friction"].is_null());
+}
+
+// ------------------------------------------------------------------------------------------------
+// A stone that is not convex: an L-shaped stone with a block in its notch
+// ------------------------------------------------------------------------------------------------
+
+/// A body of the planar program below: its weight (∝ its area) and its centroid (x, z).
+struct PlanarBody {
+    weight: f64,
+    centroid: [f64; 2],
+}
+
+/// A contact point of the planar program: the body that receives +f (the upper, or the one the
+/// normal points into), the other body (None: the ground), the point (x, z) and the unit normal
+/// (nₓ, n_z) into the first body. f = fₙ n + f_t t, t = (n_z, −nₓ), fₙ ≥ 0, f_t free.
+struct PlanarContact {
+    into: usize,
+    from: Option<usize>,
+    at: [f64; 2],
+    normal: [f64; 2],
+}
+
+/// The static theorem in the x–z plane for bodies of any shape: the largest λ (≤ [`LAMBDA_CAP`])
+/// for which every body is in equilibrium under its weight W and the horizontal load −λ W dx at
+/// its centroid, with the contact forces of `contacts`: no tension, and no sliding (f_t free) or
+/// Coulomb friction |f_t| ≤ μ fₙ (exact in the plane).
+fn planar_contact_lp(
+    bodies: &[PlanarBody],
+    contacts: &[PlanarContact],
+    dx: f64,
+    mu: Option<f64>,
+) -> f64 {
+    let mut lp = Lp::new(1 + 2 * contacts.len());
+    lp.cost[0] = -1.0;
+    let mut eqs: Vec<[Vec<(usize, f64)>; 3]> = vec![Default::default(); bodies.len()];
+    for (k, b) in bodies.iter().enumerate() {
+        eqs[k][0].push((0, -b.weight * dx));
+    }
+    for (p, c) in contacts.iter().enumerate() {
+        let (vn, vt) = (1 + 2 * p, 2 + 2 * p);
+        let [nx, nz] = c.normal;
+        let (tx, tz) = (nz, -nx);
+        for (body, sign) in [(Some(c.into), 1.0), (c.from, -1.0)] {
+            let Some(k) = body else { continue };
+            let r = [
+                c.at[0] - bodies[k].centroid[0],
+                c.at[1] - bodies[k].centroid[1],
+            ];
+            // The force sign·(fₙ n + f_t t) on body k, and its moment about y: r_z f_x − r_x f_z.
+            eqs[k][0].extend([(vn, sign * nx), (vt, sign * tx)]);
+            eqs[k][1].extend([(vn, sign * nz), (vt, sign * tz)]);
+            eqs[k][2].extend([
+                (vn, sign * (r[1] * nx - r[0] * nz)),
+                (vt, sign * (r[1] * tx - r[0] * tz)),
+            ]);
+        }
+        lp.le.push((vec![(vn, -1.0)], 0.0));
+        if let Some(mu) = mu {
+            lp.le.push((vec![(vt, 1.0), (vn, -mu)], 0.0));
+            lp.le.push((vec![(vt, -1.0), (vn, -mu)], 0.0));
+        }
+    }
+    for (k, e) in eqs.into_iter().enumerate() {
+        let rhs = [0.0, bodies[k].weight, 0.0];
+        for (row, b) in e.into_iter().zip(rhs) {
+            lp.eq.push((row, b));
+        }
+    }
+    lp.le.push((vec![(0, 1.0)], LAMBDA_CAP));
+    let sol = lp.solve().unwrap_or_else(|s| panic!("planar LP: {s:?}"));
+    assert!((sol.primal - sol.dual).abs() < 1e-9, "planar LP gap");
+    sol.x[0]
+}
+
+/// An L-shaped stone (a foot 1.0 × 0.4 m and an upright 0.3 × 1.1 m at its left end, 0.4 m
+/// deep) with a block 0.6 × 1.0 m standing on its foot against its upright: the two meet on a
+/// bed and on a side face, in two planes (before 2026-12-07 `crr assemble --all-contacts`
+/// refused them: "meets on more than one face"). Each face is an interface of its own, the side
+/// one closing a loop, and the multiplier is the planar LP's of the two bodies written here from
+/// the rectangles (to 1e-7), in the plane and in 3D, without a friction limit and with μ = 0.7.
+///
+/// By hand: without a friction limit the two tip together as one body about the stone's foot
+/// edge on the side the load goes, λ = Σ W d / Σ W z_c (d the centroids' distances from that
+/// edge) in both directions: pushed away from the upright, the block holds on by shear at the
+/// foot of the side face, where a push of no lever arm about its far bed edge can carry any
+/// shear. With μ = 0.7 that shear is bounded (λ between b/h = 0.3/0.5, the block alone on a
+/// frictionless upright, and the frictionless value; the LP decides).
+#[test]
+fn an_l_shaped_stone_with_a_block_in_its_notch_matches_the_planar_lp() {
+    use crr::analysis::assemble::read_assembly;
+    let dir = crate::common::scratch("l_in_notch");
+    let path = dir.join("ell.toml");
+    std::fs::write(
+        &path,
+        "name = \"ell\"\n\
+         [[body]]\nname = \"ell\"\ndensity = 2000.0\n\
+         prism = { polygon = [[-0.5, -0.2, 0.0], [0.5, -0.2, 0.0], [0.5, -0.2, 0.4], \
+         [-0.2, -0.2, 0.4], [-0.2, -0.2, 1.5], [-0.5, -0.2, 1.5]], extrude = [0.0, 0.4, 0.0] }\n\
+         [[body]]\nname = \"block\"\ndensity = 2000.0\n\
+         box = { center = [0.1, 0.0, 0.9], size = [0.6, 0.4, 1.0] }\n",
+    )
+    .unwrap();
+    let file = read_assembly(&path).unwrap();
+    // The stone from its two rectangles: the foot and the upright above it.
+    let (foot, upright) = ((1.0 * 0.4, [0.0, 0.2]), (0.3 * 1.1, [-0.35, 0.95]));
+    let ell_area = foot.0 + upright.0;
+    let bodies = [
+        PlanarBody {
+            weight: ell_area,
+            centroid: [
+                (foot.0 * foot.1[0] + upright.0 * upright.1[0]) / ell_area,
+                (foot.0 * foot.1[1] + upright.0 * upright.1[1]) / ell_area,
+            ],
+        },
+        PlanarBody {
+            weight: 0.6,
+            centroid: [0.1, 0.9],
+        },
+    ];
+    // Both tipping together about the foot's left (dx = +1, load towards −x) or right edge.
+    let together = |edge: f64| {
+        let lever = |b: &PlanarBody| b.weight * (b.centroid[0] - edge).abs();
+        let height = |b: &PlanarBody| b.weight * b.centroid[1];
+        bodies.iter().map(lever).sum::<f64>() / bodies.iter().map(height).sum::<f64>()
+    };
+    let point = |into, from, at, normal| PlanarContact {
+        into,
+        from,
+        at,
+        normal,
+    };
+    let contacts = [
+        point(0, None, [-0.5, 0.0], [0.0, 1.0]),
+        point(0, None, [0.5, 0.0], [0.0, 1.0]),
+        point(1, Some(0), [-0.2, 0.4], [0.0, 1.0]),
+        point(1, Some(0), [0.4, 0.4], [0.0, 1.0]),
+        point(1, Some(0), [-0.2, 0.4], [1.0, 0.0]),
+        point(1, Some(0), [-0.2, 1.4], [1.0, 0.0]),
+    ];
+    let options = StaticsOptions {
+        sliding_lift_off: false,
+        ..StaticsOptions::default()
+    };
+    for planar in [true, false] {
+        let assembled = every_contact(&path, &file, planar);
+        let names: Vec<&str> = assembled
+            .model
+            .interfaces
+            .iter()
+            .map(|i| i.name.as_str())
+            .collect();
+        assert_eq!(
+            names,
+            ["ell_on_ground", "block_on_ell", "block_on_ell_2"],
+            "planar {planar}"
+        );
+        assert_eq!(assembled.model.closures.len(), 1, "planar {planar}");
+        for (dx, mu) in [
+            (1.0, None),
+            (-1.0, None),
+            (1.0, Some(0.7)),
+            (-1.0, Some(0.7)),
+        ] {
+            let expected = planar_contact_lp(&bodies, &contacts, dx, mu);
+            let by_hand = match (dx > 0.0, mu) {
+                (true, None) => Some(together(-0.5)),
+                (false, None) => Some(together(0.5)),
+                (false, Some(_)) => {
+                    assert!(expected > 0.6 && expected < together(0.5), "{expected}");
+                    None
+                }
+                (true, Some(_)) => None,
+            };
+            if let Some(by_hand) = by_hand {
+                assert!((expected - by_hand).abs() < 1e-9, "{expected} {by_hand}");
+            }
+            let options = StaticsOptions {
+                friction: mu.map_or(Friction::NoSliding, Friction::Pyramid),
+                ..options
+            };
+            let got = collapse_multiplier(&assembled.model, Vector3::new(dx, 0.0, 0.0), &options)
+                .unwrap()
+                .lambda;
+            println!("planar {planar}, dx {dx:+}, μ {mu:?}: LP {expected:.9}, engine {got:?}");
+            assert_close(
+                &format!("the L and its block, planar {planar}, dx = {dx:+}, μ {mu:?}"),
+                got,
+                expected,
+                RTOL,
+            );
+        }
+    }
 }

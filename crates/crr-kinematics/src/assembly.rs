@@ -692,12 +692,21 @@ pub fn detect_contacts(
             (d.lower == c.lower && d.upper == c.upper)
                 || (d.lower == Some(c.upper) && c.lower == Some(d.upper))
         };
-        // Two blocks meet on one face (convex blocks do); a block may meet the ground (its
-        // plane and the fixed blocks) on faces in several planes: interfaces `…_on_ground`,
-        // `…_on_ground_2`.
+        // Two faces of a pair in one plane that merge_coplanar left apart: their hull is no
+        // rectangle, and one rocking interface cannot stand for them.
+        let same_plane = |d: &ContactFace| {
+            d.normal.dot(&c.normal).abs() >= MAX_CONTACT_TILT.cos()
+                && (c.corners[0] - d.corners[0]).dot(&c.normal).abs() <= tolerance
+        };
+        // Two convex blocks meet on one face; a block that is not convex (an L-shaped stone in
+        // a notch, a joggled voussoir), like a block on the ground (its plane and the fixed
+        // blocks), may meet another on faces in several planes: interfaces `…_on_ground`,
+        // `…_on_ground_2`, one per plane (structure_of).
         if let Some(lower) = c.lower
             && counts(c)
-            && contacts[..k].iter().any(|d| counts(d) && same_pair(d))
+            && contacts[..k]
+                .iter()
+                .any(|d| counts(d) && same_pair(d) && same_plane(d))
         {
             let lower = &bodies[lower].name;
             return Err(error(
