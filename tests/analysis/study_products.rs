@@ -458,7 +458,7 @@ fn violation_times(dir: &Path) -> Vec<Option<f64>> {
 /// hop; tests/cli/warnings.rs): the study's case of that pulse gives the same time, bit for bit,
 /// the same kind and interface as `summary.json`'s `hypothesis_violation` of `crr simulate` on
 /// the model file, and counts it in `study.json` (a run's and a merge's of its two shards), on
-/// stderr and in the map's caption and legend. Under 1.0 m/s², below the column's uplift acceleration g tan α ≈ 1.34 m/s² (the
+/// stderr and in the map's caption and legend. Under 1.0 m/s², below the column's uplift acceleration g tan α = 1.19 m/s² (the
 /// whole column rocking on its base), the column stays seated: no impact and no violation.
 #[test]
 fn a_case_that_leaves_the_model_says_so_as_crr_simulate_does() {
