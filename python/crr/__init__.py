@@ -139,11 +139,66 @@ def _direction_text(d: Any) -> str:
     return ",".join(repr(float(v)) for v in values)
 
 
+def _cgroup_memory_left(
+    root: str = "/sys/fs/cgroup", membership: str = "/proc/self/cgroup"
+) -> Optional[float]:
+    """Bytes the process's control groups still let it use (a container's or a batch job's
+    memory limit, which ``MemAvailable`` does not see: a run sized on the machine's memory was
+    killed by the limit instead of refused): cgroup v2, ``memory.max`` − ``memory.current`` of
+    its group and every group above it, the least; cgroup v1, ``memory.limit_in_bytes`` −
+    ``memory.usage_in_bytes`` of its memory group. None where no limit is set or readable."""
+
+    def number(path: str) -> Optional[float]:
+        try:
+            with open(path) as f:
+                text = f.read().strip()
+        except OSError:
+            return None
+        try:
+            return float(text)
+        except ValueError:
+            return None  # "max": no limit
+
+    try:
+        with open(membership) as f:
+            lines = [l.strip().split(":", 2) for l in f if l.strip()]
+    except OSError:
+        return None
+    left: List[float] = []
+    for fields in lines:
+        if len(fields) != 3:
+            continue
+        _, controllers, path = fields
+        if controllers == "":
+            # v2: the limits of the group and of every group above it apply.
+            parts = [p for p in path.split("/") if p]
+            for depth in range(len(parts), -1, -1):
+                folder = os.path.join(root, *parts[:depth])
+                limit = number(os.path.join(folder, "memory.max"))
+                used = number(os.path.join(folder, "memory.current"))
+                if limit is not None and used is not None:
+                    left.append(max(limit - used, 0.0))
+        elif "memory" in controllers.split(","):
+            folder = os.path.join(root, "memory", *[p for p in path.split("/") if p])
+            for where in (folder, os.path.join(root, "memory")):
+                limit = number(os.path.join(where, "memory.limit_in_bytes"))
+                used = number(os.path.join(where, "memory.usage_in_bytes"))
+                # v1 writes an unset limit as a huge number (2⁶³ rounded to the page size).
+                if limit is not None and used is not None and limit < 2.0**60:
+                    left.append(max(limit - used, 0.0))
+                    break
+    return min(left) if left else None
+
+
 def _memory_available() -> Optional[float]:
     """Bytes this process can still allocate, where the system tells: the memory available
-    (``MemAvailable`` of ``/proc/meminfo``), and below the address-space limit (``RLIMIT_AS``)
-    what the process has not mapped yet; None when neither is known."""
+    (``MemAvailable`` of ``/proc/meminfo``), what its control groups' memory limits leave
+    (:func:`_cgroup_memory_left`), and below the address-space limit (``RLIMIT_AS``) what the
+    process has not mapped yet; None when none is known."""
     known: List[float] = []
+    cgroup = _cgroup_memory_left()
+    if cgroup is not None:
+        known.append(cgroup)
     try:
         with open("/proc/meminfo") as f:
             for line in f:
