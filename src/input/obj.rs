@@ -100,8 +100,8 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
     // /dev/zero exhausted the memory); materials are not read (only the geometry is used).
     let bytes = crr_dynamics::input::read_regular_file(&path, OBJ_FILE_LIMIT)
         .map_err(|e| here(e.to_string()))?;
-    let bytes = groups_inside_objects_dropped(bytes);
-    let (models, _) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| {
+    let text = ObjText::new(&bytes);
+    let (models, _) = tobj::load_obj_buf(&mut text.bytes.as_slice(), &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| here(format!("{e}")))?;
@@ -110,7 +110,8 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
     }
     let mut bodies: Vec<BodySpec> = Vec::with_capacity(models.len());
     for (k, m) in models.iter().enumerate() {
-        let name = if m.name.trim().is_empty() {
+        // A file without `o` or `g` is one block, which tobj calls "unnamed_object".
+        let name = if m.name.trim().is_empty() || !text.named_blocks {
             format!("object_{}", k + 1)
         } else {
             m.name.trim().to_string()
@@ -120,7 +121,7 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
                 "object \"{name}\" appears twice: every block needs its own name"
             )));
         }
-        let item = |m: String| here(format!("object \"{name}\": {m}"));
+        let item = |m: String| here(format!("object \"{name}\": {m}{}", text.groups_hint(&name)));
         let block = Block::from_mesh(&m.mesh, spec).map_err(item)?;
         let mut block = block;
         block.orient_faces_alike();
@@ -137,35 +138,82 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
     Ok(bodies)
 }
 
-/// The file's text with its `g` statements made comments when it has `o` statements: a block is
-/// an object, and the groups inside one (a CAD program's material or layer groups: a column's
-/// sides `g stone` and its polished top `g polished`) are parts of its surface. tobj starts a
-/// model at each `o` and each `g` alike, so a column so written was split into two open meshes.
-/// A file without objects keeps its groups as its blocks. The line count is unchanged.
-fn groups_inside_objects_dropped(bytes: Vec<u8>) -> Vec<u8> {
-    let keyword = |line: &[u8]| {
-        let line = line.trim_ascii_start();
-        let end = line
-            .iter()
-            .position(|b| b.is_ascii_whitespace())
-            .unwrap_or(line.len());
-        line[..end].to_vec()
-    };
-    let has_objects = bytes.split(|&b| b == b'\n').any(|l| keyword(l) == b"o");
-    if !has_objects {
-        return bytes;
-    }
-    let mut out = Vec::with_capacity(bytes.len() + 64);
-    for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        if k > 0 {
-            out.push(b'\n');
+/// An OBJ file's text as tobj is given it, and what was changed: each object (`o`) is one block,
+/// the groups (`g`) inside an object are parts of its surface (a CAD program's material or
+/// layer groups: a column's sides `g stone` and its polished top `g polished`; tobj starts a
+/// model at each `o` and each `g` alike, so a column so written was split into open meshes);
+/// groups before the first object, or in a file without objects, stay blocks. A statement
+/// without a name is named `object_N` (N the block's number). The line count is unchanged.
+struct ObjText {
+    bytes: Vec<u8>,
+    /// The groups merged into each object, by the object's name.
+    groups_of: HashMap<String, Vec<String>>,
+    /// Whether any `o` or `g` statement starts a block (none: the file is one block).
+    named_blocks: bool,
+}
+
+impl ObjText {
+    fn new(bytes: &[u8]) -> ObjText {
+        let mut out = Vec::with_capacity(bytes.len() + 64);
+        let mut groups_of: HashMap<String, Vec<String>> = HashMap::new();
+        let (mut object, mut blocks) = (None::<String>, 0usize);
+        for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
+            if k > 0 {
+                out.push(b'\n');
+            }
+            let text = String::from_utf8_lossy(line);
+            let trimmed = text.trim_start();
+            let mut words = trimmed.splitn(2, char::is_whitespace);
+            let keyword = words.next().unwrap_or("");
+            let name = words.next().unwrap_or("").trim().to_string();
+            match keyword {
+                "g" if object.is_some() => {
+                    let inside = object.clone().unwrap_or_default();
+                    groups_of.entry(inside).or_default().push(name);
+                    out.extend_from_slice(b"# ");
+                    out.extend_from_slice(line);
+                }
+                "o" | "g" => {
+                    blocks += 1;
+                    let name = if name.is_empty() {
+                        format!("object_{blocks}")
+                    } else {
+                        name
+                    };
+                    if keyword == "o" {
+                        object = Some(name.clone());
+                    }
+                    out.extend_from_slice(format!("{keyword} {name}").as_bytes());
+                    if line.ends_with(b"\r") {
+                        out.push(b'\r');
+                    }
+                }
+                _ => out.extend_from_slice(line),
+            }
         }
-        if keyword(line) == b"g" {
-            out.extend_from_slice(b"# ");
+        ObjText {
+            bytes: out,
+            groups_of,
+            named_blocks: blocks > 0,
         }
-        out.extend_from_slice(line);
     }
-    out
+
+    /// What an object that is refused should be told about the groups merged into it.
+    fn groups_hint(&self, object: &str) -> String {
+        match self.groups_of.get(object) {
+            Some(groups) if !groups.is_empty() => format!(
+                " (its faces come in the groups {} inside object \"{object}\": the groups \
+                 inside an object are parts of one block; if each group is a block, write an \
+                 `o` line before each, or remove the object's `o` line)",
+                groups
+                    .iter()
+                    .map(|g| format!("\"{g}\""))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            _ => String::new(),
+        }
+    }
 }
 
 /// One object's mesh with its vertices welded (m, z up).
@@ -289,12 +337,11 @@ impl Block {
         }
     }
 
-    /// Every edge is met once in each direction: two faces share it, oriented alike.
+    /// Every edge is met once in each direction: two faces share it, oriented alike. A hole or
+    /// an edge of more than two faces is named first (the first such edge in the faces' order,
+    /// whatever the winding of the others), then an edge met twice the same way, which
+    /// [`Block::orient_faces_alike`] leaves only on a one-sided surface.
     fn check_closed(&self) -> Result<(), String> {
-        let mut count: HashMap<(usize, usize), i32> = HashMap::new();
-        for (a, b) in self.edges() {
-            *count.entry((a, b)).or_default() += 1;
-        }
         if let Some((a, _)) = self.edges().find(|(a, b)| a == b) {
             let p = self.vertices[a];
             return Err(format!(
@@ -302,23 +349,32 @@ impl Block {
                 p.x, p.y, p.z
             ));
         }
-        for (&(a, b), &n) in &count {
-            let back = count.get(&(b, a)).copied().unwrap_or(0);
-            if n != 1 || back != 1 {
-                let (p, q) = (self.vertices[a], self.vertices[b]);
-                return Err(format!(
-                    "the mesh is not a closed surface: the edge from ({:.6}, {:.6}, {:.6}) to \
-                     ({:.6}, {:.6}, {:.6}) m belongs to {} face(s) (each edge of a closed, \
-                     consistently oriented mesh belongs to two, once each way)",
-                    p.x,
-                    p.y,
-                    p.z,
-                    q.x,
-                    q.y,
-                    q.z,
-                    n + back
-                ));
-            }
+        let mut count: HashMap<(usize, usize), usize> = HashMap::new();
+        for (a, b) in self.edges() {
+            *count.entry((a, b)).or_default() += 1;
+        }
+        let met = |a: usize, b: usize| count.get(&(a, b)).copied().unwrap_or(0);
+        let edge = |a: usize, b: usize| {
+            let (p, q) = (self.vertices[a], self.vertices[b]);
+            format!(
+                "the edge from ({:.6}, {:.6}, {:.6}) to ({:.6}, {:.6}, {:.6}) m",
+                p.x, p.y, p.z, q.x, q.y, q.z
+            )
+        };
+        if let Some((a, b)) = self.edges().find(|&(a, b)| met(a, b) + met(b, a) != 2) {
+            return Err(format!(
+                "the mesh is not a closed surface: {} belongs to {} face(s) (each edge of a \
+                 closed surface belongs to two)",
+                edge(a, b),
+                met(a, b) + met(b, a)
+            ));
+        }
+        if let Some((a, b)) = self.edges().find(|&(a, b)| met(a, b) != 1) {
+            return Err(format!(
+                "the surface has no consistent orientation: {} is met twice the same way \
+                 whichever faces are turned (a one-sided surface)",
+                edge(a, b)
+            ));
         }
         Ok(())
     }

@@ -125,3 +125,92 @@ fn an_angle_released_a_hair_past_its_seat_still_has_its_impact() {
         println!("×{scale}: largest angle past its pivot at a sample {largest:e} rad");
     }
 }
+
+/// A landing whose snap puts a rocking angle past its pivot says how far the snap moved the
+/// state, from the state before the landing, and why (an independent review's bridge: two
+/// blocks 1 × 1 m under a beam 1.5 × 0.5 m, a one-sine pulse of 12 m/s², 0.4 s; at 0.2513 s
+/// the beam lands back on the right block, 2.25 mrad off its seat, and the loop's closure on
+/// the new pivot moves the left foot across its pivot). The amount the message gives is the
+/// largest change of a coordinate between the history's two rows at that instant (before and
+/// after the landing), read back from history.csv.
+#[test]
+fn a_snap_past_a_pivot_says_how_far_it_moved_the_state() {
+    let text = r#"name = "bridge"
+gravity = 9.81
+[[body]]
+name = "BL"
+density = 2000.0
+box = { center = [-0.55, 0.0, 0.5], size = [1.0, 0.5, 1.0] }
+[[body]]
+name = "BR"
+density = 2000.0
+box = { center = [0.55, 0.0, 0.5], size = [1.0, 0.5, 1.0] }
+[[body]]
+name = "T"
+density = 2000.0
+box = { center = [0.0, 0.0, 1.25], size = [1.5, 0.5, 0.5] }
+[[interface]]
+name = "footL"
+parent = "ground"
+child = "BL"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [-0.05, 0.0, 0.0]
+pivot_negative = [-1.05, 0.0, 0.0]
+[[interface]]
+name = "footR"
+parent = "ground"
+child = "BR"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [1.05, 0.0, 0.0]
+pivot_negative = [0.05, 0.0, 0.0]
+[[interface]]
+name = "topL"
+parent = "BL"
+child = "T"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [-0.05, 0.0, 1.0]
+pivot_negative = [-0.75, 0.0, 1.0]
+[[interface]]
+name = "topR"
+parent = "BR"
+child = "T"
+axis = [0.0, 1.0, 0.0]
+pivot_positive = [0.75, 0.0, 1.0]
+pivot_negative = [0.05, 0.0, 1.0]
+[ground_motion]
+x = { one_sine_pulse = { amplitude = 12, period = 0.4 } }
+[analysis]
+duration = 1.0
+"#;
+    let (err, out) = common::simulate_failing("snap_past_pivot", text);
+    assert!(
+        err.contains("the state is on the wrong side of its pivot"),
+        "{err}"
+    );
+    let at = err.find("the snap moved \"").expect("the snap's size") + "the snap moved \"".len();
+    let name: String = err[at..].chars().take_while(|&c| c != '"').collect();
+    let by = &err[at + name.len() + "\" by ".len()..];
+    let said: f64 = by[..by.find(" rad").unwrap()].parse().unwrap();
+    // The history's last two rows: the same instant, before and after the landing.
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = history.lines().map(|l| l.split(',').collect()).collect();
+    let header = &rows[0];
+    let (before, after) = (&rows[rows.len() - 2], &rows[rows.len() - 1]);
+    assert_eq!(before[0], after[0], "two rows at the landing's instant");
+    let (column, moved) = ["footL", "footR", "topL"]
+        .iter()
+        .map(|c| {
+            let k = header.iter().position(|h| h == c).unwrap();
+            let (x, y): (f64, f64) = (before[k].parse().unwrap(), after[k].parse().unwrap());
+            (*c, (y - x).abs())
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap();
+    assert_eq!(name, column, "{err}");
+    // The message gives two significant digits.
+    assert!(
+        (said - moved).abs() <= 0.05e-4,
+        "said {said:e}, the history {moved:e}"
+    );
+    assert!(moved > 1e-4, "{moved:e}");
+}

@@ -1406,6 +1406,7 @@ struct PlanarBody {
 /// A contact point of the planar program: the body that receives +f (the upper, or the one the
 /// normal points into), the other body (None: the ground), the point (x, z) and the unit normal
 /// (nₓ, n_z) into the first body. f = fₙ n + f_t t, t = (n_z, −nₓ), fₙ ≥ 0, f_t free.
+#[derive(Clone)]
 struct PlanarContact {
     into: usize,
     from: Option<usize>,
@@ -1581,6 +1582,160 @@ fn an_l_shaped_stone_with_a_block_in_its_notch_matches_the_planar_lp() {
                 expected,
                 RTOL,
             );
+        }
+    }
+}
+
+/// The area and centroid (x, z) of a simple polygon in the x–z plane (shoelace formula).
+fn polygon_body(points: &[[f64; 2]]) -> PlanarBody {
+    let (mut a, mut cx, mut cz) = (0.0, 0.0, 0.0);
+    for i in 0..points.len() {
+        let ([x0, z0], [x1, z1]) = (points[i], points[(i + 1) % points.len()]);
+        let cross = x0 * z1 - x1 * z0;
+        a += cross / 2.0;
+        cx += (x0 + x1) * cross / 6.0;
+        cz += (z0 + z1) * cross / 6.0;
+    }
+    PlanarBody {
+        weight: a.abs(),
+        centroid: [cx / a, cz / a],
+    }
+}
+
+/// A joggled lintel between two fixed piers (x ∈ [−1.2, −0.8] and [0.8, 1.2], 2 m high): two
+/// stones meeting on a stepped joint, `b`'s lip resting on `a`'s ledge at z = 2.4 m, above `b`'s
+/// own centre (z = 2.311 m). The model takes the side of a joint's child from its centre of mass
+/// by default, which put that ledge's child on the wrong side: the joint could only pull `b` down
+/// (an independent review: λ along −x 0.700 for 0.486 at μ = 0.7, and 4.0 for 0.574 on its beds;
+/// `crr simulate` left it at rest at 0.71 g). `crr assemble` now writes the ledge's `normal`,
+/// and the multipliers are the planar LP's of the two stones written here from their polygons,
+/// with every contact (μ = 0.7 and none) and with the beds only, in the plane and in 3D, to 1e-7
+/// (beds only: λ = 4.0 along +x and 0.574074 along −x; every contact at μ = 0.7: 0.7 and
+/// 0.485716, the review's own LP's values).
+#[test]
+fn a_joggled_lintel_resting_on_a_ledge_above_its_centre_matches_the_planar_lp() {
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    let a = [
+        [-1.2, 2.0],
+        [0.1, 2.0],
+        [0.1, 2.4],
+        [-0.1, 2.4],
+        [-0.1, 2.6],
+        [-1.2, 2.6],
+    ];
+    let b = [
+        [0.1, 2.0],
+        [1.2, 2.0],
+        [1.2, 2.6],
+        [-0.1, 2.6],
+        [-0.1, 2.4],
+        [0.1, 2.4],
+    ];
+    let prism = |p: &[[f64; 2]]| {
+        let corners: Vec<String> = p
+            .iter()
+            .map(|[x, z]| format!("[{x:?}, -0.2, {z:?}]"))
+            .collect();
+        format!(
+            "prism = {{ polygon = [{}], extrude = [0.0, 0.4, 0.0] }}",
+            corners.join(", ")
+        )
+    };
+    let dir = crate::common::scratch("joggled_lintel");
+    let path = dir.join("lintel.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "name = \"lintel\"\nfixed = [\"pier_l\", \"pier_r\"]\n\
+             [[body]]\nname = \"pier_l\"\ndensity = 2000.0\n\
+             box = {{ center = [-1.0, 0.0, 1.0], size = [0.4, 0.4, 2.0] }}\n\
+             [[body]]\nname = \"pier_r\"\ndensity = 2000.0\n\
+             box = {{ center = [1.0, 0.0, 1.0], size = [0.4, 0.4, 2.0] }}\n\
+             [[body]]\nname = \"a\"\ndensity = 2000.0\n{}\n\
+             [[body]]\nname = \"b\"\ndensity = 2000.0\n{}\n",
+            prism(&a),
+            prism(&b)
+        ),
+    )
+    .unwrap();
+    let file = read_assembly(&path).unwrap();
+    let bodies = [polygon_body(&a), polygon_body(&b)];
+    assert!(
+        (bodies[1].centroid[1] - 2.311).abs() < 1e-3,
+        "{:?}",
+        bodies[1].centroid
+    );
+    let point = |into, from, at, normal| PlanarContact {
+        into,
+        from,
+        at,
+        normal,
+    };
+    let beds = vec![
+        point(0, None, [-1.2, 2.0], [0.0, 1.0]),
+        point(0, None, [-0.8, 2.0], [0.0, 1.0]),
+        point(1, None, [0.8, 2.0], [0.0, 1.0]),
+        point(1, None, [1.2, 2.0], [0.0, 1.0]),
+        // b's lip on a's ledge.
+        point(1, Some(0), [-0.1, 2.4], [0.0, 1.0]),
+        point(1, Some(0), [0.1, 2.4], [0.0, 1.0]),
+    ];
+    let mut every = beds.clone();
+    every.extend([
+        point(1, Some(0), [0.1, 2.0], [1.0, 0.0]),
+        point(1, Some(0), [0.1, 2.4], [1.0, 0.0]),
+        point(1, Some(0), [-0.1, 2.4], [1.0, 0.0]),
+        point(1, Some(0), [-0.1, 2.6], [1.0, 0.0]),
+    ]);
+    let options = StaticsOptions {
+        sliding_lift_off: false,
+        ..StaticsOptions::default()
+    };
+    for planar in [true, false] {
+        for (all, contacts) in [(false, &beds), (true, &every)] {
+            let mut asked = AssemblyOptions {
+                planar,
+                ..Default::default()
+            };
+            if all {
+                asked = asked.with_all_contacts();
+            }
+            let assembled = assemble(&path, &file, &asked).unwrap();
+            // The ledge alone says which side is its child's.
+            let told: Vec<_> = assembled
+                .file
+                .interface
+                .iter()
+                .filter(|i| i.normal.is_some())
+                .collect();
+            assert_eq!(told.len(), 1, "planar {planar}, all {all}");
+            assert!(told[0].name.starts_with("b_on_a"), "{}", told[0].name);
+            assert_eq!(told[0].normal, Some([0.0, 0.0, 1.0]), "planar {planar}");
+            // On its beds alone the lintel stands by shear (stone `a` reaches out beyond its
+            // pier, held by `b` across the ledge): at μ = 0.7 it has no equilibrium at all.
+            let frictions: &[Option<f64>] = if all { &[None, Some(0.7)] } else { &[None] };
+            for &mu in frictions {
+                for dx in [1.0, -1.0] {
+                    let expected = planar_contact_lp(&bodies, contacts, dx, mu);
+                    let options = StaticsOptions {
+                        friction: mu.map_or(Friction::NoSliding, Friction::Pyramid),
+                        ..options
+                    };
+                    let got =
+                        collapse_multiplier(&assembled.model, Vector3::new(dx, 0.0, 0.0), &options)
+                            .unwrap()
+                            .lambda;
+                    println!(
+                        "planar {planar}, all {all}, μ {mu:?}, dx {dx:+}: LP {expected:.6}, engine {got:?}"
+                    );
+                    assert_close(
+                        &format!("lintel, planar {planar}, all {all}, μ {mu:?}, dx {dx:+}"),
+                        got,
+                        expected,
+                        RTOL,
+                    );
+                }
+            }
         }
     }
 }

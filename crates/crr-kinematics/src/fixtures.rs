@@ -78,6 +78,7 @@ pub fn hinge(
         pivot_positive: Some(PivotSpec::Point(pos)),
         pivot_negative: Some(PivotSpec::Point(neg)),
         rocking_base: None,
+        normal: None,
         impact: ImpactLaw::Momentum,
     }
 }
@@ -100,6 +101,7 @@ pub fn rocking_base(
             corners: corners.to_vec(),
             twist: false,
         }),
+        normal: None,
         impact: ImpactLaw::Momentum,
     }
 }

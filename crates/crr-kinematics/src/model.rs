@@ -517,6 +517,51 @@ fn pivot_point(
     }
 }
 
+/// A point on the child's side of an interface whose points are `face` given its face's normal
+/// `n` into the child (the spec's `normal`): the face's centre moved by the model's size along n.
+/// The normal must be a direction perpendicular to the face (within 1e-6 rad of it for every
+/// pair of the face's points: an assembly writes the contact's own).
+fn normal_side_point(
+    n: &[f64; 3],
+    face: &[[f64; 3]],
+    item: &str,
+    size: f64,
+) -> Result<Vector3<f64>, ModelError> {
+    let item_n = format!("{item} (normal)");
+    let n = finite3(n, &item_n, "normal")?;
+    let largest = n.amax();
+    if largest == 0.0 {
+        return Err(ModelError::new(item_n, "the normal is the zero vector"));
+    }
+    let n = (n / largest).normalize();
+    let points: Vec<Vector3<f64>> = face.iter().map(|x| Vector3::from(*x)).collect();
+    for a in &points {
+        for b in &points {
+            let d = b - a;
+            if d.norm() > GEOMETRY_TOLERANCE * size && n.dot(&d).abs() > 1e-6 * d.norm() {
+                return Err(ModelError::new(
+                    item_n,
+                    format!(
+                        "[{:.6}, {:.6}, {:.6}] is not perpendicular to the joint face: it makes                          {:.4}° with the line between two of its points",
+                        n.x,
+                        n.y,
+                        n.z,
+                        90.0 - n.dot(&d.normalize()).abs().acos().to_degrees()
+                    ),
+                ));
+            }
+        }
+    }
+    let centre = points.iter().sum::<Vector3<f64>>() / points.len().max(1) as f64;
+    Ok(centre + n * size)
+}
+
+/// The point [`Model::from_spec`] takes for the child's side of an interface with no `normal`,
+/// whose points are `face`, on the body of `spec` ([`side_point`]); None for a body it refuses.
+pub(crate) fn default_side_point(spec: &BodySpec, face: &[[f64; 3]]) -> Option<Vector3<f64>> {
+    build_body(spec).ok().map(|body| side_point(&body, face))
+}
+
 /// A point on the child's side of an interface whose points are `face`: its centre of mass, or
 /// for a compound body (a rigid domain of several blocks, not convex) the centroid of the part
 /// the face lies on: the part on whose surface most of the face's points lie; among equals, the
@@ -1394,7 +1439,10 @@ fn build_interfaces(
                 ),
             ));
         }
-        let child_side = side_point(&bodies[child], &given);
+        let child_side = match i.normal {
+            None => side_point(&bodies[child], &given),
+            Some(n) => normal_side_point(&n, &given, &item, size)?,
+        };
         let kind = match &i.rocking_base {
             Some(rb) => {
                 if i.axis.is_some() || i.pivot_positive.is_some() || i.pivot_negative.is_some() {

@@ -318,6 +318,12 @@ pub struct InterfaceSpec {
     /// A rocking base instead of a hinge (no axis or pivots then).
     #[serde(default)]
     pub rocking_base: Option<RockingBaseSpec>,
+    /// The normal of the joint face, pointing into the child: which side of the face is the
+    /// child's. Default: the side of the child's centre of mass, which a stone that is not
+    /// convex may lie across (a joggled or hooked stone resting on a ledge above its centre);
+    /// `crr assemble` writes it there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
     /// Impact law at this interface (default `"momentum"`).
     #[serde(default)]
     pub impact: ImpactLaw,

@@ -508,6 +508,10 @@ pub struct Simulation<'a> {
     lost_at_impacts: f64,
     /// Σ|ΔT + ΔU| of the snaps booked in `dissipated_at_impacts` ([`Trajectory::energy_at_snaps`]).
     energy_at_snaps: f64,
+    /// The first sample of the last instant samples were taken at: its time, the chain's
+    /// coordinates by name and their values. Taken before that instant's events (an impact, a
+    /// landing) switch the state: what their snaps moved ([`Self::snap_shift`]).
+    pre_event: (f64, Vec<(String, f64)>),
     /// The snaps and the impacts' losses when the monitor first found a hypothesis failing.
     snaps_at_violation: Option<SnapsAndLosses>,
     /// Uplift events in a row that released nothing ([`SimulationError::Undecided`]).
@@ -1035,6 +1039,7 @@ impl<'a> Simulation<'a> {
             peak_abs: vec![0.0; n],
             balance_error: 0.0,
             last_sample_t: f64::NEG_INFINITY,
+            pre_event: (f64::NAN, Vec::new()),
             samples: Samples::with_capacity(
                 n,
                 model.slot_count,
@@ -1446,12 +1451,45 @@ impl<'a> Simulation<'a> {
         if names.is_empty() {
             return integration;
         }
+        let moved = match self.snap_shift() {
+            Some((name, shift)) => format!(
+                " (the snap moved \"{name}\" by {shift:.1e} rad, to close the loops on the new \
+                 pivots: bodies that meet away from the points their pivots had at rest, after a \
+                 flight or a rattle, are brought back to them)"
+            ),
+            None => String::new(),
+        };
         format!(
             "{integration}; the state at this instant was set by the impact or landing of {} and \
-             its snap, which a tolerance does not change: if the failure comes back at the same \
-             instant, the contacts rattle beyond what the event-driven model resolves",
+             its snap{moved}, which a tolerance does not change: if the failure comes back at \
+             the same instant, the contacts rattle beyond what the event-driven model resolves",
             names.join(", ")
         )
+    }
+
+    /// The coordinate the events of this instant moved most, and by how much (rad): the
+    /// difference between the state now and the sample taken just before the first event of
+    /// the instant. An impact law changes the rates only, so what moved the angles is the
+    /// snaps (impacting angles to 0, seats, loops closed on the new pivots). None where no
+    /// event sample was taken at this instant, the chain has changed since, or nothing moved.
+    fn snap_shift(&self) -> Option<(String, f64)> {
+        let (t, before) = &self.pre_event;
+        let coords = &self.model.coords;
+        // The same chain (a landing that closes a loop keeps its tree; a re-rooted one may turn
+        // an interface round, whose angles then change sign).
+        if *t != self.t
+            || before.len() != coords.len()
+            || before
+                .iter()
+                .zip(coords)
+                .any(|((name, _), c)| *name != c.name)
+        {
+            return None;
+        }
+        let (k, shift) = (0..coords.len())
+            .map(|k| (k, (self.y[k] - before[k].1).abs()))
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        (shift > 0.0).then(|| (coords[k].name.clone(), shift))
     }
 
     fn step_unchecked(&mut self) -> Result<StopReason, SimulationError> {

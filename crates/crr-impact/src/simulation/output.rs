@@ -182,6 +182,17 @@ impl Simulation<'_> {
 
     /// Takes and records the sample of the current state at `t`.
     pub(super) fn record_current_sample(&mut self, t: f64) {
+        // The first sample of an instant is the state before its events (snap_shift).
+        if self.pre_event.0 != t {
+            self.pre_event.0 = t;
+            self.pre_event.1.clear();
+            let coords = &self.model.coords;
+            let values = coords
+                .iter()
+                .zip(&self.y)
+                .map(|(c, &q)| (c.name.clone(), q));
+            self.pre_event.1.extend(values);
+        }
         let y = std::mem::take(&mut self.y);
         let s = self.sample_at(t, &y);
         self.y = y;
