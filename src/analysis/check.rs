@@ -524,6 +524,15 @@ pub fn to_text(r: &CheckReport) -> String {
             }
         }
     }
+    if r.static_multipliers.iter().any(|m| m.friction_unbounded) {
+        // Such an answer stands on shear across a joint whose compression vanishes: no friction
+        // gives it, and a rounding of the geometry moves it (an arch turned 30° and written
+        // with six decimals: 0.435159 for the exact geometry's 0.423857, both 0.423857 at 0.7).
+        s += "  an answer that needs μ > 1000 rests on shear across a joint that carries no \
+              compression, which no masonry joint gives, and may change with small changes of \
+              the geometry: `--friction MU` (a masonry μ, e.g. 0.6 to 0.8) gives the multipliers \
+              with Coulomb friction at every contact (docs/check.md)\n";
+    }
     if let Some(note) = &r.static_multipliers_note {
         s += &format!("static multiplier: {note}\n");
     }

@@ -422,8 +422,9 @@ fn a_larger_budget_of_sets_makes_the_answer_exhaustive() {
 /// A wall of beds only whose answer without sliding rests on shear across a joint whose
 /// compression vanishes ([0.301 | 0.699] under [0.585 | 0.415], courses 0.5 m, along −x; the
 /// independent LP of `tests/statics/independent.rs` finds λ(1000) 2.5e-5 of λ short): the line
-/// says "needs μ > 1000" and the JSON `friction_unbounded`, with no μ; with `--friction 0.7`
-/// the multiplier is lower, the one a real wall has.
+/// says "needs μ > 1000" and the JSON `friction_unbounded`, with no μ, and the text ends the
+/// multipliers with what such an answer means and the option that answers with friction; with
+/// `--friction 0.7` the multiplier is lower, the one a real wall has.
 #[test]
 fn a_multiplier_that_needs_unbounded_friction_says_so() {
     let courses: [&[f64]; 2] = [&[0.301, 0.699], &[0.585, 0.415]];
@@ -446,6 +447,15 @@ fn a_multiplier_that_needs_unbounded_friction_says_so() {
         text.contains(&format!("λ = {lambda:.6} (needs μ > 1000)")),
         "{text}"
     );
+    // The report tells what to do with such an answer, once; not where no answer needs it.
+    let advice = "an answer that needs μ > 1000 rests on shear across a joint";
+    assert_eq!(text.matches(advice).count(), 1, "{text}");
+    assert!(text.contains("`--friction MU`"), "{text}");
+    let o = crate::common::crr(&["check", model, "--direction", "-x", "--friction", "0.7"]);
+    assert!(!String::from_utf8_lossy(&o.stdout).contains(advice));
+    let block = crate::common::bundled_path("single_block");
+    let o = crate::common::crr(&["check", block.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&o.stdout).contains(advice));
 }
 
 /// A stone between two fixed piers, touching only their vertical faces, with nothing under it
