@@ -144,49 +144,60 @@ def _cgroup_memory_left(
 ) -> Optional[float]:
     """Bytes the process's control groups still let it use (a container's or a batch job's
     memory limit, which ``MemAvailable`` does not see: a run sized on the machine's memory was
-    killed by the limit instead of refused): cgroup v2, ``memory.max`` − ``memory.current`` of
-    its group and every group above it, the least; cgroup v1, ``memory.limit_in_bytes`` −
-    ``memory.usage_in_bytes`` of its memory group. None where no limit is set or readable."""
+    killed by the limit instead of refused): the limit less the usage, the usage without the
+    page cache the kernel reclaims first (``inactive_file`` of ``memory.stat``), of the process's
+    group and of every group above it, the least. cgroup v2: ``memory.max``, ``memory.current``;
+    v1: ``memory.limit_in_bytes``, ``memory.usage_in_bytes`` (an unset limit is a huge number).
+    None where no limit is set or readable."""
 
-    def number(path: str) -> Optional[float]:
+    def read(path: str) -> Optional[str]:
         try:
-            with open(path) as f:
-                text = f.read().strip()
+            with open(path, encoding="utf-8", errors="replace") as f:
+                return f.read()
         except OSError:
             return None
+
+    def number(path: str) -> Optional[float]:
+        text = read(path)
         try:
-            return float(text)
+            return float(text.strip()) if text is not None else None
         except ValueError:
             return None  # "max": no limit
 
-    try:
-        with open(membership) as f:
-            lines = [l.strip().split(":", 2) for l in f if l.strip()]
-    except OSError:
+    def reclaimable(folder: str, key: str) -> float:
+        for line in (read(os.path.join(folder, "memory.stat")) or "").splitlines():
+            fields = line.split()
+            if len(fields) == 2 and fields[0] == key:
+                try:
+                    return float(fields[1])
+                except ValueError:
+                    return 0.0
+        return 0.0
+
+    text = read(membership)
+    if text is None:
         return None
     left: List[float] = []
-    for fields in lines:
+    for line in text.splitlines():
+        fields = line.strip().split(":", 2)
         if len(fields) != 3:
             continue
         _, controllers, path = fields
+        parts = [p for p in path.split("/") if p]
         if controllers == "":
-            # v2: the limits of the group and of every group above it apply.
-            parts = [p for p in path.split("/") if p]
-            for depth in range(len(parts), -1, -1):
-                folder = os.path.join(root, *parts[:depth])
-                limit = number(os.path.join(folder, "memory.max"))
-                used = number(os.path.join(folder, "memory.current"))
-                if limit is not None and used is not None:
-                    left.append(max(limit - used, 0.0))
+            base, files, cache = root, ("memory.max", "memory.current"), "inactive_file"
         elif "memory" in controllers.split(","):
-            folder = os.path.join(root, "memory", *[p for p in path.split("/") if p])
-            for where in (folder, os.path.join(root, "memory")):
-                limit = number(os.path.join(where, "memory.limit_in_bytes"))
-                used = number(os.path.join(where, "memory.usage_in_bytes"))
-                # v1 writes an unset limit as a huge number (2⁶³ rounded to the page size).
-                if limit is not None and used is not None and limit < 2.0**60:
-                    left.append(max(limit - used, 0.0))
-                    break
+            base = os.path.join(root, "memory")
+            files, cache = ("memory.limit_in_bytes", "memory.usage_in_bytes"), "total_inactive_file"
+        else:
+            continue
+        # The limits of the group and of every group above it apply.
+        for depth in range(len(parts), -1, -1):
+            folder = os.path.join(base, *parts[:depth])
+            limit, used = number(os.path.join(folder, files[0])), number(os.path.join(folder, files[1]))
+            if limit is None or used is None or limit >= 2.0**60:
+                continue
+            left.append(max(limit - max(used - reclaimable(folder, cache), 0.0), 0.0))
     return min(left) if left else None
 
 
@@ -216,7 +227,8 @@ def _memory_available() -> Optional[float]:
             known.append(max(float(soft) - mapped, 0.0))
     except (ImportError, OSError, StopIteration, ValueError):
         pass
-    return min(known) if known else None
+    # Nothing left is a limit too (0 would read as "unknown" to the sample limit below).
+    return max(min(known), 1.0) if known else None
 
 
 def _samples(name: str, values: npt.ArrayLike) -> np.ndarray:

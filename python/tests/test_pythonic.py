@@ -104,34 +104,43 @@ def test_a_run_that_cannot_fit_in_memory_is_refused_before_it_starts() -> None:
 
 def test_a_control_groups_memory_limit_counts(tmp_path: Path) -> None:
     # A container's limit (cgroup v2) that MemAvailable does not see: the least of what the
-    # group and the groups above it leave; no limit ("max") and no file leave None.
+    # group and the groups above it leave, their page cache (inactive_file) counted as free;
+    # no limit ("max") and no file leave None.
     from crr import _cgroup_memory_left
 
-    def group(path: str, limit: str, used: int) -> None:
-        folder = tmp_path / "v2" / path
+    def group(root: Path, path: str, names: tuple, limit: str, used: int, cache: int = 0) -> None:
+        folder = root / path
         folder.mkdir(parents=True, exist_ok=True)
-        (folder / "memory.max").write_text(limit + "\n")
-        (folder / "memory.current").write_text(f"{used}\n")
+        (folder / names[0]).write_text(limit + "\n")
+        (folder / names[1]).write_text(f"{used}\n")
+        (folder / "memory.stat").write_text(f"anon 1\n{names[2]} {cache}\nfile 2\n")
 
-    group("", "max", 5 << 30)
-    group("jobs", str(4 << 30), 3 << 30)
-    group("jobs/run", str(2 << 30), 512 << 20)
+    v2 = ("memory.max", "memory.current", "inactive_file")
+    group(tmp_path / "v2", "", v2, "max", 5 << 30)
+    group(tmp_path / "v2", "jobs", v2, str(4 << 30), 3 << 30)
+    group(tmp_path / "v2", "jobs/run", v2, str(2 << 30), 1 << 30, cache=512 << 20)
     membership = tmp_path / "cgroup"
     membership.write_text("0::/jobs/run\n")
     left = _cgroup_memory_left(str(tmp_path / "v2"), str(membership))
-    assert left == float(1 << 30)  # the parent's 4 GiB − 3 GiB, below the job's 1.5 GiB
+    assert left == float(1 << 30)  # the parent's 4 GiB − 3 GiB, below the job's 2 − 0.5 GiB
     membership.write_text("0::/\n")
     assert _cgroup_memory_left(str(tmp_path / "v2"), str(membership)) is None
-    # cgroup v1: the memory controller's group; an unset limit is a huge number.
-    v1 = tmp_path / "v1" / "memory" / "batch"
-    v1.mkdir(parents=True)
-    (v1 / "memory.limit_in_bytes").write_text(f"{3 << 30}\n")
-    (v1 / "memory.usage_in_bytes").write_text(f"{1 << 30}\n")
-    membership.write_text("12:cpu,cpuacct:/batch\n11:memory:/batch\n")
+    # At its limit with no cache: nothing left, which is a number, not "unknown".
+    group(tmp_path / "full", "", v2, str(2 << 30), 2 << 30)
+    assert _cgroup_memory_left(str(tmp_path / "full"), str(membership)) == 0.0
+    # cgroup v1: the memory controller's group and the groups above it; an unset limit is a
+    # huge number.
+    v1 = ("memory.limit_in_bytes", "memory.usage_in_bytes", "total_inactive_file")
+    group(tmp_path / "v1" / "memory", "batch", v1, str(3 << 30), 1 << 30)
+    group(tmp_path / "v1" / "memory", "batch/step", v1, "9223372036854771712", 1 << 30)
+    membership.write_text("12:cpu,cpuacct:/batch/step\n11:memory:/batch/step\n")
     assert _cgroup_memory_left(str(tmp_path / "v1"), str(membership)) == float(2 << 30)
-    (v1 / "memory.limit_in_bytes").write_text("9223372036854771712\n")
+    (tmp_path / "v1" / "memory" / "batch" / "memory.limit_in_bytes").write_text("9223372036854771712\n")
     assert _cgroup_memory_left(str(tmp_path / "v1"), str(membership)) is None
     assert _cgroup_memory_left(str(tmp_path / "none"), str(tmp_path / "missing")) is None
+    # A membership file that is not UTF-8 is read, not raised.
+    membership.write_bytes(b"0::/jobs/\xff\n")
+    assert _cgroup_memory_left(str(tmp_path / "v2"), str(membership)) == float(1 << 30)
 
 
 def test_a_sample_limit_stops_the_run_with_its_results() -> None:

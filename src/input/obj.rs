@@ -110,8 +110,7 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
     }
     let mut bodies: Vec<BodySpec> = Vec::with_capacity(models.len());
     for (k, m) in models.iter().enumerate() {
-        // A file without `o` or `g` is one block, which tobj calls "unnamed_object".
-        let name = if m.name.trim().is_empty() || !text.named_blocks {
+        let name = if m.name.trim().is_empty() {
             format!("object_{}", k + 1)
         } else {
             m.name.trim().to_string()
@@ -142,59 +141,104 @@ pub fn obj_bodies(spec: &ObjSpec, folder: &Path) -> Result<Vec<BodySpec>, Error>
 /// the groups (`g`) inside an object are parts of its surface (a CAD program's material or
 /// layer groups: a column's sides `g stone` and its polished top `g polished`; tobj starts a
 /// model at each `o` and each `g` alike, so a column so written was split into open meshes);
-/// groups before the first object, or in a file without objects, stay blocks. A statement
-/// without a name is named `object_N` (N the block's number). The line count is unchanged.
+/// groups before the first object, or in a file without objects, stay blocks. A block without a
+/// name is `object_N`, N its number among the blocks that have faces (`object_N_2` … where the
+/// file names another block so), and faces before any `o` or `g` are a block of their own
+/// (`o object_1` is put before them; every other line keeps its place).
 struct ObjText {
     bytes: Vec<u8>,
     /// The groups merged into each object, by the object's name.
     groups_of: HashMap<String, Vec<String>>,
-    /// Whether any `o` or `g` statement starts a block (none: the file is one block).
-    named_blocks: bool,
 }
 
 impl ObjText {
     fn new(bytes: &[u8]) -> ObjText {
+        let lines: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
+        let parsed: Vec<(String, String)> = lines
+            .iter()
+            .map(|line| {
+                let text = String::from_utf8_lossy(line);
+                let mut words = text.trim_start().splitn(2, char::is_whitespace);
+                let keyword = words.next().unwrap_or("").to_string();
+                (keyword, words.next().unwrap_or("").trim().to_string())
+            })
+            .collect();
+        // Which lines start a block: every `o`, and a `g` before the first `o`.
+        let first_object = parsed.iter().position(|(k, _)| k == "o");
+        let starts: Vec<bool> = parsed
+            .iter()
+            .enumerate()
+            .map(|(i, (k, _))| k == "o" || (k == "g" && first_object.is_none_or(|o| i < o)))
+            .collect();
+        // A block is numbered when faces follow it before the next start; faces before any
+        // start are a block of their own (block 1).
+        let mut with_faces = vec![false; lines.len()];
+        let mut current = None;
+        let mut leading_faces = false;
+        for (i, (k, _)) in parsed.iter().enumerate() {
+            if starts[i] {
+                current = Some(i);
+            } else if k == "f" {
+                match current {
+                    Some(c) => with_faces[c] = true,
+                    None => leading_faces = true,
+                }
+            }
+        }
+        let mut taken: std::collections::HashSet<String> = parsed
+            .iter()
+            .zip(&starts)
+            .filter(|((_, name), start)| **start && !name.is_empty())
+            .map(|((_, name), _)| name.clone())
+            .collect();
+        let mut fresh = |number: usize| {
+            let name = (1..)
+                .map(|k| match k {
+                    1 => format!("object_{number}"),
+                    k => format!("object_{number}_{k}"),
+                })
+                .find(|n| !taken.contains(n))
+                .expect("a free name");
+            taken.insert(name.clone());
+            name
+        };
         let mut out = Vec::with_capacity(bytes.len() + 64);
         let mut groups_of: HashMap<String, Vec<String>> = HashMap::new();
-        let (mut object, mut blocks) = (None::<String>, 0usize);
-        for (k, line) in bytes.split(|&b| b == b'\n').enumerate() {
-            if k > 0 {
+        let (mut object, mut number) = (None::<String>, usize::from(leading_faces));
+        if leading_faces {
+            out.extend_from_slice(format!("o {}\n", fresh(1)).as_bytes());
+        }
+        for (i, line) in lines.iter().enumerate() {
+            if i > 0 {
                 out.push(b'\n');
             }
-            let text = String::from_utf8_lossy(line);
-            let trimmed = text.trim_start();
-            let mut words = trimmed.splitn(2, char::is_whitespace);
-            let keyword = words.next().unwrap_or("");
-            let name = words.next().unwrap_or("").trim().to_string();
-            match keyword {
-                "g" if object.is_some() => {
-                    let inside = object.clone().unwrap_or_default();
-                    groups_of.entry(inside).or_default().push(name);
-                    out.extend_from_slice(b"# ");
-                    out.extend_from_slice(line);
+            let (keyword, name) = &parsed[i];
+            if starts[i] {
+                number += usize::from(with_faces[i]);
+                let name = if name.is_empty() {
+                    fresh(number)
+                } else {
+                    name.clone()
+                };
+                if keyword == "o" {
+                    object = Some(name.clone());
                 }
-                "o" | "g" => {
-                    blocks += 1;
-                    let name = if name.is_empty() {
-                        format!("object_{blocks}")
-                    } else {
-                        name
-                    };
-                    if keyword == "o" {
-                        object = Some(name.clone());
-                    }
-                    out.extend_from_slice(format!("{keyword} {name}").as_bytes());
-                    if line.ends_with(b"\r") {
-                        out.push(b'\r');
-                    }
+                out.extend_from_slice(format!("{keyword} {name}").as_bytes());
+                if line.ends_with(b"\r") {
+                    out.push(b'\r');
                 }
-                _ => out.extend_from_slice(line),
+            } else if keyword == "g" {
+                let inside = object.clone().unwrap_or_default();
+                groups_of.entry(inside).or_default().push(name.clone());
+                out.extend_from_slice(b"# ");
+                out.extend_from_slice(line);
+            } else {
+                out.extend_from_slice(line);
             }
         }
         ObjText {
             bytes: out,
             groups_of,
-            named_blocks: blocks > 0,
         }
     }
 

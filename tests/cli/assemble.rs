@@ -695,7 +695,9 @@ fn an_obj_stone_in_material_groups_and_a_face_wound_back_are_blocks() {
 /// OBJ files as exporters write them, where the old reading went wrong (an independent
 /// review): groups before the first object stay blocks (`g base` then `o upper`: the new reading
 /// first merged the group into nothing, an "unnamed_object"); an object without a name is
-/// `object_N` as documented (two were "unnamed_object" twice, refused); a single object
+/// `object_N` as documented, N its number among the blocks with faces, skipping a name the file
+/// gives (two were "unnamed_object" twice, refused; faces before any object were another
+/// "unnamed_object"); a single object
 /// wrapping two stones' groups is refused with what its groups are and what to write; and an
 /// open stone with a face wound back names its hole, the same edge at every run (the message
 /// came from a hash map's order, and named an edge of the reversed face in 8 runs of 12).
@@ -724,6 +726,20 @@ fn obj_groups_before_objects_unnamed_objects_and_holes() {
     );
     let unnamed = lower("x", "o").replacen("o x", "o", 1) + &upper("y").replacen("o y", "o", 1);
     assert_eq!(names_of("obj_unnamed", &unnamed), ["object_1", "object_2"]);
+    // Faces before any object are block 1; a generated name skips one the file gives; an
+    // object without faces is no block and takes no number.
+    let leading = lower("x", "o").replacen("o x\n", "", 1) + &upper("upper");
+    assert_eq!(
+        names_of("obj_leading_faces", &leading),
+        ["object_1", "upper"]
+    );
+    let clash = lower("x", "o").replacen("o x", "o", 1) + &upper("object_1");
+    assert_eq!(
+        names_of("obj_name_clash", &clash),
+        ["object_1_2", "object_1"]
+    );
+    let ghost = format!("o ghost\n{unnamed}");
+    assert_eq!(names_of("obj_ghost", &ghost), ["object_1", "object_2"]);
     // One object around two stones' groups.
     let scene = format!(
         "o Scene\n{}{}",

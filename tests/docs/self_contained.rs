@@ -80,11 +80,25 @@ fn references_to_sections_of_physics_md_name_sections_it_has() {
 }
 
 /// GitHub's anchor of a heading: lower case, letters, digits, `-` and `_` kept, spaces turned
-/// into `-`, everything else (backticks, parentheses, punctuation, dashes other than `-`) dropped.
+/// into `-`, everything else (backticks, parentheses, punctuation, dashes other than `-`) dropped;
+/// a link in it counts by its text.
 fn heading_anchor(heading: &str) -> String {
-    heading
-        .trim()
-        .to_lowercase()
+    let mut text = String::new();
+    let mut rest = heading.trim();
+    // [text](target) → text.
+    while let Some(open) = rest.find('[') {
+        let Some(close) = rest[open..].find("](").map(|c| open + c) else {
+            break;
+        };
+        let Some(end) = rest[close..].find(')').map(|e| close + e) else {
+            break;
+        };
+        text.push_str(&rest[..open]);
+        text.push_str(&rest[open + 1..close]);
+        rest = &rest[end + 1..];
+    }
+    text.push_str(rest);
+    text.to_lowercase()
         .chars()
         .filter_map(|c| match c {
             ' ' => Some('-'),
@@ -94,21 +108,63 @@ fn heading_anchor(heading: &str) -> String {
         .collect()
 }
 
-/// The anchors of a Markdown file's headings (outside code blocks); a heading met again gets
-/// `-1`, `-2`, … as on GitHub.
+/// The lines of a Markdown file outside fenced code blocks (``` or ~~~), with their numbers and
+/// their inline code spans blanked out.
+fn prose_lines(markdown: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    let mut fence: Option<&str> = None;
+    for (n, line) in markdown.lines().enumerate() {
+        let trimmed = line.trim_start();
+        let marker = ["```", "~~~"].into_iter().find(|m| trimmed.starts_with(m));
+        match (fence, marker) {
+            (None, Some(m)) => fence = Some(m),
+            (Some(f), Some(m)) if f == m => fence = None,
+            _ => {}
+        }
+        if fence.is_some() || marker.is_some() {
+            continue;
+        }
+        // Inline code: every other segment between backticks.
+        let prose: String = line
+            .split('`')
+            .enumerate()
+            .map(|(k, part)| {
+                if k % 2 == 0 {
+                    part.to_string()
+                } else {
+                    " ".repeat(part.len())
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(" ");
+        out.push((n + 1, prose));
+    }
+    out
+}
+
+/// The anchors of a Markdown file's headings (ATX `#` and setext, outside code); a heading met
+/// again gets `-1`, `-2`, … as on GitHub.
 fn anchors_of(markdown: &str) -> std::collections::BTreeSet<String> {
     let mut seen = std::collections::BTreeMap::<String, usize>::new();
     let mut out = std::collections::BTreeSet::new();
-    let mut in_code = false;
-    for line in markdown.lines() {
-        if line.trim_start().starts_with("```") {
-            in_code = !in_code;
+    let lines = prose_lines(markdown);
+    let all: Vec<&str> = markdown.lines().collect();
+    for (n, _) in &lines {
+        let line = all[n - 1];
+        let next = all.get(*n).map(|l| l.trim()).unwrap_or("");
+        let setext = !line.trim().is_empty()
+            && !line.starts_with('#')
+            && !line.trim_start().starts_with(['|', '-', '*', '>'])
+            && !next.is_empty()
+            && (next.chars().all(|c| c == '=') || next.chars().all(|c| c == '-'));
+        let heading = if line.starts_with('#') {
+            line.trim_start_matches('#')
+        } else if setext {
+            line
+        } else {
             continue;
-        }
-        if in_code || !line.starts_with('#') {
-            continue;
-        }
-        let anchor = heading_anchor(line.trim_start_matches('#'));
+        };
+        let anchor = heading_anchor(heading);
         let n = seen.entry(anchor.clone()).or_insert(0);
         out.insert(if *n == 0 {
             anchor.clone()
@@ -120,15 +176,24 @@ fn anchors_of(markdown: &str) -> std::collections::BTreeSet<String> {
     out
 }
 
-/// The targets of a Markdown file's inline links `[text](target)`, with their line numbers.
+/// The targets of a Markdown file's links outside code: inline `[text](target "title")` (the
+/// target without its title) and reference definitions `[label]: target`, with line numbers.
 fn link_targets(markdown: &str) -> Vec<(usize, String)> {
     let mut out = Vec::new();
-    for (n, line) in markdown.lines().enumerate() {
+    for (n, line) in prose_lines(markdown) {
         for (i, _) in line.match_indices("](") {
             let rest = &line[i + 2..];
             if let Some(end) = rest.find(')') {
-                out.push((n + 1, rest[..end].to_string()));
+                let target = rest[..end].split_whitespace().next().unwrap_or("");
+                out.push((n, target.trim_matches(['<', '>']).to_string()));
             }
+        }
+        let t = line.trim_start();
+        if t.starts_with('[')
+            && let Some(close) = t.find("]:")
+        {
+            let target = t[close + 2..].split_whitespace().next().unwrap_or("");
+            out.push((n, target.trim_matches(['<', '>']).to_string()));
         }
     }
     out
@@ -149,7 +214,7 @@ fn every_link_of_the_docs_reaches_a_file_and_a_heading() {
         }
         let text = std::fs::read_to_string(&file).unwrap();
         for (line, target) in link_targets(&text) {
-            if target.contains("://") || target.starts_with("mailto:") || target.contains(' ') {
+            if target.is_empty() || target.contains("://") || target.starts_with("mailto:") {
                 continue;
             }
             let (path, anchor) = match target.split_once('#') {
@@ -189,8 +254,22 @@ fn heading_anchors_are_githubs() {
         heading_anchor(" The `crr check` report (λ, μ) — 3D"),
         "the-crr-check-report-λ-μ--3d"
     );
-    let anchors = anchors_of("# A\n```\n# not a heading\n```\n## A\n### b c\n");
-    let expected: std::collections::BTreeSet<String> =
-        ["a", "a-1", "b-c"].iter().map(|s| s.to_string()).collect();
+    assert_eq!(
+        heading_anchor(" See [the format](x.md) here"),
+        "see-the-format-here"
+    );
+    let anchors = anchors_of(
+        "# A\n```\n# not a heading\n```\n~~~\n# nor this\n~~~\n## A\n### b c\nSetext\n======\n",
+    );
+    let expected: std::collections::BTreeSet<String> = ["a", "a-1", "b-c", "setext"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     assert_eq!(anchors, expected);
+    // Links in code are none; a titled link's target and a reference definition's are read.
+    let links = link_targets(
+        "`v[0](x)` and\n```\nf[0](z)\n```\n[a](b.md \"title\") [c][r]\n[r]: <d.md#e>\n",
+    );
+    let targets: Vec<&str> = links.iter().map(|(_, t)| t.as_str()).collect();
+    assert_eq!(targets, ["b.md", "d.md#e"]);
 }

@@ -517,15 +517,27 @@ fn pivot_point(
     }
 }
 
-/// A point on the child's side of an interface whose points are `face` given its face's normal
-/// `n` into the child (the spec's `normal`): the face's centre moved by the model's size along n.
-/// The normal must be a direction perpendicular to the face (within 1e-6 rad of it for every
-/// pair of the face's points: an assembly writes the contact's own).
-fn normal_side_point(
+/// Which side of a joint face is its child's: the side of a point (its centre of mass, or the
+/// centroid of the part of a compound body the face lies on, [`side_point`]), or the side the
+/// interface's `normal` points to.
+enum ChildSide {
+    Point(Vector3<f64>),
+    Normal(Vector3<f64>),
+}
+
+/// How far (rad) an interface's `normal` may be from its joint face's own normal: it only says
+/// which side of the face is the child's, and a face written with rounded coordinates (accepted
+/// to 1e-6 of the model's size) has a normal off the exact one.
+const NORMAL_SLACK: f64 = 0.01745; // 1°
+
+/// The unit direction of an interface's `normal` (finite, not zero), refused otherwise; for a
+/// convex child (a box or a polyhedron) it must point to its centre's side, where the whole
+/// body lies.
+fn given_normal(
     n: &[f64; 3],
+    child: &Body,
     face: &[[f64; 3]],
     item: &str,
-    size: f64,
 ) -> Result<Vector3<f64>, ModelError> {
     let item_n = format!("{item} (normal)");
     let n = finite3(n, &item_n, "normal")?;
@@ -534,26 +546,67 @@ fn normal_side_point(
         return Err(ModelError::new(item_n, "the normal is the zero vector"));
     }
     let n = (n / largest).normalize();
-    let points: Vec<Vector3<f64>> = face.iter().map(|x| Vector3::from(*x)).collect();
-    for a in &points {
-        for b in &points {
-            let d = b - a;
-            if d.norm() > GEOMETRY_TOLERANCE * size && n.dot(&d).abs() > 1e-6 * d.norm() {
+    let convex = matches!(child.shape, Shape::Box(_) | Shape::Polyhedron(_));
+    let on_face = face.first().map_or(child.com, |x| Vector3::from(*x));
+    if convex && n.dot(&(child.com - on_face)) < 0.0 {
+        return Err(ModelError::new(
+            item_n,
+            format!(
+                "[{:.6}, {:.6}, {:.6}] points away from the centre of mass of its child, a \
+                 convex body that lies wholly on its centre's side of any face it touches: \
+                 reverse it (or leave it out)",
+                n.x, n.y, n.z
+            ),
+        ));
+    }
+    Ok(n)
+}
+
+/// The side of `face_normal` (unit, a joint face's own) the child is on: +1 or −1, or an error
+/// where it cannot be told (the child's point in the face's plane, within `tolerance` m) or the
+/// interface's normal is not the face's (beyond [`NORMAL_SLACK`]). `what` names the face's
+/// normal in the message.
+fn side_of(
+    child: &ChildSide,
+    face_normal: &Vector3<f64>,
+    on_face: &Vector3<f64>,
+    tolerance: f64,
+    item: &str,
+    what: &str,
+) -> Result<f64, ModelError> {
+    match child {
+        ChildSide::Point(p) => {
+            let side = face_normal.dot(&(p - on_face));
+            if side.abs() <= tolerance {
                 return Err(ModelError::new(
-                    item_n,
+                    item,
                     format!(
-                        "[{:.6}, {:.6}, {:.6}] is not perpendicular to the joint face: it makes                          {:.4}° with the line between two of its points",
-                        n.x,
-                        n.y,
-                        n.z,
-                        90.0 - n.dot(&d.normalize()).abs().acos().to_degrees()
+                        "the child's centre of mass lies in {what}: cannot tell which side is \
+                         the child's (give the interface's `normal`)"
                     ),
                 ));
             }
+            Ok(side.signum())
+        }
+        ChildSide::Normal(n) => {
+            let cos = n.dot(face_normal);
+            if cos.abs() < NORMAL_SLACK.cos() {
+                return Err(ModelError::new(
+                    format!("{item} (normal)"),
+                    format!(
+                        "[{:.6}, {:.6}, {:.6}] is not the normal of {what}: it is {:.4}° from \
+                         it (at most {:.0}°)",
+                        n.x,
+                        n.y,
+                        n.z,
+                        cos.abs().min(1.0).acos().to_degrees(),
+                        NORMAL_SLACK.to_degrees()
+                    ),
+                ));
+            }
+            Ok(cos.signum())
         }
     }
-    let centre = points.iter().sum::<Vector3<f64>>() / points.len().max(1) as f64;
-    Ok(centre + n * size)
 }
 
 /// The point [`Model::from_spec`] takes for the child's side of an interface with no `normal`,
@@ -618,7 +671,7 @@ fn side_point(body: &Body, face: &[[f64; 3]]) -> Vector3<f64> {
 
 fn hinge_kind(
     spec: &InterfaceSpec,
-    child_com: &Vector3<f64>,
+    child: &ChildSide,
     item: &str,
     size: f64,
 ) -> Result<InterfaceKind, ModelError> {
@@ -648,25 +701,49 @@ fn hinge_kind(
     })?;
     let pp = pivot_point(pp, &axis, item, "pivot_positive", size)?;
     let pn = pivot_point(pn, &axis, item, "pivot_negative", size)?;
+    // A given normal lies across the axis (the joint face contains it).
+    if let ChildSide::Normal(n) = child
+        && n.dot(&axis).abs() > NORMAL_SLACK.sin()
+    {
+        return Err(ModelError::new(
+            format!("{item} (normal)"),
+            format!(
+                "[{:.6}, {:.6}, {:.6}] is not perpendicular to the axis: it makes {:.4}° with \
+                 it, not within {:.0}° of 90° (the joint face contains the axis)",
+                n.x,
+                n.y,
+                n.z,
+                n.dot(&axis).abs().min(1.0).acos().to_degrees(),
+                NORMAL_SLACK.to_degrees()
+            ),
+        ));
+    }
     // Offset between the two pivot lines, perpendicular to the axis.
     let offset = (pn - pp) - axis * axis.dot(&(pn - pp));
     if offset.norm() > GEOMETRY_TOLERANCE * size {
         // A small positive rotation about P⁺ moves P⁻ with velocity u × (P⁻ − P⁺): it must go
         // towards the child's side of the joint face, i.e. the side of the child's centre.
-        let lift = axis.cross(&offset);
-        let side = lift.dot(&(child_com - pp)) / (lift.norm() * size);
-        if side.abs() <= GEOMETRY_TOLERANCE {
-            return Err(ModelError::new(
-                item,
-                "the child's centre of mass lies in the joint face through the two pivots: cannot tell which side is the child's",
-            ));
-        }
+        let lift = axis.cross(&offset).normalize();
+        let side = side_of(
+            child,
+            &lift,
+            &pp,
+            GEOMETRY_TOLERANCE * size,
+            item,
+            "the joint face through the two pivots",
+        )?;
         if side < 0.0 {
+            let away = match child {
+                ChildSide::Point(_) => "away from the child's centre of mass",
+                ChildSide::Normal(_) => "against the interface's normal",
+            };
             return Err(ModelError::new(
                 item,
-                "pivots swapped: a small positive rotation about pivot_positive moves pivot_negative into the parent \
-                 (away from the child's centre of mass). With a right-handed angle about the axis, pivot_positive must be \
-                 the edge the child rocks on when the angle is positive; exchange pivot_positive and pivot_negative, or reverse the axis",
+                format!(
+                    "pivots swapped: a small positive rotation about pivot_positive moves pivot_negative into the parent \
+                     ({away}). With a right-handed angle about the axis, pivot_positive must be \
+                     the edge the child rocks on when the angle is positive; exchange pivot_positive and pivot_negative, or reverse the axis"
+                ),
             ));
         }
     }
@@ -680,7 +757,7 @@ fn hinge_kind(
 fn rocking_base_kind(
     corners: &[[f64; 3]],
     twist: bool,
-    child_com: &Vector3<f64>,
+    child: &ChildSide,
     item: &str,
     size: f64,
 ) -> Result<InterfaceKind, ModelError> {
@@ -726,14 +803,7 @@ fn rocking_base_kind(
             ));
         }
     }
-    let side = normal.dot(&(child_com - c[0]));
-    if side.abs() <= tol {
-        return Err(ModelError::new(
-            item_c,
-            "the child's centre of mass lies in the contact plane: cannot tell which side is the child's",
-        ));
-    }
-    if side < 0.0 {
+    if side_of(child, &normal, &c[0], tol, &item_c, "the contact plane")? < 0.0 {
         normal = -normal;
     }
     let e1 = edges[0].normalize();
@@ -1440,8 +1510,8 @@ fn build_interfaces(
             ));
         }
         let child_side = match i.normal {
-            None => side_point(&bodies[child], &given),
-            Some(n) => normal_side_point(&n, &given, &item, size)?,
+            None => ChildSide::Point(side_point(&bodies[child], &given)),
+            Some(n) => ChildSide::Normal(given_normal(&n, &bodies[child], &given, &item)?),
         };
         let kind = match &i.rocking_base {
             Some(rb) => {

@@ -385,3 +385,69 @@ fn models_beyond_the_dense_size_are_refused() {
     let model = Model::from_spec(&blocks(1024)).expect("2 048 coordinates build");
     assert_eq!(model.dof(), MAX_COORDINATES);
 }
+
+/// An interface's `normal` says which side of its face is the child's. It is refused where it
+/// is not the face's normal within 1° (a hinge: across its axis, and normal to the face through
+/// its pivot lines), zero or not finite, or where it points away from a convex child's centre
+/// (a box lies wholly on its centre's side); a normal off by the rounding of a face's corners
+/// (1e-5 rad) is the face's. With a normal along the hinge's lift the block is the same model as
+/// without it, and pointing the other way the pivots are "swapped" against the normal.
+#[test]
+fn a_given_normal_is_the_face_s_within_a_degree() {
+    let with = |normal: &str| {
+        build(&BLOCK.replacen(
+            "pivot_negative = [-0.25, 0.0, 0.0]",
+            &format!("pivot_negative = [-0.25, 0.0, 0.0]\nnormal = {normal}"),
+            1,
+        ))
+    };
+    let plain = build(BLOCK).unwrap();
+    assert_eq!(
+        with("[0.0, 0.0, 2.0]").unwrap().interfaces,
+        plain.interfaces
+    );
+    assert_eq!(
+        with("[1e-5, 0.0, 1.0]").unwrap().interfaces,
+        plain.interfaces
+    );
+    let e = with("[0.0, 0.0, -1.0]").unwrap_err();
+    assert_mentions(
+        &e,
+        "base",
+        &["points away from the centre of mass", "convex"],
+    );
+    let e = with("[0.0, 1.0, 0.02]").unwrap_err();
+    assert_mentions(
+        &e,
+        "base",
+        &["is not perpendicular to the axis", "makes 1.1458° with it"],
+    );
+    let e = with("[0.05, 0.0, 1.0]").unwrap_err();
+    assert_mentions(
+        &e,
+        "base",
+        &["is not the normal of the joint face", "2.8624°"],
+    );
+    let e = with("[0.0, 0.0, 0.0]").unwrap_err();
+    assert_mentions(&e, "base", &["the zero vector"]);
+    let e = with("[0.0, nan, 1.0]").unwrap_err();
+    assert_mentions(&e, "base", &["normal"]);
+    // A rocking base: the corners' plane, z = 0.
+    let base = BLOCK.replacen(
+        "axis = [0.0, 1.0, 0.0]\npivot_positive = [0.25, 0.0, 0.0]\npivot_negative = [-0.25, 0.0, 0.0]",
+        "rocking_base = { corners = [[-0.25, -0.25, 0.0], [0.25, -0.25, 0.0], [0.25, 0.25, 0.0], [-0.25, 0.25, 0.0]] }",
+        1,
+    );
+    let plain = build(&base).unwrap();
+    let with = |normal: &str| build(&format!("{base}normal = {normal}\n"));
+    assert_eq!(
+        with("[0.0, 0.0, 1.0]").unwrap().interfaces,
+        plain.interfaces
+    );
+    let e = with("[1.0, 0.0, 0.0]").unwrap_err();
+    assert_mentions(
+        &e,
+        "base",
+        &["is not the normal of the contact plane", "90.0000° from it"],
+    );
+}

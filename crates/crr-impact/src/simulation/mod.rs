@@ -511,7 +511,7 @@ pub struct Simulation<'a> {
     /// The first sample of the last instant samples were taken at: its time, the chain's
     /// coordinates by name and their values. Taken before that instant's events (an impact, a
     /// landing) switch the state: what their snaps moved ([`Self::snap_shift`]).
-    pre_event: (f64, Vec<(String, f64)>),
+    pre_event: (f64, Vec<(String, f64)>, Vec<Side>),
     /// The snaps and the impacts' losses when the monitor first found a hypothesis failing.
     snaps_at_violation: Option<SnapsAndLosses>,
     /// Uplift events in a row that released nothing ([`SimulationError::Undecided`]).
@@ -1039,7 +1039,7 @@ impl<'a> Simulation<'a> {
             peak_abs: vec![0.0; n],
             balance_error: 0.0,
             last_sample_t: f64::NEG_INFINITY,
-            pre_event: (f64::NAN, Vec::new()),
+            pre_event: (f64::NAN, Vec::new(), Vec::new()),
             samples: Samples::with_capacity(
                 n,
                 model.slot_count,
@@ -1365,7 +1365,7 @@ impl<'a> Simulation<'a> {
                 return Err(SimulationError::Invariant(format!(
                     "at t = {} s the loops are open by {residual:.3e} (row-scaled |Φ|): the state has left the closed chain; {}",
                     self.t,
-                    self.remedy()
+                    self.remedy_without_slot()
                 )));
             }
         }
@@ -1382,7 +1382,7 @@ impl<'a> Simulation<'a> {
                 "at t = {} s a corner of the open face of \"{name}\" is {:.3e} m inside its support: its landing was missed; {}",
                 self.t,
                 -gap,
-                self.remedy()
+                self.remedy_without_slot()
             )));
         }
         let mut broken = None;
@@ -1393,11 +1393,11 @@ impl<'a> Simulation<'a> {
                 let angle = angles[s];
                 if angle.is_nan() || angle.abs() > tol {
                     self.spare.invariant_angles = angles;
+                    let remedy = self.remedy((s, angle), |x| x.is_nan() || x.abs() > tol);
                     return Err(SimulationError::Invariant(format!(
-                        "at t = {} s the angle \"{}\" is {angle:.6} rad while it is seated: the state has left its seat; {}",
+                        "at t = {} s the angle \"{}\" is {angle:.6} rad while it is seated: the state has left its seat; {remedy}",
                         self.t,
                         model.slot_name(s),
-                        self.remedy()
                     )));
                 }
                 continue;
@@ -1412,15 +1412,15 @@ impl<'a> Simulation<'a> {
         }
         self.spare.invariant_angles = angles;
         if let Some((s, side, angle)) = broken {
+            let remedy = self.remedy((s, angle), |x| x.is_nan() || side.sign() * x < -tol);
             return Err(SimulationError::Invariant(format!(
-                "at t = {} s the angle \"{}\" is {angle:.6} rad while it rocks on its {} pivot: the state is on the wrong side of its pivot (an impact was missed); {}",
+                "at t = {} s the angle \"{}\" is {angle:.6} rad while it rocks on its {} pivot: the state is on the wrong side of its pivot (an impact was missed); {remedy}",
                 self.t,
                 model.slot_name(s),
                 match side {
                     Side::Positive => "+",
                     Side::Negative => "-",
                 },
-                self.remedy()
             )));
         }
         Ok(())
@@ -1432,7 +1432,57 @@ impl<'a> Simulation<'a> {
     /// changes: the message says so (on the bundled wall under a pulse of 12 m/s², as of commit
     /// 6ac4261, a landing's snap put a rocking angle 7.9e-5 rad past its pivot, the same with
     /// rtol 1e-10 and 1e-12).
-    fn remedy(&self) -> String {
+    fn remedy_without_slot(&self) -> String {
+        let names = self.event_names();
+        self.remedy_with(&names, String::new())
+    }
+
+    /// The interfaces of every impact or landing record of this instant (landings that push
+    /// other faces in come in a cascade).
+    fn event_names(&self) -> Vec<String> {
+        self.impacts
+            .iter()
+            .rev()
+            .take_while(|i| i.t == self.t)
+            .flat_map(|i| i.interfaces.iter().cloned())
+            .collect()
+    }
+
+    /// [`Self::remedy_without_slot`] for the failing slot s at its angle now, `wrong` telling
+    /// an angle outside the model (past its pivot, or off its seat): how the events of this
+    /// instant moved it, and whether it was already wrong before them (then the integration
+    /// missed an impact, which the tolerance does change).
+    fn remedy(&mut self, (s, now): (usize, f64), wrong: impl Fn(f64) -> bool) -> String {
+        let names = self.event_names();
+        let before = if names.is_empty() {
+            None
+        } else {
+            self.angle_before_events(s)
+        };
+        let name = self.model.slot_name(s);
+        // On the same pivot before the events as now (an impact switches its own).
+        let same_side = self.pre_event.2.get(s) == self.dynamics.pivots.sides.get(s);
+        match before {
+            Some(before) if same_side && wrong(before) => format!(
+                "{} (\"{name}\" was already at {before:.3e} rad before the impact or landing \
+                 of {} at this instant: the integration passed an impact)",
+                self.remedy_with(&[], String::new()),
+                names.join(", ")
+            ),
+            Some(before) if (now - before).abs() > 0.0 => self.remedy_with(
+                &names,
+                format!(
+                    " (the events moved \"{name}\" from {before:.3e} to {now:.3e} rad: a snap \
+                     closes the loops on the new pivots, and bodies that meet away from the \
+                     points their pivots had at rest, after a flight or a rattle, are brought \
+                     back to them)"
+                ),
+            ),
+            _ => self.remedy_with(&names, String::new()),
+        }
+    }
+
+    fn remedy_with(&self, names: &[String], moved: String) -> String {
         let integration = match self.params.method {
             Method::Rk4 { step } => format!("shorten analysis.rk4_step (now {step:e} s)"),
             _ => format!(
@@ -1440,25 +1490,9 @@ impl<'a> Simulation<'a> {
                 self.params.options.rtol
             ),
         };
-        // Every record of this instant (landings that push other faces in come in a cascade).
-        let names: Vec<&str> = self
-            .impacts
-            .iter()
-            .rev()
-            .take_while(|i| i.t == self.t)
-            .flat_map(|i| i.interfaces.iter().map(String::as_str))
-            .collect();
         if names.is_empty() {
             return integration;
         }
-        let moved = match self.snap_shift() {
-            Some((name, shift)) => format!(
-                " (the snap moved \"{name}\" by {shift:.1e} rad, to close the loops on the new \
-                 pivots: bodies that meet away from the points their pivots had at rest, after a \
-                 flight or a rattle, are brought back to them)"
-            ),
-            None => String::new(),
-        };
         format!(
             "{integration}; the state at this instant was set by the impact or landing of {} and \
              its snap{moved}, which a tolerance does not change: if the failure comes back at \
@@ -1467,16 +1501,17 @@ impl<'a> Simulation<'a> {
         )
     }
 
-    /// The coordinate the events of this instant moved most, and by how much (rad): the
-    /// difference between the state now and the sample taken just before the first event of
-    /// the instant. An impact law changes the rates only, so what moved the angles is the
-    /// snaps (impacting angles to 0, seats, loops closed on the new pivots). None where no
-    /// event sample was taken at this instant, the chain has changed since, or nothing moved.
-    fn snap_shift(&self) -> Option<(String, f64)> {
-        let (t, before) = &self.pre_event;
-        let coords = &self.model.coords;
-        // The same chain (a landing that closes a loop keeps its tree; a re-rooted one may turn
-        // an interface round, whose angles then change sign).
+    /// Slot `s`'s angle before the events of this instant (an impact, a landing), from the
+    /// sample taken just before the first of them: a coordinate's value, or a closure angle
+    /// from the bodies' rotations then (which the pivots do not change). An impact law changes
+    /// the rates only, so what moved an angle at this instant is the events' snaps (impacting
+    /// angles to 0, seats, loops closed on the new pivots). None where no event sample was
+    /// taken at this instant, or the chain's tree has changed since (a re-rooted chain may turn
+    /// an interface round, whose angles then change sign).
+    fn angle_before_events(&mut self, s: usize) -> Option<f64> {
+        let (t, before, _) = &self.pre_event;
+        let model = Arc::clone(&self.model);
+        let coords = &model.coords;
         if *t != self.t
             || before.len() != coords.len()
             || before
@@ -1486,10 +1521,15 @@ impl<'a> Simulation<'a> {
         {
             return None;
         }
-        let (k, shift) = (0..coords.len())
-            .map(|k| (k, (self.y[k] - before[k].1).abs()))
-            .max_by(|a, b| a.1.total_cmp(&b.1))?;
-        (shift > 0.0).then(|| (coords[k].name.clone(), shift))
+        let n = coords.len();
+        if s < n {
+            return Some(before[s].1);
+        }
+        let q = DVector::from_iterator(n, before.iter().map(|(_, x)| *x));
+        forward_kinematics(&model, &mut self.out_kin, &q, &self.dynamics.pivots);
+        let mut angles = vec![0.0; model.slot_count - n];
+        closure_angles(&model, &self.out_kin, &mut angles);
+        angles.get(s - n).copied()
     }
 
     fn step_unchecked(&mut self) -> Result<StopReason, SimulationError> {

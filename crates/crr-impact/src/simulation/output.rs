@@ -192,6 +192,7 @@ impl Simulation<'_> {
                 .zip(&self.y)
                 .map(|(c, &q)| (c.name.clone(), q));
             self.pre_event.1.extend(values);
+            self.pre_event.2.clone_from(&self.dynamics.pivots.sides);
         }
         let y = std::mem::take(&mut self.y);
         let s = self.sample_at(t, &y);
