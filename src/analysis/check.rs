@@ -340,6 +340,10 @@ fn sliding_note(m: &crate::analysis::static_multiplier::StaticMultiplier, budget
         Some(crr_impact::statics::Unexhausted::SolverFailed(status)) => format!(
             "a program of the pass over the sets of joints that may open and slide did not solve ({status}), so not every set was tried"
         ),
+        Some(crr_impact::statics::Unexhausted::WithFriction) => "with Coulomb friction the \
+            statics solve the convex program alone, the search for joints that open and slide \
+            running without sliding (its answer is taken where the friction asked covers it)"
+            .to_string(),
         _ => match m.exhaustive_sets_needed {
             Some(needed) => format!(
                 "the structure's loops give {needed} sets of joints that may open and slide, more than the statics try ({budget}): `crr check --exhaustive-sets {needed}` tries them all, at one to three linear programs a set"

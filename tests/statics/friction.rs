@@ -174,3 +174,53 @@ fn holding_up_to_the_cap_says_the_friction_it_needs() {
         assert!((lambda - 9.0).abs() < 1e-7 * 9.0, "{d:?}: {lambda}");
     }
 }
+
+/// With friction μ the report is never above a collapse state found without sliding whose own
+/// friction μ covers: that state is admissible with μ too. The bundled wall along +x: without a
+/// friction limit its corner wedge opens at λ = 7/11 (virtual work, the model's header) and
+/// needs μ ≥ 0.6364; asked with μ = 1.5, 3 and 10 the report gave 0.810, 0.902 and 0.943 (the
+/// convex program with friction alone, marked exhaustive: an independent review) and now gives
+/// 7/11 with the wedge's need. Below that need (μ = 0.5) the wall slides on its base at
+/// λ = μ by hand, an answer of the convex program alone, which the report marks as not
+/// exhaustive (`with_friction`): a mechanism that opens a joint while others slide within μ may
+/// open lower.
+#[test]
+fn a_friction_that_covers_a_collapse_state_without_sliding_keeps_it() {
+    use crr::analysis::static_multiplier::{MultiplierOptions, static_multiplier_with};
+    use crr::impact::statics::Unexhausted;
+    let model = bundled("wall");
+    let with = |friction: Option<f64>| {
+        static_multiplier_with(
+            &model,
+            Vector3::x(),
+            &MultiplierOptions {
+                friction,
+                ..MultiplierOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let plain = with(None);
+    assert!(
+        (plain.lambda.unwrap() - 7.0 / 11.0).abs() < 1e-7,
+        "{plain:?}"
+    );
+    let need = plain.required_friction.unwrap();
+    assert!(need < 0.64, "{need}");
+    for mu in [1.5, 3.0, 10.0] {
+        let m = with(Some(mu));
+        assert!(
+            (m.lambda.unwrap() - 7.0 / 11.0).abs() < 1e-7,
+            "μ = {mu}: {m:?}"
+        );
+        assert_eq!(m.required_friction, Some(need));
+        assert!(m.exhaustive);
+    }
+    let slides = with(Some(0.5));
+    assert!((slides.lambda.unwrap() - 0.5).abs() < 1e-7, "{slides:?}");
+    assert!(!slides.exhaustive);
+    assert_eq!(
+        slides.not_exhaustive_because,
+        Some(Unexhausted::WithFriction)
+    );
+}

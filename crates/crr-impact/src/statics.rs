@@ -265,6 +265,11 @@ pub enum Unexhausted {
     SolverFailed(String),
     /// Only the convex program was asked (`sliding_lift_off: false`) on a structure with loops.
     ConvexOnly,
+    /// Coulomb friction was asked on a structure with loops: the search for joints that open
+    /// and slide runs without a friction limit only, so with friction λ is the convex
+    /// program's (an upper bound: a mechanism in which a joint opens while others slide within
+    /// the friction may open lower).
+    WithFriction,
 }
 
 impl Unexhausted {
@@ -339,15 +344,16 @@ pub fn collapse_multiplier(
     let faces = contact_faces(model);
     let mut free = vec![false; faces.len()];
     let convex = solve_program(model, &faces, d, options, &free, &[])?;
+    // A tree has no interface that a collapse state may unload: the convex answer is exact.
+    let candidates = unloaded_sets::candidates(model, &faces);
     if options.friction != Friction::NoSliding {
+        let tree = candidates.is_empty();
         return Ok(Collapse {
-            exhaustive: true,
-            unexhausted: None,
+            exhaustive: tree,
+            unexhausted: (!tree).then_some(Unexhausted::WithFriction),
             ..convex
         });
     }
-    // A tree has no interface that a collapse state may unload: the convex answer is exact.
-    let candidates = unloaded_sets::candidates(model, &faces);
     if candidates.is_empty() {
         return Ok(Collapse {
             exhaustive: true,
