@@ -223,8 +223,11 @@ pub fn static_multiplier_with(
     };
     // With friction μ: a collapse state found without sliding whose own friction is within μ is
     // a collapse state with μ too, and where it is lower it is the answer (the convex program
-    // with friction, without the search, answered up to 48 % above it on the bundled wall).
-    if let Some(mu) = friction {
+    // with friction, without the search, answered up to 48 % above it on the bundled wall). On
+    // a tree (an exhaustive answer) the convex program is exact and the two agree.
+    if let Some(mu) = friction
+        && !collapse.exhaustive
+    {
         let plain = static_multiplier_with(
             model,
             direction,

@@ -1116,21 +1116,10 @@ pub fn structure_of(
 /// not clearly the contact's: its direction from the face within 0.06° of the face's plane, or
 /// beyond it.
 fn needs_normal(bodies: &[BodySpec], c: &ContactFace, spec: &InterfaceSpec) -> bool {
-    let face: Vec<[f64; 3]> = match (
-        &spec.rocking_base,
-        &spec.pivot_positive,
-        &spec.pivot_negative,
-    ) {
-        (Some(rb), _, _) => rb.corners.clone(),
-        (None, Some(p), Some(n)) => [p, n]
-            .into_iter()
-            .flat_map(|x| match x {
-                PivotSpec::Point(a) => vec![*a],
-                PivotSpec::Segment(s) => s.to_vec(),
-            })
-            .collect(),
-        _ => return false,
-    };
+    let face = spec.face_points();
+    if face.is_empty() {
+        return false;
+    }
     let Some(side) = crate::model::default_side_point(&bodies[c.upper], &face) else {
         return false;
     };

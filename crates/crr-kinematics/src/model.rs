@@ -1484,17 +1484,7 @@ fn build_interfaces(
         // (millimetres for metres). 100 times the child's size leaves room for any real
         // joint and catches those.
         let reach = PIVOT_REACH * bodies[child].volume.cbrt();
-        let given: Vec<[f64; 3]> = match (&i.rocking_base, &i.pivot_positive, &i.pivot_negative) {
-            (Some(rb), _, _) => rb.corners.clone(),
-            (None, p, n) => [p, n]
-                .into_iter()
-                .flatten()
-                .flat_map(|x| match x {
-                    PivotSpec::Point(a) => vec![*a],
-                    PivotSpec::Segment(s) => s.to_vec(),
-                })
-                .collect(),
-        };
+        let given = i.face_points();
         if let Some(far) = given
             .iter()
             .map(|x| (Vector3::from(*x) - child_com).norm())

@@ -262,6 +262,28 @@ pub struct RockingBaseSpec {
     pub twist: bool,
 }
 
+impl InterfaceSpec {
+    /// The points the interface gives on its joint face: a rocking base's corners, a hinge's
+    /// pivot points (both ends of a pivot given as an edge).
+    pub fn face_points(&self) -> Vec<[f64; 3]> {
+        match (
+            &self.rocking_base,
+            &self.pivot_positive,
+            &self.pivot_negative,
+        ) {
+            (Some(rb), _, _) => rb.corners.clone(),
+            (None, p, n) => [p, n]
+                .into_iter()
+                .flatten()
+                .flat_map(|x| match x {
+                    PivotSpec::Point(a) => vec![*a],
+                    PivotSpec::Segment(s) => s.to_vec(),
+                })
+                .collect(),
+        }
+    }
+}
+
 /// How an impact at this interface dissipates energy (used by the impact stage).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]

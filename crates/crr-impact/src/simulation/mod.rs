@@ -510,7 +510,7 @@ pub struct Simulation<'a> {
     energy_at_snaps: f64,
     /// The first sample of the last instant samples were taken at: its time, the chain's
     /// coordinates by name and their values. Taken before that instant's events (an impact, a
-    /// landing) switch the state: what their snaps moved ([`Self::snap_shift`]).
+    /// landing) switch the state: what their snaps moved ([`Self::angle_before_events`]).
     pre_event: (f64, Vec<(String, f64)>, Vec<Side>),
     /// The snaps and the impacts' losses when the monitor first found a hypothesis failing.
     snaps_at_violation: Option<SnapsAndLosses>,

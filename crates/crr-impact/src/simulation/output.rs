@@ -182,7 +182,8 @@ impl Simulation<'_> {
 
     /// Takes and records the sample of the current state at `t`.
     pub(super) fn record_current_sample(&mut self, t: f64) {
-        // The first sample of an instant is the state before its events (snap_shift).
+        // The first sample of an instant is the state before its events
+        // (angle_before_events).
         if self.pre_event.0 != t {
             self.pre_event.0 = t;
             self.pre_event.1.clear();
