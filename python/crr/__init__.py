@@ -389,6 +389,9 @@ class Model:
                 sliding, and the report gives the μ each multiplier needs.
             exhaustive_sets: the most sets of joints that may open and slide the exhaustive
                 pass tries per direction, as ``--exhaustive-sets`` (default 4096).
+
+        Ctrl-C stops the check after the stage under way (one linear program of the statics,
+        or the mobility's factorisation) and raises ``KeyboardInterrupt``.
         """
         directions: Optional[List[str]] = None
         if direction is not None:

@@ -246,9 +246,19 @@ impl PyModel {
         if let Some(n) = exhaustive_sets {
             asked.exhaustive_sets = n;
         }
-        let report =
-            py.detach(|| crr::analysis::check::check_with(&self.structure, &directions, &asked));
-        Ok(serde_json::to_string(&report).expect("the report serialises"))
+        // Ctrl-C stops the check after the stage under way (one linear program of the statics,
+        // or one factorisation of the mobility) and raises KeyboardInterrupt: a check has no
+        // partial result to keep.
+        let cancel = crr::Cancel::new();
+        asked.cancel = Some(cancel.clone());
+        match interruptible(py, &cancel, || {
+            crr::analysis::check::check_with(&self.structure, &directions, &asked)
+        }) {
+            Ok(Ok(report)) => Ok(serde_json::to_string(&report).expect("the report serialises")),
+            // Only a Ctrl-C sets the flag, and it comes back as the interrupt below.
+            Ok(Err(interrupted)) => Err(PyRuntimeError::new_err(interrupted.to_string())),
+            Err((interrupt, _)) => Err(interrupt),
+        }
     }
 
     /// `crr poincare` of this model (nothing written): the options as the command line takes

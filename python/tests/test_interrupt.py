@@ -127,3 +127,20 @@ def test_ctrl_c_stops_a_poincare_sweep_and_keeps_the_points_computed() -> None:
     # Python is usable afterwards.
     again = crr.poincare(BLOCK, 4.0, 2.0, periods=3, transient=1, rest=True)
     assert again.summary["section"]["points"] == 3
+
+
+def test_ctrl_c_stops_a_long_check() -> None:
+    # The bundled planar wall along 96 directions (2186 sets of joints that may open and slide
+    # each, some 2.7 s a direction): about two minutes of two cores uninterrupted. The check has
+    # nothing partial to keep: KeyboardInterrupt, then Python goes on.
+    wall = crr.Model.from_file(ROOT / "examples" / "models" / "wall.toml")
+    directions = [(1.0 if k % 2 == 0 else -1.0, 0.0, 1e-3 * k) for k in range(96)]
+    timer, sent = _interrupt_after(0.5)
+    with pytest.raises(KeyboardInterrupt):
+        wall.check(direction=directions)
+    caught = time.monotonic()
+    timer.join()
+    assert caught - sent["t"] < STOPPED_WITHIN_S, f"{caught - sent['t']:.3f} s after the signal"
+    # Python is usable afterwards, and so is the model: the wall's corner wedge along +x, 7/11.
+    again = wall.check(direction="+x")
+    assert abs(again["static_multipliers"][0]["lambda"] - 7.0 / 11.0) < 1e-9

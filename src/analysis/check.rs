@@ -241,22 +241,39 @@ pub const FINITE_STEP: f64 = 0.01;
 
 /// Builds the report, with the static multipliers along ±x and ±y without sliding.
 pub fn check(model: &Model) -> CheckReport {
-    check_with(
+    match check_with(
         model,
         &horizontal_directions(),
         &MultiplierOptions::default(),
-    )
+    ) {
+        Ok(report) => report,
+        Err(CheckInterrupted) => unreachable!("a check without a request to stop runs through"),
+    }
 }
 
+/// A check stopped by its request to stop ([`MultiplierOptions::cancel`]): it has no report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the check was interrupted")]
+pub struct CheckInterrupted;
+
 /// Builds the report, with the static multipliers along `directions` (unit or not; the ground
-/// accelerating along each), asked with `asked` (friction, the exhaustive pass's budget).
+/// accelerating along each), asked with `asked` (friction, the exhaustive pass's budget, a
+/// request to stop). Once `asked.cancel` is set the check stops after the stage under way (the
+/// mobility's factorisation, the finite step, the one-DOF mechanism, or one linear program of
+/// the statics) and answers [`CheckInterrupted`].
 pub fn check_with(
     model: &Model,
     directions: &[Vector3<f64>],
     asked: &MultiplierOptions,
-) -> CheckReport {
+) -> Result<CheckReport, CheckInterrupted> {
+    let go_on = || match &asked.cancel {
+        Some(cancel) if cancel.is_cancelled() => Err(CheckInterrupted),
+        _ => Ok(()),
+    };
+    go_on()?;
     let zero = DVector::zeros(model.dof());
     let mob = mobility(model, &zero, &ActivePivots::uniform(model, Side::Positive));
+    go_on()?;
     let (finite, finite_note) = if model.closure_rows > 0 && !mob.locked {
         match mobility_after_step(model, FINITE_STEP) {
             Ok(f) => (Some(f), None),
@@ -265,6 +282,7 @@ pub fn check_with(
     } else {
         (None, None)
     };
+    go_on()?;
     let (mech, note) = if mob.dof2 == 1 {
         match mechanism(model) {
             Ok(m) => (Some(m), None),
@@ -301,11 +319,14 @@ pub fn check_with(
             .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect::<Result<Vec<_>, _>>()
     });
+    // An interrupted direction answers an error, and one that ran through may have run past
+    // the request: neither is reported.
+    go_on()?;
     let (statics, statics_note) = match statics {
         Ok(v) => (v, None),
         Err(e) => (Vec::new(), Some(e)),
     };
-    CheckReport {
+    Ok(CheckReport {
         model: model.name.clone(),
         gravity: model.gravity,
         coordinates: model.coords.iter().map(|c| c.name.clone()).collect(),
@@ -328,7 +349,7 @@ pub fn check_with(
             .chain(crate::analysis::contact_geometry::bodies_held_by_shear_alone(model))
             .chain(crate::analysis::body_sizes::bodies_too_large(model))
             .collect(),
-    }
+    })
 }
 
 /// The lines of a multiplier's report on joints that open and slide: where λ comes from them,

@@ -103,6 +103,18 @@ impl Cancel {
     pub fn is_cancelled(&self) -> bool {
         self.0.load(Ordering::Relaxed)
     }
+
+    /// The same flag as the statics' request to stop ([`crr_impact::statics::Interrupt`]).
+    pub fn as_statics_interrupt(&self) -> crr_impact::statics::Interrupt {
+        crr_impact::statics::Interrupt(Arc::clone(&self.0))
+    }
+}
+
+/// Two are equal where they share the flag.
+impl PartialEq for Cancel {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 /// Everything a run needs, read and checked from the inputs.

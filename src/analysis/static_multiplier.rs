@@ -16,6 +16,7 @@ use std::collections::BTreeMap;
 use nalgebra::Vector3;
 use serde::Serialize;
 
+use crate::analysis::simulation::Cancel;
 use crr_impact::statics::{
     COUNTED_SETS, Collapse, Friction, Motion, StaticsError, StaticsOptions, Unexhausted,
     collapse_multiplier, exhaustive_sets_needed, hinges_out_of_plane, required_friction,
@@ -110,7 +111,7 @@ pub struct StaticMultiplier {
 }
 
 /// What the static multipliers are asked with.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MultiplierOptions {
     /// Coulomb friction μ at every contact point (the exact cone ‖(f₁, f₂)‖ ≤ μ fₙ; a hinge's
     /// in its plane); `None`: no sliding, and the report gives the friction each multiplier
@@ -120,13 +121,21 @@ pub struct MultiplierOptions {
     /// ([`crr_impact::statics::StaticsOptions::exhaustive_sets`]); beyond them λ is the
     /// search's answer, an upper bound.
     pub exhaustive_sets: usize,
+    /// A request to stop: once set, the statics stop after the linear program under way and
+    /// [`static_multiplier_with`] answers [`INTERRUPTED`] (the search and the exhaustive pass
+    /// solve hundreds to thousands of programs on a wall).
+    pub cancel: Option<Cancel>,
 }
+
+/// The error of a multiplier whose [`MultiplierOptions::cancel`] was set.
+pub const INTERRUPTED: &str = "interrupted";
 
 impl Default for MultiplierOptions {
     fn default() -> Self {
         MultiplierOptions {
             friction: None,
             exhaustive_sets: crr_impact::statics::EXHAUSTIVE_SETS,
+            cancel: None,
         }
     }
 }
@@ -169,8 +178,10 @@ pub fn static_multiplier_with(
     let options = StaticsOptions {
         friction: friction.map_or(Friction::NoSliding, Friction::Cone),
         exhaustive_sets: asked.exhaustive_sets,
+        interrupt: asked.cancel.as_ref().map(Cancel::as_statics_interrupt),
         ..StaticsOptions::default()
     };
+    let cancelled = || asked.cancel.as_ref().is_some_and(Cancel::is_cancelled);
     let along_axis = out_of_plane(model, &direction);
     if along_axis == Some(1.0) {
         // Along a planar model's hinge axis the hinges hold any load, so there is no multiplier
@@ -202,6 +213,10 @@ pub fn static_multiplier_with(
         });
     }
     let collapse = collapse_multiplier(model, direction, &options).map_err(|e| e.to_string())?;
+    // The friction's and the hinges' programs take no request to stop: a few programs each.
+    if cancelled() {
+        return Err(INTERRUPTED.into());
+    }
     // The friction the answer relies on: for a collapse state of the search for joints that
     // open and slide, that of its own holding points (more than the convex program's).
     let required = match (collapse.lambda, friction) {
@@ -233,7 +248,7 @@ pub fn static_multiplier_with(
             direction,
             &MultiplierOptions {
                 friction: None,
-                ..*asked
+                ..asked.clone()
             },
         )?;
         let covered = plain.required_friction.is_some_and(|need| need <= mu);

@@ -224,3 +224,96 @@ fn a_sample_limit_stops_a_run_in_memory() {
         assert_eq!((x.t, x.q, x.qdot), (y.t, y.q, y.qdot));
     }
 }
+
+/// The bundled planar wall (`wall.toml`: 2186 sets of joints that may open and slide per
+/// direction, about 2.7 s of a release build each) along `n` directions in the plane, each
+/// with a small vertical part of its own: some n × 1.35 s on two cores uninterrupted.
+fn wall_directions(n: usize) -> (crr::kinematics::Model, Vec<nalgebra::Vector3<f64>>) {
+    let model = common::bundled_model("wall");
+    let directions = (0..n)
+        .map(|k| {
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            nalgebra::Vector3::new(sign, 0.0, 1e-3 * k as f64)
+        })
+        .collect();
+    (model, directions)
+}
+
+/// A check whose request to stop is set before it starts gives no report, and so do the
+/// statics below it (`static_multiplier_with`, `collapse_multiplier`); a request not set
+/// changes nothing.
+#[test]
+fn a_check_asked_to_stop_before_it_starts_gives_no_report() {
+    use crr::analysis::check::{CheckInterrupted, check_with};
+    use crr::analysis::static_multiplier::{
+        INTERRUPTED, MultiplierOptions, static_multiplier_with,
+    };
+    use crr::impact::statics::{StaticsError, StaticsOptions, collapse_multiplier};
+    let (model, _) = wall_directions(0);
+    let x = nalgebra::Vector3::x();
+    let cancel = Cancel::new();
+    cancel.cancel();
+    let asked = MultiplierOptions {
+        cancel: Some(cancel.clone()),
+        ..MultiplierOptions::default()
+    };
+    assert_eq!(
+        check_with(&model, &[x], &asked).err(),
+        Some(CheckInterrupted)
+    );
+    assert_eq!(
+        static_multiplier_with(&model, x, &asked).err(),
+        Some(INTERRUPTED.to_string())
+    );
+    let options = StaticsOptions {
+        interrupt: Some(cancel.as_statics_interrupt()),
+        ..StaticsOptions::default()
+    };
+    assert_eq!(
+        collapse_multiplier(&model, x, &options).err(),
+        Some(StaticsError::Interrupted)
+    );
+    // Not set: the same report as without a flag (the wall's 7/11 along +x, its corner wedge).
+    let asked = MultiplierOptions {
+        cancel: Some(Cancel::new()),
+        ..MultiplierOptions::default()
+    };
+    let flagged = check_with(&model, &[x], &asked).unwrap();
+    let plain = check_with(&model, &[x], &MultiplierOptions::default()).unwrap();
+    assert_eq!(
+        serde_json::to_string(&flagged).unwrap(),
+        serde_json::to_string(&plain).unwrap()
+    );
+    let lambda = plain.static_multipliers[0].lambda.unwrap();
+    assert!((lambda - 7.0 / 11.0).abs() < 1e-9, "{lambda}");
+}
+
+/// A check of 96 directions of the wall (some two minutes of two cores uninterrupted) asked to
+/// stop 0.2 s in stops after the linear program under way on each direction's thread: it answers
+/// no report, long before the directions could have run through (the bound is a fraction of the
+/// uninterrupted time, far above any scheduling delay on a loaded machine).
+#[test]
+fn a_check_asked_to_stop_while_it_runs_stops_after_the_program_under_way() {
+    use crr::analysis::check::{CheckInterrupted, check_with};
+    use crr::analysis::static_multiplier::MultiplierOptions;
+    let (model, directions) = wall_directions(96);
+    let cancel = Cancel::new();
+    let remote = cancel.clone();
+    let timer = std::thread::spawn(move || {
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        remote.cancel();
+    });
+    let asked = MultiplierOptions {
+        cancel: Some(cancel),
+        ..MultiplierOptions::default()
+    };
+    let started = std::time::Instant::now();
+    let report = check_with(&model, &directions, &asked);
+    let took = started.elapsed();
+    timer.join().unwrap();
+    assert_eq!(report.err(), Some(CheckInterrupted));
+    assert!(
+        took < std::time::Duration::from_secs(40),
+        "the check went on for {took:?} after the request to stop"
+    );
+}

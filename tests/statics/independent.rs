@@ -1570,7 +1570,7 @@ fn an_l_shaped_stone_with_a_block_in_its_notch_matches_the_planar_lp() {
             }
             let options = StaticsOptions {
                 friction: mu.map_or(Friction::NoSliding, Friction::Pyramid),
-                ..options
+                ..options.clone()
             };
             let got = collapse_multiplier(&assembled.model, Vector3::new(dx, 0.0, 0.0), &options)
                 .unwrap()
@@ -1719,7 +1719,7 @@ fn a_joggled_lintel_resting_on_a_ledge_above_its_centre_matches_the_planar_lp() 
                     let expected = planar_contact_lp(&bodies, contacts, dx, mu);
                     let options = StaticsOptions {
                         friction: mu.map_or(Friction::NoSliding, Friction::Pyramid),
-                        ..options
+                        ..options.clone()
                     };
                     let got =
                         collapse_multiplier(&assembled.model, Vector3::new(dx, 0.0, 0.0), &options)

@@ -27,6 +27,9 @@
 //! contact is closed; one that keeps some points rocks about them (its pivot sides are the signs
 //! of the relative rotation about its axes, the CRR chain's sides); one that keeps none lifts off,
 //! which the CRR chain does not represent.
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use nalgebra::Vector3;
 use serde::Serialize;
 
@@ -65,7 +68,7 @@ pub enum Friction {
 pub const EXHAUSTIVE_SETS: usize = 4096;
 
 /// Options of [`collapse_multiplier`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct StaticsOptions {
     /// Friction at the contact points.
     pub friction: Friction,
@@ -77,6 +80,34 @@ pub struct StaticsOptions {
     /// With `sliding_lift_off`: the most sets of joints that may open and slide the exhaustive
     /// pass tries; beyond them the search answers alone ([`Collapse::exhaustive`] false).
     pub exhaustive_sets: usize,
+    /// A request to stop, polled before every linear program: once set,
+    /// [`collapse_multiplier`] returns [`StaticsError::Interrupted`] after the program under
+    /// way (the search and the exhaustive pass run hundreds to thousands of them on a wall).
+    pub interrupt: Option<Interrupt>,
+}
+
+/// A request to stop the statics, shared between them and whoever may interrupt them (a
+/// signal handler, another thread): cloning it shares the flag. Two are equal where they share
+/// it.
+#[derive(Clone, Debug, Default)]
+pub struct Interrupt(pub Arc<AtomicBool>);
+
+impl Interrupt {
+    /// Whether the stop was asked.
+    pub fn is_set(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+impl PartialEq for Interrupt {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// Whether `options` ask to stop.
+fn interrupted(options: &StaticsOptions) -> bool {
+    options.interrupt.as_ref().is_some_and(Interrupt::is_set)
 }
 
 impl Default for StaticsOptions {
@@ -86,6 +117,7 @@ impl Default for StaticsOptions {
             lambda_max: LAMBDA_MAX,
             sliding_lift_off: true,
             exhaustive_sets: EXHAUSTIVE_SETS,
+            interrupt: None,
         }
     }
 }
@@ -153,6 +185,9 @@ pub enum StaticsError {
     /// The solver did not reach an answer.
     #[error("the linear program of the statics did not solve: {0}")]
     Solver(String),
+    /// [`StaticsOptions::interrupt`] was set: no answer.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// The force of one contact point (N, from the parent on the child).
@@ -331,6 +366,21 @@ fn unit_direction(direction: Vector3<f64>) -> Result<Vector3<f64>, StaticsError>
 /// The collapse multiplier of `model` at rest under gravity plus a constant ground acceleration
 /// λ g `direction` (see the module's docs).
 pub fn collapse_multiplier(
+    model: &Model,
+    direction: Vector3<f64>,
+    options: &StaticsOptions,
+) -> Result<Collapse, StaticsError> {
+    let answer = collapse_multiplier_uninterrupted(model, direction, options);
+    // Once interrupted, every program that follows fails at once and the search and the pass
+    // take what they have: an answer computed so is no answer.
+    if interrupted(options) {
+        return Err(StaticsError::Interrupted);
+    }
+    answer
+}
+
+/// [`collapse_multiplier`] before its answer is checked for an interruption.
+fn collapse_multiplier_uninterrupted(
     model: &Model,
     direction: Vector3<f64>,
     options: &StaticsOptions,
@@ -672,7 +722,7 @@ fn lowering_probes(
     let probe_options = |mu: f64| StaticsOptions {
         friction: Friction::Pyramid(mu),
         sliding_lift_off: false,
-        ..*options
+        ..options.clone()
     };
     // (Written as the negation of "holds as high": a NaN λ counts as lowering, as it always has,
     // and goes on to the candidate's own program.)
@@ -906,6 +956,7 @@ pub fn required_friction(
             lambda_max,
             sliding_lift_off: false,
             exhaustive_sets: 0,
+            interrupt: None,
         };
         match collapse_multiplier(model, direction, &options) {
             Ok(c) => Ok(Some(c.lambda.unwrap_or(lambda_max) - target)),
@@ -949,6 +1000,7 @@ pub fn state_friction(
             lambda_max,
             sliding_lift_off: false,
             exhaustive_sets: 0,
+            interrupt: None,
         };
         // With few points loaded and little friction the program may have no equilibrium at
         // any λ ≥ 0, which the solver reports as not converging: that μ does not reach λ.
@@ -1189,6 +1241,8 @@ struct Program {
     cones: Vec<SupportedConeT<f64>>,
     /// Forces are in units of the total weight W; moments in W·size.
     weight: f64,
+    /// The options' request to stop.
+    interrupt: Option<Interrupt>,
 }
 
 impl Program {
@@ -1257,6 +1311,7 @@ impl Program {
             b: Vec::new(),
             cones: Vec::new(),
             weight,
+            interrupt: options.interrupt.clone(),
         };
         program.equilibrium_rows(model, d, total_mass, size);
         program.inequality_rows(faces, options);
@@ -1469,6 +1524,9 @@ impl Program {
         b: &[f64],
         cones: &[SupportedConeT<f64>],
     ) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
+        if self.interrupt.as_ref().is_some_and(Interrupt::is_set) {
+            return Err(StaticsError::Interrupted);
+        }
         let mut failed = None;
         for attempt in &SOLVER_ATTEMPTS {
             let settings = DefaultSettingsBuilder::default()

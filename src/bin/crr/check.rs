@@ -102,6 +102,8 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
     let asked = crr::analysis::static_multiplier::MultiplierOptions {
         friction,
         exhaustive_sets: a.exhaustive_sets,
+        // Ctrl-C ends `crr check` at once (it has nothing to keep).
+        cancel: None,
     };
     let loaded = paths
         .iter()
@@ -110,7 +112,8 @@ pub(crate) fn run(a: Args) -> Result<(), Failure> {
     let reports: Vec<_> = loaded
         .iter()
         .map(|(_, m)| crr::analysis::check::check_with(m, &directions, &asked))
-        .collect();
+        .collect::<Result<_, _>>()
+        .map_err(|e| Failure::Simulation(e.to_string()))?;
     // The sweep needs a one-DOF mechanism; its failure is reported after the reports.
     let mut sweeps: Vec<Option<crr::analysis::size_sweep::SizeSweep>> = vec![None; reports.len()];
     let mut sweep_error = None;
