@@ -227,3 +227,100 @@ fn the_chain_s_tree_changes_no_multiplier() {
         assert!(turned_any, "{name}: no chain turned an interface round");
     }
 }
+
+/// Two blocks 0.5 × 0.3 × 0.25 m side by side along their wall's own x, written as an OBJ file
+/// turned by `degrees` about the vertical, moved by `offset`, with `decimals` decimals (as CAD
+/// programs write them), assembled with every contact a joint (`crr assemble --all-contacts`,
+/// the ground at the offset's height).
+fn two_blocks_written(degrees: f64, offset: [f64; 3], decimals: usize) -> Model {
+    use crr::analysis::assemble::{AssemblyOptions, assemble, read_assembly};
+    let (c, s) = (degrees.to_radians().cos(), degrees.to_radians().sin());
+    let mut obj = String::new();
+    for (k, x0) in [0.0, 0.5].into_iter().enumerate() {
+        obj += &format!("o b{k}\n");
+        for (x, y, z) in [
+            (x0, 0.0, 0.0),
+            (x0 + 0.5, 0.0, 0.0),
+            (x0 + 0.5, 0.3, 0.0),
+            (x0, 0.3, 0.0),
+            (x0, 0.0, 0.25),
+            (x0 + 0.5, 0.0, 0.25),
+            (x0 + 0.5, 0.3, 0.25),
+            (x0, 0.3, 0.25),
+        ] {
+            let p = [
+                c * x - s * y + offset[0],
+                s * x + c * y + offset[1],
+                z + offset[2],
+            ];
+            obj += &format!(
+                "v {:.decimals$} {:.decimals$} {:.decimals$}\n",
+                p[0], p[1], p[2]
+            );
+        }
+        let b = 8 * k;
+        for f in [
+            [1, 4, 3, 2],
+            [5, 6, 7, 8],
+            [1, 2, 6, 5],
+            [2, 3, 7, 6],
+            [3, 4, 8, 7],
+            [4, 1, 5, 8],
+        ] {
+            obj += &format!("f {} {} {} {}\n", b + f[0], b + f[1], b + f[2], b + f[3]);
+        }
+    }
+    let name = format!("two_blocks_{degrees}_{decimals}_{}", offset[0] as i64);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("placements");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(format!("{name}.obj")), obj).unwrap();
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(
+        &path,
+        format!("name = \"{name}\"\ngravity = 9.81\n\n[[obj]]\nfile = \"{name}.obj\"\ndensity = 2000.0\n"),
+    )
+    .unwrap();
+    let file = read_assembly(&path).unwrap();
+    let options = AssemblyOptions {
+        ground_level: offset[2],
+        ..AssemblyOptions::default().with_all_contacts()
+    };
+    assemble(&path, &file, &options).unwrap().model
+}
+
+/// An answer marked exhaustive is the multiplier, wherever and however the structure is
+/// written. Two blocks of b/h = 0.5/0.25 = 2 side by side, the ground accelerating along their
+/// row: the first tips away from the second about its outer foot at λ = b/h = 2 (the pair as one
+/// would tip at 1.0/0.25 = 4). Written exactly, at the origin or turned, the exhaustive pass
+/// finds 2. Turned 30° with six decimals, or 80° at survey coordinates (500 km east, 4500 km
+/// north, 350 m up) with fifteen, round-off at the model's precision leaves the test of that
+/// collapse state a program the solver cannot settle: the answer there must not claim to be
+/// exhaustive unless it is 2 (it claimed 4 as exhaustive; an independent review of 1330
+/// placements).
+#[test]
+fn an_answer_marked_exhaustive_is_the_multiplier_wherever_the_structure_is_written() {
+    let cases: [(f64, [f64; 3], usize); 5] = [
+        (0.0, [0.0; 3], 15),
+        (30.0, [0.0; 3], 15),
+        (30.0, [0.0; 3], 6),
+        (80.0, [0.0; 3], 15),
+        (80.0, [500_000.0, 4_500_000.0, 350.0], 15),
+    ];
+    for (degrees, offset, decimals) in cases {
+        let model = two_blocks_written(degrees, offset, decimals);
+        let along = Vector3::new(degrees.to_radians().cos(), degrees.to_radians().sin(), 0.0);
+        let c = collapse_multiplier(&model, along, &StaticsOptions::default()).unwrap();
+        let lambda = c.lambda.unwrap();
+        let case = format!("{degrees}° at {offset:?}, {decimals} decimals: λ = {lambda}");
+        if offset == [0.0; 3] && decimals == 15 {
+            assert!(c.exhaustive, "{case}");
+        }
+        // The model's precision: its faces are planar to 1e-6 of its size.
+        if c.exhaustive {
+            assert!((lambda - 2.0).abs() < 1e-5, "{case}, marked exhaustive");
+        } else {
+            // Not exhaustive: an upper bound, at most the convex program's pair.
+            assert!(lambda > 2.0 - 1e-5 && lambda < 4.0 + 1e-5, "{case}");
+        }
+    }
+}

@@ -865,9 +865,15 @@ fn repaired_set(
 }
 
 /// Relative loss of λ within which the points that separate or slide count as unloaded at the
-/// multiplier (the solver's gaps are 1e-12; its λ agrees to about
-/// 1e-10).
-const UNLOADED_TOLERANCE: f64 = 1e-8;
+/// multiplier: the model's geometric precision, ten times [`crr_kinematics::GEOMETRY_TOLERANCE`]
+/// (faces whose corners lie off their plane by 1e-6 of the model's size are planar to the
+/// model), far above the solver's 1e-12. Two programs that differ only in contacts whose
+/// geometry agrees to that precision give multipliers that differ by about as much: two blocks
+/// of b/h = 2 side by side in an OBJ wall turned 30° with six decimals tip at 1.9999976 and
+/// 2.000001, and 8.7e-7 between the programs with their head joint unloaded and freed counted
+/// as a proof that no collapse state unloads it (at 1e-8, the exhaustive pass then answered 4,
+/// the pair tipping as one, for the multiplier 2 of the same wall unturned).
+const UNLOADED_TOLERANCE: f64 = 10.0 * crr_kinematics::GEOMETRY_TOLERANCE;
 
 /// `collapse` (the program's answer with the interfaces `free` freed) as a physical collapse,
 /// or None. The program without sliding lets a contact carry shear with no compression, so its
@@ -890,10 +896,30 @@ fn physical(
     free: &[bool],
     collapse: Collapse,
 ) -> Option<Collapse> {
-    let lambda = collapse.lambda?;
+    physical_test(model, faces, d, options, free, collapse)
+        .ok()
+        .flatten()
+}
+
+/// [`physical`] that tells a program the solver did not solve (an error) from a collapse that
+/// is not physical (None): the exhaustive pass proves that no set lowers λ only with programs
+/// that solved. A failed one counted as "not physical" there made the pass answer 4 as
+/// exhaustive where 2 was the multiplier (the test's program of two blocks tipping on their
+/// edges, whose equilibrium exists at one λ only, stopped in `NumericalError`).
+fn physical_test(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    free: &[bool],
+    collapse: Collapse,
+) -> Result<Option<Collapse>, StaticsError> {
+    let Some(lambda) = collapse.lambda else {
+        return Ok(None);
+    };
     let unloaded = moving_points(faces, &collapse);
     if unloaded.is_empty() {
-        return Some(collapse);
+        return Ok(Some(collapse));
     }
     let program = Program::build(
         model,
@@ -904,19 +930,23 @@ fn physical(
         &unloaded,
         &twist_reactions(faces, &collapse, model.size),
     );
-    let spared = solve_built(model, faces, d, options, &program).ok()?;
+    let spared = match solve_built(model, faces, d, options, &program) {
+        Ok(spared) => spared,
+        Err(StaticsError::DoesNotHold(_)) => return Ok(None),
+        Err(e) => return Err(e),
+    };
     if !spared
         .lambda
         .is_some_and(|l| l >= lambda * (1.0 - UNLOADED_TOLERANCE))
     {
-        return None;
+        return Ok(None);
     }
     let mut collapse = collapse;
     for (kept, spared) in collapse.interfaces.iter_mut().zip(spared.interfaces) {
         kept.forces = spared.forces;
         kept.twist = spared.twist;
     }
-    Some(collapse)
+    Ok(Some(collapse))
 }
 
 /// The interfaces whose faces may carry the no-twist reaction at a single loaded corner in the

@@ -64,8 +64,8 @@ pub use gamma::mass_matrix_gamma;
 pub use kinematics::{body_point, body_points, body_rotation, forward_kinematics, jacobians};
 pub use mass_matrix::{kinetic_energy, mass_matrix, mass_matrix_from_jacobians};
 pub use model::{
-    Body, Closure, Coordinate, Interface, InterfaceKind, MAX_COORDINATES, MIN_DIRAC_WIDTH,
-    MOVED_BEYOND, Model, Parent, Parts, Role, Side, exact_reference,
+    Body, Closure, Coordinate, GEOMETRY_TOLERANCE, Interface, InterfaceKind, MAX_COORDINATES,
+    MIN_DIRAC_WIDTH, MOVED_BEYOND, Model, Parent, Parts, Role, Side, exact_reference,
 };
 pub use pivots::ActivePivots;
 pub use potential::{generalized_gravity, potential_energy};

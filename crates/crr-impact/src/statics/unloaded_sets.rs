@@ -39,7 +39,7 @@ use nalgebra::Vector3;
 
 use super::{
     Collapse, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted, moving_points,
-    physical, solve_program,
+    physical_test, solve_program,
 };
 use crr_kinematics::{ContactFace, Model, Parent};
 
@@ -316,7 +316,9 @@ impl<'a> Pass<'a> {
         if self.unloads_below(set, &freed, holding, lambda) {
             return Ok(());
         }
-        if let Some(collapse) = physical(self.model, self.faces, self.d, self.options, &free, freed)
+        if let Some(collapse) =
+            physical_test(self.model, self.faces, self.d, self.options, &free, freed)
+                .map_err(Unexhausted::failed)?
         {
             self.best = collapse;
             self.best_lambda = lambda;
