@@ -37,9 +37,10 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
-use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent, Side, contact_faces};
+use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent, Side};
 
 mod closure;
+mod precision;
 mod unloaded_sets;
 mod wedges;
 
@@ -391,7 +392,7 @@ fn collapse_multiplier_uninterrupted(
     {
         return Err(StaticsError::Friction(mu));
     }
-    let faces = contact_faces(model);
+    let faces = precision::faces_at_precision(model);
     let mut free = vec![false; faces.len()];
     let convex = solve_program(model, &faces, d, options, &free, &[])?;
     // A tree has no interface that a collapse state may unload: the convex answer is exact.
@@ -453,7 +454,7 @@ pub const COUNTED_SETS: usize = 100_000;
 /// `most`, or where the structure has no pass to run (a tree).
 pub fn exhaustive_sets_needed(model: &Model, collapse: &Collapse, most: usize) -> Option<usize> {
     let d = unit_direction(Vector3::from(collapse.direction)).ok()?;
-    let faces = contact_faces(model);
+    let faces = precision::faces_at_precision(model);
     let candidates = unloaded_sets::candidates(model, &faces);
     // A structure that holds: the pass runs below the cap.
     let lambda = collapse.lambda.unwrap_or(LAMBDA_MAX);
@@ -504,7 +505,7 @@ pub fn hinges_out_of_plane(
         return Ok(Vec::new());
     }
     let d = unit_direction(direction)?;
-    let faces = contact_faces(model);
+    let faces = precision::faces_at_precision(model);
     let free = vec![false; faces.len()];
     let program = Program::build(model, &faces, d, options, &free, &[], &[]);
     let columns: Vec<usize> = program
@@ -1019,7 +1020,7 @@ pub fn state_friction(
         return Ok(None);
     };
     let d = unit_direction(Vector3::from(collapse.direction))?;
-    let faces = contact_faces(model);
+    let faces = precision::faces_at_precision(model);
     let unloaded = moving_points(&faces, collapse);
     let free = vec![false; faces.len()];
     let target = lambda - 1e-6 * lambda.abs();
