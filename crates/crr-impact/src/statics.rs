@@ -145,6 +145,24 @@ struct SolverAttempt {
     equilibrate: bool,
 }
 
+/// The solver's attempts at the model's precision ([`Precision::Model`]): its answers are
+/// compared to [`EQUILIBRIUM_RESIDUAL`], so gaps of 1e-9 are ample, and its penalty and
+/// residual bounds set scales 1e-4 and 1e-5 apart from the forces that 1e-12 does not reach.
+const SOLVER_ATTEMPTS_AT_PRECISION: [SolverAttempt; 2] = [
+    SolverAttempt {
+        tolerance: 1e-9,
+        max_iter: 400,
+        refinement_steps: 10,
+        equilibrate: true,
+    },
+    SolverAttempt {
+        tolerance: 1e-8,
+        max_iter: 1000,
+        refinement_steps: 50,
+        equilibrate: false,
+    },
+];
+
 const SOLVER_ATTEMPTS: [SolverAttempt; 3] = [
     SolverAttempt {
         tolerance: 1e-12,
@@ -507,7 +525,7 @@ pub fn hinges_out_of_plane(
     let d = unit_direction(direction)?;
     let faces = precision::faces_at_precision(model);
     let free = vec![false; faces.len()];
-    let program = Program::build(model, &faces, d, options, &free, &[], &[]);
+    let program = Program::build(model, &faces, d, options, &free, &[], &[], Precision::Exact);
     let columns: Vec<usize> = program
         .unknowns
         .iter()
@@ -567,12 +585,25 @@ fn solve_program(
     free: &[bool],
     unloaded: &[(usize, usize)],
 ) -> Result<Collapse, StaticsError> {
+    solve_program_at(model, faces, d, options, free, unloaded, Precision::Exact)
+}
+
+/// [`solve_program`] as written or at the model's precision ([`Precision`]).
+fn solve_program_at(
+    model: &Model,
+    faces: &[ContactFace],
+    d: Vector3<f64>,
+    options: &StaticsOptions,
+    free: &[bool],
+    unloaded: &[(usize, usize)],
+    precision: Precision,
+) -> Result<Collapse, StaticsError> {
     solve_built(
         model,
         faces,
         d,
         options,
-        &Program::build(model, faces, d, options, free, unloaded, &[]),
+        &Program::build(model, faces, d, options, free, unloaded, &[], precision),
     )
 }
 
@@ -897,7 +928,7 @@ fn physical(
     free: &[bool],
     collapse: Collapse,
 ) -> Option<Collapse> {
-    physical_test(model, faces, d, options, free, collapse)
+    physical_test(model, faces, d, options, free, collapse, Precision::Exact)
         .ok()
         .flatten()
 }
@@ -914,6 +945,7 @@ fn physical_test(
     options: &StaticsOptions,
     free: &[bool],
     collapse: Collapse,
+    precision: Precision,
 ) -> Result<Option<Collapse>, StaticsError> {
     let Some(lambda) = collapse.lambda else {
         return Ok(None);
@@ -930,6 +962,7 @@ fn physical_test(
         free,
         &unloaded,
         &twist_reactions(faces, &collapse, model.size),
+        precision,
     );
     let spared = match solve_built(model, faces, d, options, &program) {
         Ok(spared) => spared,
@@ -1024,30 +1057,39 @@ pub fn state_friction(
     let unloaded = moving_points(&faces, collapse);
     let free = vec![false; faces.len()];
     let target = lambda - 1e-6 * lambda.abs();
+    // As written first; where no μ reaches λ that way, at the model's precision (a state the
+    // exhaustive pass found there: two blocks on their edges whose round-off leaves them no
+    // common exact equilibrium).
     let mut failure = None;
-    let mu = smallest_friction(|mu: f64| -> Result<Option<f64>, StaticsError> {
-        let options = StaticsOptions {
-            friction: Friction::Cone(mu),
-            lambda_max,
-            sliding_lift_off: false,
-            exhaustive_sets: 0,
-            interrupt: None,
-        };
-        // With few points loaded and little friction the program may have no equilibrium at
-        // any λ ≥ 0, which the solver reports as not converging: that μ does not reach λ.
-        match solve_program(model, &faces, d, &options, &free, &unloaded) {
-            Ok(c) => Ok(Some(c.lambda.unwrap_or(lambda_max) - target)),
-            Err(StaticsError::DoesNotHold(_)) => Ok(None),
-            Err(StaticsError::Solver(status)) => {
-                failure = Some(status);
-                Ok(None)
+    for precision in [Precision::Exact, Precision::Model] {
+        failure = None;
+        let mu = smallest_friction(|mu: f64| -> Result<Option<f64>, StaticsError> {
+            let options = StaticsOptions {
+                friction: Friction::Cone(mu),
+                lambda_max,
+                sliding_lift_off: false,
+                exhaustive_sets: 0,
+                interrupt: None,
+            };
+            // With few points loaded and little friction the program may have no equilibrium
+            // at any λ ≥ 0, which the solver reports as not converging: that μ does not reach λ.
+            match solve_program_at(model, &faces, d, &options, &free, &unloaded, precision) {
+                Ok(c) => Ok(Some(c.lambda.unwrap_or(lambda_max) - target)),
+                Err(StaticsError::DoesNotHold(_)) => Ok(None),
+                Err(StaticsError::Solver(status)) => {
+                    failure = Some(status);
+                    Ok(None)
+                }
+                Err(e) => Err(e),
             }
-            Err(e) => Err(e),
+        })?;
+        if mu.is_finite() {
+            return Ok(Some(mu));
         }
-    })?;
-    match (mu.is_finite(), failure) {
-        (false, Some(status)) => Err(StaticsError::Solver(status)),
-        _ => Ok(Some(mu)),
+    }
+    match failure {
+        Some(status) => Err(StaticsError::Solver(status)),
+        None => Ok(Some(f64::INFINITY)),
     }
 }
 
@@ -1272,9 +1314,46 @@ struct Program {
     cones: Vec<SupportedConeT<f64>>,
     /// Forces are in units of the total weight W; moments in W·size.
     weight: f64,
+    /// The normal forces of freed points, which the objective charges [`WEDGE_PENALTY`] each at
+    /// the model's precision (empty otherwise).
+    penalized: Vec<usize>,
+    /// At the model's precision, the columns of the equilibrium's residuals, 6 per body (none
+    /// otherwise): after the forces.
+    residuals: usize,
+    /// As written or at the model's precision.
+    precision: Precision,
     /// The options' request to stop.
     interrupt: Option<Interrupt>,
 }
+
+/// Whether a program of the exhaustive pass holds the geometry as written, or only to the
+/// model's precision ([`Program::build`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Precision {
+    /// Every body in equilibrium exactly, and freed points' normal forces free.
+    Exact,
+    /// Every body in equilibrium to [`EQUILIBRIUM_RESIDUAL`] of its weight, and freed points'
+    /// normal forces charged [`WEDGE_PENALTY`] each in the objective.
+    Model,
+}
+
+/// The residual of a body's equilibrium, force and moment (over the model's size), that the
+/// programs at the model's precision allow, as a share of its weight. Round-off of the corners by
+/// [`crr_kinematics::GEOMETRY_TOLERANCE`] of the model's size moves a centre of mass off the
+/// edge it balances on by as much: two blocks that tip at b/h side by side then tip at λ that
+/// differ by about 1e-6 and have no common equilibrium on their edges, and an upper block of
+/// running bond centred over the joint below no longer balances on either half.
+const EQUILIBRIUM_RESIDUAL: f64 = 10.0 * crr_kinematics::GEOMETRY_TOLERANCE;
+
+/// What a freed point's normal force costs in the objective at the model's precision, in g per
+/// total weight: a freed joint that must press harder than 1/WEDGE_PENALTY = 1e4 times the
+/// structure's weight per g of λ is wedged by round-off. A joint that slides exactly along its
+/// face in the mechanism closes at the tilt of round-off when its corners are rounded (1e-6 rad
+/// with six decimals), and holding the body against that closing takes its weight over the tilt:
+/// two courses of running bond turned 30° with six decimals held their middle block out of plane
+/// that way up to λ = 0.6 (its head joints wedged) where it turns at 0.514286. Forces of a
+/// structure that is not wedged grow with λ by its weight times its proportions, far below.
+pub(crate) const WEDGE_PENALTY: f64 = 1e-4;
 
 impl Program {
     fn build(
@@ -1285,6 +1364,7 @@ impl Program {
         free: &[bool],
         unloaded: &[(usize, usize)],
         twist_reactions: &[usize],
+        precision: Precision,
     ) -> Program {
         let mut unknowns = Vec::new();
         let mut point_columns = Vec::with_capacity(faces.len());
@@ -1342,11 +1422,55 @@ impl Program {
             b: Vec::new(),
             cones: Vec::new(),
             weight,
+            penalized: Vec::new(),
+            residuals: 0,
+            precision,
             interrupt: options.interrupt.clone(),
         };
         program.equilibrium_rows(model, d, total_mass, size);
         program.inequality_rows(faces, options);
+        if precision == Precision::Model {
+            program.precision_terms(model, faces, free, total_mass);
+        }
         program
+    }
+
+    /// At the model's precision: a residual column per equilibrium row (the first 6 per body),
+    /// bounded by [`EQUILIBRIUM_RESIDUAL`] of the body's weight, and the freed points' normal
+    /// forces charged [`WEDGE_PENALTY`].
+    fn precision_terms(
+        &mut self,
+        model: &Model,
+        faces: &[ContactFace],
+        free: &[bool],
+        total_mass: f64,
+    ) {
+        let first_column = 1 + self.unknowns.len();
+        let bodies = model.bodies.len();
+        let first = self.rows;
+        for (n, body) in model.bodies.iter().enumerate() {
+            let bound = EQUILIBRIUM_RESIDUAL * body.mass / total_mass;
+            for k in 0..6 {
+                let column = first_column + 6 * n + k;
+                // The equilibrium rows are the program's first: row 6n + k.
+                self.push(6 * n + k, column, -1.0);
+                let row = first + 2 * (6 * n + k);
+                self.push(row, column, 1.0);
+                self.push(row + 1, column, -1.0);
+                self.b.push(bound);
+                self.b.push(bound);
+            }
+        }
+        self.residuals = 6 * bodies;
+        self.rows = first + 12 * bodies;
+        self.cones
+            .push(SupportedConeT::NonnegativeConeT(12 * bodies));
+        for (face, columns) in faces.iter().zip(&self.point_columns) {
+            if free[face.interface] && !face.pin {
+                self.penalized
+                    .extend(columns.iter().map(|c| c[0]).filter(|&c| c != NO_COLUMN));
+            }
+        }
     }
 
     /// The lumped shear of `face` ([`LumpedShear`]) and its columns (none where every point is
@@ -1510,7 +1634,7 @@ impl Program {
         lambda: f64,
         columns: &[usize],
     ) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
-        let n = 1 + self.unknowns.len();
+        let n = 1 + self.unknowns.len() + self.residuals;
         let p = CscMatrix::new_from_triplets(
             n,
             n,
@@ -1532,10 +1656,13 @@ impl Program {
     }
 
     fn solve(&self) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
-        let n = 1 + self.unknowns.len();
+        let n = 1 + self.unknowns.len() + self.residuals;
         let p = CscMatrix::zeros((n, n));
         let mut q = vec![0.0; n];
         q[0] = -1.0;
+        for &column in &self.penalized {
+            q[column] = WEDGE_PENALTY;
+        }
         let a = CscMatrix::new_from_triplets(
             self.rows,
             n,
@@ -1559,7 +1686,11 @@ impl Program {
             return Err(StaticsError::Interrupted);
         }
         let mut failed = None;
-        for attempt in &SOLVER_ATTEMPTS {
+        let attempts: &[SolverAttempt] = match self.precision {
+            Precision::Exact => &SOLVER_ATTEMPTS,
+            Precision::Model => &SOLVER_ATTEMPTS_AT_PRECISION,
+        };
+        for attempt in attempts {
             let settings = DefaultSettingsBuilder::default()
                 .verbose(false)
                 .tol_gap_abs(attempt.tolerance)

@@ -38,8 +38,8 @@
 use nalgebra::Vector3;
 
 use super::{
-    Collapse, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted, moving_points,
-    physical_test, solve_program,
+    Collapse, Precision, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted,
+    WEDGE_PENALTY, moving_points, physical_test, solve_program_at,
 };
 use crr_kinematics::{ContactFace, Model, Parent};
 
@@ -217,11 +217,37 @@ impl<'a> Pass<'a> {
     /// holds. With no equilibrium at any λ ≥ 0 it bounds nothing (its subsets may hold).
     fn below_best(&mut self, set: &[usize]) -> Result<bool, Unexhausted> {
         let free = self.flags(set);
-        match solve_program(self.model, self.faces, self.d, self.options, &free, &[]) {
-            Ok(c) => Ok(c.lambda.is_some_and(|l| self.lowers(l))),
-            Err(StaticsError::DoesNotHold(_)) => Ok(true),
-            Err(e) => Err(Unexhausted::failed(e)),
+        for precision in [Precision::Exact, Precision::Model] {
+            let below = match self.solve(&free, &[], precision) {
+                Ok(c) => c.lambda.is_some_and(|l| self.lowers(l)),
+                Err(StaticsError::DoesNotHold(_)) => true,
+                Err(StaticsError::Solver(_)) if precision == Precision::Exact => false,
+                Err(e) => return Err(Unexhausted::failed(e)),
+            };
+            if below {
+                return Ok(true);
+            }
         }
+        Ok(false)
+    }
+
+    /// The program with the interfaces `free` freed and the points `unloaded` unloaded, as
+    /// written or at the model's precision ([`Precision`]).
+    fn solve(
+        &self,
+        free: &[bool],
+        unloaded: &[(usize, usize)],
+        precision: Precision,
+    ) -> Result<Collapse, StaticsError> {
+        solve_program_at(
+            self.model,
+            self.faces,
+            self.d,
+            self.options,
+            free,
+            unloaded,
+            precision,
+        )
     }
 
     /// Whether the physical test of U's freed answer (λ_f = `lambda`) must fail, without its
@@ -278,15 +304,17 @@ impl<'a> Pass<'a> {
                 .iter()
                 .flat_map(|&i| (0..self.faces[i].points.len()).map(move |p| (i, p)))
                 .collect();
+            // As written first; where that has no equilibrium or does not solve, at the model's
+            // precision (an upper block centred over the joint below balances on neither half
+            // once rounded).
             let none = vec![false; self.faces.len()];
-            let holding = match solve_program(
-                self.model,
-                self.faces,
-                self.d,
-                self.options,
-                &none,
-                &unloaded,
-            ) {
+            let holding = match self.solve(&none, &unloaded, Precision::Exact) {
+                Err(StaticsError::DoesNotHold(_) | StaticsError::Solver(_)) => {
+                    self.solve(&none, &unloaded, Precision::Model)
+                }
+                exact => exact,
+            };
+            let holding = match holding {
                 Ok(c) => c.lambda.unwrap_or(self.options.lambda_max),
                 Err(StaticsError::DoesNotHold(_)) => continue,
                 Err(e) => return Err(Unexhausted::failed(e)),
@@ -303,26 +331,101 @@ impl<'a> Pass<'a> {
 
     /// U freed, kept as the best where it lowers λ and passes the physical test. `holding` is
     /// λ_u, U's program with every point of U unloaded.
+    ///
+    /// The freed program is solved as written first and, where that finds nothing or does not
+    /// solve, again at the model's precision ([`Precision`]): round-off of the corners can
+    /// wedge a body between U's faces, so that the freed program holds it above λ_u by normal
+    /// forces of its weight over the tilt of round-off. The retry is skipped where the answer
+    /// as written shows it cannot lower the best: its own forces cost too little at
+    /// [`WEDGE_PENALTY`] ([`Pass::wedge_free`]). Where the programs as written decide, the
+    /// answers are theirs.
     fn try_set(&mut self, set: &[usize], holding: f64) -> Result<(), Unexhausted> {
         let free = self.flags(set);
-        let freed = match solve_program(self.model, self.faces, self.d, self.options, &free, &[]) {
+        match self.solve(&free, &[], Precision::Exact) {
+            Ok(freed) => match freed.lambda.filter(|&l| self.lowers(l)) {
+                Some(lambda)
+                    if self.accept(set, &free, &freed, holding, lambda, Precision::Exact)? =>
+                {
+                    return Ok(());
+                }
+                Some(_) => {}
+                None if self.wedge_free(set, &freed) => return Ok(()),
+                None => {}
+            },
+            Err(StaticsError::DoesNotHold(_) | StaticsError::Solver(_)) => {}
+            Err(e) => return Err(Unexhausted::failed(e)),
+        }
+        let freed = match self.solve(&free, &[], Precision::Model) {
             Ok(freed) => freed,
             Err(StaticsError::DoesNotHold(_)) => return Ok(()),
             Err(e) => return Err(Unexhausted::failed(e)),
         };
-        let Some(lambda) = freed.lambda.filter(|&l| self.lowers(l)) else {
-            return Ok(());
-        };
-        if self.unloads_below(set, &freed, holding, lambda) {
-            return Ok(());
-        }
-        if let Some(collapse) =
-            physical_test(self.model, self.faces, self.d, self.options, &free, freed)
-                .map_err(Unexhausted::failed)?
-        {
-            self.best = collapse;
-            self.best_lambda = lambda;
+        if let Some(lambda) = freed.lambda.filter(|&l| self.lowers(l)) {
+            self.accept(set, &free, &freed, holding, lambda, Precision::Model)?;
         }
         Ok(())
+    }
+
+    /// Whether U's freed answer as written (`freed`, not below the best) shows that the freed
+    /// program at the model's precision cannot lower the best either: that program maximises
+    /// λ − [`WEDGE_PENALTY`]·Σfₙ over U's points (forces in units of the total weight), and
+    /// `freed`'s own forces are feasible there, so its λ is at least λ_f − WEDGE_PENALTY·Σfₙ.
+    fn wedge_free(&self, set: &[usize], freed: &Collapse) -> bool {
+        let weight: f64 =
+            self.model.bodies.iter().map(|b| b.mass).sum::<f64>() * self.model.gravity;
+        let pressing: f64 = freed
+            .interfaces
+            .iter()
+            .filter(|i| set.contains(&i.interface))
+            .flat_map(|i| i.forces.iter())
+            .map(|f| f.normal.max(0.0))
+            .sum();
+        let lambda = freed.lambda.unwrap_or(self.options.lambda_max);
+        !self.lowers(lambda - WEDGE_PENALTY * pressing / weight)
+    }
+
+    /// `freed` (U's freed answer at `precision`, λ_f = `lambda` below the best) kept as the best
+    /// where it passes the physical test: as written (where the freed program was), then at the
+    /// model's precision. Whether it was kept.
+    fn accept(
+        &mut self,
+        set: &[usize],
+        free: &[bool],
+        freed: &Collapse,
+        holding: f64,
+        lambda: f64,
+        precision: Precision,
+    ) -> Result<bool, Unexhausted> {
+        if self.unloads_below(set, freed, holding, lambda) {
+            return Ok(false);
+        }
+        let test = |test_precision| {
+            physical_test(
+                self.model,
+                self.faces,
+                self.d,
+                self.options,
+                free,
+                freed.clone(),
+                test_precision,
+            )
+        };
+        let as_written = match precision {
+            Precision::Exact => test(Precision::Exact),
+            Precision::Model => Ok(None),
+        };
+        let physical = match as_written {
+            Ok(Some(collapse)) => collapse,
+            Err(StaticsError::Interrupted) => {
+                return Err(Unexhausted::failed(StaticsError::Interrupted));
+            }
+            _ => match test(Precision::Model).map_err(Unexhausted::failed)? {
+                Some(collapse) => collapse,
+                None => return Ok(false),
+            },
+        };
+        self.best = physical;
+        self.best_lambda = lambda;
+        Ok(true)
     }
 }
