@@ -314,8 +314,8 @@ fn written(
 /// north, 350 m up) with fifteen, round-off at the model's precision makes the blocks tip at λ
 /// that differ by about 1e-6, so that no exact equilibrium has both on their edges: the pass
 /// answered 4 marked exhaustive (an independent review of 1330 placements), then 4 marked not
-/// exhaustive. Its programs at the model's precision (each body in equilibrium to 1e-5 of its
-/// weight) find 2 again, exhaustively, both ways along the row.
+/// exhaustive. Its physical test at the model's precision (each body in equilibrium to 1e-5 of
+/// its weight) finds 2 again, exhaustively, both ways along the row.
 #[test]
 fn an_answer_marked_exhaustive_is_the_multiplier_wherever_the_structure_is_written() {
     let cases: [(f64, [f64; 3], usize); 5] = [
@@ -383,14 +383,13 @@ fn a_wall_at_survey_coordinates_turns_out_of_its_plane_as_written_exactly() {
 }
 
 /// The same wall turned 30° and written with six decimals, as CAD programs write it: its corners
-/// are off by up to 5e-7 m, so the middle block's feet are no longer square to its head joints
-/// (about 1e-6 rad), and each block of the upper course, centred over a head joint below, no
-/// longer balances on either half. As written, the middle block cannot turn out of the wall
-/// without closing a head joint, and the pass answered 0.545455 marked exhaustive (an end block
-/// and the block over it), both ways out of the plane, where the wall's multiplier is 0.514286.
-/// At the model's precision (each body in equilibrium to 1e-5 of its weight, a freed joint that
-/// must press harder than 1e4 times the structure's weight per g wedged by round-off) the pass
-/// finds the wall's own collapse, to the model's precision, both ways.
+/// are off by up to 5e-7 m, so each block of the upper course, centred over a head joint below,
+/// no longer balances on either half. As written, the program with one half's joint unloaded has
+/// no equilibrium, the pass dropped that set and every set below it (the wall's own collapse
+/// among them), and answered 0.545455 marked exhaustive (an end block and the block over it),
+/// both ways out of the plane, where the wall's multiplier is 0.514286. At the model's precision
+/// (each body in equilibrium to 1e-5 of its weight) the pass finds the wall's own collapse, to
+/// the model's precision, both ways.
 #[test]
 fn a_wall_written_with_six_decimals_turns_out_of_its_plane_as_written_exactly() {
     let blocks = [

@@ -146,8 +146,8 @@ struct SolverAttempt {
 }
 
 /// The solver's attempts at the model's precision ([`Precision::Model`]): its answers are
-/// compared to [`EQUILIBRIUM_RESIDUAL`], so gaps of 1e-9 are ample, and its penalty and
-/// residual bounds set scales 1e-4 and 1e-5 apart from the forces that 1e-12 does not reach.
+/// compared at [`EQUILIBRIUM_RESIDUAL`], so gaps of 1e-9 are ample, and its residual bounds set
+/// a scale 1e-5 apart from the forces that 1e-12 does not reach.
 const SOLVER_ATTEMPTS_AT_PRECISION: [SolverAttempt; 2] = [
     SolverAttempt {
         tolerance: 1e-9,
@@ -1314,9 +1314,6 @@ struct Program {
     cones: Vec<SupportedConeT<f64>>,
     /// Forces are in units of the total weight W; moments in W·size.
     weight: f64,
-    /// The normal forces of freed points, which the objective charges [`WEDGE_PENALTY`] each at
-    /// the model's precision (empty otherwise).
-    penalized: Vec<usize>,
     /// At the model's precision, the columns of the equilibrium's residuals, 6 per body (none
     /// otherwise): after the forces.
     residuals: usize,
@@ -1330,10 +1327,9 @@ struct Program {
 /// model's precision ([`Program::build`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Precision {
-    /// Every body in equilibrium exactly, and freed points' normal forces free.
+    /// Every body in equilibrium exactly.
     Exact,
-    /// Every body in equilibrium to [`EQUILIBRIUM_RESIDUAL`] of its weight, and freed points'
-    /// normal forces charged [`WEDGE_PENALTY`] each in the objective.
+    /// Every body in equilibrium to [`EQUILIBRIUM_RESIDUAL`] of its weight.
     Model,
 }
 
@@ -1344,16 +1340,6 @@ enum Precision {
 /// differ by about 1e-6 and have no common equilibrium on their edges, and an upper block of
 /// running bond centred over the joint below no longer balances on either half.
 const EQUILIBRIUM_RESIDUAL: f64 = 10.0 * crr_kinematics::GEOMETRY_TOLERANCE;
-
-/// What a freed point's normal force costs in the objective at the model's precision, in g per
-/// total weight: a freed joint that must press harder than 1/WEDGE_PENALTY = 1e4 times the
-/// structure's weight per g of λ is wedged by round-off. A joint that slides exactly along its
-/// face in the mechanism closes at the tilt of round-off when its corners are rounded (1e-6 rad
-/// with six decimals), and holding the body against that closing takes its weight over the tilt:
-/// two courses of running bond turned 30° with six decimals held their middle block out of plane
-/// that way up to λ = 0.6 (its head joints wedged) where it turns at 0.514286. Forces of a
-/// structure that is not wedged grow with λ by its weight times its proportions, far below.
-pub(crate) const WEDGE_PENALTY: f64 = 1e-4;
 
 impl Program {
     fn build(
@@ -1422,7 +1408,6 @@ impl Program {
             b: Vec::new(),
             cones: Vec::new(),
             weight,
-            penalized: Vec::new(),
             residuals: 0,
             precision,
             interrupt: options.interrupt.clone(),
@@ -1430,21 +1415,14 @@ impl Program {
         program.equilibrium_rows(model, d, total_mass, size);
         program.inequality_rows(faces, options);
         if precision == Precision::Model {
-            program.precision_terms(model, faces, free, total_mass);
+            program.equilibrium_residuals(model, total_mass);
         }
         program
     }
 
     /// At the model's precision: a residual column per equilibrium row (the first 6 per body),
-    /// bounded by [`EQUILIBRIUM_RESIDUAL`] of the body's weight, and the freed points' normal
-    /// forces charged [`WEDGE_PENALTY`].
-    fn precision_terms(
-        &mut self,
-        model: &Model,
-        faces: &[ContactFace],
-        free: &[bool],
-        total_mass: f64,
-    ) {
+    /// bounded by [`EQUILIBRIUM_RESIDUAL`] of the body's weight.
+    fn equilibrium_residuals(&mut self, model: &Model, total_mass: f64) {
         let first_column = 1 + self.unknowns.len();
         let bodies = model.bodies.len();
         let first = self.rows;
@@ -1465,12 +1443,6 @@ impl Program {
         self.rows = first + 12 * bodies;
         self.cones
             .push(SupportedConeT::NonnegativeConeT(12 * bodies));
-        for (face, columns) in faces.iter().zip(&self.point_columns) {
-            if free[face.interface] && !face.pin {
-                self.penalized
-                    .extend(columns.iter().map(|c| c[0]).filter(|&c| c != NO_COLUMN));
-            }
-        }
     }
 
     /// The lumped shear of `face` ([`LumpedShear`]) and its columns (none where every point is
@@ -1660,9 +1632,6 @@ impl Program {
         let p = CscMatrix::zeros((n, n));
         let mut q = vec![0.0; n];
         q[0] = -1.0;
-        for &column in &self.penalized {
-            q[column] = WEDGE_PENALTY;
-        }
         let a = CscMatrix::new_from_triplets(
             self.rows,
             n,

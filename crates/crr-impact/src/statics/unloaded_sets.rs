@@ -39,7 +39,7 @@ use nalgebra::Vector3;
 
 use super::{
     Collapse, Precision, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted,
-    WEDGE_PENALTY, moving_points, physical_test, solve_program_at,
+    moving_points, physical_test, solve_program_at,
 };
 use crr_kinematics::{ContactFace, Model, Parent};
 
@@ -217,18 +217,11 @@ impl<'a> Pass<'a> {
     /// holds. With no equilibrium at any λ ≥ 0 it bounds nothing (its subsets may hold).
     fn below_best(&mut self, set: &[usize]) -> Result<bool, Unexhausted> {
         let free = self.flags(set);
-        for precision in [Precision::Exact, Precision::Model] {
-            let below = match self.solve(&free, &[], precision) {
-                Ok(c) => c.lambda.is_some_and(|l| self.lowers(l)),
-                Err(StaticsError::DoesNotHold(_)) => true,
-                Err(StaticsError::Solver(_)) if precision == Precision::Exact => false,
-                Err(e) => return Err(Unexhausted::failed(e)),
-            };
-            if below {
-                return Ok(true);
-            }
+        match self.solve(&free, &[], Precision::Exact) {
+            Ok(c) => Ok(c.lambda.is_some_and(|l| self.lowers(l))),
+            Err(StaticsError::DoesNotHold(_)) => Ok(true),
+            Err(e) => Err(Unexhausted::failed(e)),
         }
-        Ok(false)
     }
 
     /// The program with the interfaces `free` freed and the points `unloaded` unloaded, as
@@ -330,102 +323,45 @@ impl<'a> Pass<'a> {
     }
 
     /// U freed, kept as the best where it lowers λ and passes the physical test. `holding` is
-    /// λ_u, U's program with every point of U unloaded.
-    ///
-    /// The freed program is solved as written first and, where that finds nothing or does not
-    /// solve, again at the model's precision ([`Precision`]): round-off of the corners can
-    /// wedge a body between U's faces, so that the freed program holds it above λ_u by normal
-    /// forces of its weight over the tilt of round-off. The retry is skipped where the answer
-    /// as written shows it cannot lower the best: its own forces cost too little at
-    /// [`WEDGE_PENALTY`] ([`Pass::wedge_free`]). Where the programs as written decide, the
-    /// answers are theirs.
+    /// λ_u, U's program with every point of U unloaded. The physical test is tried as written
+    /// and, where that finds no equilibrium, at the model's precision ([`Precision`]): two
+    /// blocks that tip at one λ written exactly tip at λ some 1e-6 apart once their corners are
+    /// rounded, and no exact equilibrium has both on their edges.
     fn try_set(&mut self, set: &[usize], holding: f64) -> Result<(), Unexhausted> {
         let free = self.flags(set);
-        match self.solve(&free, &[], Precision::Exact) {
-            Ok(freed) => match freed.lambda.filter(|&l| self.lowers(l)) {
-                Some(lambda)
-                    if self.accept(set, &free, &freed, holding, lambda, Precision::Exact)? =>
-                {
-                    return Ok(());
-                }
-                Some(_) => {}
-                None if self.wedge_free(set, &freed) => return Ok(()),
-                None => {}
-            },
-            Err(StaticsError::DoesNotHold(_) | StaticsError::Solver(_)) => {}
-            Err(e) => return Err(Unexhausted::failed(e)),
-        }
-        let freed = match self.solve(&free, &[], Precision::Model) {
+        let freed = match self.solve(&free, &[], Precision::Exact) {
             Ok(freed) => freed,
             Err(StaticsError::DoesNotHold(_)) => return Ok(()),
             Err(e) => return Err(Unexhausted::failed(e)),
         };
-        if let Some(lambda) = freed.lambda.filter(|&l| self.lowers(l)) {
-            self.accept(set, &free, &freed, holding, lambda, Precision::Model)?;
+        let Some(lambda) = freed.lambda.filter(|&l| self.lowers(l)) else {
+            return Ok(());
+        };
+        if self.unloads_below(set, &freed, holding, lambda) {
+            return Ok(());
         }
-        Ok(())
-    }
-
-    /// Whether U's freed answer as written (`freed`, not below the best) shows that the freed
-    /// program at the model's precision cannot lower the best either: that program maximises
-    /// λ − [`WEDGE_PENALTY`]·Σfₙ over U's points (forces in units of the total weight), and
-    /// `freed`'s own forces are feasible there, so its λ is at least λ_f − WEDGE_PENALTY·Σfₙ.
-    fn wedge_free(&self, set: &[usize], freed: &Collapse) -> bool {
-        let weight: f64 =
-            self.model.bodies.iter().map(|b| b.mass).sum::<f64>() * self.model.gravity;
-        let pressing: f64 = freed
-            .interfaces
-            .iter()
-            .filter(|i| set.contains(&i.interface))
-            .flat_map(|i| i.forces.iter())
-            .map(|f| f.normal.max(0.0))
-            .sum();
-        let lambda = freed.lambda.unwrap_or(self.options.lambda_max);
-        !self.lowers(lambda - WEDGE_PENALTY * pressing / weight)
-    }
-
-    /// `freed` (U's freed answer at `precision`, λ_f = `lambda` below the best) kept as the best
-    /// where it passes the physical test: as written (where the freed program was), then at the
-    /// model's precision. Whether it was kept.
-    fn accept(
-        &mut self,
-        set: &[usize],
-        free: &[bool],
-        freed: &Collapse,
-        holding: f64,
-        lambda: f64,
-        precision: Precision,
-    ) -> Result<bool, Unexhausted> {
-        if self.unloads_below(set, freed, holding, lambda) {
-            return Ok(false);
-        }
-        let test = |test_precision| {
+        let test = |precision| {
             physical_test(
                 self.model,
                 self.faces,
                 self.d,
                 self.options,
-                free,
+                &free,
                 freed.clone(),
-                test_precision,
+                precision,
             )
         };
-        let as_written = match precision {
-            Precision::Exact => test(Precision::Exact),
-            Precision::Model => Ok(None),
-        };
-        let physical = match as_written {
-            Ok(Some(collapse)) => collapse,
+        let physical = match test(Precision::Exact) {
+            Ok(Some(collapse)) => Some(collapse),
             Err(StaticsError::Interrupted) => {
                 return Err(Unexhausted::failed(StaticsError::Interrupted));
             }
-            _ => match test(Precision::Model).map_err(Unexhausted::failed)? {
-                Some(collapse) => collapse,
-                None => return Ok(false),
-            },
+            Ok(None) | Err(_) => test(Precision::Model).map_err(Unexhausted::failed)?,
         };
-        self.best = physical;
-        self.best_lambda = lambda;
-        Ok(true)
+        if let Some(collapse) = physical {
+            self.best = collapse;
+            self.best_lambda = lambda;
+        }
+        Ok(())
     }
 }
