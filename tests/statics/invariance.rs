@@ -288,7 +288,15 @@ fn written(
             obj += &format!("f {} {} {} {}\n", b + f[0], b + f[1], b + f[2], b + f[3]);
         }
     }
-    let name = format!("{name}_{degrees}_{decimals}_{}", offset[0] as i64);
+    // A file of its own per call: tests run in parallel, and two that write the same placement
+    // would truncate each other's file while it is read.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let name = format!(
+        "{name}_{degrees}_{decimals}_{}_{}_{call}",
+        offset[0] as i64,
+        std::process::id()
+    );
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("placements");
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join(format!("{name}.obj")), obj).unwrap();
@@ -343,6 +351,24 @@ fn an_answer_marked_exhaustive_is_the_multiplier_wherever_the_structure_is_writt
     }
 }
 
+/// Two courses of running bond, 1.5 m long: three blocks under two and two half blocks, each
+/// [x₀, x₁, z₀] along the wall's own x (see [`written`]).
+const RUNNING_BOND: [[f64; 3]; 7] = [
+    [0.0, 0.5, 0.0],
+    [0.5, 1.0, 0.0],
+    [1.0, 1.5, 0.0],
+    [0.0, 0.25, 0.25],
+    [0.25, 0.75, 0.25],
+    [0.75, 1.25, 0.25],
+    [1.25, 1.5, 0.25],
+];
+
+/// The horizontal unit vector square to a wall turned `degrees` about the vertical: its own y.
+fn out_of_plane(degrees: f64) -> Vector3<f64> {
+    let a = degrees.to_radians();
+    Vector3::new(-a.sin(), a.cos(), 0.0)
+}
+
 /// A wall of two courses in running bond, 1.5 m long (three blocks under two and two half
 /// blocks), loaded out of its plane: written exactly at the origin its multiplier is 0.514286,
 /// found among the joints that open and slide (its middle lower block and the two blocks over
@@ -353,26 +379,19 @@ fn an_answer_marked_exhaustive_is_the_multiplier_wherever_the_structure_is_writt
 /// statics take the faces' directions at the model's precision: the same multiplier, to 1e-7.
 #[test]
 fn a_wall_at_survey_coordinates_turns_out_of_its_plane_as_written_exactly() {
-    let blocks = [
-        [0.0, 0.5, 0.0],
-        [0.5, 1.0, 0.0],
-        [1.0, 1.5, 0.0],
-        [0.0, 0.25, 0.25],
-        [0.25, 0.75, 0.25],
-        [0.75, 1.25, 0.25],
-        [1.25, 1.5, 0.25],
-    ];
-    let out_of_plane = |degrees: f64| {
-        let a = degrees.to_radians();
-        Vector3::new(-a.sin(), a.cos(), 0.0)
-    };
-    let exact = written("bond", &blocks, 0.0, [0.0; 3], 15);
+    let exact = written("bond", &RUNNING_BOND, 0.0, [0.0; 3], 15);
     let reference =
         collapse_multiplier(&exact, out_of_plane(0.0), &StaticsOptions::default()).unwrap();
     let lambda = reference.lambda.unwrap();
     assert!(reference.exhaustive);
     assert!((lambda - 0.514286).abs() < 1e-6, "{lambda}");
-    let survey = written("bond", &blocks, 40.0, [500_000.0, 4_500_000.0, 350.0], 15);
+    let survey = written(
+        "bond",
+        &RUNNING_BOND,
+        40.0,
+        [500_000.0, 4_500_000.0, 350.0],
+        15,
+    );
     let c = collapse_multiplier(&survey, out_of_plane(40.0), &StaticsOptions::default()).unwrap();
     let got = c.lambda.unwrap();
     assert!(c.exhaustive, "{got}");
@@ -392,26 +411,19 @@ fn a_wall_at_survey_coordinates_turns_out_of_its_plane_as_written_exactly() {
 /// the model's precision, both ways.
 #[test]
 fn a_wall_written_with_six_decimals_turns_out_of_its_plane_as_written_exactly() {
-    let blocks = [
-        [0.0, 0.5, 0.0],
-        [0.5, 1.0, 0.0],
-        [1.0, 1.5, 0.0],
-        [0.0, 0.25, 0.25],
-        [0.25, 0.75, 0.25],
-        [0.75, 1.25, 0.25],
-        [1.25, 1.5, 0.25],
-    ];
-    let a = 30.0_f64.to_radians();
-    let out_of_plane = Vector3::new(-a.sin(), a.cos(), 0.0);
-    let exact = written("bond", &blocks, 0.0, [0.0; 3], 15);
-    let rounded = written("bond", &blocks, 30.0, [0.0; 3], 6);
+    let exact = written("bond", &RUNNING_BOND, 0.0, [0.0; 3], 15);
+    let rounded = written("bond", &RUNNING_BOND, 30.0, [0.0; 3], 6);
     for sign in [1.0, -1.0] {
         let reference =
             collapse_multiplier(&exact, sign * Vector3::y(), &StaticsOptions::default()).unwrap();
         let lambda = reference.lambda.unwrap();
         assert!(reference.exhaustive);
-        let c =
-            collapse_multiplier(&rounded, sign * out_of_plane, &StaticsOptions::default()).unwrap();
+        let c = collapse_multiplier(
+            &rounded,
+            sign * out_of_plane(30.0),
+            &StaticsOptions::default(),
+        )
+        .unwrap();
         let got = c.lambda.unwrap();
         assert!(c.exhaustive, "{sign:+}: {got}, {:?}", c.unexhausted);
         assert!(
