@@ -38,8 +38,8 @@
 use nalgebra::Vector3;
 
 use super::{
-    Collapse, Precision, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted,
-    moving_points, physical_test, solve_program_at,
+    Collapse, HOLDS_FROM, StaticsError, StaticsOptions, UNLOADED_TOLERANCE, Unexhausted,
+    moving_points, physical_test, solve_program, solve_to_precision,
 };
 use crr_kinematics::{ContactFace, Model, Parent};
 
@@ -217,7 +217,7 @@ impl<'a> Pass<'a> {
     /// holds. With no equilibrium at any λ ≥ 0 it bounds nothing (its subsets may hold).
     fn below_best(&mut self, set: &[usize]) -> Result<bool, Unexhausted> {
         let free = self.flags(set);
-        match self.solve(&free, &[], Precision::Exact) {
+        match self.solve(&free, &[]) {
             Ok(c) => Ok(c.lambda.is_some_and(|l| self.lowers(l))),
             Err(StaticsError::DoesNotHold(_)) => Ok(true),
             Err(e) => Err(Unexhausted::failed(e)),
@@ -226,21 +226,8 @@ impl<'a> Pass<'a> {
 
     /// The program with the interfaces `free` freed and the points `unloaded` unloaded, as
     /// written or at the model's precision ([`Precision`]).
-    fn solve(
-        &self,
-        free: &[bool],
-        unloaded: &[(usize, usize)],
-        precision: Precision,
-    ) -> Result<Collapse, StaticsError> {
-        solve_program_at(
-            self.model,
-            self.faces,
-            self.d,
-            self.options,
-            free,
-            unloaded,
-            precision,
-        )
+    fn solve(&self, free: &[bool], unloaded: &[(usize, usize)]) -> Result<Collapse, StaticsError> {
+        solve_program(self.model, self.faces, self.d, self.options, free, unloaded)
     }
 
     /// Whether the physical test of U's freed answer (λ_f = `lambda`) must fail, without its
@@ -299,14 +286,18 @@ impl<'a> Pass<'a> {
                 .collect();
             // As written first; where that has no equilibrium or does not solve, at the model's
             // precision (an upper block centred over the joint below balances on neither half
-            // once rounded).
+            // once rounded), unless the answer as written rules that out.
             let none = vec![false; self.faces.len()];
-            let holding = match self.solve(&none, &unloaded, Precision::Exact) {
-                Err(StaticsError::DoesNotHold(_) | StaticsError::Solver(_)) => {
-                    self.solve(&none, &unloaded, Precision::Model)
-                }
-                exact => exact,
-            };
+            let holding = solve_to_precision(
+                self.model,
+                self.faces,
+                self.d,
+                self.options,
+                &none,
+                &unloaded,
+                &[],
+                HOLDS_FROM,
+            );
             let holding = match holding {
                 Ok(c) => c.lambda.unwrap_or(self.options.lambda_max),
                 Err(StaticsError::DoesNotHold(_)) => continue,
@@ -324,12 +315,11 @@ impl<'a> Pass<'a> {
 
     /// U freed, kept as the best where it lowers λ and passes the physical test. `holding` is
     /// λ_u, U's program with every point of U unloaded. The physical test is tried as written
-    /// and, where that finds no equilibrium, at the model's precision ([`Precision`]): two
-    /// blocks that tip at one λ written exactly tip at λ some 1e-6 apart once their corners are
-    /// rounded, and no exact equilibrium has both on their edges.
+    /// and, where that falls short and its dual leaves room, at the model's precision
+    /// ([`super::Precision`]).
     fn try_set(&mut self, set: &[usize], holding: f64) -> Result<(), Unexhausted> {
         let free = self.flags(set);
-        let freed = match self.solve(&free, &[], Precision::Exact) {
+        let freed = match self.solve(&free, &[]) {
             Ok(freed) => freed,
             Err(StaticsError::DoesNotHold(_)) => return Ok(()),
             Err(e) => return Err(Unexhausted::failed(e)),
@@ -340,24 +330,16 @@ impl<'a> Pass<'a> {
         if self.unloads_below(set, &freed, holding, lambda) {
             return Ok(());
         }
-        let test = |precision| {
-            physical_test(
-                self.model,
-                self.faces,
-                self.d,
-                self.options,
-                &free,
-                freed.clone(),
-                precision,
-            )
-        };
-        let physical = match test(Precision::Exact) {
-            Ok(Some(collapse)) => Some(collapse),
-            Err(StaticsError::Interrupted) => {
-                return Err(Unexhausted::failed(StaticsError::Interrupted));
-            }
-            Ok(None) | Err(_) => test(Precision::Model).map_err(Unexhausted::failed)?,
-        };
+        let physical = physical_test(
+            self.model,
+            self.faces,
+            self.d,
+            self.options,
+            &free,
+            freed,
+            true,
+        )
+        .map_err(Unexhausted::failed)?;
         if let Some(collapse) = physical {
             self.best = collapse;
             self.best_lambda = lambda;
