@@ -294,7 +294,11 @@ pub fn check_with(
     } else if mob.locked {
         (
             None,
-            Some("locked: DOF(2) = 0, the structure cannot move".into()),
+            Some(
+                "locked: DOF(2) = 0, the CRR chain cannot move with every joint seated; the \
+                 structure can still move where a joint opens (the static multipliers below)"
+                    .into(),
+            ),
         )
     } else {
         (
@@ -418,6 +422,19 @@ pub fn to_text(r: &CheckReport) -> String {
         m.dof2,
         if m.locked { " (locked)" } else { "" }
     );
+    if m.dof2_at_precision != m.dof2 {
+        s += &format!(
+            "DOF(2) at the model's precision = {}: Φ_q has {} singular value(s) between 1e-9 \
+             and {:.0e} of its largest, so its loops close only to the round-off of its geometry \
+             (coordinates with few decimals, or far from the origin). The dynamics follows the \
+             loops as written (DOF(2) = {}); written with more decimals, or nearer the origin, \
+             they move as meant\n",
+            m.dof2_at_precision,
+            m.dof2_at_precision - m.dof2,
+            crr_dynamics::closed_chain::PRECISION_RANK_TOLERANCE,
+            m.dof2
+        );
+    }
     if let Some(f) = &r.finite_mobility {
         s += &format!(
             "DOF(2) after a {} rad step along the mechanism = {}\n",

@@ -294,3 +294,21 @@ fn colonnade_initial_states_have_consistent_pivots() {
         }
     }
 }
+
+/// Every reference structure's mobility is the same at the model's precision: their loops are
+/// exact (the fixtures above), so no singular value of Φ_q lies between 1e-9 and 1e-5 of the
+/// largest.
+#[test]
+fn exact_structures_have_the_same_dof2_at_the_model_s_precision() {
+    for spec in [
+        single_block(0.2, 1.0, 2500.0),
+        trilithon(0.25, 1.5, 2.0, 0.5, 1.0),
+        four_hinge_arch(4.0, 4.6, 1.0, false),
+        four_hinge_arch(4.0, 4.6, 1.0, true),
+        colonnade(0.3, 2.0, 2.0, 0.4),
+        skew_four_hinge_loop(),
+    ] {
+        let m = mobility_at_rest(&spec);
+        assert_eq!(m.dof2_at_precision, m.dof2, "{}", spec.name);
+    }
+}
