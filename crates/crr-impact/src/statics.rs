@@ -1557,8 +1557,17 @@ impl Program {
     /// weak duality λ = −qᵀx ≤ (b + δ)ᵀz ≤ bᵀz + Σₖ εₖ|zₖ| for every δ. A certificate of
     /// infeasibility (Aᵀz = 0, z ∈ K*, bᵀz < 0) proves the moved program infeasible as well
     /// where bᵀz + Σₖ εₖ|zₖ| < 0. The solver's z holds its equations to its tolerances only, so
-    /// the sum counts twice, and a certificate must hold with half of bᵀz to spare.
+    /// the sum counts twice, and a certificate must hold with half of bᵀz to spare. An answer
+    /// at the solver's reduced tolerances (`AlmostSolved`, `AlmostPrimalInfeasible`: dual
+    /// residuals up to 5e-5) proves nothing this way (its residual times the forces may exceed
+    /// the margin; an independent review), so it leaves the second program to run.
     fn reach_at_precision(&self, solution: &clarabel::solver::DefaultSolution<f64>) -> f64 {
+        if !matches!(
+            solution.status,
+            SolverStatus::Solved | SolverStatus::PrimalInfeasible
+        ) {
+            return f64::INFINITY;
+        }
         let spread: f64 = self
             .residual_bounds
             .iter()
