@@ -5,8 +5,6 @@
 //! results folder is [`crate::output::simulate`]'s.
 
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::Vector3;
 
@@ -82,40 +80,10 @@ pub struct RunOptions {
     pub max_samples: Option<usize>,
 }
 
-/// A request to stop a run, shared between the run and whoever may interrupt it (a signal
-/// handler, another thread): cloning it shares the flag.
-#[derive(Clone, Debug, Default)]
-pub struct Cancel(Arc<AtomicBool>);
-
-impl Cancel {
-    /// A flag not set.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Asks every run holding this flag to stop: within one integration step of its
-    /// current step ([`Simulation::set_interrupt`]), at a state of the motion.
-    pub fn cancel(&self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
-
-    /// Whether [`Self::cancel`] was called.
-    pub fn is_cancelled(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-
-    /// The same flag as the statics' request to stop ([`crr_impact::statics::Interrupt`]).
-    pub fn as_statics_interrupt(&self) -> crr_impact::statics::Interrupt {
-        crr_impact::statics::Interrupt(Arc::clone(&self.0))
-    }
-}
-
-/// Two are equal where they share the flag.
-impl PartialEq for Cancel {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-    }
-}
+/// A request to stop a run, a check or a study ([`crr_dynamics::Cancel`]): a run stops within
+/// one integration step of its current step ([`Simulation::set_interrupt`]), at a state of the
+/// motion; the statics after the linear program under way.
+pub use crr_dynamics::Cancel;
 
 /// Everything a run needs, read and checked from the inputs.
 #[derive(Clone, Debug)]
@@ -659,7 +627,7 @@ pub fn simulate_observed(
     observe: &mut dyn FnMut(&mut Simulation, &Result<StopReason, SimulationError>) -> Flow,
 ) -> Result<(Trajectory, Option<SimulationError>), SimulationError> {
     let mut sim = Simulation::new(model, ground, initial, params.clone())?;
-    sim.set_interrupt(cancel.map(|c| Arc::clone(&c.0)));
+    sim.set_interrupt(cancel.cloned());
     let total = params.duration;
     let mut shown = -1i64;
     let error = loop {

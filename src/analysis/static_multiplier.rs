@@ -178,7 +178,7 @@ pub fn static_multiplier_with(
     let options = StaticsOptions {
         friction: friction.map_or(Friction::NoSliding, Friction::Cone),
         exhaustive_sets: asked.exhaustive_sets,
-        interrupt: asked.cancel.as_ref().map(Cancel::as_statics_interrupt),
+        cancel: asked.cancel.clone(),
         ..StaticsOptions::default()
     };
     let cancelled = || asked.cancel.as_ref().is_some_and(Cancel::is_cancelled);

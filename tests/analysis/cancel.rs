@@ -266,7 +266,7 @@ fn a_check_asked_to_stop_before_it_starts_gives_no_report() {
         Some(INTERRUPTED.to_string())
     );
     let options = StaticsOptions {
-        interrupt: Some(cancel.as_statics_interrupt()),
+        cancel: Some(cancel.clone()),
         ..StaticsOptions::default()
     };
     assert_eq!(

@@ -65,8 +65,7 @@ mod events;
 mod stages;
 mod tableau;
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use crate::Cancel;
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -399,7 +398,7 @@ pub struct Solver {
     /// Event fired last (index, time).
     fired: Option<(usize, f64)>,
     /// Read after every accepted step that does not end the advance ([`Solver::set_interrupt`]).
-    interrupt: Option<Arc<AtomicBool>>,
+    interrupt: Option<Cancel>,
 }
 
 impl Solver {
@@ -455,20 +454,18 @@ impl Solver {
     /// caller that goes on after an interrupt makes progress. A long advance (a quiet stretch of
     /// many steps, a stalled one of many short steps) is then stopped within one step of the
     /// request instead of at its end.
-    pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
-        self.interrupt = flag;
+    pub fn set_interrupt(&mut self, cancel: Option<Cancel>) {
+        self.interrupt = cancel;
     }
 
-    /// The flag of [`Self::set_interrupt`].
-    pub fn interrupt(&self) -> Option<&Arc<AtomicBool>> {
+    /// The request of [`Self::set_interrupt`].
+    pub fn interrupt(&self) -> Option<&Cancel> {
         self.interrupt.as_ref()
     }
 
-    /// Whether the flag of [`Self::set_interrupt`] is set.
+    /// Whether the request of [`Self::set_interrupt`] was made.
     pub fn interrupted(&self) -> bool {
-        self.interrupt
-            .as_ref()
-            .is_some_and(|f| f.load(Ordering::Relaxed))
+        self.interrupt.as_ref().is_some_and(Cancel::is_cancelled)
     }
 
     /// Forgets which event fired last. Call it when the next `advance` uses a different set of

@@ -10,6 +10,7 @@
 
 pub mod analysis;
 pub mod articulated_body;
+pub mod cancel;
 pub mod closed_chain;
 pub mod energy;
 pub mod eom;
@@ -26,6 +27,7 @@ pub mod system;
 
 pub use analysis::{AnalysisSpec, MethodName};
 pub use articulated_body::ArticulatedBody;
+pub use cancel::Cancel;
 pub use closed_chain::{
     FiniteMobility, InitialSpec, InitialState, Mobility, Partition, mobility, mobility_after_step,
     partition, solve_initial,

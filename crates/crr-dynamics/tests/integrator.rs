@@ -6,8 +6,8 @@ use crr_dynamics::integrator::{
     SolveError, Solver, StepEnds, Stop,
 };
 use std::f64::consts::PI;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+
+use crr_dynamics::Cancel;
 
 // ------------------------------------------------------------------ systems
 
@@ -927,7 +927,7 @@ fn max_steps_is_an_error() {
 /// The oscillator, raising a flag when a stage reaches `at` (as another thread would).
 struct FlagAt {
     at: f64,
-    flag: Arc<AtomicBool>,
+    flag: Cancel,
 }
 impl OdeSystem for FlagAt {
     fn dim(&self) -> usize {
@@ -935,28 +935,28 @@ impl OdeSystem for FlagAt {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RhsError> {
         if t >= self.at {
-            self.flag.store(true, Ordering::Relaxed);
+            self.flag.cancel();
         }
         Oscillator.rhs(t, y, dydt)
     }
 }
 
 /// An interrupt stops an advance at the end of the accepted step in which it is seen, a state of
-/// the solution (cos t, −sin t) to the tolerances; cleared, the advance goes on to the end as
-/// the uninterrupted one does.
+/// the solution (cos t, −sin t) to the tolerances; without it, the advance goes on to the end
+/// as the uninterrupted one does.
 #[test]
 fn an_interrupt_stops_an_advance_at_an_accepted_step() {
     let opts = Options {
         h_max: 0.1,
         ..Options::default()
     };
-    let flag = Arc::new(AtomicBool::new(false));
+    let flag = Cancel::new();
     let mut s = Solver::new(Method::Dop853, opts, 2).unwrap();
-    s.set_interrupt(Some(Arc::clone(&flag)));
+    s.set_interrupt(Some(flag.clone()));
     s.reset(0.0, &[1.0, 0.0]);
     let mut sys = FlagAt {
         at: 3.0,
-        flag: Arc::clone(&flag),
+        flag: flag.clone(),
     };
     let err = s
         .advance(&mut sys, 10.0, &mut NoEvents, &mut ignore)
@@ -970,7 +970,7 @@ fn an_interrupt_stops_an_advance_at_an_accepted_step() {
     assert_eq!(s.t(), t);
     // The global error of DOP853 at rtol 1e-10 over 3 s stays far below 1e-8.
     assert!((s.y()[0] - t.cos()).abs() < 1e-8 && (s.y()[1] + t.sin()).abs() < 1e-8);
-    flag.store(false, Ordering::Relaxed);
+    s.set_interrupt(None);
     sys.at = f64::INFINITY;
     let stop = s
         .advance(&mut sys, 10.0, &mut NoEvents, &mut ignore)
@@ -988,7 +988,9 @@ fn an_advance_under_a_set_interrupt_takes_one_step() {
         ..Options::default()
     };
     let mut s = Solver::new(Method::Dopri5, opts, 2).unwrap();
-    s.set_interrupt(Some(Arc::new(AtomicBool::new(true))));
+    let cancelled = Cancel::new();
+    cancelled.cancel();
+    s.set_interrupt(Some(cancelled));
     s.reset(0.0, &[1.0, 0.0]);
     let mut t_prev = 0.0;
     for _ in 0..3 {

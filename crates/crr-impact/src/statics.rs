@@ -27,8 +27,6 @@
 //! contact is closed; one that keeps some points rocks about them (its pivot sides are the signs
 //! of the relative rotation about its axes, the CRR chain's sides); one that keeps none lifts off,
 //! which the CRR chain does not represent.
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::Vector3;
 use serde::Serialize;
@@ -37,6 +35,7 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
 };
+use crr_dynamics::Cancel;
 use crr_kinematics::{ContactFace, InterfaceKind, Model, Parent, Side};
 
 mod closure;
@@ -84,31 +83,12 @@ pub struct StaticsOptions {
     /// A request to stop, polled before every linear program: once set,
     /// [`collapse_multiplier`] returns [`StaticsError::Interrupted`] after the program under
     /// way (the search and the exhaustive pass run hundreds to thousands of them on a wall).
-    pub interrupt: Option<Interrupt>,
-}
-
-/// A request to stop the statics, shared between them and whoever may interrupt them (a
-/// signal handler, another thread): cloning it shares the flag. Two are equal where they share
-/// it.
-#[derive(Clone, Debug, Default)]
-pub struct Interrupt(pub Arc<AtomicBool>);
-
-impl Interrupt {
-    /// Whether the stop was asked.
-    pub fn is_set(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-}
-
-impl PartialEq for Interrupt {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-    }
+    pub cancel: Option<Cancel>,
 }
 
 /// Whether `options` ask to stop.
 fn interrupted(options: &StaticsOptions) -> bool {
-    options.interrupt.as_ref().is_some_and(Interrupt::is_set)
+    options.cancel.as_ref().is_some_and(Cancel::is_cancelled)
 }
 
 impl Default for StaticsOptions {
@@ -118,7 +98,7 @@ impl Default for StaticsOptions {
             lambda_max: LAMBDA_MAX,
             sliding_lift_off: true,
             exhaustive_sets: EXHAUSTIVE_SETS,
-            interrupt: None,
+            cancel: None,
         }
     }
 }
@@ -204,7 +184,7 @@ pub enum StaticsError {
     /// The solver did not reach an answer.
     #[error("the linear program of the statics did not solve: {0}")]
     Solver(String),
-    /// [`StaticsOptions::interrupt`] was set: no answer.
+    /// [`StaticsOptions::cancel`] was set: no answer.
     #[error("interrupted")]
     Interrupted,
 }
@@ -1117,7 +1097,7 @@ pub fn required_friction(
             lambda_max,
             sliding_lift_off: false,
             exhaustive_sets: 0,
-            interrupt: None,
+            cancel: None,
         };
         match collapse_multiplier(model, direction, &options) {
             Ok(c) => Ok(Some(c.lambda.unwrap_or(lambda_max) - target)),
@@ -1166,7 +1146,7 @@ pub fn state_friction(
                 lambda_max,
                 sliding_lift_off: false,
                 exhaustive_sets: 0,
-                interrupt: None,
+                cancel: None,
             };
             // With few points loaded and little friction the program may have no equilibrium
             // at any λ ≥ 0, which the solver reports as not converging: that μ does not reach λ.
@@ -1420,7 +1400,7 @@ struct Program {
     /// the model's precision allows ([`EQUILIBRIUM_RESIDUAL`] of the body's share of the weight).
     residual_bounds: Vec<f64>,
     /// The options' request to stop.
-    interrupt: Option<Interrupt>,
+    cancel: Option<Cancel>,
 }
 
 /// Whether a program of the exhaustive pass holds the geometry as written, or only to the
@@ -1516,7 +1496,7 @@ impl Program {
             residuals: 0,
             precision,
             residual_bounds,
-            interrupt: options.interrupt.clone(),
+            cancel: options.cancel.clone(),
         };
         program.equilibrium_rows(model, d, total_mass, size);
         program.inequality_rows(faces, options);
@@ -1802,7 +1782,7 @@ impl Program {
         b: &[f64],
         cones: &[SupportedConeT<f64>],
     ) -> Result<clarabel::solver::DefaultSolution<f64>, StaticsError> {
-        if self.interrupt.as_ref().is_some_and(Interrupt::is_set) {
+        if self.cancel.as_ref().is_some_and(Cancel::is_cancelled) {
             return Err(StaticsError::Interrupted);
         }
         let mut failed = None;

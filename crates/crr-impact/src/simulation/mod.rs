@@ -23,7 +23,6 @@
 //! (its rate set to 0, the other generalized momenta kept); the run continues seated until uplift.
 
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
 use nalgebra::DVector;
 use serde::Serialize;
@@ -1206,8 +1205,8 @@ impl<'a> Simulation<'a> {
     /// advances at least once, so a caller that reads the flag between steps too stops after the
     /// first. Without it a step runs to its event, breakpoint or end, which may take long (a
     /// quiet stretch of a large structure, a stalled step of many short steps).
-    pub fn set_interrupt(&mut self, flag: Option<Arc<AtomicBool>>) {
-        self.solver.set_interrupt(flag);
+    pub fn set_interrupt(&mut self, cancel: Option<crr_dynamics::Cancel>) {
+        self.solver.set_interrupt(cancel);
     }
 
     fn reset_solver(&mut self) {
