@@ -96,6 +96,15 @@ pub(super) struct OpenFace {
     /// it is.
     points: Vec<Vector3<f64>>,
     pub(super) point_sides: Vec<Vec<Side>>,
+    /// The face's tangents at rest (t₁, t₂) and its extent along each, the least and greatest
+    /// tᵢ · x over its points (None: unbounded, a hinge's t₂ = u out of its plane of motion).
+    tangents: [Vector3<f64>; 2],
+    extent: [Option<(f64, f64)>; 2],
+    /// How far (m) a point may lie outside the extent and still face the face: 1e-12 of the
+    /// model's size, round-off of the poses. (A corner that has moved past the edge by δ with
+    /// a tilt θ = δ/w reads a false penetration of about δθ/2 from the extended plane: below
+    /// 1e-24 of the size within this tolerance.)
+    extent_tolerance: f64,
 }
 
 impl OpenFace {
@@ -138,9 +147,31 @@ impl OpenFace {
             },
             child: iface.child,
             normal: face.normal,
+            tangents: face.tangents,
+            extent: [0, 1].map(|k| {
+                // A hinge's face is a line: out of its plane (t₂ = u) it has no edge.
+                (k == 0 || face.friction_tangents == 2).then(|| {
+                    let along = face.points.iter().map(|x| face.tangents[k].dot(x));
+                    along.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                        (lo.min(v), hi.max(v))
+                    })
+                })
+            }),
+            extent_tolerance: 1e-12 * model.size,
             points: face.points,
             point_sides,
         }
+    }
+
+    /// Whether the point `x` of a body, given in that body's rest frame, lies over the face as
+    /// the body carries it: its tangential coordinates within the face's extent.
+    fn over_face(&self, x: &Vector3<f64>) -> bool {
+        self.tangents.iter().zip(&self.extent).all(|(t, extent)| {
+            extent.is_none_or(|(lo, hi)| {
+                let v = t.dot(x);
+                v >= lo - self.extent_tolerance && v <= hi + self.extent_tolerance
+            })
+        })
     }
 
     /// Number of contact points.
@@ -150,20 +181,44 @@ impl OpenFace {
 
     /// The normal gap of point `i` (m) in the poses of `kin` ([`forward_kinematics`] of a chain
     /// with the same tree as `model`).
+    ///
+    /// Point i is a corner of the face on either body, x_c on the child and x_p on the parent
+    /// (the same point at rest). Either may be the one that meets the other body's face: the
+    /// child's corner is measured from the parent's face plane, n_p · (x_c − x_p), where it lies
+    /// over the parent's face, and the parent's corner from the child's face plane,
+    /// n_c · (x_c − x_p), where it lies over the child's; the gap is the least of those that
+    /// apply (the two agree to first order in the motion). A corner that has moved past the
+    /// other face's edge meets nothing there: a block that tips away from its neighbour about
+    /// its far foot takes its face's lower edge up and away from the neighbour's face, while the
+    /// neighbour's corner, measured from the tipped face's plane extended past that edge, would
+    /// read a penetration of w(1 − cos θ) (w the block's width, θ its tilt). Where neither
+    /// applies (the faces twisted apart about their normal), the child's corner from the
+    /// parent's plane.
     pub(super) fn gap(&self, model: &Model, kin: &Data, i: usize) -> f64 {
         let p = &self.points[i];
-        let child = crr_kinematics::body_point(model, kin, self.child, p);
-        let (parent, normal) = match self.parent {
-            None => (*p, self.normal),
-            Some(b) => {
-                let k = model.body_coord[b];
-                (
-                    crr_kinematics::body_point(model, kin, b, p),
-                    kin.rot_ops[k] * self.normal,
-                )
-            }
+        let child_coord = model.body_coord[self.child];
+        let (child, child_rot) = (
+            crr_kinematics::body_point(model, kin, self.child, p),
+            kin.rot_ops[child_coord],
+        );
+        let (parent, parent_rot) = match self.parent {
+            None => (*p, nalgebra::Matrix3::identity()),
+            Some(b) => (
+                crr_kinematics::body_point(model, kin, b, p),
+                kin.rot_ops[model.body_coord[b]],
+            ),
         };
-        normal.dot(&(child - parent))
+        let apart = child - parent;
+        let from_parent = (parent_rot * self.normal).dot(&apart);
+        // Each corner in the other body's rest frame: x_p + Γ_pᵀ(x_c − x_p), and back.
+        let child_over_parent = self.over_face(&(p + parent_rot.transpose() * apart));
+        let parent_over_child = self.over_face(&(p - child_rot.transpose() * apart));
+        let from_child = (child_rot * self.normal).dot(&apart);
+        match (child_over_parent, parent_over_child) {
+            (true, true) => from_parent.min(from_child),
+            (false, true) => from_child,
+            _ => from_parent,
+        }
     }
 }
 
@@ -1184,5 +1239,146 @@ mod tests {
             1,
             &[false, true, true]
         ));
+    }
+}
+
+#[cfg(test)]
+mod gap_tests {
+    use super::*;
+    use crr_kinematics::Role;
+    use crr_kinematics::fixtures::{box_body, rocking_base};
+    use crr_kinematics::spec::StructureSpec;
+    use nalgebra::{Rotation3, Vector3};
+
+    /// Width w (x), depth (y) and height (z) of the two blocks.
+    const W: f64 = 0.5;
+    const DEPTH: f64 = 0.5;
+    const H: f64 = 1.0;
+
+    /// Two blocks side by side on the ground, `a` on x ∈ [−w, 0] and `b` on x ∈ [0, w], their
+    /// head joint x = 0 a rocking base (b on a) that closes the loop through the ground.
+    fn pair() -> Model {
+        let (d, h) = (DEPTH / 2.0, H);
+        let spec = StructureSpec {
+            name: "pair".into(),
+            gravity: 9.81,
+            body: vec![
+                box_body("a", 2000.0, [-W / 2.0, 0.0, h / 2.0], [W, DEPTH, h]),
+                box_body("b", 2000.0, [W / 2.0, 0.0, h / 2.0], [W, DEPTH, h]),
+            ],
+            interface: vec![
+                rocking_base(
+                    "a_on_ground",
+                    "ground",
+                    "a",
+                    [[-W, -d, 0.0], [0.0, -d, 0.0], [0.0, d, 0.0], [-W, d, 0.0]],
+                ),
+                rocking_base(
+                    "b_on_ground",
+                    "ground",
+                    "b",
+                    [[0.0, -d, 0.0], [W, -d, 0.0], [W, d, 0.0], [0.0, d, 0.0]],
+                ),
+                rocking_base(
+                    "b_on_a",
+                    "a",
+                    "b",
+                    [[0.0, -d, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, -d, h]],
+                ),
+            ],
+            symmetry: Vec::new(),
+        };
+        Model::from_spec(&spec).unwrap()
+    }
+
+    /// The head face's four gaps with `a` turned by `turn_a` and `b` by `turn_b` (rad, about
+    /// +y, each on the edge of its base at its least x: the blocks tip towards −x).
+    fn head_gaps(model: &Model, turn_a: f64, turn_b: f64) -> Vec<f64> {
+        let mut pivots = ActivePivots::uniform(model, Side::Positive);
+        let mut q = DVector::zeros(model.dof());
+        for (name, turn) in [("a_on_ground", turn_a), ("b_on_ground", turn_b)] {
+            let iface = &model.interfaces[model.interface_index(name).unwrap()];
+            let Role::Tree { first_coord } = iface.role else {
+                panic!("{name} is in the tree");
+            };
+            // Tilt about e₂ = +y, its second angle; negative: the pivot at the least x.
+            pivots.sides[iface.slots.start + 1] = Side::Negative;
+            q[first_coord + 1] = -turn;
+        }
+        let mut kin = Data::new(model);
+        forward_kinematics(model, &mut kin, &q, &pivots);
+        let face = OpenFace::of(model, model.interface_index("b_on_a").unwrap());
+        (0..face.len()).map(|i| face.gap(model, &kin, i)).collect()
+    }
+
+    /// A point at rest turned by `turn` about +y through `pivot` (the block tipping towards −x).
+    fn tipped(x: Vector3<f64>, pivot: Vector3<f64>, turn: f64) -> Vector3<f64> {
+        pivot + Rotation3::from_axis_angle(&Vector3::y_axis(), -turn) * (x - pivot)
+    }
+
+    /// A block that tips away from its neighbour about its far foot takes the lower edge of its
+    /// face up and away from the neighbour's face: the gap there is the distance of that edge
+    /// from the neighbour's plane x = 0, w(1 − cos θ) > 0, by the rotation written here. At the
+    /// upper edge, which leaves at first order, each corner lies over the other block's face and
+    /// the gap is the nearer of the two, a's corner from b's plane and b's corner from a's
+    /// turned plane. (Measured from the tipped face's plane extended past its lower edge, the
+    /// neighbour's lower corner would read −w(1 − cos θ), a landing at once.)
+    #[test]
+    fn a_block_tipping_away_from_its_neighbour_opens_their_face() {
+        let model = pair();
+        let face = OpenFace::of(&model, 2);
+        for turn in [1e-6, 1e-3, 0.1] {
+            let gaps = head_gaps(&model, turn, 0.0);
+            let foot = Vector3::new(-W, 0.0, 0.0);
+            let a_normal = Rotation3::from_axis_angle(&Vector3::y_axis(), -turn) * Vector3::x();
+            for (i, gap) in gaps.iter().enumerate() {
+                let corner = face.points[i];
+                // a's corner from b's face plane x = 0 (b does not move), and b's corner from
+                // a's turned face plane.
+                let a_corner = tipped(corner, foot, turn);
+                let from_b = -a_corner.x;
+                let from_a = a_normal.dot(&(corner - a_corner));
+                let expected = if corner.z == 0.0 {
+                    from_b
+                } else {
+                    from_b.min(from_a)
+                };
+                assert!(
+                    (gap - expected).abs() <= 1e-15,
+                    "θ = {turn}: gap {gap:e} at corner {i}, expected {expected:e}"
+                );
+                assert!(*gap > 0.0, "θ = {turn}: corner {i} reads {gap:e}");
+            }
+            let lower = W * (1.0 - turn.cos());
+            assert!((gaps[0] - lower).abs() <= 1e-15 && (gaps[1] - lower).abs() <= 1e-15);
+        }
+    }
+
+    /// Both blocks tipping together by the same θ (each about its −x foot): a's lower corner
+    /// enters b, behind b's turned face by w(1 − cos θ) while it lies over that face, a
+    /// penetration the gap must read (b's corner, its pivot, stays below a's lifted base).
+    #[test]
+    fn blocks_tipping_together_press_their_face_at_second_order() {
+        let model = pair();
+        for turn in [1e-3, 0.1] {
+            let gaps = head_gaps(&model, turn, turn);
+            let inside = W * (1.0 - turn.cos());
+            for i in [0, 1] {
+                // The distance of a's turned corner from b's turned plane, by the rotations.
+                let corner = OpenFace::of(&model, 2).points[i];
+                let a_corner = tipped(corner, Vector3::new(-W, 0.0, 0.0), turn);
+                let b_normal = Rotation3::from_axis_angle(&Vector3::y_axis(), -turn) * Vector3::x();
+                let expected = b_normal.dot(&(corner - a_corner));
+                assert!(
+                    (expected + inside).abs() <= 1e-15,
+                    "{expected:e} against −{inside:e}"
+                );
+                assert!(
+                    (gaps[i] - expected).abs() <= 1e-15,
+                    "θ = {turn}: gap {:e} at corner {i}, expected {expected:e}",
+                    gaps[i]
+                );
+            }
+        }
     }
 }
