@@ -1158,9 +1158,11 @@ fn warnings(
         } else if v.kind == "sliding_unloaded" {
             "slides while keeping contact, carrying nothing, in a mechanism whose multiplier \
              the ground acceleration exceeds (found by the search for joints that open and \
-             slide, `crr check`); the CRR chain, whose joints do not slide, holds the structure \
-             at rest by shear across it with no compression, which no friction gives: a real \
-             structure may move from here (docs/simulation.md, \"Joints that open may slide\")"
+             slide, `crr check`), and the motion without it presses its face (the face would \
+             have to slide under compression, as between two equal blocks tipping together); \
+             the CRR chain, whose joints do not slide, holds the structure at rest by shear \
+             across it with no compression, which no friction gives: a real structure may move \
+             from here (docs/simulation.md, \"Joints that open may slide\")"
                 .to_string()
         } else {
             if v.friction_demand.is_finite() {

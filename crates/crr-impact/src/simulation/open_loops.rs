@@ -408,52 +408,25 @@ impl Simulation<'_> {
         let (mut d, _, _) = self.dynamics_on(chain, loops, &[]);
         // The chain's own decision at this state: the releases of its uplift test, those of
         // faces it would lift off too left out (decided once it integrates), kept where its
-        // exact solve opens them.
-        let mut trial = d.clone();
+        // exact solve opens them. From rest it is asked again with them released until it
+        // releases nothing more: its test opens the strongest single release of an open chain
+        // (the others follow at the next step's test), and every part that opens at t = 0 moves
+        // in the motion that decides whether a face grazing between two of them opens.
         let mut rest = super::uplift_from_rest::RestCache::default();
         rest.global = self.axis_memory.statics_for(chain);
         let parts = chain.parts();
-        let decided = super::seating::opening_mode_in(
-            chain,
-            self.ground,
-            &d,
-            &mut trial,
-            &mut rest,
-            &parts.of_slot,
-            self.t,
-            &q,
-            &qdot,
-        );
-        self.axis_memory.remember(chain, &rest.global);
-        let lifting_further = rest.lift_off.unwrap_or_default();
-        let candidates: Vec<(usize, Side)> = decided
-            .unwrap_or_default()
-            .into_iter()
-            .filter(|&(k, _)| {
-                let name = &chain.interfaces[slot_interface(chain, k)].name;
-                !lifting_further.contains(name)
-            })
-            .collect();
-        let tol = 1e-9 * chain.gravity / chain.size;
-        let releases = super::seating::confirmed_releases(
-            chain,
-            self.ground,
-            &d,
-            &mut trial,
-            candidates,
-            self.t,
-            &q,
-            &qdot,
-            tol,
-            &mut rest.doubtful,
-        )
-        .flatten();
-        // Its checks decide this run's faces: kept with the run's own.
-        self.spare.rest.doubtful.append(&mut rest.doubtful);
-        for &(k, side) in releases.iter().flatten() {
-            d.pivots.sides[k] = side;
-            d.seated.retain(|&s| s != k);
+        let rounds = if self.at_rest() { chain.slot_count } else { 1 };
+        for _ in 0..rounds {
+            let releases = self.chain_releases(chain, &d, &mut rest, &parts.of_slot, (&q, &qdot));
+            let Some(releases) = releases.filter(|r| !r.is_empty()) else {
+                break;
+            };
+            for &(k, side) in &releases {
+                d.pivots.sides[k] = side;
+                d.seated.retain(|&s| s != k);
+            }
         }
+        self.axis_memory.remember(chain, &rest.global);
         d.accelerations(chain, self.ground, self.t, &q, &qdot)
             .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
         let (g, size) = (chain.gravity, chain.size);
@@ -469,6 +442,14 @@ impl Simulation<'_> {
             .collect();
         let mut kin = Data::new(chain);
         let motion = gap_motion(chain, &mut kin, &d.pivots, &faces, (&q, &qdot, &d.qddot));
+        // From rest, a point that moves along its support at first order grazes (a block's
+        // lowest edge rising along its neighbour's face): its gap's curvature along the motion
+        // decides.
+        let along_motion = if self.at_rest() {
+            gap_along_motion(chain, &mut kin, &d, &faces, &q)
+        } else {
+            None
+        };
         // Still: seated (held at its seat: a coordinate that closed a loop in the chain before
         // maps its rate from the poses, round-off rather than 0.0), or q̇ and q̈ exactly 0.0.
         let still: Vec<bool> = (0..chain.dof())
@@ -477,14 +458,24 @@ impl Simulation<'_> {
         Ok(motion
             .iter()
             .zip(&faces)
-            .map(|(points, face)| {
+            .enumerate()
+            .map(|(f, (points, face))| {
                 let touching = || points.iter().filter(|p| p.gap <= 1e-9 * size);
+                let grazing_in = || {
+                    along_motion.as_ref().is_some_and(|c| {
+                        points
+                            .iter()
+                            .zip(&c[f])
+                            .any(|(p, along)| p.gap <= 1e-9 * size && along.grazes_in(size))
+                    })
+                };
                 if touching().next().is_some()
                     && child_still_on_parent(chain, face.parent, face.child, &still)
                 {
                     Separation::Still
                 } else if touching()
                     .any(|p| p.rate <= -1e-9 * (g * size).sqrt() || p.acceleration <= -1e-6 * g)
+                    || grazing_in()
                 {
                     Separation::Approaches
                 } else {
@@ -492,6 +483,57 @@ impl Simulation<'_> {
                 }
             })
             .collect())
+    }
+
+    /// The releases the uplift test of `chain` (its dynamics `d`, its rest cache `rest`) makes
+    /// at (q, q̇), those of faces it would lift off too left out (decided once it integrates),
+    /// kept where its exact solve opens them ([`super::seating::confirmed_releases`], whose
+    /// checks are kept with the run's own); None where it releases nothing.
+    fn chain_releases(
+        &mut self,
+        chain: &Model,
+        d: &Dynamics,
+        rest: &mut super::uplift_from_rest::RestCache,
+        slot_part: &[usize],
+        (q, qdot): (&DVector<f64>, &DVector<f64>),
+    ) -> Option<Vec<(usize, Side)>> {
+        let mut trial = d.clone();
+        rest.lift_off = None;
+        let decided = super::seating::opening_mode_in(
+            chain,
+            self.ground,
+            d,
+            &mut trial,
+            rest,
+            slot_part,
+            self.t,
+            q,
+            qdot,
+        );
+        let lifting_further = rest.lift_off.take().unwrap_or_default();
+        let candidates: Vec<(usize, Side)> = decided?
+            .into_iter()
+            .filter(|&(k, _)| {
+                let name = &chain.interfaces[slot_interface(chain, k)].name;
+                !lifting_further.contains(name)
+            })
+            .collect();
+        let tol = 1e-9 * chain.gravity / chain.size;
+        let releases = super::seating::confirmed_releases(
+            chain,
+            self.ground,
+            d,
+            &mut trial,
+            candidates,
+            self.t,
+            q,
+            qdot,
+            tol,
+            &mut rest.doubtful,
+        )
+        .flatten();
+        self.spare.rest.doubtful.append(&mut rest.doubtful);
+        releases
     }
 
     /// The dynamics of `chain` (its maps `loops`) at the current state: every slot keeps its
@@ -1171,6 +1213,110 @@ struct GapMotion {
 
 /// The normal gap of every point of `faces` at q, with its rate and acceleration: central
 /// differences over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g)), on `model` with `pivots`.
+/// A gap's slope along the motion at or below this (× the model's size, per rad) grazes: the
+/// point moves along its support at first order, and its curvature decides. Far above the
+/// difference's own error (about the curvature × 1e-4² / 1e-4 ~ 1e-8) and far below a lifting
+/// corner's slope (its lever, a fraction of the size).
+const GRAZING_SLOPE: f64 = 1e-6;
+
+/// A gap curvature along the motion below −this (× the model's size, per rad²) enters the other
+/// body: far above the second difference's round-off (1e-16 of the size over (1e-4)², about 1e-8)
+/// and far below a block's own, −w(1 − cos θ)'' = −w.
+const GRAZING_CURVATURE: f64 = 1e-6;
+
+/// The largest angle (rad) of the steps along q̈ of [`gap_along_motion`].
+const GRAZING_STEP: f64 = 1e-4;
+
+/// A point's gap along the motion from rest, per unit of the largest coordinate's turn.
+#[derive(Clone, Copy, Debug)]
+struct AlongMotion {
+    /// Its first derivative (m/rad).
+    slope: f64,
+    /// Its second derivative (m/rad²).
+    curvature: f64,
+}
+
+impl AlongMotion {
+    /// The point moves along its support at first order and into it at second.
+    fn grazes_in(&self, size: f64) -> bool {
+        self.slope.abs() <= GRAZING_SLOPE * size && self.curvature < -GRAZING_CURVATURE * size
+    }
+}
+
+/// The slope and curvature of each point's gap along the motion from rest at q: the states
+/// q + σq̈ at σ = 0, s, 2s (s turns the coordinate of largest q̈ by ε = [`GRAZING_STEP`]), their
+/// loops closed again by the least change of the coordinates that are not seated, and the
+/// differences (4g(s) − g(2s) − 3g(0))/2ε and (g(2s) − 2g(s) + g(0))/ε². The motion's own
+/// magnitude drops out: the slope says whether the point leaves or enters its support at first
+/// order in the displacement, whatever the load's margin (at the multiplier itself q̈ is of
+/// order 1e-9 g/L), and the curvature, which the first-order part does not reach, decides where
+/// it does neither. From rest the motion is q + ½t²q̈ + O(t⁴): the gap of a point that grazes
+/// (J q̈ = 0) is ⅛t⁴ q̈ᵀ(∂²g/∂q²)q̈ plus the fourth-order part of the motion itself, which this
+/// leaves out (exact where the face's two bodies move relative to each other in one coordinate,
+/// a block tipping away from its neighbour, two equal blocks tipping together). None where
+/// q̈ = 0 or the loops cannot be closed again.
+fn gap_along_motion(
+    model: &Model,
+    kin: &mut Data,
+    dynamics: &Dynamics,
+    faces: &[&OpenFace],
+    q: &DVector<f64>,
+) -> Option<Vec<Vec<AlongMotion>>> {
+    let qddot = &dynamics.qddot;
+    let largest = qddot.amax();
+    if !(largest > 0.0 && largest.is_finite()) {
+        return None;
+    }
+    let n = model.dof();
+    let free: Vec<usize> = (0..n).filter(|k| !dynamics.seated.contains(k)).collect();
+    let held: Vec<(usize, f64)> = dynamics
+        .seated
+        .iter()
+        .filter(|&&s| s >= n)
+        .map(|&s| (s, 0.0))
+        .collect();
+    let step = GRAZING_STEP / largest;
+    let mut gaps = |sigma: f64| -> Option<Vec<Vec<f64>>> {
+        let mut at = q + qddot * sigma;
+        if model.constraint_rows > 0 {
+            crr_dynamics::closed_chain::project_positions_holding(
+                model,
+                kin,
+                &dynamics.pivots,
+                &mut at,
+                Some(&free),
+                &held,
+            )
+            .ok()?;
+        }
+        forward_kinematics(model, kin, &at, &dynamics.pivots);
+        Some(
+            faces
+                .iter()
+                .map(|f| (0..f.len()).map(|i| f.gap(model, kin, i)).collect())
+                .collect(),
+        )
+    };
+    let (g0, g1, g2) = (gaps(0.0)?, gaps(step)?, gaps(2.0 * step)?);
+    let eps = GRAZING_STEP;
+    Some(
+        g0.iter()
+            .zip(&g1)
+            .zip(&g2)
+            .map(|((a, b), c)| {
+                a.iter()
+                    .zip(b)
+                    .zip(c)
+                    .map(|((a, b), c)| AlongMotion {
+                        slope: (4.0 * b - c - 3.0 * a) / (2.0 * eps),
+                        curvature: (c - 2.0 * b + a) / (eps * eps),
+                    })
+                    .collect()
+            })
+            .collect(),
+    )
+}
+
 fn gap_motion(
     model: &Model,
     kin: &mut Data,

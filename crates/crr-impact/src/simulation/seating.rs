@@ -205,8 +205,9 @@ fn opening_mode_decided(
         return Some(local);
     }
     // (None: held, the chain cannot follow the mechanism.)
-    let collapse = followable_collapse(model, rest, collapse, &a, t)?;
-    let lifting: Vec<String> = collapse.lifting_off().map(|i| i.name.clone()).collect();
+    let (collapse, grazing) = followable_collapse(model, rest, collapse, &a, t, q)?;
+    let mut lifting: Vec<String> = collapse.lifting_off().map(|i| i.name.clone()).collect();
+    lifting.extend(grazing);
     let sides: Vec<(usize, Side)> = collapse
         .interfaces
         .iter()
@@ -229,34 +230,48 @@ fn opening_mode_decided(
     .or(Some(sides))
 }
 
-/// The collapse exceeded by the load `a` that the CRR chain can follow, or None where it holds.
+/// The collapse exceeded by the load `a` at rest in `q` that the CRR chain can follow, with the
+/// joints it slides while keeping contact that open entirely (below), or None where it holds.
 ///
-/// A mechanism of the search for joints that open and slide whose sliding joints keep contact
-/// while carrying nothing (a block against a pier turning about its far foot, its lowest edge
-/// sliding up the pier; part of a 3D wall turning out of its plane, its head joints sliding
-/// past their neighbours; a corner wedge whose half block slides up its head joint) is one the
-/// chain cannot follow, with or without the faces it lifts off: its joints do not slide, and its
-/// own local test has found no opening. Up to the convex program's λ along
-/// the load (no sliding anywhere, the chain's own mechanisms included) the chain holds by shear
-/// across those joints with no compression, which no friction gives: the instant and the joints
-/// are recorded in `rest.sliding_unloaded` (the run's `sliding_unloaded` violation) and the
-/// structure stays at rest. Beyond it, the convex program's collapse along the load decides, as
-/// for a structure without such a mechanism. Releasing the sliding mechanism's sides, as before
+/// A mechanism of the search for joints that open and slide may have joints that slide while
+/// keeping contact, carrying nothing (a block against a pier turning about its far foot, its
+/// lowest edge sliding up the pier; a corner wedge whose half block slides up its head joint;
+/// part of a 3D wall turning out of its plane, its head joints sliding past their neighbours).
+/// The chain's joints do not slide, and its own local test has found no opening. Up to the
+/// convex program's λ along the load (no sliding anywhere, the chain's own mechanisms included):
+/// - those joints are offered as faces that open entirely, with the faces the mechanism lifts
+///   off (the caller's `rest.lift_off`): the chain without them moves, and where its motion
+///   takes every point of those faces off its support, at second order in the displacement
+///   where the first leaves them grazing (`Simulation::faces_separate`: the block's lowest
+///   edge rises along the pier and leaves it by w(1 − cos θ)), they open and the structure
+///   leaves rest;
+/// - where it does not (two equal blocks side by side, tipping together, press their common
+///   face at second order: the motion needs that face to slide under compression), the chain
+///   holds by shear across those joints with no compression, which no friction gives: the
+///   instant and the joints are recorded in `rest.sliding_unloaded` (the run's
+///   `sliding_unloaded` violation) and the structure stays at rest; the set is then held at
+///   that state without asking again (`rest.grazing_refused`).
+///
+/// Beyond the convex λ, the convex program's collapse along the load decides, as for a
+/// structure without such a mechanism. Releasing the sliding mechanism's sides, as before
 /// 2026-12-05, moved nothing (rates of 1e-17 rad/s) and reported an uplift; lifting its faces
-/// off, the faces landed at once, for ever (a `Chatter` stop at t = 0).
+/// off before 2026-12-08 landed them at once, for ever (a `Chatter` stop at t = 0), because a
+/// face's gap was measured from its parent's plane extended past the edge the tipping block
+/// had lifted (`OpenFace::gap`).
 fn followable_collapse(
     model: &Model,
     rest: &mut RestCache,
     collapse: crate::statics::Collapse,
     a: &Vector3<f64>,
     t: f64,
-) -> Option<crate::statics::Collapse> {
+    q: &DVector<f64>,
+) -> Option<(crate::statics::Collapse, Vec<String>)> {
     let mut sliding: Vec<String> = collapse
         .sliding_in_contact()
         .map(|i| i.name.clone())
         .collect();
     if sliding.is_empty() {
-        return Some(collapse);
+        return Some((collapse, Vec::new()));
     }
     let beyond_convex = collapse
         .convex_lambda
@@ -264,8 +279,17 @@ fn followable_collapse(
     if !beyond_convex {
         // In name order: the same record whatever order the file lists the joints in.
         sliding.sort_unstable();
-        rest.sliding_unloaded.push((t, sliding));
-        return None;
+        let state = state_bits(q);
+        if rest
+            .grazing_refused
+            .iter()
+            .any(|(set, at)| *set == sliding && *at == state)
+        {
+            rest.sliding_unloaded.push((t, sliding));
+            return None;
+        }
+        rest.grazing.clone_from(&sliding);
+        return Some((collapse, sliding));
     }
     let convex = crate::statics::StaticsOptions {
         sliding_lift_off: false,
@@ -274,6 +298,16 @@ fn followable_collapse(
     crate::statics::collapse_multiplier(model, a.normalize(), &convex)
         .ok()
         .filter(|c| c.lambda.is_some())
+        .map(|c| (c, Vec::new()))
+}
+
+/// Most sets of joints sliding in contact a run keeps as refused ([`RestCache::grazing_refused`]);
+/// the oldest is dropped beyond.
+const GRAZING_REFUSALS: usize = 16;
+
+/// A state q as bits (an exact key).
+pub(super) fn state_bits(q: &DVector<f64>) -> Vec<u64> {
+    q.iter().map(|x| x.to_bits()).collect()
 }
 
 /// The faces on the ground where the effective gravity g_eff(t) pulls a structure at rest off
@@ -1479,6 +1513,7 @@ impl Simulation<'_> {
         let mut trial = self.take_trial();
         self.spare.rest.lift_off = None;
         self.spare.rest.thrown_off = false;
+        self.spare.rest.grazing.clear();
         let mode = opening_mode_in(
             &self.model,
             self.ground,
@@ -1494,6 +1529,12 @@ impl Simulation<'_> {
         let mut mode = mode;
         if let Some(interfaces) = self.spare.rest.lift_off.take() {
             let in_flight = bodies_without_support(&self.model, &interfaces);
+            // Joints that slide in contact in the mechanism, offered as faces that open
+            // (`followable_collapse`): held at rest unless the chain without them opens them.
+            let grazing = std::mem::take(&mut self.spare.rest.grazing);
+            if !grazing.is_empty() && !in_flight.is_empty() {
+                return Ok(self.hold_on_grazing(grazing, &q));
+            }
             // Thrown off the ground: every body flies, no face is held for a pivot event.
             let thrown = std::mem::take(&mut self.spare.rest.thrown_off);
             // The proposal's other joints and sides, by the file's slots (the chain changes).
@@ -1515,6 +1556,7 @@ impl Simulation<'_> {
                         }
                         return self.release_mechanism(&proposal);
                     }
+                    _ if !grazing.is_empty() => return Ok(self.hold_on_grazing(grazing, &q)),
                     FaceRelease::Impossible(why) => Some(format!(
                         "every body keeps a support through other contacts, but no chain of \
                          the CRR model is left without them ({why})"
@@ -1627,6 +1669,24 @@ impl Simulation<'_> {
             self.apply_release(mode)?;
         }
         Ok(mode)
+    }
+
+    /// A structure at rest in `q` held on the joints `grazing` of a mechanism, which slide in
+    /// contact carrying nothing and which the chain without them does not open
+    /// ([`followable_collapse`]): the instant is recorded as `sliding_unloaded`, the set held at
+    /// that state without asking again, and nothing is released.
+    fn hold_on_grazing(
+        &mut self,
+        grazing: Vec<String>,
+        q: &DVector<f64>,
+    ) -> Option<Vec<(usize, Side)>> {
+        let refused = &mut self.spare.rest.grazing_refused;
+        if refused.len() >= GRAZING_REFUSALS {
+            refused.remove(0);
+        }
+        refused.push((grazing.clone(), state_bits(q)));
+        self.spare.rest.sliding_unloaded.push((self.t, grazing));
+        None
     }
 
     /// The releases of an uplift event ([`Self::release_if_opening`]): one ends the row of

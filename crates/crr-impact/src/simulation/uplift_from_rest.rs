@@ -64,6 +64,14 @@ pub(super) struct RestCache {
     /// whose joints slide while keeping contact (`seating::opening_mode_in`), with those
     /// interfaces, since the run last collected them.
     pub(super) sliding_unloaded: Vec<(f64, Vec<String>)>,
+    /// The joints of the mechanism exceeded at rest that slide while keeping contact, carrying
+    /// nothing (`seating::followable_collapse`), offered with `lift_off` as faces that open
+    /// entirely: where the chain without them does not confirm it, the structure is held at rest
+    /// and the instant recorded in `sliding_unloaded`, as before such faces were offered.
+    pub(super) grazing: Vec<String>,
+    /// The sets of such joints whose opening the chain without them contradicted, each with the
+    /// state at rest it was asked at (q as bits): held there without asking again.
+    pub(super) grazing_refused: Vec<(Vec<String>, Vec<u64>)>,
     /// The instants at which the structure at rest was held on a multiplier that is not
     /// exhaustive (`statics::RestStatics::held_on_search`), with the load, since the run last
     /// collected them.
