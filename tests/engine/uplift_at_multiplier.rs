@@ -581,6 +581,83 @@ fn two_blocks_that_tip_together_press_their_common_face_and_are_held() {
     }
 }
 
+/// The same decisions where a load crosses the multiplier: a one-sine pulse of amplitude
+/// 1.5 λ g and period 0.5 s reaches λ g at t* = (T/2π) asin(1/1.5), and the run's uplift test
+/// finds that instant by bisection, where the chain without the joints that slide in contact
+/// has no opening of its own (its multiplier is the structure's, within its test's margin): the
+/// mechanism's sides move it there. The block against the fixed pier leaves rest at t* (to
+/// 1e-7 s) with no violation and turns; the pair of equal blocks is held from t* with the
+/// `sliding_unloaded` violation and nothing moves, the run going to its end.
+#[test]
+fn joints_sliding_in_contact_are_decided_where_a_pulse_crosses_the_multiplier() {
+    use crr::dynamics::ground_motion::SineSpec;
+    let pulse = |amplitude: f64| {
+        let spec = ComponentSpec::new(SignalSpec::Sine(SineSpec {
+            amplitude,
+            period: Some(0.5),
+            frequency: None,
+            phase: 0.0,
+            cycles: Some(1.0),
+            start: 0.0,
+        }));
+        GroundMotion::none()
+            .with_component(Axis::X, &spec, std::path::Path::new("."))
+            .unwrap()
+    };
+    let crossing = 0.5 / (2.0 * std::f64::consts::PI) * (1.0f64 / 1.5).asin();
+    let run = |model: &Model, amplitude: f64| {
+        let initial = solve_initial(model, &InitialSpec::default()).unwrap();
+        let params = Parameters {
+            duration: 0.2,
+            ..Default::default()
+        };
+        Simulation::new(model, &pulse(amplitude), &initial, params)
+            .unwrap()
+            .run()
+            .unwrap()
+    };
+    let largest = |t: &crr::impact::Trajectory| {
+        t.samples
+            .iter()
+            .flat_map(|s| s.q.iter())
+            .fold(0.0_f64, |m, q| m.max(q.abs()))
+    };
+    let bodies = format!(
+        "name = \"infill\"\nfixed = [\"pier\"]\n{}{}",
+        crate::common::box_body("pier", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0]),
+        crate::common::box_body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]),
+    );
+    let pier = assembled("pier_pulse", &bodies, false);
+    let t = run(&pier, -1.5 * 0.4 * pier.gravity);
+    let uplift = t.uplift_time.expect("the block leaves rest");
+    assert!(
+        (uplift - crossing).abs() < 1e-7,
+        "{uplift} against {crossing}"
+    );
+    assert!(t.violation.is_none(), "{:?}", t.violation);
+    assert!(largest(&t) > 1e-4, "{}", largest(&t));
+
+    let mut bodies = String::from("name = \"pair\"\n");
+    bodies.push_str(&crate::common::box_body(
+        "left",
+        [-0.25, 0.0, 0.5],
+        [0.5, 1.0, 1.0],
+    ));
+    bodies.push_str(&crate::common::box_body(
+        "right",
+        [0.25, 0.0, 0.5],
+        [0.5, 1.0, 1.0],
+    ));
+    let pair = assembled("pair_pulse", &bodies, true);
+    let t = run(&pair, 1.5 * 0.5 * pair.gravity);
+    assert_eq!(t.uplift_time, None);
+    assert_eq!(largest(&t), 0.0);
+    assert!(t.end_time >= 0.2 - 1e-12, "{}", t.end_time);
+    let v = t.violation.expect("the hold is a violation");
+    assert_eq!(v.kind, "sliding_unloaded");
+    assert!((v.t - crossing).abs() < 1e-7, "{} against {crossing}", v.t);
+}
+
 /// A run that holds a load at rest on a multiplier the search alone found says so. The bundled
 /// wall has 2186 sets of joints that may open and slide along ±x (more than the 256 a run tries
 /// along an axis, fewer than the 4096 of `crr check`): under half its multiplier along +x it

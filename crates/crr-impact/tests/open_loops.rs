@@ -48,8 +48,6 @@ fn wall_under_a_pulse(
     (model, sine_pulse(8.0, 0.5), init, params)
 }
 
-/// The normal gap and the relative velocity (child − parent) of both contact points of hinge
-/// `k` at the state of `sample`, from the bodies' poses and velocities.
 /// The least clearance (m) between the two faces of hinge `k` in `sample`: each end of the
 /// face (its two pivot points) as the child carries it, measured from the parent's face plane
 /// where it lies over the parent's face, and as the parent carries it, from the child's face
@@ -108,6 +106,8 @@ fn face_clearance(model: &Model, data: &mut Data, sample: &Sample, k: usize) -> 
     least
 }
 
+/// The normal gap and the relative velocity (child − parent) of both contact points of hinge
+/// `k` at the state of `sample`, from the bodies' poses and velocities.
 fn face_points(
     model: &Model,
     data: &mut Data,

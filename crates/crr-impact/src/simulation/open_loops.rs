@@ -327,8 +327,10 @@ impl Simulation<'_> {
         }
         self.lost_at_impacts += record.energy_lost;
         self.impacts.push(record);
-        // Faces kept on their pivots after a contradicted lift-off are offered it again.
+        // Faces kept on their pivots after a contradicted lift-off are offered it again, and
+        // so are joints sliding in contact whose opening was refused at rest.
         self.spare.rest.held_faces.clear();
+        self.spare.rest.grazing_refused.clear();
         // An impact ends a row of uplift events without a release (SimulationError::Undecided).
         self.undecided.end();
     }
@@ -341,7 +343,16 @@ impl Simulation<'_> {
     /// to enter it: [`FaceRelease::Impossible`] with why). In motion, faces that do not move
     /// ([`FaceRelease::Ties`]) stay closed, and the others are released without them (checked
     /// again on the chain that keeps them).
-    pub(super) fn release_faces(&mut self, lifting: &[String]) -> FaceRelease {
+    ///
+    /// `grazing`: where the faces are offered because their joints slide in contact in the
+    /// mechanism exceeded at rest (`seating::followable_collapse`), that mechanism's sides (the
+    /// file's slots), which move the chain without the faces where it makes no release of its
+    /// own (at the multiplier itself) ([`Self::faces_separate`]); empty otherwise.
+    pub(super) fn release_faces(
+        &mut self,
+        lifting: &[String],
+        grazing: &[(usize, Side)],
+    ) -> FaceRelease {
         let mut open = self.open.interfaces();
         let opening: Vec<usize> = lifting
             .iter()
@@ -352,7 +363,7 @@ impl Simulation<'_> {
             Ok(built) => built,
             Err(e) => return FaceRelease::Impossible(e.to_string()),
         };
-        let verdicts = match self.faces_separate(&built, &opening) {
+        let verdicts = match self.faces_separate(&built, &opening, grazing) {
             Ok(verdicts) => verdicts,
             Err(_) => return FaceRelease::Unsolved,
         };
@@ -372,7 +383,7 @@ impl Simulation<'_> {
             return if moving.is_empty() {
                 FaceRelease::Ties
             } else {
-                self.release_faces(&moving)
+                self.release_faces(&moving, grazing)
             };
         }
         match self.switch_chain(built, &[]) {
@@ -399,10 +410,18 @@ impl Simulation<'_> {
     /// its support stays closed: opening it would make it land at once, over and over. A chain
     /// whose equations cannot be solved is an error here ([`FaceRelease::Unsolved`]: the faces
     /// stay closed, undecided).
+    ///
+    /// Faces offered because their joints slide in contact (`grazing`, the mechanism's sides,
+    /// not empty) must leave from rest: where the chain without them releases nothing (at the
+    /// multiplier itself, within its test's margin) the mechanism's sides move it, each checked
+    /// by the chain's exact solve without the margin (as [`Self::release_mechanism`] does); a
+    /// face whose bodies still do not move, or a point that enters its support at first order
+    /// along the motion however slow, counts as approaching.
     fn faces_separate(
         &mut self,
         (loops, chain): &(OpenLoops, Model),
         opening: &[usize],
+        grazing: &[(usize, Side)],
     ) -> Result<Vec<Separation>, SimulationError> {
         let (q, qdot) = self.state_on(chain, loops);
         let (mut d, _, _) = self.dynamics_on(chain, loops, &[]);
@@ -427,6 +446,32 @@ impl Simulation<'_> {
             }
         }
         self.axis_memory.remember(chain, &rest.global);
+        let grazing_at_rest = self.at_rest() && !grazing.is_empty();
+        if grazing_at_rest && d.seated.len() == chain.slot_count {
+            let proposed: Vec<(usize, Side)> = grazing
+                .iter()
+                .filter_map(|&(file_slot, side)| Some((loops.active_slot(file_slot)?, side)))
+                .filter(|(s, _)| d.seated.contains(s))
+                .collect();
+            let mut trial = d.clone();
+            let released = super::seating::confirmed_releases(
+                chain,
+                self.ground,
+                &d,
+                &mut trial,
+                proposed,
+                self.t,
+                &q,
+                &qdot,
+                0.0,
+                &mut self.spare.rest.doubtful,
+            )
+            .flatten();
+            for &(k, side) in released.iter().flatten() {
+                d.pivots.sides[k] = side;
+                d.seated.retain(|&s| s != k);
+            }
+        }
         d.accelerations(chain, self.ground, self.t, &q, &qdot)
             .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
         let (g, size) = (chain.gravity, chain.size);
@@ -463,15 +508,23 @@ impl Simulation<'_> {
                 let touching = || points.iter().filter(|p| p.gap <= 1e-9 * size);
                 let grazing_in = || {
                     along_motion.as_ref().is_some_and(|c| {
-                        points
-                            .iter()
-                            .zip(&c[f])
-                            .any(|(p, along)| p.gap <= 1e-9 * size && along.grazes_in(size))
+                        points.iter().zip(&c[f]).any(|(p, along)| {
+                            p.gap <= 1e-9 * size
+                                && if grazing_at_rest {
+                                    along.enters(size)
+                                } else {
+                                    along.slope.abs() <= GRAZING_SLOPE * size
+                                        && along.curvature < -GRAZING_CURVATURE * size
+                                }
+                        })
                     })
                 };
-                if touching().next().is_some()
-                    && child_still_on_parent(chain, face.parent, face.child, &still)
-                {
+                let still_here = touching().next().is_some()
+                    && child_still_on_parent(chain, face.parent, face.child, &still);
+                if still_here && grazing_at_rest {
+                    // Offered to leave from rest, it does not move: not confirmed.
+                    Separation::Approaches
+                } else if still_here {
                     Separation::Still
                 } else if touching()
                     .any(|p| p.rate <= -1e-9 * (g * size).sqrt() || p.acceleration <= -1e-6 * g)
@@ -1211,21 +1264,21 @@ struct GapMotion {
     acceleration: f64,
 }
 
-/// The normal gap of every point of `faces` at q, with its rate and acceleration: central
-/// differences over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g)), on `model` with `pivots`.
-/// A gap's slope along the motion at or below this (× the model's size, per rad) grazes: the
-/// point moves along its support at first order, and its curvature decides. Far above the
-/// difference's own error (about the curvature × 1e-4² / 1e-4 ~ 1e-8) and far below a lifting
-/// corner's slope (its lever, a fraction of the size).
-const GRAZING_SLOPE: f64 = 1e-6;
+/// A gap's slope along the motion within this (× the model's size, per rad) grazes: the point
+/// moves along its support at first order, and its curvature decides; below −this it enters its
+/// support. Far above the one-sided difference's error (ε² g‴/3 with ε = [`GRAZING_STEP`], about
+/// 3e-7 of the lever, and the loops' closure to 1e-13 over ε) and far below a lifting corner's
+/// slope (its lever, a fraction of the size).
+const GRAZING_SLOPE: f64 = 1e-5;
 
 /// A gap curvature along the motion below −this (× the model's size, per rad²) enters the other
-/// body: far above the second difference's round-off (1e-16 of the size over (1e-4)², about 1e-8)
-/// and far below a block's own, −w(1 − cos θ)'' = −w.
-const GRAZING_CURVATURE: f64 = 1e-6;
+/// body: far above the second difference's errors (ε g‴, about 1e-3 of the lever, and the loops'
+/// closure to 1e-13 of the size over ε² = 1e-6, about 4e-7) and far below a block's own,
+/// −w(1 − cos θ)″ = −w.
+const GRAZING_CURVATURE: f64 = 1e-2;
 
 /// The largest angle (rad) of the steps along q̈ of [`gap_along_motion`].
-const GRAZING_STEP: f64 = 1e-4;
+const GRAZING_STEP: f64 = 1e-3;
 
 /// A point's gap along the motion from rest, per unit of the largest coordinate's turn.
 #[derive(Clone, Copy, Debug)]
@@ -1237,9 +1290,12 @@ struct AlongMotion {
 }
 
 impl AlongMotion {
-    /// The point moves along its support at first order and into it at second.
-    fn grazes_in(&self, size: f64) -> bool {
-        self.slope.abs() <= GRAZING_SLOPE * size && self.curvature < -GRAZING_CURVATURE * size
+    /// The point moves into its support: at first order, or along it at first order and into
+    /// it at second.
+    fn enters(&self, size: f64) -> bool {
+        self.slope < -GRAZING_SLOPE * size
+            || (self.slope.abs() <= GRAZING_SLOPE * size
+                && self.curvature < -GRAZING_CURVATURE * size)
     }
 }
 
@@ -1317,6 +1373,8 @@ fn gap_along_motion(
     )
 }
 
+/// The normal gap of every point of `faces` at q, with its rate and acceleration: central
+/// differences over the states q ± h q̇ + ½h² q̈ (h = 1e-4 √(L/g)), on `model` with `pivots`.
 fn gap_motion(
     model: &Model,
     kin: &mut Data,

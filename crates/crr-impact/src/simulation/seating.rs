@@ -74,6 +74,7 @@ pub(super) fn opening_mode_in(
     if at_rest && let Some(thrown) = free_fall(model, ground, t).filter(|f| f.along) {
         rest.lift_off = Some(thrown.faces);
         rest.thrown_off = true;
+        rest.grazing.clear();
         return Some(Vec::new());
     }
     let decided = opening_mode_decided(model, ground, template, trial, rest, slot_part, t, q, qdot);
@@ -90,6 +91,7 @@ pub(super) fn opening_mode_in(
     {
         rest.lift_off = Some(faces);
         rest.thrown_off = true;
+        rest.grazing.clear();
         return Some(Vec::new());
     }
     decided
@@ -279,7 +281,7 @@ fn followable_collapse(
     if !beyond_convex {
         // In name order: the same record whatever order the file lists the joints in.
         sliding.sort_unstable();
-        let state = state_bits(q);
+        let state = grazing_key(q, a);
         if rest
             .grazing_refused
             .iter()
@@ -305,9 +307,16 @@ fn followable_collapse(
 /// the oldest is dropped beyond.
 const GRAZING_REFUSALS: usize = 16;
 
-/// A state q as bits (an exact key).
-pub(super) fn state_bits(q: &DVector<f64>) -> Vec<u64> {
-    q.iter().map(|x| x.to_bits()).collect()
+/// The key of a refused set of joints sliding in contact ([`RestCache::grazing_refused`]): the
+/// state q as bits (exact) and the load's direction to 1e-3 (the motion that decided depends on
+/// it; a record's load turning keeps asking).
+pub(super) fn grazing_key(q: &DVector<f64>, a: &Vector3<f64>) -> Vec<u64> {
+    let norm = a.norm();
+    let direction = if norm > 0.0 { a / norm } else { *a };
+    q.iter()
+        .map(|x| x.to_bits())
+        .chain(direction.iter().map(|x| (x * 1e3).round() as i64 as u64))
+        .collect()
 }
 
 /// The faces on the ground where the effective gravity g_eff(t) pulls a structure at rest off
@@ -1548,7 +1557,8 @@ impl Simulation<'_> {
             // decides again; a body left without support is outside the model.
             let mut contradicted = false;
             let reason = if in_flight.is_empty() {
-                match self.release_faces(&interfaces) {
+                let offered: &[(usize, Side)] = if grazing.is_empty() { &[] } else { &proposal };
+                match self.release_faces(&interfaces, offered) {
                     FaceRelease::Released => {
                         let released = self.release_once()?;
                         if released.is_some() || !from_rest {
@@ -1684,7 +1694,8 @@ impl Simulation<'_> {
         if refused.len() >= GRAZING_REFUSALS {
             refused.remove(0);
         }
-        refused.push((grazing.clone(), state_bits(q)));
+        let a = self.ground.acceleration(self.t);
+        refused.push((grazing.clone(), grazing_key(q, &a)));
         self.spare.rest.sliding_unloaded.push((self.t, grazing));
         None
     }
