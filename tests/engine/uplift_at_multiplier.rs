@@ -441,6 +441,26 @@ fn leaves_rest_as(
     );
 }
 
+/// The assembly of a block 0.4 × 1 × 1 m standing against a pier 1 × 1 × 2 m (fixed or free),
+/// on the pier's +x face (`side` 1) or its −x face (−1).
+fn pier_bodies(fixed: bool, side: f64) -> String {
+    format!(
+        "name = \"infill\"\n{}{}{}",
+        if fixed { "fixed = [\"pier\"]\n" } else { "" },
+        crate::common::box_body("pier", [-0.5 * side, 0.0, 1.0], [1.0, 1.0, 2.0]),
+        crate::common::box_body("block", [0.2 * side, 0.0, 0.5], [0.4, 1.0, 1.0]),
+    )
+}
+
+/// The assembly of two equal blocks 0.5 × 1 × 1 m side by side, their common face at x = 0.
+fn pair_bodies() -> String {
+    format!(
+        "name = \"pair\"\n{}{}",
+        crate::common::box_body("left", [-0.25, 0.0, 0.5], [0.5, 1.0, 1.0]),
+        crate::common::box_body("right", [0.25, 0.0, 0.5], [0.5, 1.0, 1.0]),
+    )
+}
+
 /// A block b × h = 0.4 × 1 m (1 m deep) standing against a face of a pier 1 × 1 × 2 m, every
 /// contact an interface, the pier free or fixed. Away from the pier it overturns at
 /// λ = b/h = 0.4 (virtual work of the block alone), turning about its far foot while its lowest
@@ -457,12 +477,7 @@ fn leaves_rest_as(
 fn a_block_tipping_away_from_a_pier_leaves_its_face() {
     for fixed in [true, false] {
         for side in [1.0, -1.0] {
-            let bodies = format!(
-                "name = \"infill\"\n{}{}{}",
-                if fixed { "fixed = [\"pier\"]\n" } else { "" },
-                crate::common::box_body("pier", [-0.5 * side, 0.0, 1.0], [1.0, 1.0, 2.0]),
-                crate::common::box_body("block", [0.2 * side, 0.0, 0.5], [0.4, 1.0, 1.0]),
-            );
+            let bodies = pier_bodies(fixed, side);
             let model = assembled(&format!("pier_{fixed}_{side}"), &bodies, false);
             let name = format!("block against a pier (fixed: {fixed}, side {side})");
             // Seen from the side it tips to: its centre 0.2 m inside its far foot, 0.5 m up.
@@ -538,17 +553,7 @@ fn a_corner_wedge_whose_half_block_rises_along_its_head_joint_leaves_rest() {
 /// program's multiplier (the pair as one block, 2b/h = 1) it leaves rest.
 #[test]
 fn two_blocks_that_tip_together_press_their_common_face_and_are_held() {
-    let mut bodies = String::from("name = \"pair\"\n");
-    bodies.push_str(&crate::common::box_body(
-        "left",
-        [-0.25, 0.0, 0.5],
-        [0.5, 1.0, 1.0],
-    ));
-    bodies.push_str(&crate::common::box_body(
-        "right",
-        [0.25, 0.0, 0.5],
-        [0.5, 1.0, 1.0],
-    ));
+    let bodies = pair_bodies();
     let model = assembled("pair", &bodies, true);
     let common = (0..model.interfaces.len())
         .find(|&i| {
@@ -622,11 +627,7 @@ fn joints_sliding_in_contact_are_decided_where_a_pulse_crosses_the_multiplier() 
             .flat_map(|s| s.q.iter())
             .fold(0.0_f64, |m, q| m.max(q.abs()))
     };
-    let bodies = format!(
-        "name = \"infill\"\nfixed = [\"pier\"]\n{}{}",
-        crate::common::box_body("pier", [-0.5, 0.0, 1.0], [1.0, 1.0, 2.0]),
-        crate::common::box_body("block", [0.2, 0.0, 0.5], [0.4, 1.0, 1.0]),
-    );
+    let bodies = pier_bodies(true, 1.0);
     let pier = assembled("pier_pulse", &bodies, false);
     let t = run(&pier, -1.5 * 0.4 * pier.gravity);
     let uplift = t.uplift_time.expect("the block leaves rest");
@@ -637,17 +638,7 @@ fn joints_sliding_in_contact_are_decided_where_a_pulse_crosses_the_multiplier() 
     assert!(t.violation.is_none(), "{:?}", t.violation);
     assert!(largest(&t) > 1e-4, "{}", largest(&t));
 
-    let mut bodies = String::from("name = \"pair\"\n");
-    bodies.push_str(&crate::common::box_body(
-        "left",
-        [-0.25, 0.0, 0.5],
-        [0.5, 1.0, 1.0],
-    ));
-    bodies.push_str(&crate::common::box_body(
-        "right",
-        [0.25, 0.0, 0.5],
-        [0.5, 1.0, 1.0],
-    ));
+    let bodies = pair_bodies();
     let pair = assembled("pair_pulse", &bodies, true);
     let t = run(&pair, 1.5 * 0.5 * pair.gravity);
     assert_eq!(t.uplift_time, None);

@@ -48,13 +48,8 @@ fn wall_under_a_pulse(
     (model, sine_pulse(8.0, 0.5), init, params)
 }
 
-/// The least clearance (m) between the two faces of hinge `k` in `sample`: each end of the
-/// face (its two pivot points) as the child carries it, measured from the parent's face plane
-/// where it lies over the parent's face, and as the parent carries it, from the child's face
-/// plane where it lies over the child's (negative: inside the other block). A corner that has
-/// moved past the other face's edge meets nothing there (over the block beside, in a wall).
-/// Positive infinity where no corner lies over the other face.
-fn face_clearance(model: &Model, data: &mut Data, sample: &Sample, k: usize) -> f64 {
+/// The bodies' poses in `sample` (`data`), each slot on the pivot of its sample state.
+fn pose_at(model: &Model, data: &mut Data, sample: &Sample) {
     let mut pivots = ActivePivots::uniform(model, Side::Positive);
     for (slot, state) in sample.states.iter().enumerate() {
         if *state == SlotState::Negative {
@@ -62,16 +57,32 @@ fn face_clearance(model: &Model, data: &mut Data, sample: &Sample, k: usize) -> 
         }
     }
     forward_kinematics(model, data, &DVector::from_column_slice(sample.q), &pivots);
-    let iface = &model.interfaces[k];
+}
+
+/// Hinge `k`'s pivot points P⁺, P⁻ at rest and its face's normal u × (P⁻ − P⁺), unit.
+fn hinge_face(model: &Model, k: usize) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
     let InterfaceKind::Hinge {
         axis,
         pivot_positive,
         pivot_negative,
-    } = iface.kind
+    } = model.interfaces[k].kind
     else {
         panic!("the wall's joints are hinges")
     };
     let lift = axis.cross(&(pivot_negative - pivot_positive)).normalize();
+    (pivot_positive, pivot_negative, lift)
+}
+
+/// The least clearance (m) between the two faces of hinge `k` in `sample`: each end of the
+/// face (its two pivot points) as the child carries it, measured from the parent's face plane
+/// where it lies over the parent's face, and as the parent carries it, from the child's face
+/// plane where it lies over the child's (negative: inside the other block). A corner that has
+/// moved past the other face's edge meets nothing there (over the block beside, in a wall).
+/// Positive infinity where no corner lies over the other face.
+fn face_clearance(model: &Model, data: &mut Data, sample: &Sample, k: usize) -> f64 {
+    pose_at(model, data, sample);
+    let iface = &model.interfaces[k];
+    let (pivot_positive, pivot_negative, lift) = hinge_face(model, k);
     let along = pivot_negative - pivot_positive;
     // A body's pose: world point of x at rest, and the rest point of a world point.
     let pose = |b: Option<usize>| match b {
@@ -114,26 +125,10 @@ fn face_points(
     sample: &Sample,
     k: usize,
 ) -> [(f64, Vector3<f64>); 2] {
-    let mut pivots = ActivePivots::uniform(model, Side::Positive);
-    for (slot, state) in sample.states.iter().enumerate() {
-        if *state == SlotState::Negative {
-            pivots.sides[slot] = Side::Negative;
-        }
-    }
-    let q = DVector::from_column_slice(sample.q);
-    let qdot = DVector::from_column_slice(sample.qdot);
-    forward_kinematics(model, data, &q, &pivots);
-    crr_kinematics::velocities(model, data, &qdot);
+    pose_at(model, data, sample);
+    crr_kinematics::velocities(model, data, &DVector::from_column_slice(sample.qdot));
     let iface = &model.interfaces[k];
-    let InterfaceKind::Hinge {
-        axis,
-        pivot_positive,
-        pivot_negative,
-    } = iface.kind
-    else {
-        panic!("the wall's joints are hinges")
-    };
-    let lift = axis.cross(&(pivot_negative - pivot_positive)).normalize();
+    let (pivot_positive, pivot_negative, lift) = hinge_face(model, k);
     // World position and velocity of the point at `x` at rest, moving with body `b`.
     let point = |data: &Data, b: usize, x: &Vector3<f64>| {
         let frame = model.body_coord[b];

@@ -440,10 +440,7 @@ impl Simulation<'_> {
             let Some(releases) = releases.filter(|r| !r.is_empty()) else {
                 break;
             };
-            for &(k, side) in &releases {
-                d.pivots.sides[k] = side;
-                d.seated.retain(|&s| s != k);
-            }
+            release_in(&mut d, &releases);
         }
         self.axis_memory.remember(chain, &rest.global);
         let grazing_at_rest = self.at_rest() && !grazing.is_empty();
@@ -467,10 +464,7 @@ impl Simulation<'_> {
                 &mut self.spare.rest.doubtful,
             )
             .flatten();
-            for &(k, side) in released.iter().flatten() {
-                d.pivots.sides[k] = side;
-                d.seated.retain(|&s| s != k);
-            }
+            release_in(&mut d, released.as_deref().unwrap_or_default());
         }
         d.accelerations(chain, self.ground, self.t, &q, &qdot)
             .map_err(|source| SimulationError::Dynamics { t: self.t, source })?;
@@ -1371,6 +1365,14 @@ fn gap_along_motion(
             })
             .collect(),
     )
+}
+
+/// The slots `releases` of `d` released on their sides.
+fn release_in(d: &mut Dynamics, releases: &[(usize, Side)]) {
+    for &(k, side) in releases {
+        d.pivots.sides[k] = side;
+        d.seated.retain(|&s| s != k);
+    }
 }
 
 /// The normal gap of every point of `faces` at q, with its rate and acceleration: central
